@@ -1,0 +1,109 @@
+"""The grid every layer writes into: geometry, Nav2 cost values and world <-> cell conversions.
+
+Frames: world frame (REP-103, metres). Cell (row, col) covers x in [origin_x + col*res, origin_x + (col+1)*res)
+and y in [origin_y + row*res, ...): row 0 is the lowest y (as in nav_msgs/OccupancyGrid; images flip it).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+FREE_SPACE = 0
+MAX_NON_OBSTACLE = 252
+INSCRIBED = 253
+LETHAL = 254
+NO_INFORMATION = 255
+
+
+@dataclass(frozen=True)
+class GridSpec:
+    """Grid geometry: resolution (m/cell), origin (world x, y of the lower-left corner), size in cells."""
+
+    resolution: float
+    origin_x: float
+    origin_y: float
+    width: int
+    height: int
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.resolution) and self.resolution > 0):
+            raise ValueError(f"map.resolution must be a positive number of metres, got {self.resolution}")
+        if not (np.isfinite(self.origin_x) and np.isfinite(self.origin_y)):
+            raise ValueError(f"map.origin must be finite, got ({self.origin_x}, {self.origin_y})")
+        if self.width <= 0 or self.height <= 0:
+            raise ValueError(f"map.size must give at least one cell, got {self.width}x{self.height} cells")
+
+    @classmethod
+    def from_size(cls, resolution: float, origin: tuple[float, float], size_m: tuple[float, float]) -> GridSpec:
+        """A grid covering ``size_m`` (width, height in metres) from ``origin``."""
+        if not (np.isfinite(resolution) and resolution > 0):
+            raise ValueError(f"map.resolution must be a positive number of metres, got {resolution}")
+        width, height = (int(round(s / resolution)) for s in size_m)
+        return cls(float(resolution), float(origin[0]), float(origin[1]), width, height)
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """(rows, cols) of the cost arrays."""
+        return (self.height, self.width)
+
+    @property
+    def size_m(self) -> tuple[float, float]:
+        return (self.width * self.resolution, self.height * self.resolution)
+
+    def world_to_cell(self, xy: np.ndarray) -> np.ndarray:
+        """World points (N, 2) -> integer cells (N, 2) as (row, col); may lie outside the grid."""
+        xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+        col = np.floor((xy[:, 0] - self.origin_x) / self.resolution).astype(np.int64)
+        row = np.floor((xy[:, 1] - self.origin_y) / self.resolution).astype(np.int64)
+        return np.stack([row, col], axis=1)
+
+    def cell_to_world(self, cells: np.ndarray) -> np.ndarray:
+        """Cells (N, 2) as (row, col) -> world (N, 2) of the cell centres."""
+        cells = np.asarray(cells, dtype=float).reshape(-1, 2)
+        x = self.origin_x + (cells[:, 1] + 0.5) * self.resolution
+        y = self.origin_y + (cells[:, 0] + 0.5) * self.resolution
+        return np.stack([x, y], axis=1)
+
+    def in_bounds(self, cells: np.ndarray) -> np.ndarray:
+        """Boolean (N,) for cells (N, 2) as (row, col) inside the grid."""
+        cells = np.asarray(cells).reshape(-1, 2)
+        return (cells[:, 0] >= 0) & (cells[:, 0] < self.height) & (cells[:, 1] >= 0) & (cells[:, 1] < self.width)
+
+    def contains(self, xy: np.ndarray) -> np.ndarray:
+        """Boolean (N,) for world points (N, 2) inside the grid."""
+        return self.in_bounds(self.world_to_cell(xy))
+
+    def cell_centres(self) -> tuple[np.ndarray, np.ndarray]:
+        """World x and y of every cell centre, each (rows, cols)."""
+        xs = self.origin_x + (np.arange(self.width) + 0.5) * self.resolution
+        ys = self.origin_y + (np.arange(self.height) + 0.5) * self.resolution
+        return np.meshgrid(xs, ys)
+
+
+@dataclass
+class Costmap2D:
+    """A uint8 cost grid (rows, cols) with its geometry. Values follow Nav2 (see module constants)."""
+
+    spec: GridSpec
+    costs: np.ndarray
+
+    def __post_init__(self) -> None:
+        self.costs = np.asarray(self.costs)
+        if self.costs.dtype != np.uint8 or self.costs.shape != self.spec.shape:
+            raise ValueError(
+                f"costmap: costs must be uint8 of shape {self.spec.shape}, got {self.costs.dtype} {self.costs.shape}"
+            )
+
+    @classmethod
+    def filled(cls, spec: GridSpec, value: int = FREE_SPACE) -> Costmap2D:
+        return cls(spec, np.full(spec.shape, value, dtype=np.uint8))
+
+    def cost_at(self, xy: np.ndarray) -> np.ndarray:
+        """Costs (N,) at world points (N, 2); points outside the grid read NO_INFORMATION."""
+        cells = self.spec.world_to_cell(xy)
+        inside = self.spec.in_bounds(cells)
+        out = np.full(len(cells), NO_INFORMATION, dtype=np.uint8)
+        out[inside] = self.costs[cells[inside, 0], cells[inside, 1]]
+        return out

@@ -1,0 +1,1 @@
+"""Path planning on a costmap: OMPL planners and a grid planner with one shared cost model."""

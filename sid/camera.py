@@ -1,0 +1,212 @@
+"""Camera calibration records and pinhole (de)projection.
+
+Frames: camera optical frame, x right, y down, z forward (metres). Pixel coordinates (u, v) follow
+librealsense: (0, 0) is the centre of the top-left pixel, u grows to the right, v downwards.
+
+Distortion: the D435i colour and depth streams report (near-)zero distortion ("Brown-Conrady" with zero
+coefficients, or "inverse Brown-Conrady" on colour); the coefficients are kept in the record but every
+function here treats the camera as an ideal pinhole. Undistort images first if your camera has real distortion.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Intrinsics:
+    """Pinhole intrinsics of one stream (pixels)."""
+
+    width: int
+    height: int
+    fx: float
+    fy: float
+    cx: float
+    cy: float
+    model: str = "none"
+    coeffs: tuple[float, ...] = (0.0, 0.0, 0.0, 0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        if self.width <= 0 or self.height <= 0:
+            raise ValueError(f"intrinsics: image size must be positive, got {self.width}x{self.height}")
+        for name in ("fx", "fy", "cx", "cy"):
+            value = getattr(self, name)
+            if not np.isfinite(value):
+                raise ValueError(f"intrinsics: {name} must be finite, got {value}")
+        if self.fx <= 0 or self.fy <= 0:
+            raise ValueError(f"intrinsics: focal lengths must be positive, got fx={self.fx}, fy={self.fy}")
+
+    @property
+    def K(self) -> np.ndarray:  # noqa: N802 - K is the standard name of the camera matrix
+        """3x3 camera matrix."""
+        return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
+
+    def scaled(self, width: int, height: int) -> Intrinsics:
+        """The same camera at another resolution (for resized images)."""
+        sx, sy = width / self.width, height / self.height
+        return Intrinsics(
+            width,
+            height,
+            self.fx * sx,
+            self.fy * sy,
+            (self.cx + 0.5) * sx - 0.5,
+            (self.cy + 0.5) * sy - 0.5,
+            self.model,
+            self.coeffs,
+        )
+
+    @classmethod
+    def from_rs(cls, intr: Any) -> Intrinsics:
+        """From a ``pyrealsense2.intrinsics`` object."""
+        return cls(
+            int(intr.width),
+            int(intr.height),
+            float(intr.fx),
+            float(intr.fy),
+            float(intr.ppx),
+            float(intr.ppy),
+            str(intr.model).split(".")[-1],
+            tuple(float(c) for c in intr.coeffs),
+        )
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> Intrinsics:
+        """From ``{"width", "height", "fx", "fy", "cx", "cy"}`` (``ppx``/``ppy`` accepted for cx/cy)."""
+        try:
+            cx = data["cx"] if "cx" in data else data["ppx"]
+            cy = data["cy"] if "cy" in data else data["ppy"]
+            return cls(
+                int(data["width"]),
+                int(data["height"]),
+                float(data["fx"]),
+                float(data["fy"]),
+                float(cx),
+                float(cy),
+                str(data.get("model", "none")),
+                tuple(float(c) for c in data.get("coeffs", (0.0,) * 5)),
+            )
+        except KeyError as exc:
+            raise ValueError(f"intrinsics: missing field {exc.args[0]!r}") from None
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "width": self.width,
+            "height": self.height,
+            "fx": self.fx,
+            "fy": self.fy,
+            "cx": self.cx,
+            "cy": self.cy,
+            "model": self.model,
+            "coeffs": list(self.coeffs),
+        }
+
+
+@dataclass(frozen=True)
+class Extrinsics:
+    """Rigid transform from frame A to frame B: ``p_B = rotation @ p_A + translation`` (metres)."""
+
+    rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
+    translation: np.ndarray = field(default_factory=lambda: np.zeros(3))
+
+    def __post_init__(self) -> None:
+        rotation = np.asarray(self.rotation, dtype=float).reshape(3, 3)
+        translation = np.asarray(self.translation, dtype=float).reshape(3)
+        if not (np.all(np.isfinite(rotation)) and np.all(np.isfinite(translation))):
+            raise ValueError("extrinsics: rotation and translation must be finite")
+        if not np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-5):
+            raise ValueError("extrinsics: rotation is not orthonormal")
+        object.__setattr__(self, "rotation", rotation)
+        object.__setattr__(self, "translation", translation)
+
+    def apply(self, points: np.ndarray) -> np.ndarray:
+        """Transform (N, 3) points from frame A to frame B."""
+        return points @ self.rotation.T + self.translation
+
+    @classmethod
+    def from_rs(cls, extr: Any) -> Extrinsics:
+        """From a ``pyrealsense2.extrinsics`` (its rotation is stored column-major)."""
+        return cls(np.asarray(extr.rotation, dtype=float).reshape(3, 3).T, np.asarray(extr.translation))
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> Extrinsics:
+        """From ``{"rotation": 3x3 row-major nested list, "translation": [x, y, z]}``."""
+        try:
+            return cls(np.asarray(data["rotation"], dtype=float), np.asarray(data["translation"], dtype=float))
+        except KeyError as exc:
+            raise ValueError(f"extrinsics: missing field {exc.args[0]!r}") from None
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"rotation": self.rotation.tolist(), "translation": self.translation.tolist()}
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """Everything needed to align depth to colour and lift colour pixels to 3D.
+
+    ``depth`` is None when the depth image is already registered to the colour image.
+    ``depth_to_color`` maps depth-camera points to colour-camera points. ``depth_scale`` is metres per
+    depth unit (0.001 for millimetre PNGs and the D435i default).
+    """
+
+    color: Intrinsics
+    depth: Intrinsics | None = None
+    depth_to_color: Extrinsics = field(default_factory=Extrinsics)
+    depth_scale: float = 0.001
+
+    @classmethod
+    def from_json(cls, path: str | Path) -> Calibration:
+        """Read a calibration JSON.
+
+        Accepted forms: ``{"color": {...}, "depth": {...}, "depth_to_color": {...}, "depth_scale": s}`` or a
+        flat intrinsics dict (``fx, fy, cx, cy, width, height[, depth_scale]``) for a registered RGB-D pair.
+        """
+        path = Path(path)
+        try:
+            data = json.loads(path.read_text())
+        except (OSError, json.JSONDecodeError) as exc:
+            raise ValueError(f"calibration {path}: cannot read JSON ({exc})") from None
+        if not isinstance(data, dict):
+            raise ValueError(f"calibration {path}: expected a JSON object")
+        try:
+            if "color" in data:
+                return cls(
+                    Intrinsics.from_dict(data["color"]),
+                    Intrinsics.from_dict(data["depth"]) if data.get("depth") else None,
+                    Extrinsics.from_dict(data["depth_to_color"]) if data.get("depth_to_color") else Extrinsics(),
+                    float(data.get("depth_scale", 0.001)),
+                )
+            return cls(Intrinsics.from_dict(data), depth_scale=float(data.get("depth_scale", 0.001)))
+        except ValueError as exc:
+            raise ValueError(f"calibration {path}: {exc}") from None
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "color": self.color.to_dict(),
+            "depth": self.depth.to_dict() if self.depth else None,
+            "depth_to_color": self.depth_to_color.to_dict(),
+            "depth_scale": self.depth_scale,
+        }
+
+
+def deproject(pixels: np.ndarray, depth_m: np.ndarray, intrinsics: Intrinsics) -> np.ndarray:
+    """Pixels (N, 2) as (u, v) with depths (N,) in metres -> (N, 3) camera-frame points: d * K^-1 [u v 1]."""
+    pixels = np.asarray(pixels, dtype=float).reshape(-1, 2)
+    depth_m = np.asarray(depth_m, dtype=float).reshape(-1)
+    x = (pixels[:, 0] - intrinsics.cx) / intrinsics.fx * depth_m
+    y = (pixels[:, 1] - intrinsics.cy) / intrinsics.fy * depth_m
+    return np.stack([x, y, depth_m], axis=1)
+
+
+def project(points: np.ndarray, intrinsics: Intrinsics) -> np.ndarray:
+    """Camera-frame points (N, 3) -> pixels (N, 2) as (u, v). Points with z <= 0 give NaN."""
+    points = np.asarray(points, dtype=float).reshape(-1, 3)
+    z = points[:, 2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        u = np.where(z > 0, points[:, 0] / z * intrinsics.fx + intrinsics.cx, np.nan)
+        v = np.where(z > 0, points[:, 1] / z * intrinsics.fy + intrinsics.cy, np.nan)
+    return np.stack([u, v], axis=1)

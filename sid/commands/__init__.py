@@ -1,0 +1,1 @@
+"""Subcommands of the ``sid`` command line, one module each."""
