@@ -33,6 +33,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
+import cv2
 import numpy as np
 
 from sid.camera import Calibration, Intrinsics
@@ -49,6 +50,10 @@ _GAP_REL = 0.05
 # A surface needs this many pixels in the patch (fewer if the patch has fewer valid pixels) so that one flying
 # pixel at a silhouette edge does not decide the depth.
 _MIN_SUPPORT = 3
+# Anything beyond this (metres) is an empty z-buffer cell.
+_FAR = 1.0e6
+# Every n-th depth pixel is enough to find the most common rectangle size.
+_CLASS_SAMPLE = 16
 
 
 def _validate_depth(depth_m: np.ndarray, intr: Intrinsics, what: str) -> np.ndarray:
@@ -221,6 +226,167 @@ def _splat_cells(
             rows.append(y0 + oy)
             masks.append((span_x >= ox) & (span_y >= oy))
     return cols, rows, masks
+
+
+class Aligner:
+    """Depth-to-colour alignment for one calibration, with everything that depends only on it precomputed.
+
+    Per depth pixel the colour-camera ray K_c R K_d^-1 [u, v, 1] (at the centre and, for rectangle splatting, at
+    the two corners) is stored as float32, so a frame costs one multiply-add per coordinate, a division, rounding
+    and the z-buffer. Reuse one Aligner for a stream; ``align_depth_to_color`` builds a throw-away one.
+
+    Z-buffer: ``np.minimum.at`` on the flat colour image (numpy >= 1.25 made it fast: 1.2 ms for 407k points
+    here, against 3.5 ms for repeated fancy assignment and 31 ms for sorting by depth). Rectangles are not
+    enumerated cell by cell (a 848x480 -> 1280x720 D435i pair gives 9-16 cells per depth pixel): depth pixels are
+    grouped by rectangle size (a handful of classes), each class is z-buffered at its top-left cell, and a
+    grey-level erosion (OpenCV's min filter) with that rectangle as kernel spreads the minimum over the rectangle.
+    This is exactly the minimum over all rectangles covering a pixel.
+    """
+
+    def __init__(self, calib: Calibration, mode: SplatMode = "rectangle", value: StoredValue = "z") -> None:
+        if calib.depth is None:
+            raise ValueError("Aligner: the calibration has no depth intrinsics (depth already registered to colour)")
+        if mode not in ("rectangle", "point"):
+            raise ValueError(f"unknown splat mode {mode!r}; use 'rectangle' or 'point'")
+        if value not in ("z", "depth"):
+            raise ValueError(f"unknown stored value {value!r}; use 'z' or 'depth'")
+        self.calib, self.mode, self.value = calib, mode, value
+        kd, kc = calib.depth, calib.color
+        m = kc.K @ calib.depth_to_color.rotation
+        self._offset = [np.float32(x) for x in kc.K @ calib.depth_to_color.translation]
+        v, u = np.mgrid[0 : kd.height, 0 : kd.width].astype(np.float64)
+
+        def rays(shift: float) -> np.ndarray:
+            x = ((u + shift - kd.cx) / kd.fx).ravel()
+            y = ((v + shift - kd.cy) / kd.fy).ravel()
+            return (m[:, :2] @ np.stack([x, y]) + m[:, 2:]).astype(np.float32)  # (3, H_d * W_d)
+
+        self._centre = rays(0.0) if mode == "point" or value == "z" else None
+        self._corners = (rays(-0.5), rays(0.5)) if mode == "rectangle" else None
+        # Scratch buffers reused across frames: fresh multi-megabyte arrays per frame cost more in page faults
+        # than the arithmetic. An Aligner is therefore not thread-safe; use one per thread.
+        self._work = np.empty((8, kd.height * kd.width), dtype=np.float32)
+        self._image = np.empty((1, kc.height * kc.width), dtype=np.float32)
+        self._canvas = np.empty(0, dtype=np.float32)
+
+    def __call__(self, depth_m: np.ndarray) -> np.ndarray:
+        """Depth image (H_d, W_d) metres -> (H_c, W_c) float32 metres in the colour grid, 0 where nothing landed."""
+        assert self.calib.depth is not None
+        depth_m = _validate_depth(depth_m, self.calib.depth, "align")
+        d = self._work[0]
+        np.fmax(depth_m.reshape(-1), np.float32(0), out=d)  # NaN and negative -> 0 (no reading)
+        out = self._points(d) if self._corners is None else self._rectangles(d)
+        # Empty cells hold +inf: threshold them to zero (OpenCV, one SIMD pass, also allocates the result).
+        return cv2.threshold(out, _FAR, 0.0, cv2.THRESH_TOZERO_INV)[1]
+
+    def _project(self, d: np.ndarray, rays: np.ndarray, z: np.ndarray, u: np.ndarray, v: np.ndarray) -> None:
+        """Colour-frame z (metres) and colour pixel (u, v) of every depth pixel along ``rays``, into z, u, v."""
+        b = self._offset
+        np.multiply(d, rays[2], out=z)
+        z += b[2]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            for axis, target in ((0, u), (1, v)):
+                np.multiply(d, rays[axis], out=target)
+                target += b[axis]
+                target /= z
+
+    def _stored(self, d: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """The value written per depth pixel: colour-frame z or the depth reading itself (metres)."""
+        if self.value == "depth":
+            return d
+        assert self._centre is not None
+        np.multiply(d, self._centre[2], out=out)
+        out += self._offset[2]
+        return out
+
+    def _points(self, d: np.ndarray) -> np.ndarray:
+        kc = self.calib.color
+        assert self._centre is not None
+        z, u, v = self._work[1:4]
+        self._project(d, self._centre, z, u, v)
+        with np.errstate(invalid="ignore"):
+            for coord in (u, v):
+                coord += 0.5
+                np.floor(coord, out=coord)
+            valid = (d > 0) & (z > 0) & (u >= 0) & (u < kc.width) & (v >= 0) & (v < kc.height)
+        keep = np.flatnonzero(valid)
+        v *= kc.width
+        v += u
+        out = self._image[0]
+        out.fill(np.inf)
+        np.minimum.at(out, v[keep].astype(np.int64), z[keep] if self.value == "z" else d[keep])
+        return out.reshape(kc.height, kc.width)
+
+    def _rectangles(self, d: np.ndarray) -> np.ndarray:
+        """Rectangle splat (see the class docstring): (H_c, W_c) float32, +inf where nothing landed."""
+        assert self._corners is not None
+        kc = self.calib.color
+        z0, x0, y0, z1, x1, y1, stored = self._work[1:8]
+        self._project(d, self._corners[0], z0, x0, y0)
+        self._project(d, self._corners[1], z1, x1, y1)
+        with np.errstate(invalid="ignore"):
+            valid = (d > 0) & (z0 > 0) & (z1 > 0)
+            for coord in (x0, y0, x1, y1):
+                coord += 0.5
+                np.floor(coord, out=coord)
+            # Keep rectangles that touch the image; their outside cells are dropped (librealsense skips them too).
+            valid &= (x1 >= 0) & (y1 >= 0) & (x0 < kc.width) & (y0 < kc.height) & (x0 <= x1) & (y0 <= y1)
+        keep = np.flatnonzero(valid)
+        stored = self._stored(d, stored)[keep]
+        x0, y0, x1, y1 = (coord[keep].astype(np.int64) for coord in (x0, y0, x1, y1))
+        span_x, span_y = x1 - x0, y1 - y0
+        # Work on a canvas padded by the largest rectangle, so that no rectangle needs clipping.
+        pad = int(max(span_x.max(initial=0), span_y.max(initial=0))) + 1
+        width, height = kc.width + 2 * pad, kc.height + 2 * pad
+        cell = (y0 + pad) * width + (x0 + pad)  # top-left cell on the padded canvas
+        # Every rectangle at least as large as the base size (the most common one, from a subsample) is the union of
+        # base-size rectangles at 1-4 offsets; those are z-buffered at their top-left cells and one grey erosion with
+        # the base rectangle (bottom-right anchor: out[q] = min over corners c in [q - base, q]) spreads them.
+        sample = (span_y[::_CLASS_SAMPLE] * pad + span_x[::_CLASS_SAMPLE]) if keep.size else np.zeros(1, np.int64)
+        base_y, base_x = divmod(int(np.argmax(np.bincount(sample))), pad)
+        extra_x, extra_y = span_x - base_x, span_y - base_y
+        covered = (extra_x >= 0) & (extra_y >= 0)
+        canvas = self._canvas_of(height * width)
+        everything = slice(None) if covered.all() else covered
+        for oy in range(int(extra_y.max(initial=0)) + 1):
+            for ox in range(int(extra_x.max(initial=0)) + 1):
+                sel = covered & (extra_x >= ox) & (extra_y >= oy) if ox or oy else everything
+                np.minimum.at(canvas, cell[sel] + (oy * width + ox), stored[sel])
+        image = canvas.reshape(height, width)
+        if base_x or base_y:
+            kernel = np.ones((base_y + 1, base_x + 1), np.uint8)
+            image = cv2.erode(
+                image, kernel, anchor=(base_x, base_y), borderType=cv2.BORDER_CONSTANT, borderValue=np.inf
+            )
+        # Rectangles smaller than the base size in some axis (rare) are written cell by cell.
+        rest = np.flatnonzero(~covered)
+        for oy in range(int(span_y[rest].max(initial=-1)) + 1):
+            for ox in range(int(span_x[rest].max(initial=-1)) + 1):
+                sel = rest[(span_x[rest] >= ox) & (span_y[rest] >= oy)]
+                np.minimum.at(image.reshape(-1), cell[sel] + (oy * width + ox), stored[sel])
+        return image[pad : pad + kc.height, pad : pad + kc.width]
+
+    def _canvas_of(self, size: int) -> np.ndarray:
+        """A flat float32 scratch canvas of ``size`` cells filled with +inf (grown on demand)."""
+        if self._canvas.size < size:
+            self._canvas = np.empty(size, dtype=np.float32)
+        canvas = self._canvas[:size]
+        canvas.fill(np.inf)
+        return canvas
+
+
+def align_depth_to_color(
+    depth_m: np.ndarray, calib: Calibration, mode: SplatMode = "rectangle", value: StoredValue = "z"
+) -> np.ndarray:
+    """Align a depth image (H_d, W_d metres, 0/NaN = none) to the colour image: (H_c, W_c) float32 metres.
+
+    See the module docstring for ``mode`` and ``value``. Registered depth (``calib.depth`` None) is returned as a
+    float32 copy with NaN set to 0. For a stream, build one ``Aligner`` and call it per frame.
+    """
+    if calib.depth is None:
+        depth_m = _validate_depth(depth_m, calib.color, "align_depth_to_color")
+        return np.nan_to_num(depth_m.astype(np.float32), nan=0.0, posinf=0.0, neginf=0.0)
+    return Aligner(calib, mode, value)(depth_m)
 
 
 def depth_at_color_pixels(
