@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import cv2
 import numpy as np
 import pytest
@@ -11,29 +9,21 @@ import pytest
 from sid.keypoints import LEFT_HIP, LEFT_SHOULDER, RIGHT_HIP, RIGHT_SHOULDER
 from sid.overlay import draw_detections
 from sid.pose import load_pose_estimator
+from tests.conftest import shared_path
 
-SHARED = Path(__file__).resolve().parents[1].parent / "shared"
-YOLO = SHARED / "models" / "yolo11n-pose-256.onnx"
-MOVENET = SHARED / "models" / "movenet_singlepose_lightning_4.onnx"
-FIVE_PEOPLE = SHARED / "data" / "rgbd" / "five_people" / "color.png"
-
-
-def _require(*paths: Path) -> None:
-    for path in paths:
-        if not path.is_file():
-            pytest.skip(f"{path} absent (../shared models and data are not part of a fresh clone)")
+YOLO = ("models", "yolo11n-pose-256.onnx")
+MOVENET = ("models", "movenet_singlepose_lightning_4.onnx")
+FIVE_PEOPLE = ("data", "rgbd", "five_people", "color.png")
 
 
 @pytest.fixture(scope="module")
 def color() -> np.ndarray:
-    _require(FIVE_PEOPLE)
-    return cv2.cvtColor(cv2.imread(str(FIVE_PEOPLE)), cv2.COLOR_BGR2RGB)
+    return cv2.cvtColor(cv2.imread(str(shared_path(*FIVE_PEOPLE))), cv2.COLOR_BGR2RGB)
 
 
 @pytest.fixture(scope="module")
 def yolo_people(color):
-    _require(YOLO)
-    estimator = load_pose_estimator(YOLO)
+    estimator = load_pose_estimator(shared_path(*YOLO))
     assert estimator.contract == "yolo_pose" and estimator.input_size == (256, 256) and estimator.normalised
     return estimator(color)
 
@@ -58,8 +48,7 @@ def test_yolo_pose_finds_the_five_people(yolo_people, color):
 
 
 def test_movenet_singlepose_on_each_crop_puts_shoulders_and_hips_on_the_body(yolo_people, color):
-    _require(MOVENET)
-    estimator = load_pose_estimator(MOVENET)
+    estimator = load_pose_estimator(shared_path(*MOVENET))
     assert estimator.contract == "movenet_singlepose" and estimator.input_size == (192, 192)
     boxes = np.array([d.box for d in yolo_people])
     found = estimator.estimate_in_boxes(color, boxes)
