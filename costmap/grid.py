@@ -75,10 +75,35 @@ class GridSpec:
         """Boolean (N,) for world points (N, 2) inside the grid."""
         return self.in_bounds(self.world_to_cell(xy))
 
-    def cell_centres(self) -> tuple[np.ndarray, np.ndarray]:
-        """World x and y of every cell centre, each (rows, cols)."""
-        xs = self.origin_x + (np.arange(self.width) + 0.5) * self.resolution
-        ys = self.origin_y + (np.arange(self.height) + 0.5) * self.resolution
+    @property
+    def bounds(self) -> tuple[float, float, float, float]:
+        """World extent (x_min, y_min, x_max, y_max) in metres."""
+        w, h = self.size_m
+        return (self.origin_x, self.origin_y, self.origin_x + w, self.origin_y + h)
+
+    def world_to_map(self, xy: np.ndarray) -> np.ndarray:
+        """World points (N, 2) -> continuous map coordinates (N, 2) as (col, row) in cells; cell centres at k + 0.5."""
+        xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+        return np.stack([(xy[:, 0] - self.origin_x) / self.resolution, (xy[:, 1] - self.origin_y) / self.resolution], 1)
+
+    def cell_distance(self, metres: float) -> int:
+        """Whole cells covering a world distance, rounded up as Nav2's ``Costmap2D::cellDistance`` does."""
+        return max(0, int(np.ceil(metres / self.resolution)))
+
+    def window(self, xy_min: tuple[float, float], xy_max: tuple[float, float]) -> tuple[slice, slice] | None:
+        """(row, col) slices of the cells overlapping the world box [xy_min, xy_max], clipped; None when outside."""
+        (r0, c0), (r1, c1) = self.world_to_cell(np.array([xy_min, xy_max], dtype=float))
+        r0, c0 = max(r0, 0), max(c0, 0)
+        r1, c1 = min(r1 + 1, self.height), min(c1 + 1, self.width)
+        if r0 >= r1 or c0 >= c1:
+            return None
+        return slice(int(r0), int(r1)), slice(int(c0), int(c1))
+
+    def cell_centres(self, window: tuple[slice, slice] | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """World x and y of every cell centre (of the whole grid or of a ``window``), each (rows, cols)."""
+        rows, cols = window if window is not None else (slice(0, self.height), slice(0, self.width))
+        xs = self.origin_x + (np.arange(cols.start, cols.stop) + 0.5) * self.resolution
+        ys = self.origin_y + (np.arange(rows.start, rows.stop) + 0.5) * self.resolution
         return np.meshgrid(xs, ys)
 
 
@@ -99,6 +124,9 @@ class Costmap2D:
     @classmethod
     def filled(cls, spec: GridSpec, value: int = FREE_SPACE) -> Costmap2D:
         return cls(spec, np.full(spec.shape, value, dtype=np.uint8))
+
+    def copy(self) -> Costmap2D:
+        return Costmap2D(self.spec, self.costs.copy())
 
     def cost_at(self, xy: np.ndarray) -> np.ndarray:
         """Costs (N,) at world points (N, 2); points outside the grid read NO_INFORMATION."""

@@ -1,0 +1,60 @@
+"""How a layer's grid is written into the combined (master) grid: Nav2's combination methods, in place.
+
+- max: keep the larger value; an unknown (255) layer cell is ignored, an unknown master cell is overwritten.
+- overwrite: copy the layer value unless it is unknown.
+- true_overwrite: copy every value, unknown included.
+- addition: sum, capped at 252 (MAX_NON_OBSTACLE); unknown layer cells are ignored and an unknown master cell
+  takes the layer value.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Literal
+
+import numpy as np
+
+from costmap.grid import INSCRIBED, NO_INFORMATION
+
+CombinationMethod = Literal["max", "overwrite", "true_overwrite", "addition"]
+
+
+def update_with_max(master: np.ndarray, layer: np.ndarray) -> None:
+    known = layer != NO_INFORMATION
+    take = known & ((master == NO_INFORMATION) | (layer > master))
+    master[take] = layer[take]
+
+
+def update_with_overwrite(master: np.ndarray, layer: np.ndarray) -> None:
+    known = layer != NO_INFORMATION
+    master[known] = layer[known]
+
+
+def update_with_true_overwrite(master: np.ndarray, layer: np.ndarray) -> None:
+    master[...] = layer
+
+
+def update_with_addition(master: np.ndarray, layer: np.ndarray) -> None:
+    known = layer != NO_INFORMATION
+    master_unknown = known & (master == NO_INFORMATION)
+    summed = np.minimum(master.astype(np.int16) + layer, INSCRIBED - 1).astype(np.uint8)
+    add = known & ~master_unknown
+    master[add] = summed[add]
+    master[master_unknown] = layer[master_unknown]
+
+
+COMBINE: dict[str, Callable[[np.ndarray, np.ndarray], None]] = {
+    "max": update_with_max,
+    "overwrite": update_with_overwrite,
+    "true_overwrite": update_with_true_overwrite,
+    "addition": update_with_addition,
+}
+
+
+def combine(master: np.ndarray, layer: np.ndarray, method: CombinationMethod = "max") -> None:
+    """Write ``layer`` into ``master`` (same shape, uint8) with one of Nav2's combination methods."""
+    if master.shape != layer.shape:
+        raise ValueError(f"combine: layer shape {layer.shape} differs from the master's {master.shape}")
+    if method not in COMBINE:
+        raise ValueError(f"unknown combination method {method!r}; use one of {sorted(COMBINE)}")
+    COMBINE[method](master, layer)

@@ -1,0 +1,108 @@
+"""Nav2's inflation layer: costs that fall off with the distance to the nearest lethal cell.
+
+Formula (nav2_costmap_2d ``InflationLayer::computeCost``), with d the distance between cell centres in metres:
+d = 0 -> LETHAL (254); d <= inscribed_radius -> INSCRIBED (253);
+otherwise floor(252 * exp(-cost_scaling_factor * (d - inscribed_radius))).
+Only cells within ``ceil(inflation_radius / resolution)`` cells of a lethal cell get a cost (Nav2's
+``cellDistance`` rounds up, so the reach can exceed ``inflation_radius`` by up to one cell).
+
+Distances come from an exact Euclidean distance transform (OpenCV's Felzenszwalb-Huttenlocher
+``DIST_MASK_PRECISE``, as newer Nav2 does; ``scipy.ndimage.distance_transform_edt`` gives the same values and
+is kept as a measured alternative). Both return d in cells; squaring and rounding recovers the exact integer
+squared distance, which indexes a cost table built with Nav2's formula, so every cell gets exactly Nav2's value.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import cv2
+import numpy as np
+from scipy import ndimage
+
+from costmap.grid import FREE_SPACE, INSCRIBED, LETHAL, MAX_NON_OBSTACLE, NO_INFORMATION, GridSpec
+
+DistanceMethod = Literal["opencv", "scipy"]
+
+
+@dataclass(frozen=True)
+class InflationParams:
+    """Nav2 inflation parameters and defaults (metres, 1/metre).
+
+    inflate_unknown: also write graded costs into unknown (255) cells; by default only costs >= 253 replace
+    unknown, as in Nav2.
+    """
+
+    inflation_radius: float = 0.55
+    cost_scaling_factor: float = 10.0
+    inflate_unknown: bool = False
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.inflation_radius) and self.inflation_radius >= 0):
+            raise ValueError(f"inflation_radius must be a finite number >= 0, got {self.inflation_radius}")
+        if not (np.isfinite(self.cost_scaling_factor) and self.cost_scaling_factor >= 0):
+            raise ValueError(f"cost_scaling_factor must be a finite number >= 0, got {self.cost_scaling_factor}")
+
+
+def inflation_cost(distance_m: np.ndarray, inscribed_radius: float, cost_scaling_factor: float) -> np.ndarray:
+    """Nav2's inflation cost (uint8) for distances (metres) to the nearest lethal cell; no radius cut-off here."""
+    d = np.asarray(distance_m, dtype=float)
+    decay = np.floor(MAX_NON_OBSTACLE * np.exp(-cost_scaling_factor * (d - inscribed_radius)))
+    cost = np.where(d <= inscribed_radius, INSCRIBED, np.clip(decay, 0, MAX_NON_OBSTACLE))
+    return np.where(d == 0, LETHAL, cost).astype(np.uint8)
+
+
+def distance_to_lethal_cells(lethal: np.ndarray, method: DistanceMethod = "opencv") -> np.ndarray:
+    """Euclidean distance (cells, float32) from every cell centre to the nearest ``lethal`` cell centre.
+
+    Undefined (large) when ``lethal`` has no True cell; callers check that first.
+    """
+    if method == "opencv":
+        return cv2.distanceTransform(np.where(lethal, 0, 1).astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+    if method == "scipy":
+        return ndimage.distance_transform_edt(~lethal).astype(np.float32)
+    raise ValueError(f"unknown distance method {method!r}; use 'opencv' or 'scipy'")
+
+
+class InflationLayer:
+    """Inflates the lethal cells of the combined grid; keeps its own grid of inflation costs.
+
+    ``inscribed_radius`` is the robot's radius (metres): Nav2's inscribed radius of a circular footprint.
+    """
+
+    name = "inflation"
+
+    def __init__(self, spec: GridSpec, params: InflationParams, inscribed_radius: float) -> None:
+        if not (np.isfinite(inscribed_radius) and inscribed_radius >= 0):
+            raise ValueError(f"robot.radius (inscribed radius) must be a finite number >= 0, got {inscribed_radius}")
+        self.spec = spec
+        self.params = params
+        self.inscribed_radius = float(inscribed_radius)
+        self.cell_radius = spec.cell_distance(params.inflation_radius)
+        # Cost by exact squared cell distance 0..R^2; one extra entry (0) for everything farther.
+        d2 = np.arange(self.cell_radius**2 + 2)
+        self._cost_by_d2 = inflation_cost(np.sqrt(d2) * spec.resolution, inscribed_radius, params.cost_scaling_factor)
+        self._cost_by_d2[-1] = FREE_SPACE
+        self.costs = np.zeros(spec.shape, dtype=np.uint8)
+
+    def compute(self, master: np.ndarray, method: DistanceMethod = "opencv") -> np.ndarray:
+        """This layer's own grid for the lethal cells of ``master``: Nav2's cost within reach, 0 beyond."""
+        lethal = master == LETHAL
+        if self.cell_radius == 0 or not lethal.any():
+            self.costs = np.where(lethal, LETHAL, FREE_SPACE).astype(np.uint8)
+            return self.costs
+        distance = distance_to_lethal_cells(lethal, method)
+        d2 = np.rint(np.square(distance, dtype=np.float32)).astype(np.int32)
+        np.minimum(d2, len(self._cost_by_d2) - 1, out=d2)
+        self.costs = self._cost_by_d2[d2]
+        return self.costs
+
+    def apply(self, master: np.ndarray, method: DistanceMethod = "opencv") -> None:
+        """Compute the inflation of ``master`` and write it in place: Nav2's max, with its rule for unknown cells."""
+        cost = self.compute(master, method)
+        unknown = master == NO_INFORMATION
+        np.maximum(master, cost, out=master)  # an unknown master cell stays 255 here
+        threshold = 1 if self.params.inflate_unknown else INSCRIBED
+        replace = unknown & (cost >= threshold)
+        master[replace] = cost[replace]
