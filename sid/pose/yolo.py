@@ -5,8 +5,9 @@ Pre-processing follows Ultralytics' ``LetterBox``: keep the aspect ratio, centre
 exports such as the reference 256 px model); which one is found once, on a blank image, when the model is loaded.
 
 NMS is OpenCV's ``cv2.dnn.NMSBoxes`` (greedy, by score, IoU on (x, y, w, h) boxes), the same algorithm as the
-torchvision NMS Ultralytics uses; after the score threshold only tens of candidates remain, so a library call is
-both simpler and fast enough (see ``sid.pose.bench``).
+torchvision NMS Ultralytics uses. On the five-people frame 49 candidates pass the score threshold; NMSBoxes keeps
+the same 5 as a vectorised numpy greedy NMS in 9 us instead of 63 us (medians of 2000 calls), so the library
+call is both simpler and faster than writing our own.
 """
 
 from __future__ import annotations
