@@ -7,7 +7,7 @@ import onnxruntime as ort
 import pytest
 from onnx import TensorProto, helper
 
-from sid.pose import load_pose_estimator
+from sid.pose import PoseEstimator, load_pose_estimator
 from sid.pose.contracts import (
     CONTRACTS,
     ModelSignature,
@@ -106,9 +106,9 @@ def test_tiny_models_are_recognised_and_explicit_options_are_checked(tmp_path):
     multipose = build_multipose_model(tmp_path / "multi.onnx")
     single = build_singlepose_model(tmp_path / "single.onnx")
     yolo = build_yolo_pose_model(tmp_path / "yolo.onnx", np.zeros((56, 10)))
-    assert load_pose_estimator(multipose).contract == "movenet_multipose"
-    assert load_pose_estimator(single).contract == "movenet_singlepose"
-    assert load_pose_estimator(yolo).contract == "yolo_pose"
+    for path, name in [(multipose, "movenet_multipose"), (single, "movenet_singlepose"), (yolo, "yolo_pose")]:
+        estimator = load_pose_estimator(path)
+        assert estimator.contract == name and isinstance(estimator, PoseEstimator)
     with pytest.raises(PoseModelError, match="does not fit"):
         load_pose_estimator(single, contract="movenet_multipose")
     with pytest.raises(ValueError, match="iou_threshold applies to yolo_pose"):
