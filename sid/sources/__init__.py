@@ -1,0 +1,79 @@
+"""Frame sources: everything that yields ``sid.frame.Frame`` (colour + depth + calibration).
+
+``open_source(spec)`` picks one from a string, as ``sid detect --source`` does:
+
+- ``"realsense"``: a live RealSense camera (``sid.sources.realsense.RealSenseSource``);
+- ``"FILE.db3"`` / ``"FILE.bag"``: a RealSense recording (librealsense 2.59+ writes .db3, older versions .bag);
+- a directory: a folder of colour + depth images (``sid.sources.folder.FolderSource``);
+- ``"synthetic:SCENARIO"``: rendered people (``sid.sources.synthetic``).
+
+Sources are iterators. A frame that cannot be read raises ``FrameReadError`` from ``next()`` and the source moves
+on to the next frame, so a caller can report it and continue (``skip_unreadable`` does exactly that). A source that
+cannot be opened at all, or breaks for good (camera unplugged), raises ``SourceError``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Iterator
+from pathlib import Path
+from typing import Any
+
+from sid.frame import Frame
+
+RECORDING_SUFFIXES = (".db3", ".bag")
+
+
+class SourceError(RuntimeError):
+    """A source cannot be opened or cannot go on (no camera, unreadable recording, missing folder)."""
+
+
+class FrameReadError(SourceError):
+    """One frame could not be read; the source has moved past it and the next ``next()`` may succeed.
+
+    index: the frame's position in the source (0-based); path: the file at fault, when there is one.
+    """
+
+    def __init__(self, message: str, index: int | None = None, path: Path | None = None) -> None:
+        super().__init__(message)
+        self.index = index
+        self.path = path
+
+
+def open_source(spec: str, **options: Any) -> Iterable[Frame]:
+    """The source named by ``spec`` (see the module docstring); ``options`` go to that source's constructor."""
+    if not isinstance(spec, str) or not spec:
+        raise SourceError("source: empty spec; use realsense, FILE.db3, FILE.bag, DIR or synthetic:SCENARIO")
+    if spec.startswith("synthetic:"):
+        from sid.sources.synthetic import synthetic_source
+
+        return synthetic_source(spec, **options)
+    if spec == "realsense":
+        from sid.sources.realsense import RealSenseSource
+
+        return RealSenseSource(None, **options)
+    path = Path(spec)
+    if path.suffix.lower() in RECORDING_SUFFIXES:
+        from sid.sources.realsense import RealSenseSource
+
+        return RealSenseSource(path, **options)
+    if path.is_dir():
+        from sid.sources.folder import FolderSource
+
+        return FolderSource(path, **options)
+    if not path.exists():
+        raise SourceError(f"source {spec!r}: no such file or directory (use realsense, FILE.db3, DIR, synthetic:...)")
+    raise SourceError(f"source {spec!r}: not a recording (.db3/.bag) or a folder of frames")
+
+
+def skip_unreadable(source: Iterable[Frame], on_error: Callable[[FrameReadError], None]) -> Iterator[Frame]:
+    """Frames of ``source``; each unreadable one is passed to ``on_error`` (e.g. to log it) and skipped."""
+    frames = iter(source)
+    while True:
+        try:
+            frame = next(frames)
+        except StopIteration:
+            return
+        except FrameReadError as error:
+            on_error(error)
+            continue
+        yield frame
