@@ -164,6 +164,8 @@ class Calibration:
 
         Accepted forms: ``{"color": {...}, "depth": {...}, "depth_to_color": {...}, "depth_scale": s}`` or a
         flat intrinsics dict (``fx, fy, cx, cy, width, height[, depth_scale]``) for a registered RGB-D pair.
+        ``depth_scale_m`` is accepted for ``depth_scale``; a flat dict with ``"depth_aligned_to_color": false`` is
+        refused (unregistered depth needs the depth intrinsics and extrinsics).
         """
         path = Path(path)
         try:
@@ -178,9 +180,11 @@ class Calibration:
                     Intrinsics.from_dict(data["color"]),
                     Intrinsics.from_dict(data["depth"]) if data.get("depth") else None,
                     Extrinsics.from_dict(data["depth_to_color"]) if data.get("depth_to_color") else Extrinsics(),
-                    float(data.get("depth_scale", 0.001)),
+                    _depth_scale(data),
                 )
-            return cls(Intrinsics.from_dict(data), depth_scale=float(data.get("depth_scale", 0.001)))
+            if data.get("depth_aligned_to_color") is False:
+                raise ValueError("depth is not aligned to colour; give color, depth and depth_to_color sections")
+            return cls(Intrinsics.from_dict(data), depth_scale=_depth_scale(data))
         except ValueError as exc:
             raise ValueError(f"calibration {path}: {exc}") from None
 
@@ -191,6 +195,13 @@ class Calibration:
             "depth_to_color": self.depth_to_color.to_dict(),
             "depth_scale": self.depth_scale,
         }
+
+
+def _depth_scale(data: dict[str, Any]) -> float:
+    scale = float(data.get("depth_scale", data.get("depth_scale_m", 0.001)))
+    if not (np.isfinite(scale) and scale > 0):
+        raise ValueError(f"depth_scale must be a positive number of metres per unit, got {scale}")
+    return scale
 
 
 def deproject(pixels: np.ndarray, depth_m: np.ndarray, intrinsics: Intrinsics) -> np.ndarray:
