@@ -1,0 +1,194 @@
+"""A planning problem on a costmap, and the lookup tables every planner shares (built once per problem).
+
+Frames and units: world frame (REP-103), metres. The robot is a disc of ``robot_radius`` whose centre moves in the
+plane; the costmap follows Nav2's values (``costmap.grid``).
+
+Validity. A robot centre is *free* in a cell when the cell is known (or ``allow_unknown``), its cost is below
+INSCRIBED (253) and no LETHAL cell centre lies within ``robot_radius`` of the cell centre. The last test is an
+exact Euclidean distance transform of the lethal cells (scipy), i.e. the disc footprint checked against every
+lethal cell at once; it agrees with Nav2's inscribed value when the inflation layer was built with this robot's
+radius, and it still protects the robot when the costmap was inflated for a smaller one.
+
+Planners see a slightly stricter mask, *plannable*: free cells whose eight neighbours are free too. A straight
+segment whose samples, at most one cell apart, all lie in plannable cells is free over its whole length (every
+point of it is within half a cell of a sample, so in that sample's cell or a neighbour). That is what lets OMPL
+check motions at the costmap resolution and still return paths that pass an exact check of every point; the price
+is one cell (``resolution``) of extra clearance. The start and goal cells are plannable when they are free.
+
+Cost. Planners minimise J = integral over the path of (1 + w * c(s) / 252) ds, where c is the cost of the cell
+under the robot centre (0..252) and w = ``cost_weight``: w = 0 is the shortest path; with w = 4 a metre through a
+cell of cost 252 counts as five metres, so the path accepts up to four metres of detour to avoid it. This is Smac
+Planner's travel-cost model (``cost_penalty``) with a larger default so that graded social zones bend the path.
+The integral uses the midpoint rule on ``ceil(L / resolution)`` equal pieces of each straight segment.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import ndimage
+
+from costmap.grid import INSCRIBED, LETHAL, MAX_NON_OBSTACLE, NO_INFORMATION, Costmap2D
+
+_LOOP_MAX = 20
+
+DEFAULT_COST_WEIGHT = 4.0
+"""w in J = integral of (1 + w c / 252) ds; see the module docstring."""
+
+
+class PlanningError(ValueError):
+    """A problem that cannot be planned (start or goal outside the map or in collision, no free path); the message
+    names the reason."""
+
+
+@dataclass(frozen=True)
+class PlanningProblem:
+    """Plan a disc robot from ``start`` to ``goal`` (world x, y in metres) on ``costmap``."""
+
+    costmap: Costmap2D
+    start: tuple[float, float]
+    goal: tuple[float, float]
+    robot_radius: float
+    cost_weight: float = DEFAULT_COST_WEIGHT
+    allow_unknown: bool = False
+
+    def __post_init__(self) -> None:
+        for name in ("start", "goal"):
+            xy = tuple(float(v) for v in getattr(self, name))
+            if len(xy) != 2 or not all(math.isfinite(v) for v in xy):
+                raise PlanningError(f"{name} must be two finite world coordinates (x, y) in metres, got {xy}")
+            object.__setattr__(self, name, xy)
+        if not (math.isfinite(self.robot_radius) and self.robot_radius >= 0):
+            raise PlanningError(f"robot_radius must be a non-negative number of metres, got {self.robot_radius}")
+        if not (math.isfinite(self.cost_weight) and self.cost_weight >= 0):
+            raise PlanningError(f"cost_weight must be a non-negative number, got {self.cost_weight}")
+
+
+@dataclass
+class CostField:
+    """Precomputed validity and cost lookups for one problem, as numpy grids (rows, cols) and flat Python lists.
+
+    ``free``: exact validity of a robot centre per cell; ``plannable``: the stricter mask planners use (module
+    docstring); ``weight``: w * c / 252 per cell (0 where not free). Scalar methods take plain floats and return
+    plain Python values: they are the OMPL callbacks' inner loops.
+    """
+
+    problem: PlanningProblem
+    free: np.ndarray = field(init=False, repr=False)
+    plannable: np.ndarray = field(init=False, repr=False)
+    weight: np.ndarray = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        problem = self.problem
+        spec = problem.costmap.spec
+        costs = problem.costmap.costs
+        self.spec = spec
+        self.resolution = spec.resolution
+        self._inv_res = 1.0 / spec.resolution
+        self._ox, self._oy = spec.origin_x, spec.origin_y
+        self._w, self._h = spec.width, spec.height
+
+        lethal = costs == LETHAL
+        if lethal.any():
+            # Distance (m) from every cell centre to the nearest lethal cell centre.
+            clearance = ndimage.distance_transform_edt(~lethal) * spec.resolution
+            touches_lethal = clearance <= problem.robot_radius
+        else:
+            touches_lethal = np.zeros(spec.shape, dtype=bool)
+        unknown = costs == NO_INFORMATION
+        blocked = (costs >= INSCRIBED) & ~unknown
+        if not problem.allow_unknown:
+            blocked |= unknown
+        self.free = ~(blocked | touches_lethal)
+        # Outside the map counts as not free, so border cells are never plannable.
+        self.plannable = ndimage.binary_erosion(self.free, structure=np.ones((3, 3), bool), border_value=0)
+        for xy in (problem.start, problem.goal):
+            cell = spec.world_to_cell(np.array(xy))[0]
+            if spec.in_bounds(cell[None])[0] and self.free[cell[0], cell[1]]:
+                self.plannable[cell[0], cell[1]] = True
+        graded = np.where(unknown, MAX_NON_OBSTACLE, np.minimum(costs, MAX_NON_OBSTACLE)).astype(float)
+        self.weight = np.where(self.free, problem.cost_weight * graded / MAX_NON_OBSTACLE, 0.0)
+        # Scalar lookups use grids padded by one row and column (copies of the last ones), so a point on the map's
+        # upper edge needs no clamping; int() truncates, which is floor for the non-negative offsets inside the map.
+        self._stride = self._w + 1
+        self._weight_padded = np.pad(self.weight, ((0, 1), (0, 1)), mode="edge")
+        self._plannable_flat: list[bool] = np.pad(self.plannable, ((0, 1), (0, 1)), mode="edge").ravel().tolist()
+        self._weight_flat: list[float] = self._weight_padded.ravel().tolist()
+
+    # ---- scalar lookups (OMPL callbacks) -------------------------------------------------------------------------
+    def is_plannable(self, x: float, y: float) -> bool:
+        """Whether a robot centre at world (x, y), inside the map, may be used by a planner."""
+        return self._plannable_flat[
+            int((y - self._oy) * self._inv_res) * self._stride + int((x - self._ox) * self._inv_res)
+        ]
+
+    def segment_cost(self, x0: float, y0: float, x1: float, y1: float) -> float:
+        """J of the straight segment (x0, y0) -> (x1, y1) (metres of weighted length), both ends inside the map."""
+        dx, dy = x1 - x0, y1 - y0
+        length = math.hypot(dx, dy)
+        n = max(1, math.ceil(length * self._inv_res))
+        # Midpoints in cell units; inside the map they floor to a cell of the padded grids (module docstring).
+        inv = self._inv_res
+        cx, cy = (x0 + 0.5 * dx / n - self._ox) * inv, (y0 + 0.5 * dy / n - self._oy) * inv
+        sx, sy = dx / n * inv, dy / n * inv
+        if n > _LOOP_MAX:  # numpy's fixed overhead pays off on long segments (measured crossover ~20 samples)
+            k = np.arange(n)
+            total = float(self._weight_padded[(cy + k * sy).astype(np.intp), (cx + k * sx).astype(np.intp)].sum())
+        else:
+            weight, stride = self._weight_flat, self._stride
+            total = 0.0
+            for i in range(n):
+                total += weight[int(cy + i * sy) * stride + int(cx + i * sx)]
+        return length * (1.0 + total / n)
+
+    # ---- vectorised lookups (planners' post-processing, validation, metrics) -------------------------------------
+    def cells(self, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(rows, cols, inside) for world points (N, 2); rows/cols are clipped into the grid."""
+        cells = self.spec.world_to_cell(xy)
+        inside = self.spec.in_bounds(cells)
+        rows = np.clip(cells[:, 0], 0, self._h - 1)
+        cols = np.clip(cells[:, 1], 0, self._w - 1)
+        return rows, cols, inside
+
+    def free_at(self, xy: np.ndarray) -> np.ndarray:
+        """Exact validity (N,) of robot centres at world points (N, 2); outside the map is not free."""
+        rows, cols, inside = self.cells(xy)
+        return self.free[rows, cols] & inside
+
+    def plannable_at(self, xy: np.ndarray) -> np.ndarray:
+        rows, cols, inside = self.cells(xy)
+        return self.plannable[rows, cols] & inside
+
+    def segments(self, p: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """J (M,) of straight segments p[i] -> q[i] (each (M, 2)) and whether each is plannable over its length.
+
+        Same midpoint rule as ``segment_cost``; plannability is checked at the midpoints and the piece ends
+        (spacing at most half a cell).
+        """
+        p = np.asarray(p, dtype=float).reshape(-1, 2)
+        q = np.asarray(q, dtype=float).reshape(-1, 2)
+        d = q - p
+        length = np.hypot(d[:, 0], d[:, 1])
+        n = np.maximum(1, np.ceil(length * self._inv_res - 1e-9)).astype(np.int64)
+        # Samples at t = k / (2n), k = 0..2n: even k are piece ends, odd k are the midpoints used for the cost.
+        counts = 2 * n + 1
+        seg = np.repeat(np.arange(len(p)), counts)
+        k = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
+        t = k / (2.0 * n[seg])
+        pts = p[seg] + t[:, None] * d[seg]
+        rows, cols, inside = self.cells(pts)
+        ok = self.plannable[rows, cols] & inside
+        mid = (k % 2) == 1
+        weights = np.bincount(seg[mid], weights=self.weight[rows[mid], cols[mid]], minlength=len(p))
+        cost = length * (1.0 + weights / n)
+        plannable = np.logical_and.reduceat(ok, np.cumsum(counts) - counts) if len(p) else np.zeros(0, bool)
+        return cost, plannable
+
+    def path_cost(self, path: np.ndarray) -> float:
+        """J of a polyline (N, 2)."""
+        path = np.asarray(path, dtype=float).reshape(-1, 2)
+        if len(path) < 2:
+            return 0.0
+        return float(self.segments(path[:-1], path[1:])[0].sum())

@@ -1,0 +1,122 @@
+"""Path simplification and smoothing on the planners' cost model, never raising the cost nor leaving free space.
+
+Every step only accepts a change whose new segments are plannable over their whole length and whose cost J
+(``planner.problem``) is lower, so each step keeps the path valid and no step makes it more expensive; ``smooth``
+compares the result with its input and returns the cheaper one all the same.
+
+Why not OMPL's ``PathSimplifier``: its vertex reduction and vertex collapsing test validity only, so under a cost
+integral they can raise J (a shortcut through a social zone is shorter but dearer), and each of its checks would be
+a Python callback. Here every candidate move of a pass is evaluated at once with numpy on the precomputed grids.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from planner.problem import CostField
+
+_DIRECTIONS = np.array([[1, 0], [0, 1], [-1, 0], [0, -1], [1, 1], [-1, 1], [-1, -1], [1, -1]], float)
+_DIRECTIONS[4:] /= np.sqrt(2.0)
+
+
+def greedy_shortcut(field: CostField, path: np.ndarray, window: int = 64) -> np.ndarray:
+    """Any-angle pass: from each kept vertex jump to the farthest of the next ``window`` vertices that a straight,
+    plannable segment reaches at no more cost than the path between them. O(len(path)) numpy calls."""
+    path = np.asarray(path, dtype=float).reshape(-1, 2)
+    if len(path) <= 2:
+        return path.copy()
+    step_cost = field.segments(path[:-1], path[1:])[0]
+    prefix = np.concatenate([[0.0], np.cumsum(step_cost)])
+    kept, a = [0], 0
+    while a < len(path) - 1:
+        js = np.arange(a + 1, min(a + window, len(path) - 1) + 1)
+        cost, ok = field.segments(np.repeat(path[a : a + 1], len(js), axis=0), path[js])
+        good = ok & (cost <= prefix[js] - prefix[a] + 1e-9)
+        good[0] = True  # the path's own next step is always kept available
+        a = int(js[np.flatnonzero(good)[-1]])
+        kept.append(a)
+    return path[kept]
+
+
+def dp_shortcut(field: CostField, path: np.ndarray) -> np.ndarray:
+    """The cheapest polyline through a subsequence of the vertices (dynamic programming over all vertex pairs).
+    The path's own segments are always allowed, so the result never costs more. Meant for short paths (O(N^2))."""
+    path = np.asarray(path, dtype=float).reshape(-1, 2)
+    n = len(path)
+    if n <= 2:
+        return path.copy()
+    i, j = np.triu_indices(n, 1)
+    cost, ok = field.segments(path[i], path[j])
+    ok |= j == i + 1
+    matrix = np.full((n, n), np.inf)
+    matrix[i[ok], j[ok]] = cost[ok]
+    best = np.full(n, np.inf)
+    best[0] = 0.0
+    previous = np.zeros(n, dtype=np.int64)
+    for k in range(1, n):
+        total = best[:k] + matrix[:k, k]
+        previous[k] = int(np.argmin(total))
+        best[k] = total[previous[k]]
+    order = [n - 1]
+    while order[-1] != 0:
+        order.append(int(previous[order[-1]]))
+    return path[order[::-1]]
+
+
+def subdivide(path: np.ndarray, max_segment: float) -> np.ndarray:
+    """Insert evenly spaced vertices so that no segment is longer than ``max_segment`` metres."""
+    path = np.asarray(path, dtype=float).reshape(-1, 2)
+    if len(path) < 2:
+        return path.copy()
+    d = np.diff(path, axis=0)
+    n = np.maximum(1, np.ceil(np.hypot(d[:, 0], d[:, 1]) / max_segment)).astype(np.int64)
+    seg = np.repeat(np.arange(len(d)), n)
+    t = (np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)) / n[seg]
+    return np.vstack([path[seg] + t[:, None] * d[seg], path[-1:]])
+
+
+def refine(field: CostField, path: np.ndarray, max_step: float, min_step: float, sweeps: int = 4) -> np.ndarray:
+    """Move interior vertices downhill in J: at step sizes from ``max_step`` halving to ``min_step`` (metres), try
+    the eight compass moves for every other vertex at once (alternate vertices share no segment) and keep each
+    move that lowers the cost of the vertex's two segments and keeps them plannable."""
+    path = np.asarray(path, dtype=float).reshape(-1, 2).copy()
+    n = len(path)
+    if n <= 2:
+        return path
+    seg_cost = field.segments(path[:-1], path[1:])[0]
+    step = max_step
+    while step >= min_step:
+        for _ in range(sweeps):
+            moved = False
+            for first in (1, 2):
+                idx = np.arange(first, n - 1, 2)
+                if len(idx) == 0:
+                    continue
+                for direction in _DIRECTIONS * step:
+                    candidate = path[idx] + direction
+                    c_in, ok_in = field.segments(path[idx - 1], candidate)
+                    c_out, ok_out = field.segments(candidate, path[idx + 1])
+                    better = ok_in & ok_out & (c_in + c_out < seg_cost[idx - 1] + seg_cost[idx] - 1e-9)
+                    if better.any():
+                        moved = True
+                        chosen = idx[better]
+                        path[chosen] = candidate[better]
+                        seg_cost[chosen - 1] = c_in[better]
+                        seg_cost[chosen] = c_out[better]
+            if not moved:
+                break
+        step /= 2
+    return path
+
+
+def smooth(field: CostField, path: np.ndarray) -> np.ndarray:
+    """Shortcut, then refine vertices spaced about ``6 * resolution`` apart, then shortcut again; return the result
+    or the input, whichever has the lower J."""
+    path = np.asarray(path, dtype=float).reshape(-1, 2)
+    if len(path) < 2:
+        return path.copy()
+    res = field.resolution
+    short = dp_shortcut(field, greedy_shortcut(field, path))
+    refined = refine(field, subdivide(short, 6 * res), max_step=4 * res, min_step=res / 8)
+    result = dp_shortcut(field, refined)
+    return result if field.path_cost(result) <= field.path_cost(path) else path.copy()
