@@ -54,6 +54,14 @@ def test_all_variations_stand_1_5_to_3_m_in_front_of_the_camera(name: str) -> No
     assert len({tuple(map(tuple, _xy(s).round(6))) for s in scenes}) == len(VARIATIONS)  # all different
 
 
+def test_focus_offset_opens_the_group_towards_the_camera() -> None:
+    scene = layout("S1", focus_offset=0.4)
+    for person in scene.people:  # both face (1.8, 0): 45 deg from each other, towards the camera
+        assert np.degrees(person.theta) == pytest.approx(np.sign(person.theta) * 135.0)
+    with pytest.raises(ValueError, match="stands on the point"):
+        layout("S1", rotation=np.pi / 2, focus_offset=0.4)  # person 0 at (1.8, 0), the focus
+
+
 def test_jitter_is_seeded() -> None:
     first = layout("S4", jitter_xy=0.05, jitter_theta=0.1, seed=3)
     assert first == layout("S4", jitter_xy=0.05, jitter_theta=0.1, seed=3)

@@ -33,7 +33,7 @@ _FOOT_LENGTH = 0.15  # ankle to toe tip along the facing direction
 _TORSO_SEMI = (0.17, 0.11, 0.08)  # lateral, front-back, rounded ends (m)
 _TORSO_BELOW_HIPS = 0.06  # the torso reaches this far below the hip joints (pelvis)
 _TORSO_ABOVE_SHOULDERS = 0.04
-_HEAD_SEMI = (0.075, 0.10, 0.115)  # lateral, front-back, vertical (m)
+_HEAD_SEMI = (0.085, 0.10, 0.115)  # lateral (ears included), front-back, vertical (m)
 
 
 def body_frame(keypoints: np.ndarray) -> np.ndarray:

@@ -21,9 +21,10 @@ hide each other least (at 0 deg the far member stands straight behind the near o
 the far members are hidden behind the near ones. With these defaults everyone stands 1.5-3.0 m in front of a
 camera mounted 0.9 m high, as in the paper, and everyone forms one conversational group.
 
-``rotation`` turns the whole formation about its centre; ``jitter_xy`` / ``jitter_theta`` add Gaussian noise
-(seeded by ``seed``) to positions and facing directions, as real people never stand on an exact circle;
-``height`` sets everyone's height, ``height_jitter`` its spread. ``VARIATIONS`` lists the documented variations
+``focus_offset`` makes everyone face a point that much nearer to the camera than the centre (a group that opens
+towards the camera); ``rotation`` turns the whole formation about its centre; ``jitter_xy`` / ``jitter_theta``
+add Gaussian noise (seeded by ``seed``) to positions and facing directions, as real people never stand on an exact
+circle; ``height`` sets everyone's height, ``height_jitter`` its spread. ``VARIATIONS`` lists the documented variations
 that ``variations(name)`` applies.
 """
 
@@ -62,7 +63,13 @@ LAYOUTS: dict[str, LayoutSpec] = {
 @dataclass(frozen=True)
 class Formation:
     """How a layout is placed: formation centre (m), radius (m, None = the layout's), rotation (rad, CCW seen
-    from above), Gaussian jitter of positions (m) and facing directions (rad), heights (m), random seed."""
+    from above), Gaussian jitter of positions (m) and facing directions (rad), heights (m), random seed.
+
+    focus_offset (m): everyone faces a point this much nearer to the camera than the centre instead of the centre
+    itself, so the group opens towards the camera (the paper authors' own two-person recording,
+    ../shared/data/seed-recordings/people_groups_data.csv, shows such a V: two people ~1 m apart side by side,
+    each turned ~60 deg from the other towards the camera). 0: face the centre.
+    """
 
     centre_distance: float | None = None
     lateral: float = 0.0
@@ -70,12 +77,13 @@ class Formation:
     rotation: float = 0.0
     jitter_xy: float = 0.0
     jitter_theta: float = 0.0
+    focus_offset: float = 0.0
     height: float = 1.70
     height_jitter: float = 0.0
     seed: int = 0
 
     def __post_init__(self) -> None:
-        for name in ("lateral", "rotation", "jitter_xy", "jitter_theta", "height", "height_jitter"):
+        for name in ("lateral", "rotation", "jitter_xy", "jitter_theta", "focus_offset", "height", "height_jitter"):
             if not np.isfinite(getattr(self, name)):
                 raise ValueError(f"layout: {name} must be finite, got {getattr(self, name)}")
         for name in ("jitter_xy", "jitter_theta", "height_jitter"):
@@ -123,7 +131,14 @@ def layout(
     n = len(spec.angles_deg)
     phi = np.radians(np.asarray(spec.angles_deg)) + formation.rotation
     xy = centre + radius * np.stack([np.cos(phi), np.sin(phi)], axis=1) + rng.normal(0.0, formation.jitter_xy, (n, 2))
-    theta = np.angle(np.exp(1j * (phi + np.pi + rng.normal(0.0, formation.jitter_theta, n))))
+    focus = centre - np.array([formation.focus_offset, 0.0])
+    towards = focus - xy
+    if np.any(np.hypot(towards[:, 0], towards[:, 1]) < 1e-6):
+        raise ValueError(
+            f"layout {name}: a person stands on the point everyone faces (focus_offset {formation.focus_offset})"
+        )
+    theta = np.arctan2(towards[:, 1], towards[:, 0]) + rng.normal(0.0, formation.jitter_theta, n)
+    theta = np.angle(np.exp(1j * theta))
     heights = formation.height + rng.normal(0.0, formation.height_jitter, n)
     people = tuple(
         ScenePerson(i, float(xy[i, 0]), float(xy[i, 1]), float(theta[i]), float(heights[i])) for i in range(n)

@@ -1,0 +1,302 @@
+"""A virtual RealSense D435i: renders a scene into an RGB-D ``Frame`` with its ground truth attached.
+
+Cameras: the colour camera's optical frame is the one ``scene.mount`` places in the world (the frame the pipeline
+lifts keypoints into); the depth camera sits ``depth_to_color`` away from it (p_color = R p_depth + t). Defaults are
+typical D435i values: colour 1280x720 with fx = fy = 910 px, depth 848x480 with fx = fy = 420 px, the depth
+camera 15 mm to the left of the colour camera (depth -> colour translation +15 mm along x).
+
+Per frame: exact depth from a ray caster (``render``), then D435-like noise (``noise.DepthNoise``); truth
+keypoints are the skeleton's joints projected with the colour intrinsics, flagged invisible when outside the
+colour image or hidden behind another person, flagged self-occluded when deep behind the person's own body (a face
+seen from behind, the far shoulder of someone in profile), and observed with ``noise.KeypointNoise`` (pixel noise,
+dropped keypoints). Scenes are static, so the exact renders are computed once per scene and reused; each frame draws its
+own noise from ``numpy.random.default_rng([seed, index])``, so any frame can be regenerated alone.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from sid.camera import Calibration, Extrinsics, Intrinsics, project
+from sid.frame import Frame
+from sid.frames import CameraMount
+from sid.groups import GroupParams
+from sid.keypoints import NUM_KEYPOINTS
+from sid.skeleton import skeleton_world
+from sid.synthetic.body import body_capsules
+from sid.synthetic.noise import DepthNoise, KeypointNoise
+from sid.synthetic.render import LABEL_GROUND, LABEL_NONE, LABEL_WALL, Background, RayCaster, Rendering
+from sid.synthetic.scene import Scene
+from sid.synthetic.truth import TruthGroup, truth_groups
+
+D435I_COLOR = Intrinsics(1280, 720, 910.0, 910.0, 639.5, 359.5)
+D435I_DEPTH = Intrinsics(848, 480, 420.0, 420.0, 423.5, 239.5)
+D435I_DEPTH_TO_COLOR = Extrinsics(np.eye(3), np.array([0.015, 0.0, 0.0]))
+
+
+def d435i_calibration(registered: bool = False) -> Calibration:
+    """Typical D435i calibration; ``registered``: depth already in the colour grid (``depth`` None)."""
+    if registered:
+        return Calibration(D435I_COLOR, None, Extrinsics(), 0.001)
+    return Calibration(D435I_COLOR, D435I_DEPTH, D435I_DEPTH_TO_COLOR, 0.001)
+
+
+@dataclass
+class TruthPerson:
+    """Ground truth of one person in one frame.
+
+    x, y (m), theta (rad), height (m): world frame. keypoints_world (17, 3): joints, world frame.
+    keypoints_px (17, 2): their exact colour-image pixels (u, v); NaN behind the camera. visible (17,): inside the
+    colour image and not hidden behind another person. self_occluded (17,): behind the person's own body surface
+    by more than the camera's ``self_occlusion_margin`` (a pose model still guesses these, less confidently; see
+    ``TruthPose``). observed_px (17, 2) / observed (17,): what a pose model reports: pixels with noise, and the
+    visible keypoints that were not dropped. box (4,): the
+    whole body's box in colour pixels (u_min, v_min, u_max, v_max) ignoring occlusion, clipped to the image.
+    """
+
+    id: int
+    x: float
+    y: float
+    theta: float
+    height: float
+    keypoints_world: np.ndarray = field(repr=False)
+    keypoints_px: np.ndarray = field(repr=False)
+    visible: np.ndarray = field(repr=False)
+    self_occluded: np.ndarray = field(repr=False)
+    observed_px: np.ndarray = field(repr=False)
+    observed: np.ndarray = field(repr=False)
+    box: np.ndarray = field(repr=False)
+
+
+@dataclass
+class FrameTruth:
+    """What a synthetic frame shows: the scene's name, people and groups, and the camera mount used."""
+
+    scene: str
+    people: list[TruthPerson]
+    groups: list[TruthGroup]
+    mount: CameraMount
+
+
+@dataclass
+class _SceneRender:
+    """Everything about a scene that does not change from frame to frame."""
+
+    depth: Rendering
+    color: np.ndarray
+    keypoints_world: list[np.ndarray]
+    keypoints_px: list[np.ndarray]
+    visible: list[np.ndarray]
+    self_occluded: list[np.ndarray]
+    boxes: list[np.ndarray]
+    groups: list[TruthGroup]
+
+
+# Flat colours (RGB) of the first people; more people cycle through them.
+PERSON_COLORS = np.array(
+    [[220, 60, 50], [50, 110, 220], [40, 170, 80], [230, 160, 30], [150, 70, 200], [30, 180, 190]], dtype=float
+)
+_SKY = np.array([200, 215, 230], dtype=float)
+_WALL = np.array([215, 205, 185], dtype=float)
+_GROUND_LIGHT, _GROUND_DARK = np.array([150, 150, 150], dtype=float), np.array([115, 115, 115], dtype=float)
+_CHECKER_M = 0.5  # side of the ground's checkerboard squares
+_MAX_CACHED_CASTERS = 8  # ray casters (mount, background) kept between scenes
+
+
+class SyntheticCamera:
+    """Renders scenes as a D435i-like RGB-D camera would see them.
+
+    calibration: default ``d435i_calibration(registered)``; with ``calibration.depth`` None the depth is rendered in
+    the colour grid. noise / keypoint_noise: see ``sid.synthetic.noise`` (``DepthNoise.exact()`` and
+    ``KeypointNoise(0, 0)`` for perfect data). sensor_focal_px: focal length (px) of the stereo pair for the noise
+    model when depth is registered (default the D435's 420 px at 848x480). occlusion_margin (m): a keypoint is
+    hidden when another person's surface lies this much nearer at its pixel. self_occlusion_margin (m): a keypoint
+    is self-occluded when its own body's surface lies this much nearer (joints sit 4-11 cm inside limbs and torso
+    seen from the front; 0.15 m catches the face seen from behind, ~0.18 m deep, and the far shoulder of someone in
+    profile, ~0.24 m, and spares the rest); None: never. shaded_color: render the colour image
+    (flat-shaded people on a checkered floor); False gives a plain grey image (faster, for metrics only).
+    group_params: detector parameters used for the groups' exact interest point and area (see ``truth``).
+    """
+
+    def __init__(
+        self,
+        calibration: Calibration | None = None,
+        registered: bool = False,
+        noise: DepthNoise | None = None,
+        keypoint_noise: KeypointNoise | None = None,
+        sensor_focal_px: float = 420.0,
+        occlusion_margin: float = 0.10,
+        self_occlusion_margin: float | None = 0.15,
+        shaded_color: bool = True,
+        fps: float = 30.0,
+        group_params: GroupParams | None = None,
+    ):
+        self.calibration = calibration or d435i_calibration(registered)
+        self.noise = noise if noise is not None else DepthNoise()
+        self.keypoint_noise = keypoint_noise if keypoint_noise is not None else KeypointNoise()
+        self.sensor_focal_px = float(sensor_focal_px)
+        if self.calibration.depth is not None:
+            self.sensor_focal_px = self.calibration.depth.fx
+        self.occlusion_margin = float(occlusion_margin)
+        self.self_occlusion_margin = None if self_occlusion_margin is None else float(self_occlusion_margin)
+        self.shaded_color = shaded_color
+        if not (np.isfinite(fps) and fps > 0):
+            raise ValueError(f"synthetic camera: fps must be positive, got {fps}")
+        self.fps = float(fps)
+        self.group_params = group_params or GroupParams()
+        self._cached: tuple[Scene, _SceneRender] | None = None
+        self._casters: dict[tuple[CameraMount, float | None], tuple[RayCaster, RayCaster | None]] = {}
+
+    @property
+    def depth_intrinsics(self) -> Intrinsics:
+        return self.calibration.depth or self.calibration.color
+
+    def world_to_color(self, mount: CameraMount) -> Extrinsics:
+        """World -> colour-camera optical frame for this mount."""
+        rotation = mount.rotation.T
+        return Extrinsics(rotation, -rotation @ np.array([0.0, 0.0, mount.height]))
+
+    def world_to_depth(self, mount: CameraMount) -> Extrinsics:
+        """World -> depth-camera optical frame (the colour frame when depth is registered)."""
+        to_color = self.world_to_color(mount)
+        if self.calibration.depth is None:
+            return to_color
+        d2c = self.calibration.depth_to_color
+        rotation = d2c.rotation.T @ to_color.rotation
+        return Extrinsics(rotation, d2c.rotation.T @ (to_color.translation - d2c.translation))
+
+    def capture(self, scene: Scene, index: int = 0, seed: int = 0) -> Frame:
+        """Frame ``index`` of ``scene``: noisy depth (depth grid, float32 m), colour image, truth."""
+        render = self._render_scene(scene)
+        rng = np.random.default_rng([seed, index])
+        depth = self.noise.apply(render.depth.depth, self.sensor_focal_px, rng, image_focal_px=self.depth_intrinsics.fx)
+        people = []
+        for i, person in enumerate(scene.people):
+            observed_px, kept = self.keypoint_noise.apply(render.keypoints_px[i], rng)
+            people.append(
+                TruthPerson(
+                    person.id,
+                    person.x,
+                    person.y,
+                    person.theta,
+                    person.height,
+                    render.keypoints_world[i],
+                    render.keypoints_px[i],
+                    render.visible[i],
+                    render.self_occluded[i],
+                    observed_px,
+                    render.visible[i] & kept,
+                    render.boxes[i],
+                )
+            )
+        truth = FrameTruth(scene.name, people, render.groups, scene.mount)
+        return Frame(index, render.color.copy(), depth, self.calibration, index / self.fps, truth)
+
+    def exact_depth(self, scene: Scene) -> Rendering:
+        """The noise-free depth and label images of ``scene`` in the depth grid (labels: person index in
+        ``scene.people``, or ``render.LABEL_*``)."""
+        return self._render_scene(scene).depth
+
+    def _render_scene(self, scene: Scene) -> _SceneRender:
+        if self._cached is not None and self._cached[0] == scene:
+            return self._cached[1]
+        keypoints_world = [skeleton_world(p.x, p.y, p.theta, p.height) for p in scene.people]
+        bodies = [body_capsules(kp, p.height) for kp, p in zip(keypoints_world, scene.people, strict=True)]
+        depth_caster, color_caster = self._ray_casters(scene)
+        depth = depth_caster.render(bodies)
+        color_intr = self.calibration.color
+        if color_caster is not None:
+            color = _paint(color_caster.render(bodies, shading=True), color_caster.background_world)
+        else:
+            color = np.full((color_intr.height, color_intr.width, 3), 128, dtype=np.uint8)
+        to_depth, to_color = depth_caster.world_to_camera, self.world_to_color(scene.mount)
+        keypoints_px, visible, self_occluded, boxes = [], [], [], []
+        for i, kp in enumerate(keypoints_world):
+            px = project(to_color.apply(kp), color_intr)
+            keypoints_px.append(px)
+            by_others, by_self = self._occlusion(kp, i, depth, to_depth)
+            visible.append(_inside(px, color_intr) & ~by_others)
+            self_occluded.append(by_self)
+            boxes.append(_body_box(kp, scene.people[i].height, to_color, color_intr))
+        groups = truth_groups(scene, self.group_params)
+        render = _SceneRender(depth, color, keypoints_world, keypoints_px, visible, self_occluded, boxes, groups)
+        self._cached = (scene, render)
+        return render
+
+    def _ray_casters(self, scene: Scene) -> tuple[RayCaster, RayCaster | None]:
+        """Depth-camera and colour-camera (None without shaded colour) ray casters for the scene's mount and
+        background; kept for the next scenes (variations of a layout share them)."""
+        key = (scene.mount, scene.wall_distance)
+        if key not in self._casters:
+            if len(self._casters) >= _MAX_CACHED_CASTERS:
+                self._casters.clear()
+            background = Background(ground=True, wall_distance=scene.wall_distance)
+            depth = RayCaster(self.depth_intrinsics, self.world_to_depth(scene.mount), background)
+            color = None
+            if self.shaded_color:
+                color = RayCaster(self.calibration.color, self.world_to_color(scene.mount), background)
+            self._casters[key] = (depth, color)
+        return self._casters[key]
+
+    def _occlusion(
+        self, keypoints: np.ndarray, index: int, depth: Rendering, to_depth: Extrinsics
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(17,) bool pair: keypoints behind another person's surface by more than ``occlusion_margin``, and behind
+        their own body's surface by more than ``self_occlusion_margin``, as the depth camera sees them."""
+        points = to_depth.apply(keypoints)
+        px = project(points, self.depth_intrinsics)
+        by_others = np.zeros(NUM_KEYPOINTS, dtype=bool)
+        by_self = np.zeros(NUM_KEYPOINTS, dtype=bool)
+        inside = _inside(px, self.depth_intrinsics)
+        u, v = (np.rint(px[inside]).astype(int)).T
+        label = depth.label[v, u]
+        in_front = points[inside, 2] - depth.depth[v, u]  # how far the surface at the pixel lies before the joint
+        by_others[inside] = (label >= 0) & (label != index) & (in_front > self.occlusion_margin)
+        if self.self_occlusion_margin is not None:
+            by_self[inside] = (label == index) & (in_front > self.self_occlusion_margin)
+        return by_others, by_self
+
+
+def _inside(px: np.ndarray, intr: Intrinsics) -> np.ndarray:
+    with np.errstate(invalid="ignore"):
+        return (
+            np.isfinite(px).all(axis=1)
+            & (px[:, 0] >= -0.5)
+            & (px[:, 0] < intr.width - 0.5)
+            & (px[:, 1] >= -0.5)
+            & (px[:, 1] < intr.height - 0.5)
+        )
+
+
+def _body_box(keypoints: np.ndarray, height: float, to_color: Extrinsics, intr: Intrinsics) -> np.ndarray:
+    """Box (u_min, v_min, u_max, v_max) of the body in colour pixels: keypoints, the top of the head and the
+    floor under the feet, widened by 0.12 m (body radius) at each point's depth; clipped to the image."""
+    centre = keypoints[[15, 16]].mean(axis=0)
+    extra = np.array([[centre[0], centre[1], height], [centre[0], centre[1], 0.0]])
+    points = to_color.apply(np.vstack([keypoints, extra]))
+    points = points[points[:, 2] > 1e-3]
+    if len(points) == 0:
+        return np.array([np.nan] * 4)
+    px = project(points, intr)
+    pad = 0.12 * intr.fx / points[:, 2]
+    box = np.array([(px[:, 0] - pad).min(), px[:, 1].min(), (px[:, 0] + pad).max(), px[:, 1].max()])
+    box[[0, 2]] = np.clip(box[[0, 2]], -0.5, intr.width - 0.5)
+    box[[1, 3]] = np.clip(box[[1, 3]], -0.5, intr.height - 0.5)
+    return box
+
+
+def _paint(rendering: Rendering, background_world: np.ndarray) -> np.ndarray:
+    """RGB uint8 image: people in flat colours shaded by the viewing angle, a checkered floor, a plain wall."""
+    label, shade = rendering.label, rendering.shade
+    image = np.empty(label.shape + (3,), dtype=float)
+    image[label == LABEL_NONE] = _SKY
+    image[label == LABEL_WALL] = _WALL
+    ground = label == LABEL_GROUND
+    cells = np.floor(background_world[ground][:, :2] / _CHECKER_M).astype(int).sum(axis=1) % 2
+    image[ground] = np.where(cells[:, None] == 0, _GROUND_LIGHT, _GROUND_DARK)
+    people = label >= 0
+    colors = PERSON_COLORS[label[people] % len(PERSON_COLORS)]
+    image[people] = colors * (0.35 + 0.65 * shade[people])[:, None]
+    return np.clip(image, 0, 255).astype(np.uint8)
