@@ -85,10 +85,12 @@ class Capsule:
 
 
 def _perpendicular_basis(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    helper = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    x = np.cross(helper, z)
-    x /= np.linalg.norm(x)
-    return x, np.cross(z, x)
+    """Two unit vectors that complete the unit vector z to a right-handed orthonormal basis."""
+    # helper x z with helper = e_x (or e_y when z is close to e_x), written out: np.cross is slow on 3-vectors.
+    x = np.array([0.0, -z[2], z[1]]) if abs(z[0]) < 0.9 else np.array([z[2], 0.0, -z[0]])
+    x /= np.sqrt(x @ x)
+    y = np.array([z[1] * x[2] - z[2] * x[1], z[2] * x[0] - z[0] * x[2], z[0] * x[1] - z[1] * x[0]])
+    return x, y
 
 
 @dataclass(frozen=True)
@@ -265,15 +267,17 @@ class RayCaster:
     ) -> None:
         """Cosine between the surface normal and the viewing ray on the pixels where shape ``number`` is nearest."""
         u0, u1, v0, v1 = window
-        mine = nearest[v0:v1, u0:u1] == number
-        if not mine.any():
+        rows, cols = np.nonzero(nearest[v0:v1, u0:u1] == number)
+        if len(rows) == 0:
             return
-        inverse, origin, d0, d1, d2 = self._unit_rays(shape, window)
-        t = depth[v0:v1, u0:u1][mine]
-        q = origin + t[:, None] * np.stack([d0[mine], d1[mine], d2[mine]], axis=1)  # unit-space hit points
+        rows += v0
+        cols += u0
+        ray = np.column_stack([self._ray_x[cols], self._ray_y[rows], np.ones(len(rows))])
+        inverse = np.linalg.inv(shape.axes)
+        q = (ray * depth[rows, cols][:, None] - shape.centre) @ inverse.T  # unit-space hit points
         q[:, 2] -= np.clip(q[:, 2], -shape.half_length, shape.half_length)  # unit-space normal
         normal = q @ inverse  # camera-frame normal (inverse^T n, as rows)
-        rx, ry = self._ray_x[None, u0:u1], self._ray_y[v0:v1, None]
-        ray = np.stack(np.broadcast_arrays(rx, ry, 1.0), axis=-1)[mine]
-        cosine = -np.sum(normal * ray, axis=1) / (np.linalg.norm(normal, axis=1) * np.linalg.norm(ray, axis=1))
-        shade[v0:v1, u0:u1][mine] = np.clip(cosine, 0.0, 1.0)
+        cosine = -np.einsum("ij,ij->i", normal, ray) / np.sqrt(
+            np.einsum("ij,ij->i", normal, normal) * np.einsum("ij,ij->i", ray, ray)
+        )
+        shade[rows, cols] = np.clip(cosine, 0.0, 1.0)

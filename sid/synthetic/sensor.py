@@ -94,6 +94,15 @@ class _SceneRender:
     groups: list[TruthGroup]
 
 
+@dataclass
+class _Views:
+    """The cameras' ray casters for one mount and background, and the colour image of the empty scene."""
+
+    depth: RayCaster
+    color: RayCaster | None
+    backdrop: np.ndarray | None
+
+
 # Flat colours (RGB) of the first people; more people cycle through them.
 PERSON_COLORS = np.array(
     [[220, 60, 50], [50, 110, 220], [40, 170, 80], [230, 160, 30], [150, 70, 200], [30, 180, 190]], dtype=float
@@ -102,7 +111,7 @@ _SKY = np.array([200, 215, 230], dtype=float)
 _WALL = np.array([215, 205, 185], dtype=float)
 _GROUND_LIGHT, _GROUND_DARK = np.array([150, 150, 150], dtype=float), np.array([115, 115, 115], dtype=float)
 _CHECKER_M = 0.5  # side of the ground's checkerboard squares
-_MAX_CACHED_CASTERS = 8  # ray casters (mount, background) kept between scenes
+_MAX_CACHED_VIEWS = 8  # ray casters (mount, background) kept between scenes
 
 
 class SyntheticCamera:
@@ -147,7 +156,7 @@ class SyntheticCamera:
         self.fps = float(fps)
         self.group_params = group_params or GroupParams()
         self._cached: tuple[Scene, _SceneRender] | None = None
-        self._casters: dict[tuple[CameraMount, float | None], tuple[RayCaster, RayCaster | None]] = {}
+        self._views: dict[tuple[CameraMount, float | None], _Views] = {}
 
     @property
     def depth_intrinsics(self) -> Intrinsics:
@@ -204,14 +213,14 @@ class SyntheticCamera:
             return self._cached[1]
         keypoints_world = [skeleton_world(p.x, p.y, p.theta, p.height) for p in scene.people]
         bodies = [body_capsules(kp, p.height) for kp, p in zip(keypoints_world, scene.people, strict=True)]
-        depth_caster, color_caster = self._ray_casters(scene)
-        depth = depth_caster.render(bodies)
+        views = self._cameras(scene)
+        depth = views.depth.render(bodies)
         color_intr = self.calibration.color
-        if color_caster is not None:
-            color = _paint(color_caster.render(bodies, shading=True), color_caster.background_world)
+        if views.color is not None:
+            color = _paint(views.color.render(bodies, shading=True), views.backdrop)
         else:
             color = np.full((color_intr.height, color_intr.width, 3), 128, dtype=np.uint8)
-        to_depth, to_color = depth_caster.world_to_camera, self.world_to_color(scene.mount)
+        to_depth, to_color = views.depth.world_to_camera, self.world_to_color(scene.mount)
         keypoints_px, visible, self_occluded, boxes = [], [], [], []
         for i, kp in enumerate(keypoints_world):
             px = project(to_color.apply(kp), color_intr)
@@ -225,20 +234,21 @@ class SyntheticCamera:
         self._cached = (scene, render)
         return render
 
-    def _ray_casters(self, scene: Scene) -> tuple[RayCaster, RayCaster | None]:
-        """Depth-camera and colour-camera (None without shaded colour) ray casters for the scene's mount and
-        background; kept for the next scenes (variations of a layout share them)."""
+    def _cameras(self, scene: Scene) -> _Views:
+        """Ray casters (and the painted background) for the scene's mount and wall, kept for the next scenes
+        (variations of a layout share them)."""
         key = (scene.mount, scene.wall_distance)
-        if key not in self._casters:
-            if len(self._casters) >= _MAX_CACHED_CASTERS:
-                self._casters.clear()
+        if key not in self._views:
+            if len(self._views) >= _MAX_CACHED_VIEWS:
+                self._views.clear()
             background = Background(ground=True, wall_distance=scene.wall_distance)
             depth = RayCaster(self.depth_intrinsics, self.world_to_depth(scene.mount), background)
-            color = None
+            color, backdrop = None, None
             if self.shaded_color:
                 color = RayCaster(self.calibration.color, self.world_to_color(scene.mount), background)
-            self._casters[key] = (depth, color)
-        return self._casters[key]
+                backdrop = _backdrop(color.render([], shading=True), color.background_world)
+            self._views[key] = _Views(depth, color, backdrop)
+        return self._views[key]
 
     def _occlusion(
         self, keypoints: np.ndarray, index: int, depth: Rendering, to_depth: Extrinsics
@@ -287,16 +297,23 @@ def _body_box(keypoints: np.ndarray, height: float, to_color: Extrinsics, intr: 
     return box
 
 
-def _paint(rendering: Rendering, background_world: np.ndarray) -> np.ndarray:
-    """RGB uint8 image: people in flat colours shaded by the viewing angle, a checkered floor, a plain wall."""
-    label, shade = rendering.label, rendering.shade
-    image = np.empty(label.shape + (3,), dtype=float)
+def _backdrop(rendering: Rendering, background_world: np.ndarray) -> np.ndarray:
+    """(H, W, 3) uint8 RGB of the empty scene: a checkered floor, a plain wall, the sky."""
+    label = rendering.label
+    image = np.empty(label.shape + (3,), dtype=np.uint8)
     image[label == LABEL_NONE] = _SKY
     image[label == LABEL_WALL] = _WALL
     ground = label == LABEL_GROUND
     cells = np.floor(background_world[ground][:, :2] / _CHECKER_M).astype(int).sum(axis=1) % 2
     image[ground] = np.where(cells[:, None] == 0, _GROUND_LIGHT, _GROUND_DARK)
+    return image
+
+
+def _paint(rendering: Rendering, backdrop: np.ndarray) -> np.ndarray:
+    """RGB uint8 image: people in flat colours shaded by the viewing angle, in front of the backdrop."""
+    label, shade = rendering.label, rendering.shade
+    image = backdrop.copy()
     people = label >= 0
     colors = PERSON_COLORS[label[people] % len(PERSON_COLORS)]
-    image[people] = colors * (0.35 + 0.65 * shade[people])[:, None]
-    return np.clip(image, 0, 255).astype(np.uint8)
+    image[people] = np.clip(colors * (0.35 + 0.65 * shade[people])[:, None], 0, 255).astype(np.uint8)
+    return image
