@@ -96,16 +96,40 @@ def test_scene_files_round_trip(tmp_path: Path) -> None:
     assert Scene.from_file(yaml_path) == scene
 
 
-def test_scenario_style_people_and_defaults(tmp_path: Path) -> None:
-    path = tmp_path / "scenario.yaml"
-    path.write_text("grid: {}\nrobot: {}\npeople:\n  - {x: 2.0, y: 0.5, yaw: 3.0}\n  - {x: 2.0, y: -0.5, yaw: -3.0}\n")
+def test_yaw_defaults_and_people_records(tmp_path: Path) -> None:
+    path = tmp_path / "people.yaml"
+    path.write_text("people:\n  - {x: 2.0, y: 0.5, yaw: 3.0}\n  - {x: 2.0, y: -0.5, yaw: -3.0}\n")
     scene = Scene.from_file(path)
     assert [p.id for p in scene.people] == [0, 1] and scene.people[0].theta == 3.0
-    assert scene.groups == () and scene.mount.height == 0.9 and scene.name == "scenario"
+    assert scene.groups == () and scene.mount.height == 0.9 and scene.name == "people"
     from_people = Scene.from_people("p", [Person(5, 2.0, 0.0, 0.0)])
     assert from_people.people[0].id == 5
     with pytest.raises(ValueError, match="theta is None"):
         Scene.from_people("p", [Person(5, 2.0, 0.0, None)])
+
+
+def test_scenario_files_are_seen_from_the_robot_start(tmp_path: Path) -> None:
+    scenario = {
+        "name": "turned",
+        "map": {"resolution": 0.1, "origin": [-5.0, -5.0], "size": [10.0, 10.0]},
+        "people": [{"id": 7, "x": 1.0, "y": 3.0, "theta": 0.0}, {"id": 8, "x": 1.0, "y": 4.0, "theta": np.pi}],
+        "robot": {"start": [1.0, 1.0, np.pi / 2], "goal": [1.0, -1.0, 0.0]},
+    }
+    path = tmp_path / "scenario.json"
+    path.write_text(json.dumps(scenario))
+    scene = Scene.from_file(path)
+    assert scene.name == "turned" and [p.id for p in scene.people] == [7, 8]
+    # The robot at (1, 1) looks along +y: person 7 is 2 m straight ahead, facing the robot's right (-pi/2).
+    assert (scene.people[0].x, scene.people[0].y) == pytest.approx((2.0, 0.0))
+    assert scene.people[0].theta == pytest.approx(-np.pi / 2)
+    assert scene.wall_distance == pytest.approx(5.0)
+    scenario["people"][0].pop("theta")
+    path.write_text(json.dumps(scenario))
+    with pytest.raises(ValueError, match="person 7 has no facing"):
+        Scene.from_file(path)
+    examples = Path(__file__).resolve().parents[1] / "examples" / "conversation.json"
+    if examples.is_file():  # the repository's example scenario renders as is (person 4 stands 6 m away)
+        assert len(Scene.from_file(examples).people) == 4
 
 
 @pytest.mark.parametrize(

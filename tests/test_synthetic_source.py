@@ -12,7 +12,7 @@ from sid.align import depth_at_color_pixels
 from sid.camera import Calibration, deproject, project
 from sid.frame import Frame
 from sid.keypoints import KP
-from sid.sources import SourceError
+from sid.sources import SourceError, open_source
 from sid.sources.synthetic import SyntheticSource, scene_from_spec, synthetic_source
 from sid.synthetic.layouts import layout
 from sid.synthetic.noise import DepthNoise, KeypointNoise
@@ -173,6 +173,10 @@ def test_specs_scenarios_and_errors(tmp_path: Path) -> None:
     bad.write_text("{}")
     with pytest.raises(SourceError, match="people"):
         synthetic_source(f"synthetic:{bad}")
+    example = Path(__file__).resolve().parents[1] / "examples" / "conversation.json"
+    if example.is_file():  # a costmap scenario file, through open_source as `sid detect` does
+        frame = next(iter(open_source(f"synthetic:{example}", frames=1)))
+        assert frame.truth.scene == "conversation" and len(frame.truth.people) == 4
     with pytest.raises(ValueError, match="frames"):
         SyntheticSource("S1", frames=-1)
     with pytest.raises(TypeError, match="Scene"):

@@ -49,11 +49,11 @@ def scene_from_spec(spec: str) -> Scene:
 class SyntheticSource:
     """Iterable of ``frames`` synthetic ``Frame``s of one scene, ground truth in ``frame.truth``.
 
-    scene_or_spec: a ``Scene``, anything with a ``people`` list of ``sid.people.Person`` (a costmap Scenario), or
-    a spec string (see ``scene_from_spec``). seed: noise seed. noise / keypoint_noise: depth and 2D keypoint noise
-    (defaults: ``DepthNoise()``, ``KeypointNoise()``; ``DepthNoise.exact()`` and ``KeypointNoise(0, 0)`` for perfect
-    data). Further keyword options go to ``SyntheticCamera`` (``registered``, ``calibration``, ``shaded_color``,
-    ``occlusion_margin``, ``fps``, ``group_params``).
+    scene_or_spec: a ``Scene``, a ``costmap.scenario.Scenario`` (seen from the robot's start pose, see
+    ``Scene.from_scenario``) or a spec string (see ``scene_from_spec``). seed: noise seed. noise / keypoint_noise:
+    depth and 2D keypoint noise (defaults: ``DepthNoise()``, ``KeypointNoise()``; ``DepthNoise.exact()`` and
+    ``KeypointNoise(0, 0)`` for perfect data). Further keyword options go to ``SyntheticCamera`` (``registered``,
+    ``calibration``, ``shaded_color``, ``occlusion_margin``, ``self_occlusion_margin``, ``fps``, ``group_params``).
     """
 
     def __init__(
@@ -69,8 +69,8 @@ class SyntheticSource:
             self.scene = scene_or_spec
         elif isinstance(scene_or_spec, (str, Path)):
             self.scene = scene_from_spec(str(scene_or_spec))
-        elif isinstance(getattr(scene_or_spec, "people", None), list):
-            self.scene = Scene.from_people(str(getattr(scene_or_spec, "name", "scenario")), scene_or_spec.people)
+        elif hasattr(scene_or_spec, "robot") and isinstance(getattr(scene_or_spec, "people", None), list):
+            self.scene = Scene.from_scenario(scene_or_spec)
         else:
             raise TypeError(
                 f"synthetic source: expected a Scene, a spec string or a scenario, got {type(scene_or_spec).__name__}"

@@ -4,8 +4,9 @@ metres and radians.
 
 Scene files (JSON or YAML) hold ``{"name": ..., "people": [{"x", "y", "theta"[, "id", "height"]}, ...],
 "groups": [[id, ...], ...], "camera": {"height": 0.9, "tilt": 0.0}, "wall_distance": 5.0}``; only ``people`` is
-required. A costmap scenario file works too: its ``people`` list is read the same way (``yaw`` is accepted for
-``theta``), everything else in it is ignored.
+required (``yaw`` is accepted for ``theta``). A costmap scenario file (it has a ``robot`` section) works too: it is
+read by ``costmap.scenario`` and its people are seen from the robot's start pose (see ``Scene.from_scenario``);
+its obstacles are not rendered.
 """
 
 from __future__ import annotations
@@ -95,13 +96,17 @@ class Scene:
         except (json.JSONDecodeError, yaml.YAMLError) as exc:
             raise ValueError(f"scene {path}: not valid {path.suffix.lstrip('.').upper() or 'JSON'} ({exc})") from None
         try:
-            return cls.from_dict(data, default_name=path.stem)
+            return cls.from_dict(data, default_name=path.stem, base_dir=path.parent)
         except ValueError as exc:
             raise ValueError(f"scene {path}: {exc}") from None
 
     @classmethod
-    def from_dict(cls, data: Any, default_name: str = "scene") -> Scene:
+    def from_dict(cls, data: Any, default_name: str = "scene", base_dir: Path | None = None) -> Scene:
         """Build a scene from the parsed file content (see the module docstring)."""
+        if isinstance(data, dict) and "robot" in data:
+            from costmap.scenario import scenario_from_dict  # costmap builds on sid: import it only when needed
+
+            return cls.from_scenario(scenario_from_dict(data, base_dir, default_name))
         if not isinstance(data, dict) or not isinstance(data.get("people"), list) or not data["people"]:
             raise ValueError('expected an object with a non-empty "people" list')
         people = tuple(_person(entry, index) for index, entry in enumerate(data["people"]))
@@ -127,6 +132,31 @@ class Scene:
         if unknown:
             raise ValueError(f"scene {name}: people {unknown} have no facing direction (theta is None)")
         return cls(name, tuple(ScenePerson(p.id, p.x, p.y, float(p.theta)) for p in people), groups, **options)
+
+    @classmethod
+    def from_scenario(cls, scenario: Any, mount: CameraMount | None = None) -> Scene:
+        """The people of a ``costmap.scenario.Scenario`` as the robot's camera sees them from its start pose.
+
+        Positions and facings are moved from the map frame into the frame of the robot's start pose (x along its
+        heading), the camera's world frame. No groups are declared; a wall stands 1 m behind the farthest person
+        (at least 5 m away) so that people have a background.
+        """
+        x0, y0, yaw = scenario.robot.start
+        c, s = np.cos(yaw), np.sin(yaw)
+        people = []
+        for person in scenario.people:
+            if person.theta is None:
+                raise ValueError(f"scenario {scenario.name}: person {person.id} has no facing direction (theta)")
+            dx, dy = person.x - x0, person.y - y0
+            people.append(
+                ScenePerson(
+                    person.id, c * dx + s * dy, -s * dx + c * dy, float(np.angle(np.exp(1j * (person.theta - yaw))))
+                )
+            )
+        if not people:
+            raise ValueError(f"scenario {scenario.name}: no people to render")
+        wall = max(5.0, max(p.x for p in people) + 1.0)
+        return cls(scenario.name, tuple(people), (), mount or CameraMount(), wall)
 
     def to_dict(self) -> dict[str, Any]:
         return {
