@@ -19,10 +19,12 @@ from costmap.grid import INSCRIBED, NO_INFORMATION
 CombinationMethod = Literal["max", "overwrite", "true_overwrite", "addition"]
 
 
-def update_with_max(master: np.ndarray, layer: np.ndarray) -> None:
-    known = layer != NO_INFORMATION
-    take = known & ((master == NO_INFORMATION) | (layer > master))
-    master[take] = layer[take]
+def update_with_max(master: np.ndarray, layer: np.ndarray, no_opinion: int = NO_INFORMATION) -> None:
+    """Nav2's max; layer cells equal to ``no_opinion`` (unknown by default) leave the master untouched."""
+    master_unknown = master == NO_INFORMATION
+    larger = np.maximum(master, layer)
+    np.copyto(larger, layer, where=master_unknown)
+    np.copyto(master, larger, where=layer != no_opinion)
 
 
 def update_with_overwrite(master: np.ndarray, layer: np.ndarray) -> None:

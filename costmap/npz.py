@@ -1,0 +1,68 @@
+"""Exact costmap archives (.npz): the combined uint8 grid, each layer's grid, resolution and origin."""
+
+from __future__ import annotations
+
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from costmap.grid import Costmap2D, GridSpec
+from costmap.layered import LayeredCostmap
+
+
+@dataclass
+class SavedCostmap:
+    """What a .npz archive holds: the combined costmap and each layer's grid by name (rows, cols), row 0 = lowest y."""
+
+    master: Costmap2D
+    layers: dict[str, np.ndarray]
+
+    @property
+    def spec(self) -> GridSpec:
+        return self.master.spec
+
+
+def save_npz(path: str | Path, layered: LayeredCostmap) -> Path:
+    """Write ``costmap`` (combined), ``layer_<name>`` grids, ``layer_names``, ``resolution`` and ``origin`` [x, y]."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    spec = layered.spec
+    layers = layered.layers
+    np.savez_compressed(
+        path,
+        costmap=layered.master.costs,
+        layer_names=np.array(list(layers)),
+        resolution=np.float64(spec.resolution),
+        origin=np.array([spec.origin_x, spec.origin_y]),
+        **{f"layer_{name}": grid for name, grid in layers.items()},
+    )
+    return path
+
+
+def load_npz(path: str | Path) -> SavedCostmap:
+    """Read an archive written by ``save_npz``; a missing key or a wrong shape names the file and the key."""
+    path = Path(path)
+    try:
+        archive = np.load(path, allow_pickle=False)
+    except (OSError, ValueError, zipfile.BadZipFile) as exc:
+        raise ValueError(f"{path}: cannot read costmap archive ({exc})") from exc
+    with archive:
+        missing = [k for k in ("costmap", "layer_names", "resolution", "origin") if k not in archive]
+        if missing:
+            raise ValueError(f"{path}: not a costmap archive, missing '{missing[0]}'")
+        costs = archive["costmap"]
+        origin = archive["origin"]
+        if costs.ndim != 2 or origin.shape != (2,):
+            raise ValueError(f"{path}: 'costmap' must be 2-D and 'origin' [x, y]")
+        rows, cols = costs.shape
+        spec = GridSpec(float(archive["resolution"]), float(origin[0]), float(origin[1]), cols, rows)
+        master = Costmap2D(spec, costs)
+        layers = {}
+        for name in archive["layer_names"].tolist():
+            key = f"layer_{name}"
+            if key not in archive or archive[key].shape != spec.shape:
+                raise ValueError(f"{path}: layer '{name}' is missing or not of shape {spec.shape}")
+            layers[name] = archive[key]
+    return SavedCostmap(master, layers)

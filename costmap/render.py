@@ -1,0 +1,215 @@
+"""Pictures of costmaps (OpenCV, BGR uint8): costs, walls, people with facing arrows, group zones, a colour scale.
+
+Image layout: world x to the right, world y up; the map sits at (MARGIN_LEFT, MARGIN_TOP) with ``scale`` pixels
+per cell, axes in metres below and left of it, the colour scale to its right. ``world_to_image`` maps world
+points to pixel coordinates of that layout so other modules (the planner) can draw on top.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import cv2
+import numpy as np
+
+from costmap.grid import INSCRIBED, LETHAL, MAX_NON_OBSTACLE, NO_INFORMATION, Costmap2D, GridSpec
+from costmap.layered import LayeredCostmap
+from costmap.scan import LaserScan
+from costmap.scenario import RobotSpec
+from costmap.social import SocialParams, group_zone_polygon
+from sid.groups import Group
+from sid.people import Person
+
+MARGIN_LEFT, MARGIN_TOP, MARGIN_BOTTOM, PANEL_WIDTH, PANEL_HEIGHT = 56, 40, 44, 190, 450
+FONT = cv2.FONT_HERSHEY_SIMPLEX
+TEXT = (40, 40, 40)
+PERSON = (200, 110, 20)  # BGR: blue
+ZONE = (40, 150, 0)  # green
+START = (60, 140, 0)
+GOAL = (30, 30, 220)  # red
+SCAN = (60, 60, 230)
+INSCRIBED_COLOUR = (200, 140, 110)  # RGB (110, 140, 200), steel blue
+UNKNOWN_COLOUR = (205, 205, 205)  # map_saver's unknown grey
+# Graded costs 1..252: ColorBrewer YlOrBr anchors (RGB), light to dark, clear of black walls and grey unknown.
+_ANCHORS = np.array([[1, 255, 247, 188], [80, 254, 196, 79], [160, 236, 112, 20], [252, 140, 45, 4]], dtype=float)
+
+
+def _cost_lut() -> np.ndarray:
+    lut = np.zeros((256, 3), dtype=np.uint8)
+    lut[0] = (255, 255, 255)
+    graded = np.arange(1, MAX_NON_OBSTACLE + 1)
+    for channel in range(3):  # RGB anchors -> BGR table
+        lut[1 : MAX_NON_OBSTACLE + 1, 2 - channel] = np.interp(graded, _ANCHORS[:, 0], _ANCHORS[:, 1 + channel])
+    lut[INSCRIBED], lut[LETHAL], lut[NO_INFORMATION] = INSCRIBED_COLOUR, (0, 0, 0), UNKNOWN_COLOUR
+    return lut
+
+
+COST_COLOURS = _cost_lut()
+
+
+def default_scale(spec: GridSpec, target_width: int = 800) -> int:
+    """Pixels per cell for a map about ``target_width`` pixels wide (at least 1)."""
+    return max(1, round(target_width / spec.width))
+
+
+def world_to_image(xy: np.ndarray, spec: GridSpec, scale: int) -> np.ndarray:
+    """World points (N, 2) -> pixel coordinates (N, 2) as (u right, v down), float, in ``render_costmap``'s layout."""
+    m = spec.world_to_map(xy)
+    return np.stack([MARGIN_LEFT + m[:, 0] * scale, MARGIN_TOP + (spec.height - m[:, 1]) * scale], axis=1)
+
+
+def _px(points: np.ndarray, spec: GridSpec, scale: int) -> np.ndarray:
+    """Integer pixel coordinates with 4 fractional bits, for OpenCV's ``shift=4`` drawing."""
+    return np.rint(world_to_image(points, spec, scale) * 16).astype(np.int32)
+
+
+def _text(img: np.ndarray, text: str, org: tuple[int, int], size: float = 0.45, colour=TEXT, thick: int = 1) -> None:
+    cv2.putText(img, text, org, FONT, size, colour, thick, cv2.LINE_AA)
+
+
+def _axes(img: np.ndarray, spec: GridSpec, scale: int) -> None:
+    x0, y0, x1, y1 = spec.bounds
+    step = 1.0 if max(x1 - x0, y1 - y0) <= 20 else 5.0
+    h_px = spec.height * scale
+    for x in np.arange(np.ceil(x0 / step) * step, x1 + 1e-9, step):
+        u = int(world_to_image([[x, y0]], spec, scale)[0, 0])
+        cv2.line(img, (u, MARGIN_TOP + h_px), (u, MARGIN_TOP + h_px + 5), TEXT, 1)
+        _text(img, f"{x:g}", (u - 8, MARGIN_TOP + h_px + 20), 0.4)
+    for y in np.arange(np.ceil(y0 / step) * step, y1 + 1e-9, step):
+        v = int(world_to_image([[x0, y]], spec, scale)[0, 1])
+        cv2.line(img, (MARGIN_LEFT - 5, v), (MARGIN_LEFT, v), TEXT, 1)
+        _text(img, f"{y:g}", (MARGIN_LEFT - 34, v + 5), 0.4)
+    _text(img, "x (m)", (MARGIN_LEFT + spec.width * scale // 2 - 20, MARGIN_TOP + h_px + 38), 0.45)
+    _text(img, "y (m)", (4, MARGIN_TOP - 8), 0.45)
+
+
+def _panel(img: np.ndarray, spec: GridSpec, scale: int) -> None:
+    """The colour scale (0..252 graded, then the three special values) and a legend, right of the map."""
+    left = MARGIN_LEFT + spec.width * scale + 22
+    top, height, width = MARGIN_TOP + 10, 200, 22
+    values = np.linspace(MAX_NON_OBSTACLE, 0, height).round().astype(np.uint8)
+    img[top : top + height, left : left + width] = COST_COLOURS[values][:, None, :]
+    cv2.rectangle(img, (left, top), (left + width, top + height), TEXT, 1)
+    _text(img, "cost", (left, top - 6), 0.45)
+    for value in (0, 50, 100, 150, 200, 252):
+        v = top + int(round((MAX_NON_OBSTACLE - value) / MAX_NON_OBSTACLE * (height - 1)))
+        cv2.line(img, (left + width, v), (left + width + 4, v), TEXT, 1)
+        _text(img, str(value), (left + width + 7, v + 4), 0.4)
+    y = top + height + 24
+    for value, label in ((INSCRIBED, "253 inscribed"), (LETHAL, "254 lethal"), (NO_INFORMATION, "255 unknown")):
+        cv2.rectangle(img, (left, y - 11), (left + width, y + 3), tuple(int(c) for c in COST_COLOURS[value]), -1)
+        cv2.rectangle(img, (left, y - 11), (left + width, y + 3), TEXT, 1)
+        _text(img, label, (left + width + 7, y), 0.4)
+        y += 22
+    y += 8
+    cv2.circle(img, (left + 11, y - 4), 6, PERSON, -1, cv2.LINE_AA)
+    cv2.arrowedLine(img, (left + 11, y - 4), (left + 26, y - 4), PERSON, 2, cv2.LINE_AA, tipLength=0.4)
+    _text(img, "person, facing", (left + 34, y), 0.4)
+    y += 22
+    cv2.rectangle(img, (left + 2, y - 10), (left + 20, y + 2), ZONE, 2)
+    _text(img, "group zone", (left + 34, y), 0.4)
+    y += 22
+    cv2.circle(img, (left + 11, y - 4), 2, SCAN, -1)
+    _text(img, "LiDAR hits", (left + 34, y), 0.4)
+    y += 22
+    cv2.circle(img, (left + 11, y - 4), 6, START, 2, cv2.LINE_AA)
+    _text(img, "robot start", (left + 34, y), 0.4)
+    y += 22
+    cv2.drawMarker(img, (left + 11, y - 4), GOAL, cv2.MARKER_TILTED_CROSS, 12, 2, cv2.LINE_AA)
+    _text(img, "goal", (left + 34, y), 0.4)
+
+
+def _draw_people(img: np.ndarray, spec: GridSpec, scale: int, people: Sequence[Person], body_radius: float) -> None:
+    px_per_m = scale / spec.resolution
+    radius = max(3, int(round(body_radius * px_per_m)))
+    for p in people:
+        centre = _px([[p.x, p.y]], spec, scale)[0]
+        cv2.circle(img, tuple(centre), radius * 16, PERSON, -1, cv2.LINE_AA, shift=4)
+        cv2.circle(img, tuple(centre), radius * 16, (255, 255, 255), 1, cv2.LINE_AA, shift=4)
+        if p.theta is not None:
+            tip = _px([[p.x + 0.6 * np.cos(p.theta), p.y + 0.6 * np.sin(p.theta)]], spec, scale)[0]
+            cv2.arrowedLine(img, tuple(centre), tuple(tip), PERSON, 2, cv2.LINE_AA, shift=4, tipLength=0.3)
+        label = str(p.id) if p.theta is not None else f"{p.id}?"
+        u, v = (centre // 16).tolist()
+        _text(img, label, (u + radius + 2, v - radius - 2), 0.4, PERSON, 1)
+
+
+def _draw_groups(img, spec, scale, groups: Sequence[Group], people: Sequence[Person], margin: float) -> None:
+    by_id = {p.id: p for p in people}
+    for group in groups:
+        polygon = group_zone_polygon(group, by_id, margin)
+        ring = _px(np.asarray(polygon.exterior.coords), spec, scale)
+        cv2.polylines(img, [ring], True, ZONE, 2, cv2.LINE_AA, shift=4)
+        zone = np.asarray(group.zone, dtype=float).reshape(-1, 2)
+        if len(zone) >= 2:
+            cv2.polylines(img, [_px(zone, spec, scale)], True, ZONE, 1, cv2.LINE_AA, shift=4)
+        centre = (_px([group.interest_point], spec, scale)[0] // 16).tolist()
+        cv2.drawMarker(img, tuple(centre), ZONE, cv2.MARKER_CROSS, 10, 2, cv2.LINE_AA)
+
+
+def _draw_robot(img: np.ndarray, spec: GridSpec, scale: int, robot: RobotSpec) -> None:
+    x, y, yaw = robot.start
+    r = int(round(robot.radius * scale / spec.resolution * 16))
+    centre = _px([[x, y]], spec, scale)[0]
+    nose = _px([[x + robot.radius * np.cos(yaw), y + robot.radius * np.sin(yaw)]], spec, scale)[0]
+    cv2.circle(img, tuple(centre), r, START, 2, cv2.LINE_AA, shift=4)
+    cv2.line(img, tuple(centre), tuple(nose), START, 2, cv2.LINE_AA, shift=4)
+    goal = (_px([robot.goal[:2]], spec, scale)[0] // 16).tolist()
+    cv2.drawMarker(img, tuple(goal), GOAL, cv2.MARKER_TILTED_CROSS, 16, 3, cv2.LINE_AA)
+
+
+def render_costmap(
+    source: LayeredCostmap | Costmap2D,
+    people: Sequence[Person] | None = None,
+    groups: Sequence[Group] | None = None,
+    *,
+    scale: int | None = None,
+    robot: RobotSpec | None = None,
+    scan: LaserScan | None = None,
+    title: str | None = None,
+    body_radius: float | None = None,
+    zone_margin: float | None = None,
+) -> np.ndarray:
+    """A readable BGR picture of a costmap (world y up) with people, group zones, robot task and colour scale.
+
+    With a LayeredCostmap, people, groups, scan, body radius and zone margin default to its own; its combined
+    grid is drawn. ``scale``: pixels per cell (default: a map about 800 px wide).
+    """
+    if isinstance(source, LayeredCostmap):
+        costmap = source.master
+        people = source.people if people is None else people
+        groups = source.groups if groups is None else groups
+        scan = source.scan if scan is None else scan
+        if source.social is not None:
+            body_radius = source.social.body_radius if body_radius is None else body_radius
+        zone_margin = source.params.social.group_margin if zone_margin is None else zone_margin
+    else:
+        costmap = source
+    spec = costmap.spec
+    scale = default_scale(spec) if scale is None else int(scale)
+    if scale < 1:
+        raise ValueError(f"render scale must be >= 1 pixel per cell, got {scale}")
+    people, groups = list(people or []), list(groups or [])
+    body_radius = 0.2 if body_radius is None else body_radius
+    zone_margin = SocialParams().group_margin if zone_margin is None else zone_margin
+
+    w_px, h_px = spec.width * scale, spec.height * scale
+    height = max(MARGIN_TOP + h_px + MARGIN_BOTTOM, PANEL_HEIGHT)
+    img = np.full((height, MARGIN_LEFT + w_px + PANEL_WIDTH, 3), 255, dtype=np.uint8)
+    tiles = COST_COLOURS[np.flipud(costmap.costs)]
+    img[MARGIN_TOP : MARGIN_TOP + h_px, MARGIN_LEFT : MARGIN_LEFT + w_px] = cv2.resize(
+        tiles, (w_px, h_px), interpolation=cv2.INTER_NEAREST
+    )
+    cv2.rectangle(img, (MARGIN_LEFT - 1, MARGIN_TOP - 1), (MARGIN_LEFT + w_px, MARGIN_TOP + h_px), TEXT, 1)
+    if scan is not None:
+        for u, v in (world_to_image(scan.hit_points(), spec, scale)).astype(int):
+            cv2.circle(img, (int(u), int(v)), 1, SCAN, -1)
+    _draw_groups(img, spec, scale, groups, people, zone_margin)
+    _draw_people(img, spec, scale, people, body_radius)
+    if robot is not None:
+        _draw_robot(img, spec, scale, robot)
+    _axes(img, spec, scale)
+    _panel(img, spec, scale)
+    if title:
+        _text(img, title, (MARGIN_LEFT, 26), 0.6, TEXT, 1)
+    return img
