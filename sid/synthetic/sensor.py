@@ -150,6 +150,9 @@ class SyntheticCamera:
             self.sensor_focal_px = self.calibration.depth.fx
         self.occlusion_margin = float(occlusion_margin)
         self.self_occlusion_margin = None if self_occlusion_margin is None else float(self_occlusion_margin)
+        margins = [self.occlusion_margin] + ([] if self.self_occlusion_margin is None else [self.self_occlusion_margin])
+        if not all(np.isfinite(m) and m >= 0 for m in margins):
+            raise ValueError(f"synthetic camera: occlusion margins must be >= 0 metres, got {margins}")
         self.shaded_color = shaded_color
         if not (np.isfinite(fps) and fps > 0):
             raise ValueError(f"synthetic camera: fps must be positive, got {fps}")
