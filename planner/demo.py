@@ -26,10 +26,10 @@ from shapely.geometry import Point
 from costmap.layered import LayeredCostmap, build_costmap
 from costmap.scenario import Scenario, scenario_from_dict
 from costmap.social import group_zone_polygon
-from planner.metrics import result_metrics
-from planner.ompl_planner import DEFAULT_PLANNER, PlanResult, plan
-from planner.problem import DEFAULT_COST_WEIGHT, PlanningProblem
+from planner.ompl_planner import DEFAULT_PLANNER, PlanResult
+from planner.problem import DEFAULT_COST_WEIGHT
 from planner.render import WITH_COLOUR, WITHOUT_COLOUR, PathStyle, add_header, add_table, render_paths
+from planner.scenario_plan import plan_scenario
 from sid.groups import Group, detect_groups
 
 
@@ -117,17 +117,15 @@ def compare_with_without(
     """
     say = progress or (lambda _: None)
     groups = detect_groups(scenario.people, scenario.group_params)
+    social_costs = build_costmap(scenario, social=True, groups=groups).master  # both paths are measured on it
     comparison = Comparison(scenario, groups)
     for step, (key, social) in enumerate((("without", False), ("with", True)), start=1):
-        layered = build_costmap(scenario, social=social, groups=groups if social else [])
-        problem = PlanningProblem.from_scenario(scenario, layered.master, cost_weight)
         say(f"[{step}/2] planning {LABELS[key]} with {planner} ...")
-        result = plan(problem, planner, time_limit=time_limit, seed=seed, max_iterations=max_iterations)
-        say(f"      {result.message} ({result.planning_time_s:.2f} s)")
-        comparison.costmaps[key], comparison.results[key] = layered, result
-    social_costs = comparison.costmaps["with"].master
-    for key, result in comparison.results.items():
-        comparison.metrics[key] = result_metrics(result, scenario.people, groups, social_costs)
+        sp = plan_scenario(
+            scenario, social, planner, time_limit, seed, max_iterations, cost_weight, groups, social_costs
+        )
+        say(f"      {sp.result.message} ({sp.result.planning_time_s:.2f} s)")
+        comparison.costmaps[key], comparison.results[key], comparison.metrics[key] = sp.costmap, sp.result, sp.metrics
     return comparison
 
 
@@ -181,6 +179,7 @@ def run_demo(
     time_limit: float = 5.0,
     seed: int | None = DEMO_SEED,
     max_iterations: int | None = DEMO_ITERATIONS,
+    cost_weight: float = DEFAULT_COST_WEIGHT,
     progress: Callable[[str], None] | None = None,
 ) -> Comparison:
     """Run the comparison (built-in scenario by default) and write ``comparison.png`` and ``metrics.json``
@@ -189,7 +188,7 @@ def run_demo(
     out.mkdir(parents=True, exist_ok=True)
     builtin = scenario is None
     scenario = demo_scenario() if builtin else scenario
-    comparison = compare_with_without(scenario, planner, time_limit, seed, max_iterations, progress=progress)
+    comparison = compare_with_without(scenario, planner, time_limit, seed, max_iterations, cost_weight, progress)
     if not cv2.imwrite(str(out / "comparison.png"), comparison_picture(comparison)):
         raise OSError(f"could not write {out / 'comparison.png'}")
     (out / "metrics.json").write_text(json.dumps(comparison.metrics, indent=2, allow_nan=False) + "\n")

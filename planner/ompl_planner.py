@@ -87,7 +87,7 @@ class PlanResult:
     planning_time_s: float
     solve_time_s: float
     raw_cost: float
-    iterations: int
+    iterations: int  # termination checks passed; ``max_iterations=iterations`` with ``seed`` repeats the run
     seed: int | None
     message: str
     raw_path: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)), repr=False)
@@ -168,15 +168,18 @@ def _solve_ompl(
     planner.setProblemDefinition(pdef)
     planner.setup()
 
+    # ``checks`` counts the termination checks answered "go on", so a rerun capped at that count stops at the same
+    # point. FMT* stops by itself after its samples, which ``max_iterations`` sets (see FMT_SAMPLES_PER_SECOND).
     checks = 0
-    # FMT* stops by itself after its samples, which ``max_iterations`` sets (see FMT_SAMPLES_PER_SECOND).
     cap = math.inf if max_iterations is None or name == "fmtstar" else max_iterations
     deadline = time.perf_counter() + time_limit
 
     def stop() -> bool:
         nonlocal checks
+        if checks >= cap or time.perf_counter() > deadline:
+            return True
         checks += 1
-        return checks > cap or time.perf_counter() > deadline
+        return False
 
     t0 = time.perf_counter()
     planner.solve(ob.PlannerTerminationCondition(stop))

@@ -225,3 +225,10 @@ def test_unseeded_run_reports_the_seed_that_repeats_it(walls):
     first = plan(walls, "rrtstar", time_limit=30.0, max_iterations=200)
     again = plan(walls, "rrtstar", time_limit=30.0, seed=first.seed, max_iterations=200)
     assert first.seed is not None and np.array_equal(first.raw_path, again.raw_path)
+
+
+@pytest.mark.parametrize("name", ["rrtstar", "bitstar"])
+def test_a_timed_run_is_replayed_by_its_seed_and_iteration_count(walls, name):
+    timed = plan(walls, name, time_limit=0.2, seed=21)
+    replay = plan(walls, name, time_limit=30.0, seed=21, max_iterations=timed.iterations)
+    assert timed.success and np.array_equal(timed.raw_path, replay.raw_path)
