@@ -79,6 +79,7 @@ class LayeredCostmap:
     ) -> None:
         self.spec = spec
         self.params = params or CostmapParams()
+        self.body_radius = float(body_radius)
         if static is not None and (static.dtype != np.uint8 or static.shape != spec.shape):
             raise ValueError(f"static layer must be uint8 of shape {spec.shape}, got {static.dtype} {static.shape}")
         self.static = static

@@ -7,7 +7,8 @@ beam's hit. Beams with no return (``inf``) clear out to ``raytrace_max_range`` w
 (Nav2's ``inf_is_valid``) and never mark; invalid beams (``nan``) are ignored.
 
 Lines are traced with a rounded DDA over integer cells (one cell per step along the major axis: the cells of
-Bresenham's algorithm up to tie-breaking), for all beams at once in numpy rather than cell by cell.
+Bresenham's algorithm up to tie-breaking), for all beams at once in numpy rather than cell by cell (line drawing
+in OpenCV or scikit-image draws one line per call, 720 Python calls per scan).
 """
 
 from __future__ import annotations

@@ -180,8 +180,7 @@ def render_costmap(
         people = source.people if people is None else people
         groups = source.groups if groups is None else groups
         scan = source.scan if scan is None else scan
-        if source.social is not None:
-            body_radius = source.social.body_radius if body_radius is None else body_radius
+        body_radius = source.body_radius if body_radius is None else body_radius
         zone_margin = source.params.social.group_margin if zone_margin is None else zone_margin
     else:
         costmap = source

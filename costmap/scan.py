@@ -149,7 +149,8 @@ def simulate_scan(
 ) -> LaserScan:
     """A 360-degree scan from ``pose`` (world x, y, yaw) against walls, boxes, circles and people's bodies.
 
-    Exact ray/segment and ray/circle intersections for all beams at once (no grid marching). People are circles
+    Exact ray/segment and ray/circle intersections for all beams at once (no grid marching), in numpy: a geometry
+    library would build one line object per beam. People are circles
     of ``body_radius`` metres (their cross-section at the scan height). ``static``: a static map whose LETHAL
     cells the beams hit too. Beams that hit nothing within ``range_max`` read ``inf``.
     """

@@ -205,7 +205,9 @@ def _person(value: Any, name: str, index: int) -> Person:
     x, y = _number(data["x"], f"{name}.x"), _number(data["y"], f"{name}.y")
     theta = data.get("theta")
     if theta is not None:
-        theta = _number(theta, f"{name}.theta")
+        if isinstance(theta, bool) or not isinstance(theta, int | float) or not math.isfinite(theta):
+            raise _fail(f"{name}.theta", "a finite number of radians, or null when unknown", theta)
+        theta = float(theta)
     quality = _number(data.get("orientation_quality", 0.0 if theta is None else 1.0), f"{name}.orientation_quality")
     if not 0 <= quality <= 1:
         raise _fail(f"{name}.orientation_quality", "a number in [0, 1]", quality)
