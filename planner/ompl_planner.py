@@ -39,10 +39,11 @@ from planner.validity import check_path, state_validity_checker
 
 ou.setLogLevel(ou.LOG_WARN)  # the default level prints OMPL's debug messages to stdout
 
-FMT_SAMPLES_PER_SECOND = 400
-"""FMT* is not anytime: it plans on a fixed sample set and returns nothing if stopped early. It takes about 1 ms per
-sample with this objective on a 10 x 8 m, 5 cm map (measured: 200 samples 0.20 s, 400 0.42 s, 1000 1.6 s), so
-its sample count follows the time budget, or equals ``max_iterations`` when that is given."""
+FMT_SAMPLES_PER_SECOND = 250
+"""FMT* is not anytime: it plans on a fixed sample set and returns nothing if stopped early. With this objective it
+takes 1.2-1.6 ms per sample on the demo scenario (measured: 100 samples 0.14 s, 300 0.49 s, 600 0.74 s), so its
+sample count follows the time budget with a margin of about two for a busy machine, or equals ``max_iterations``
+when that is given."""
 
 
 def _fmt(si: ob.SpaceInformation, time_limit: float, max_iterations: int | None) -> ob.Planner:
