@@ -109,6 +109,8 @@ class LayeredCostmap:
     def update(self, people: Sequence[Person], groups: Sequence[Group], scan: LaserScan | None = None) -> None:
         """Bring every layer to the current people, groups and (optional) scan, then recombine the master."""
         people = _check_people(people)
+        if scan is not None and not self.spec.contains([scan.pose[:2]])[0]:  # checked before anything changes
+            raise ValueError(f"scan: sensor at ({scan.pose[0]:.2f}, {scan.pose[1]:.2f}) is outside the costmap")
         if self.social is not None:
             self.lidar.clear_discs([(p.x, p.y) for p in self.people], self.people_clear_radius)
         if scan is not None:

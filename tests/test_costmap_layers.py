@@ -322,8 +322,13 @@ def test_something_left_at_a_person_old_position_is_kept_when_the_scan_sees_it()
     assert lethal_near(layered.master.costs, (4.0, 0.0), 0.3) > 0
 
 
-def test_update_rejects_nan_people_and_duplicate_ids():
+def test_update_rejects_nan_people_duplicate_ids_and_a_sensor_off_the_map_before_changing_anything():
     layered = LayeredCostmap(SPEC)
+    layered.update([Person(1, 4.0, 0.0)], [], scan_of([Person(1, 4.0, 0.0)]))
+    before = layered.master.costs.copy()
+    with pytest.raises(ValueError, match="outside the costmap"):
+        layered.update([Person(1, 5.0, 0.0)], [], scan_of([], pose=(20.0, 0.0, 0.0)))
+    np.testing.assert_array_equal(layered.master.costs, before)
     with pytest.raises(ValueError, match="person 3"):
         layered.update([Person(3, np.nan, 0.0)], [])
     with pytest.raises(ValueError, match="twice"):
