@@ -36,7 +36,9 @@ from costmap.scenario import Scenario
 _LOOP_MAX = 20
 
 DEFAULT_COST_WEIGHT = 4.0
-"""w in J = integral of (1 + w c / 252) ds; see the module docstring."""
+"""w in J = integral of (1 + w c / 252) ds; see the module docstring. Measured on the demo scenario (grid planner):
+w = 0.5 still cuts through the conversation, w = 1 goes around it passing 1.11 m from a member, w = 4 keeps every
+path sample beyond Hall's personal distance (1.28 m) for a path 0.9 % longer than with w = 1."""
 
 
 class PlanningError(ValueError):

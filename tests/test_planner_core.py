@@ -232,3 +232,28 @@ def test_a_timed_run_is_replayed_by_its_seed_and_iteration_count(walls, name):
     timed = plan(walls, name, time_limit=0.2, seed=21)
     replay = plan(walls, name, time_limit=30.0, seed=21, max_iterations=timed.iterations)
     assert timed.success and np.array_equal(timed.raw_path, replay.raw_path)
+
+
+@settings(max_examples=12, deadline=None)
+@given(
+    st.lists(st.tuples(st.floats(0.5, 9.5), st.floats(0.5, 7.5), st.floats(0.1, 0.6)), min_size=3, max_size=12),
+    st.tuples(st.floats(0.2, 9.8), st.floats(0.2, 7.8), st.floats(0.2, 9.8), st.floats(0.2, 7.8)),
+    st.sampled_from(["grid", "rrtconnect", "bitstar"]),
+)
+def test_random_maps_give_a_valid_path_or_a_clear_refusal(discs, ends, name):
+    spec = GridSpec.from_size(0.05, (0.0, 0.0), (10.0, 8.0))
+    x, y = spec.cell_centres()
+    lethal = np.zeros(spec.shape, bool)
+    for cx, cy, r in discs:
+        lethal |= np.hypot(x - cx, y - cy) <= r
+    costmap = Costmap2D(spec, inflate(lethal, spec))
+    problem = PlanningProblem(costmap, ends[:2], ends[2:], RADIUS)
+    try:
+        result = plan(problem, name, time_limit=30.0, seed=1, max_iterations=CAPS[name])
+    except PlanningError as exc:
+        assert "in collision" in str(exc) or "separate free regions" in str(exc)
+        return
+    if result.success:
+        assert independent_collisions(costmap, result.path) == 0
+    else:
+        assert len(result.path) == 0 and result.message
