@@ -3,8 +3,9 @@
 Same cost model as the OMPL planners (``planner.problem``): an edge between neighbouring cell centres costs its
 length times (1 + the mean of the two cells' w c / 252), the exact integral of the piecewise-constant cost along
 it. Diagonal steps need all four cells around them plannable, so no edge cuts a corner. scipy's csgraph Dijkstra
-does the search in C; 8-connected paths are about 6 % longer than any-angle ones, hence the shortcut pass
-(``planner.smoothing``), after which this is the yardstick for the sampling planners' cost.
+does the search in C. 8-connected paths are about 6 % longer than any-angle ones, so the facade
+(``planner.ompl_planner.plan``) passes this path through the same smoothing as every planner, whose first step is
+the any-angle shortcut pass; the result is the yardstick for the sampling planners' cost.
 """
 
 from __future__ import annotations
@@ -14,7 +15,6 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from planner.problem import CostField, PlanningError
-from planner.smoothing import dp_shortcut, greedy_shortcut
 
 _MOVES = ((0, 1), (1, 0), (1, 1), (1, -1))  # (drow, dcol); the graph is undirected
 
@@ -63,9 +63,3 @@ def grid_search(field: CostField) -> np.ndarray:
     path = spec.cell_to_world(np.stack(np.unravel_index(flat, node.shape), axis=1))
     path[0], path[-1] = problem.start, problem.goal
     return path
-
-
-def grid_plan(field: CostField) -> tuple[np.ndarray, np.ndarray]:
-    """(any-angle path, raw 8-connected path), both (N, 2) world frame."""
-    raw = grid_search(field)
-    return dp_shortcut(field, greedy_shortcut(field, raw)), raw

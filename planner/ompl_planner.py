@@ -31,7 +31,7 @@ from ompl import geometric as og
 from ompl import util as ou
 from scipy import ndimage
 
-from planner.grid_planner import grid_plan
+from planner.grid_planner import grid_search
 from planner.objective import CostmapObjective
 from planner.problem import CostField, PlanningError, PlanningProblem
 from planner.smoothing import smooth
@@ -227,11 +227,10 @@ def plan(
 
     if name == "grid":
         t_solve = time.perf_counter()
-        raw, _ = grid_plan(field)
-        path, iterations, solve_time = raw, 0, time.perf_counter() - t_solve
+        raw, iterations, solve_time = grid_search(field), 0, time.perf_counter() - t_solve
     else:
         raw, iterations, solve_time = _solve_ompl(field, name, time_limit, max_iterations)
-        path = raw
+    path = raw
     raw_cost = math.inf if path is None else field.path_cost(raw)
     result = PlanResult(name, False, np.zeros((0, 2)), math.inf, 0.0, 0.0, solve_time, raw_cost, iterations, seed, "")
     if path is None:
