@@ -2,7 +2,8 @@
 
 Each run's cost J is divided by the cost of the grid planner's path (Dijkstra + any-angle shortcut + the same
 smoothing) on the same costmap: the reference, as close to the optimum as this project gets deterministically
-(a ratio below 1 means the sampling planner found a slightly better local optimum). Runs use seeds 1..K, so a
+(a ratio below 1 means the sampling planner found a slightly better local optimum). The raw ratio is that of the
+planner's own path before smoothing (for the grid planner: its 8-connected path). Runs use seeds 1..K, so a
 comparison is repeatable up to where time budgets cut the planners.
 """
 
@@ -37,6 +38,7 @@ class Run:
     time_limit: float
     metrics: dict
     cost_ratio: float | None
+    raw_cost_ratio: float | None  # the planner's own path, before smoothing
 
 
 def run_matrix(
@@ -80,7 +82,8 @@ def run_matrix(
         result = plan(problem, name, time_limit=limit, seed=seed)
         metrics = result_metrics(result, scenario.people, groups, layered.master)
         ratio = result.cost / reference_cost if result.success else None
-        out.append(Run(scenario.name, social, name, seed, limit, metrics, ratio))
+        raw_ratio = result.raw_cost / reference_cost if result.success else None
+        out.append(Run(scenario.name, social, name, seed, limit, metrics, ratio, raw_ratio))
     if progress:
         progress(len(jobs), len(jobs), "done")
     return out
@@ -113,6 +116,7 @@ def summarise(runs: Sequence[Run], by_scenario: bool = True) -> list[dict]:
                 "median_time_s": _median([r.metrics["planning_time_s"] for r in members]),
                 "median_cost_ratio": _median(ratios),
                 "worst_cost_ratio": max(ratios) if ratios else None,
+                "median_raw_cost_ratio": _median([r.raw_cost_ratio for r in ok]),
                 "median_intrusion_m": _median([r.metrics["ospace_intrusion_m"] for r in ok]),
                 "crossing_rate": sum(bool(r.metrics["crosses_group"]) for r in ok) / len(ok) if ok else None,
             }
@@ -127,7 +131,7 @@ def _fmt(value: float | None, spec: str) -> str:
 def format_summary(rows: Sequence[dict]) -> str:
     """A plain-text table of ``summarise`` rows."""
     header = ["scenario", "social", "budget", "planner", "runs", "success", "time (med)", "cost/grid", "worst",
-              "in zone (med)", "crosses"]  # fmt: skip
+              "raw/grid", "in zone (med)", "crosses"]  # fmt: skip
     table = [header] + [
         [
             row["scenario"],
@@ -139,6 +143,7 @@ def format_summary(rows: Sequence[dict]) -> str:
             _fmt(row["median_time_s"], ".3f") + " s",
             _fmt(row["median_cost_ratio"], ".3f"),
             _fmt(row["worst_cost_ratio"], ".3f"),
+            _fmt(row["median_raw_cost_ratio"], ".3f"),
             _fmt(row["median_intrusion_m"], ".2f") + " m",
             "-" if row["crossing_rate"] is None else f"{100 * row['crossing_rate']:.0f} %",
         ]
