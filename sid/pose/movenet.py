@@ -92,11 +92,8 @@ class MoveNetMultiPose:
         self.score_threshold = float(score_threshold)
         fixed = model.signature.inputs[0].shape[1:3]
         self._fixed = (fixed[0], fixed[1]) if None not in fixed else None
-        if (
-            self._fixed is not None
-            and size is not None
-            and (tuple(size) if isinstance(size, list) else size) != self._fixed
-        ):
+        requested = tuple(size) if isinstance(size, (list, tuple)) else size
+        if self._fixed is not None and requested is not None and requested != self._fixed:
             raise ValueError(f"movenet: this MultiPose model has a fixed input {self._fixed}, cannot use size {size!r}")
         self.size = MULTIPOSE_LONG_SIDE if size is None else size
         if self._fixed is None:
