@@ -1,0 +1,219 @@
+"""``bench.json`` / ``bench.md``: the machine, the settings, one record per stage; and comparing two reports.
+
+``bench.json`` (format ``sid-bench/1``; keep it stable so successive runs compare)::
+
+    {"format": "sid-bench/1",
+     "machine": {"cpu", "logical_cores", "physical_cores", "usable_cores", "load_average", "platform", "python",
+                 "numpy", "scipy", "scikit-learn", "shapely", "opencv-python-headless", "onnxruntime", "ompl",
+                 "pyrealsense2", "onnxruntime_providers", "commit", "date"},
+     "settings": {"quick", "only", "warmup", "min_runs", "max_runs", "budget_s", "plan_runs"},
+     "stages": {NAME: {"median_ms", "min_ms", "max_ms", "runs", ...optional extras}},
+     "notes": [...], "failures": {NAME: message}}
+
+Optional stage extras: ``paper_ms`` (the paper's Jetson figure for that step), ``ratio`` and ``ratio_to`` (median /
+the median of stage ``ratio_to``), ``cost_ratio`` (planning), and counts that show the stage did its work.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+import subprocess
+from datetime import UTC, datetime
+from importlib import metadata
+from pathlib import Path
+from typing import Any
+
+FORMAT = "sid-bench/1"
+LIBRARIES = ("numpy", "scipy", "scikit-learn", "shapely", "opencv-python-headless", "onnxruntime", "ompl",
+             "pyrealsense2")  # fmt: skip
+FIXED_FIELDS = ("median_ms", "min_ms", "max_ms", "runs")
+PAPER_COLUMN = "paper (Jetson Orin NX, another machine) ms"
+# A change beyond these ratios is flagged by ``format_comparison`` (timings of a busy machine move by ~10 %).
+SLOWER, FASTER = 1.10, 1 / 1.10
+
+
+def _cpu_model() -> str:
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.lower().startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine()
+
+
+def _physical_cores() -> int | None:
+    """Distinct (physical id, core id) pairs of /proc/cpuinfo; None where it is not available."""
+    try:
+        cores, package = set(), "0"
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            key, _, value = line.partition(":")
+            if key.strip() == "physical id":
+                package = value.strip()
+            elif key.strip() == "core id":
+                cores.add((package, value.strip()))
+        return len(cores) or None
+    except OSError:
+        return None
+
+
+def _commit(repo: Path) -> str | None:
+    try:
+        head = subprocess.run(["git", "-C", str(repo), "rev-parse", "--short", "HEAD"], capture_output=True,
+                              text=True, timeout=5, check=True).stdout.strip()  # fmt: skip
+        dirty = subprocess.run(["git", "-C", str(repo), "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True, timeout=5, check=True).stdout.strip()  # fmt: skip
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return head + ("-dirty" if dirty else "")
+
+
+def machine_info(repo: Path) -> dict[str, Any]:
+    """Where the numbers come from: CPU, cores, load, Python and library versions, commit and date (UTC)."""
+    info: dict[str, Any] = {
+        "cpu": _cpu_model(),
+        "logical_cores": os.cpu_count(),
+        "physical_cores": _physical_cores(),
+        "usable_cores": len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count(),
+        "load_average": [round(v, 2) for v in os.getloadavg()] if hasattr(os, "getloadavg") else None,
+        "platform": platform.platform(),
+        "python": platform.python_version(),
+    }
+    for name in LIBRARIES:
+        try:
+            info[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            info[name] = None
+    try:
+        import onnxruntime
+
+        info["onnxruntime_providers"] = onnxruntime.get_available_providers()
+    except ImportError:
+        info["onnxruntime_providers"] = None
+    info["commit"] = _commit(repo)
+    info["date"] = datetime.now(UTC).isoformat(timespec="seconds")
+    return info
+
+
+def build_report(
+    machine: dict[str, Any],
+    settings: dict[str, Any],
+    stages: dict[str, dict[str, Any]],
+    notes: list[str],
+    failures: dict[str, str],
+) -> dict[str, Any]:
+    return {"format": FORMAT, "machine": machine, "settings": settings, "stages": stages, "notes": notes,
+            "failures": failures}  # fmt: skip
+
+
+def load_report(path: str | Path) -> dict[str, Any]:
+    """Read a ``bench.json``; ValueError naming the file and the problem when it is not one."""
+    path = Path(path)
+    try:
+        data = json.loads(path.read_text())
+    except OSError as exc:
+        raise ValueError(f"bench: cannot read {path} ({exc.strerror})") from None
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"bench: {path} is not JSON ({exc})") from None
+    stages = data.get("stages") if isinstance(data, dict) else None
+    if not isinstance(stages, dict):
+        raise ValueError(f'bench: {path} is not a sid bench report (no "stages" object)')
+    for name, stage in stages.items():
+        if not isinstance(stage, dict) or not isinstance(stage.get("median_ms"), int | float):
+            raise ValueError(f'bench: {path}: stage {name!r} has no numeric "median_ms"')
+    return data
+
+
+def _details(stage: dict[str, Any]) -> str:
+    parts = []
+    if "ratio" in stage:
+        parts.append(f"{stage['ratio']:.2f} x {stage['ratio_to']}")
+    for key, value in stage.items():
+        if key in FIXED_FIELDS or key in ("paper_ms", "ratio", "ratio_to"):
+            continue
+        if isinstance(value, float):
+            value = f"{value:.3g}"
+        elif isinstance(value, list):
+            value = "x".join(str(v) for v in value)
+        parts.append(f"{key} {value}")
+    return ", ".join(str(p) for p in parts)
+
+
+def _ms(value: float) -> str:
+    return f"{value:.3f}" if value < 100 else f"{value:.1f}"
+
+
+def markdown(report: dict[str, Any], comparison: str | None = None) -> str:
+    """The report as a markdown page: machine, settings, the stage table with the paper column, notes."""
+    m, s = report["machine"], report["settings"]
+    libraries = ", ".join(f"{name} {m.get(name)}" for name in LIBRARIES if m.get(name))
+    lines = [
+        "# sid bench",
+        "",
+        f"- machine: {m['cpu']}, {m['logical_cores']} logical cores ({m.get('physical_cores')} physical, "
+        f"{m.get('usable_cores')} usable), load average at start {m.get('load_average')}",
+        f"- software: Python {m['python']} on {m['platform']}; {libraries}",
+        f"- commit {m.get('commit')}, {m['date']}",
+        f"- settings: {'--quick' if s['quick'] else 'full run'}"
+        + (f", --only {s['only']}" if s.get("only") else "")
+        + f"; per stage {s['warmup']} warm-up calls, then {s['min_runs']}-{s['max_runs']} timed calls within "
+        f"{s['budget_s']} s; {s['plan_runs']} seed(s) per sampling planner",
+        "",
+        "Times in milliseconds per call: median, minimum and maximum over the timed runs. The paper column is the "
+        "paper's Table 2 on a Jetson Orin NX (another machine, GPU pose model); it is shown where a stage does the "
+        "same step. See docs/benchmarks.md for what each stage measures.",
+        "",
+        f"| stage | median ms | min ms | max ms | runs | {PAPER_COLUMN} | details |",
+        "|---|---:|---:|---:|---:|---:|---|",
+    ]
+    for name, stage in report["stages"].items():
+        paper = stage.get("paper_ms")
+        lines.append(
+            f"| {name} | {_ms(stage['median_ms'])} | {_ms(stage['min_ms'])} | {_ms(stage['max_ms'])} | "
+            f"{stage['runs']} | {'' if paper is None else paper} | {_details(stage)} |"
+        )
+    if report.get("notes"):
+        lines += ["", "## Notes", ""] + [f"- {note}" for note in report["notes"]]
+    if comparison:
+        lines += ["", "## Change against the earlier report", "", "```", comparison, "```"]
+    return "\n".join(lines) + "\n"
+
+
+def write_report(report: dict[str, Any], out_dir: str | Path, comparison: str | None = None) -> tuple[Path, Path]:
+    """Write ``bench.json`` and ``bench.md`` into ``out_dir`` (created if missing); returns their paths."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    json_path, md_path = out / "bench.json", out / "bench.md"
+    json_path.write_text(json.dumps(report, indent=2) + "\n")
+    md_path.write_text(markdown(report, comparison))
+    return json_path, md_path
+
+
+def format_comparison(old: dict[str, Any], new: dict[str, Any]) -> str:
+    """Per stage present in both: old and new median (ms) and new / old, flagged beyond +-10 %; then the stages
+    found in only one of them, and a warning when the two ran on different CPUs."""
+    old_stages, new_stages = old["stages"], new["stages"]
+    common = [name for name in new_stages if name in old_stages]
+    rows = [("stage", "old ms", "new ms", "new/old", "")]
+    for name in common:
+        before, after = old_stages[name]["median_ms"], new_stages[name]["median_ms"]
+        ratio = after / before if before > 0 else float("inf")
+        flag = "slower" if ratio > SLOWER else "faster" if ratio < FASTER else ""
+        rows.append((name, _ms(before), _ms(after), f"{ratio:.2f}", flag))
+    widths = [max(len(r[i]) for r in rows) for i in range(5)]
+    lines = ["  ".join(c.ljust(w) if i == 0 else c.rjust(w) for i, (c, w) in enumerate(zip(r, widths, strict=True)))
+             .rstrip() for r in rows]  # fmt: skip
+    only_old = [n for n in old_stages if n not in new_stages]
+    only_new = [n for n in new_stages if n not in old_stages]
+    if only_old:
+        lines.append("only in the old report: " + ", ".join(only_old))
+    if only_new:
+        lines.append("only in the new report: " + ", ".join(only_new))
+    old_cpu, new_cpu = old.get("machine", {}).get("cpu"), new.get("machine", {}).get("cpu")
+    if old_cpu != new_cpu:
+        lines.append(f"warning: different machines (old: {old_cpu}, new: {new_cpu}); ratios mix machine and code")
+    if not common:
+        lines.append("no stage in common")
+    return "\n".join(lines)
