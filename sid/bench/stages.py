@@ -84,15 +84,16 @@ def record(stats: Stats, **extra: Any) -> dict[str, Any]:
 def grouping_scene(n: int, seed: int = 0) -> list[Person]:
     """``n`` people in conversation circles facing their centre, world frame (metres, radians).
 
-    Up to 6 people stand in one circle (radius 0.4 m for 2, i.e. 0.8 m apart as the paper's S1, 0.69 m for 3,
-    0.8 m for 4-5, 1.0 m for 6); more are split into circles of 4 whose centres lie 6 m apart on a grid, farther
-    than either detector's DBSCAN eps. Positions get 3 cm and facings 3 degrees of seeded Gaussian noise, so that
-    rays cross at distinct points as they do on real estimates (exact rays all meet in one point).
+    Up to 6 people stand in one circle (radius 0.4 m for 2, i.e. 0.8 m apart as the paper's S1; 0.69 m for 3;
+    0.8 m for 4-5; 0.85 m for 6: neighbours 0.8-0.85 m apart); more are split into circles of 4 whose centres lie
+    6 m apart on a grid, farther than either detector's DBSCAN eps. Positions get 3 cm and facings 3 degrees of
+    seeded Gaussian noise, so that rays cross at distinct points as they do on real estimates (exact rays all meet
+    in one point).
     """
     if n < 1:
         raise ValueError(f"bench: a grouping scene needs at least one person, got {n}")
     sizes = [n] if n <= 6 else [4] * (n // 4) + ([n % 4] if n % 4 else [])
-    radius = {1: 0.4, 2: 0.4, 3: 0.69, 4: 0.8, 5: 0.8, 6: 1.0}
+    radius = {1: 0.4, 2: 0.4, 3: 0.69, 4: 0.8, 5: 0.8, 6: 0.85}
     rng = np.random.default_rng(seed)
     people: list[Person] = []
     for k, size in enumerate(sizes):
