@@ -368,7 +368,7 @@ def _pipeline_pose(ctx: Context) -> tuple[Callable, str]:
 
     truth = TruthPose()
     models = [p for p in pose_models(ctx.shared) if p.stem.startswith("yolo")]
-    image, image_name = _pose_image(ctx)
+    image, image_name = _pose_image(ctx) if models else (None, "")
     if not models or not image_name.startswith("five_people"):
         ctx.note("per-frame pipeline: no YOLO-pose model or real image in ../shared, pose = TruthPose (no network)")
         return truth, "TruthPose"
