@@ -61,16 +61,41 @@ def rs_extrinsics(ext: Extrinsics) -> rs.extrinsics:
     return out
 
 
-def calibration_from_profile(profile: rs.pipeline_profile) -> Calibration:
-    """Calibration of a started pipeline: colour and depth intrinsics, depth-to-colour extrinsics, depth scale."""
-    depth = profile.get_stream(rs.stream.depth).as_video_stream_profile()
-    color = profile.get_stream(rs.stream.color).as_video_stream_profile()
+def calibration_from_profiles(
+    depth: rs.video_stream_profile, color: rs.video_stream_profile, depth_scale: float
+) -> Calibration:
+    """Calibration from the depth and colour stream profiles of a device or recording (depth_scale: m per unit)."""
     return Calibration(
         Intrinsics.from_rs(color.get_intrinsics()),
         Intrinsics.from_rs(depth.get_intrinsics()),
         Extrinsics.from_rs(depth.get_extrinsics_to(color)),
-        float(profile.get_device().first_depth_sensor().get_depth_scale()),
+        float(depth_scale),
     )
+
+
+def calibration_from_profile(profile: rs.pipeline_profile) -> Calibration:
+    """Calibration of a started pipeline: colour and depth intrinsics, depth-to-colour extrinsics, depth scale."""
+    return calibration_from_profiles(
+        profile.get_stream(rs.stream.depth).as_video_stream_profile(),
+        profile.get_stream(rs.stream.color).as_video_stream_profile(),
+        profile.get_device().first_depth_sensor().get_depth_scale(),
+    )
+
+
+def make_frameset(frames: list[rs.frame]) -> rs.composite_frame:
+    """Bundle single frames into one frameset (what ``rs.align`` takes), through a librealsense processing block."""
+
+    def bundle(first: rs.frame, source: rs.frame_source) -> None:
+        source.frame_ready(source.allocate_composite_frame(frames))
+
+    block = rs.processing_block(bundle)
+    queue = rs.frame_queue(1, keep_frames=True)
+    block.start(queue)
+    block.invoke(frames[0])
+    ok, frameset = queue.try_wait_for_frame(1000)
+    if not ok:
+        raise RuntimeError("librealsense did not bundle the frames into a frameset")
+    return frameset.as_frameset()
 
 
 @dataclass

@@ -1,6 +1,6 @@
 """librealsense cross-check: synthetic frames recorded through a software device, replayed through rs.pipeline.
 
-The recording uses the paper's resolutions (848x480 depth, 1280x720 colour: 0.2 s to record three frames) with
+The recording uses the paper's resolutions (848x480 depth, 1280x720 colour: 0.2 s to record four frames) with
 D435i-like intrinsics and a depth-to-colour transform of a few centimetres and about a degree per axis, then
 ``rs.align(rs.stream.color)`` and ``sid.align.Aligner`` align the same depth images.
 """
@@ -16,7 +16,8 @@ from scipy.spatial.transform import Rotation
 
 from sid.align import Aligner
 from sid.camera import Calibration, Extrinsics, Intrinsics
-from sid.realsense import record_synthetic, rs_extrinsics, rs_intrinsics
+from sid.realsense import RealSenseFrames, record_synthetic, rs_extrinsics, rs_intrinsics
+from sid.sources import FrameReadError, skip_unreadable
 from sid.sources.realsense import RealSenseSource
 
 DEPTH = Intrinsics(848, 480, 426.2, 425.9, 423.5, 239.8)
@@ -25,7 +26,7 @@ ROTATION = Rotation.from_euler("xyz", [0.8, -1.2, 0.5], degrees=True).as_matrix(
 CALIB = Calibration(COLOR, DEPTH, Extrinsics(ROTATION, [0.015, 0.001, 0.002]), 0.001)
 
 
-def synthetic_frames(count: int = 3) -> list[tuple[np.ndarray, np.ndarray]]:
+def synthetic_frames(count: int = 4) -> list[tuple[np.ndarray, np.ndarray]]:
     """A slanted wall 3-6 m away, a person-sized box at 1.5 m moving right, 5 % holes; random colour."""
     rng = np.random.default_rng(0)
     rows, cols = np.mgrid[0 : DEPTH.height, 0 : DEPTH.width]
@@ -39,6 +40,22 @@ def synthetic_frames(count: int = 3) -> list[tuple[np.ndarray, np.ndarray]]:
     return frames
 
 
+def raw_framesets(source: RealSenseSource) -> list[RealSenseFrames]:
+    """Every frameset of a recording; librealsense may miss the first frame's colour or depth (then reported)."""
+    raws = []
+    while True:
+        try:
+            raws.append(source.next_raw())
+        except StopIteration:
+            return raws
+        except FrameReadError as error:
+            assert not raws and "at 0.000 s" in str(error), error  # only ever the very first frame
+
+
+def recorded_index(timestamp: float) -> int:
+    return round(timestamp * 30)
+
+
 @pytest.fixture(scope="module")
 def recording(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[tuple[np.ndarray, np.ndarray]]]:
     frames = synthetic_frames()
@@ -50,14 +67,11 @@ def test_recording_round_trips_frames_and_calibration(recording: tuple[Path, lis
     path, frames = recording
     with RealSenseSource(path, align="none") as source:
         calib = source.calibration
-        raws = []
-        while True:
-            try:
-                raws.append(source.next_raw())
-            except StopIteration:
-                break
-    assert len(raws) == len(frames)
-    for raw, (color, depth) in zip(raws, frames, strict=True):
+        raws = raw_framesets(source)
+    assert [recorded_index(raw.timestamp) for raw in raws] == list(range(len(frames)))[-len(raws) :]
+    assert len(raws) >= len(frames) - 1
+    for raw in raws:
+        color, depth = frames[recorded_index(raw.timestamp)]
         assert np.array_equal(raw.color, color) and np.array_equal(raw.depth, depth)
     # librealsense stores calibration as float32.
     for ours, theirs in ((calib.color, COLOR), (calib.depth, DEPTH)):
@@ -66,7 +80,7 @@ def test_recording_round_trips_frames_and_calibration(recording: tuple[Path, lis
     np.testing.assert_allclose(calib.depth_to_color.rotation, ROTATION, atol=1e-6)
     np.testing.assert_allclose(calib.depth_to_color.translation, CALIB.depth_to_color.translation, atol=1e-7)
     assert calib.depth_scale == pytest.approx(0.001)
-    assert raws[1].timestamp == pytest.approx(1 / 30)
+    assert raws[-1].timestamp == pytest.approx((len(frames) - 1) / 30)
 
 
 def test_our_alignment_agrees_with_librealsense(recording: tuple[Path, list]) -> None:
@@ -84,7 +98,7 @@ def test_our_alignment_agrees_with_librealsense(recording: tuple[Path, list]) ->
     with RealSenseSource(path, align="librealsense") as source:
         aligner = Aligner(source.calibration, mode="rectangle", value="depth")
         scale = np.float32(source.calibration.depth_scale)
-        for raw in iter(source.next_raw, None):
+        for raw in raw_framesets(source):
             theirs = raw.aligned.astype(np.int64)
             ours = np.rint(aligner(raw.depth.astype(np.float32) * scale) / scale).astype(np.int64)
             assert np.count_nonzero(theirs) > 0.9 * theirs.size
@@ -104,7 +118,7 @@ def test_colour_frame_z_differs_from_the_reading_by_the_extrinsics(recording: tu
     path, frames = recording
     depth = frames[0][1].astype(np.float32) * np.float32(0.001)
     with RealSenseSource(path, align="none") as source:
-        calib = source.calibration
+        calib = source.calibration  # as librealsense stores it (float32)
     z = Aligner(calib, value="z")(depth)
     reading = Aligner(calib, value="depth")(depth)
     both = (z > 0) & (reading > 0)
@@ -117,17 +131,17 @@ def test_sources_yield_registered_metres(recording: tuple[Path, list]) -> None:
     path, frames = recording
     for align in ("sid", "librealsense"):
         with RealSenseSource(path, align=align) as source:
-            got = list(source)
-        assert [f.index for f in got] == [0, 1, 2]
-        frame = got[0]
+            got = list(skip_unreadable(source, lambda error: None))
+        assert len(got) >= len(frames) - 1
+        frame = got[-1]
         assert frame.calibration.depth is None and frame.depth.dtype == np.float32
         assert frame.depth.shape == (COLOR.height, COLOR.width)
-        assert np.array_equal(frame.color, frames[0][0])
+        assert np.array_equal(frame.color, frames[recorded_index(frame.timestamp)][0])
         assert 1.4 < np.median(frame.depth[frame.depth > 0]) < 6.0
     with RealSenseSource(path, align="none") as source:
-        frame = next(iter(source))
+        frame = list(skip_unreadable(source, lambda error: None))[-1]
     assert frame.calibration.depth is not None and frame.depth.shape == (DEPTH.height, DEPTH.width)
-    np.testing.assert_allclose(frame.depth, frames[0][1] * 0.001, atol=1e-6)
+    np.testing.assert_allclose(frame.depth, frames[recorded_index(frame.timestamp)][1] * 0.001, atol=1e-6)
 
 
 def test_bad_recordings_get_clear_errors(tmp_path: Path) -> None:

@@ -13,8 +13,15 @@ recording. Depth alignment (``align=``):
 - ``"none"``: the raw depth image in the depth camera's grid with the full calibration. The cheapest option when only
   keypoints need depth: ``sid.align.depth_at_color_pixels`` looks them up sparsely.
 
-Recordings play as fast as they are read (real-time playback off, so no frame is dropped) and stop at the end of
-the file.
+Recordings play as fast as they are read (real-time playback off, so no frame is dropped for a slow reader) and
+stop at the end of the file. They are read from the playback device (``rs.context().load_device``) through a syncer,
+not through ``rs.pipeline`` + ``rs.config.enable_device_from_file``: the pipeline lost 1 to 3 of the first frames of
+a 4-frame recording in 5 of 5 runs here, and 12-21 of 60 frames in 2 of 5 runs, even with real-time playback off
+(realsense-ros moved to the playback API for the same reason, its PR #2669). librealsense starts playing when the
+first sensor starts, so the first colour or depth image can still be missed (about half of the runs here): that
+first frame then comes with one stream only and is reported as a ``FrameReadError`` and skipped. Rewinding or
+pausing the playback around the start made it stall for 10 s or jump to the end of the file in some runs, so it is
+not done. The syncer delivers the first frames one stream at a time; they are paired by timestamp here.
 """
 
 from __future__ import annotations
@@ -31,7 +38,13 @@ import pyrealsense2 as rs
 from sid.align import Aligner
 from sid.camera import Calibration, Extrinsics
 from sid.frame import Frame
-from sid.realsense import RealSenseFrames, calibration_from_profile, read_frameset
+from sid.realsense import (
+    RealSenseFrames,
+    calibration_from_profile,
+    calibration_from_profiles,
+    make_frameset,
+    read_frameset,
+)
 from sid.sources import RECORDING_SUFFIXES, FrameReadError, SourceError
 
 AlignMode = Literal["sid", "librealsense", "none"]
@@ -44,7 +57,7 @@ class RealSenseSource:
     Live options: ``serial`` (first camera when None), ``color_size`` / ``depth_size`` (width, height) and ``fps``
     (default: the paper's 1280x720 colour, 848x480 depth, 30 fps). ``timeout_s``: how long to wait for a frameset.
     After ``max_failures`` failed reads in a row the source gives up with ``SourceError``.
-    The pipeline starts in the constructor (errors surface at once) and stops at the end or on ``close()``.
+    Streaming starts in the constructor (errors surface at once) and stops at the end or on ``close()``.
     """
 
     def __init__(
@@ -67,55 +80,14 @@ class RealSenseSource:
         self.max_failures = int(max_failures)
         self._index = 0
         self._failures = 0
-        self._pipeline: rs.pipeline | None = rs.pipeline()
-        config = rs.config()
-        if self.path is None:
-            self._configure_camera(config, serial, color_size, depth_size, fps)
-        else:
-            self._configure_file(config)
-        try:
-            profile = self._pipeline.start(config)
-        except RuntimeError as exc:
-            self._pipeline = None
-            what = f"recording {self.path}" if self.path else "the RealSense camera"
-            raise SourceError(f"cannot start {what}: {exc}") from None
-        self._playback = None
-        if self.path is not None:
-            self._playback = profile.get_device().as_playback()
-            self._playback.set_real_time(False)
-        try:
-            self.calibration: Calibration = calibration_from_profile(profile)
-        except RuntimeError as exc:
-            self.close()
-            raise SourceError(f"{self._name()}: needs a depth and a colour stream ({exc})") from None
+        self._reader: _LiveReader | _RecordingReader | None = (
+            _LiveReader(serial, color_size, depth_size, fps) if self.path is None else _RecordingReader(self.path)
+        )
+        self.calibration: Calibration = self._reader.calibration
         registered = Calibration(self.calibration.color, None, Extrinsics(), self.calibration.depth_scale)
         self._frame_calibration = self.calibration if align == "none" else registered
         self._rs_align = rs.align(rs.stream.color) if align == "librealsense" else None
         self._aligner = Aligner(self.calibration) if align == "sid" else None
-
-    def _configure_camera(
-        self, config: rs.config, serial: str | None, color_size: tuple[int, int], depth_size: tuple[int, int], fps: int
-    ) -> None:
-        devices = rs.context().query_devices()
-        if len(devices) == 0:
-            raise SourceError(
-                "no RealSense camera is connected (check the USB 3 cable and that no other program holds it)"
-            )
-        if serial is not None:
-            serials = [d.get_info(rs.camera_info.serial_number) for d in devices]
-            if serial not in serials:
-                raise SourceError(f"no RealSense camera with serial {serial}; connected: {', '.join(serials)}")
-            config.enable_device(serial)
-        config.enable_stream(rs.stream.depth, depth_size[0], depth_size[1], rs.format.z16, fps)
-        config.enable_stream(rs.stream.color, color_size[0], color_size[1], rs.format.rgb8, fps)
-
-    def _configure_file(self, config: rs.config) -> None:
-        assert self.path is not None
-        if self.path.suffix.lower() not in RECORDING_SUFFIXES:
-            raise SourceError(f"{self.path}: not a RealSense recording (expected .db3 or .bag)")
-        if not self.path.is_file():
-            raise SourceError(f"recording {self.path} does not exist")
-        config.enable_device_from_file(str(self.path), repeat_playback=False)
 
     def _name(self) -> str:
         return f"recording {self.path}" if self.path else "RealSense camera"
@@ -142,9 +114,15 @@ class RealSenseSource:
         Raises StopIteration at the end of a recording, FrameReadError for a frameset that cannot be used (the
         source moves on) and SourceError after ``max_failures`` failures in a row.
         """
-        if self._pipeline is None:
+        if self._reader is None:
             raise StopIteration
-        frames = self._wait()
+        try:
+            frames = self._reader.next_frameset(self.timeout_s)
+        except StopIteration:
+            self.close()
+            raise
+        except IncompleteFrame as exc:
+            return self._failed(f"{self._name()}: {exc}")
         if frames is None:
             return self._failed(f"{self._name()}: no frames within {self.timeout_s:g} s")
         try:
@@ -153,20 +131,6 @@ class RealSenseSource:
             return self._failed(f"{self._name()}: frame {self._index}: {exc}")
         self._failures = 0
         return raw
-
-    def _wait(self) -> rs.composite_frame | None:
-        """The next frameset, None after ``timeout_s``; StopIteration at the end of a recording."""
-        deadline = time.monotonic() + self.timeout_s
-        while True:
-            # Short waits so the end of a recording is noticed at once rather than after the timeout.
-            ok, frames = self._pipeline.try_wait_for_frames(_POLL_MS)
-            if ok:
-                return frames
-            if self._playback is not None and self._playback.current_status() == rs.playback_status.stopped:
-                self.close()
-                raise StopIteration
-            if time.monotonic() > deadline:
-                return None
 
     def _failed(self, message: str) -> RealSenseFrames:
         self._failures += 1
@@ -178,14 +142,163 @@ class RealSenseSource:
         raise FrameReadError(message, index, self.path)
 
     def close(self) -> None:
-        """Stop the pipeline (idempotent)."""
-        if self._pipeline is not None:
-            pipeline, self._pipeline = self._pipeline, None
-            with contextlib.suppress(RuntimeError):  # never started or already stopped
-                pipeline.stop()
+        """Stop streaming (idempotent)."""
+        if self._reader is not None:
+            reader, self._reader = self._reader, None
+            reader.close()
 
     def __enter__(self) -> RealSenseSource:
         return self
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+class IncompleteFrame(Exception):
+    """A recorded frame whose other stream never came (reported by the source as a FrameReadError)."""
+
+
+def _orphan_message(frame: rs.frame) -> str:
+    stream = "depth" if frame.get_profile().stream_type() == rs.stream.depth else "colour"
+    other = "colour" if stream == "depth" else "depth"
+    return f"{stream} frame at {frame.get_timestamp() / 1000:.3f} s has no {other} frame in the playback; skipped"
+
+
+class _LiveReader:
+    """Framesets from a connected camera through ``rs.pipeline``."""
+
+    def __init__(self, serial: str | None, color_size: tuple[int, int], depth_size: tuple[int, int], fps: int) -> None:
+        devices = rs.context().query_devices()
+        if len(devices) == 0:
+            raise SourceError(
+                "no RealSense camera is connected (check the USB 3 cable and that no other program holds it)"
+            )
+        config = rs.config()
+        if serial is not None:
+            serials = [d.get_info(rs.camera_info.serial_number) for d in devices]
+            if serial not in serials:
+                raise SourceError(f"no RealSense camera with serial {serial}; connected: {', '.join(serials)}")
+            config.enable_device(serial)
+        config.enable_stream(rs.stream.depth, depth_size[0], depth_size[1], rs.format.z16, fps)
+        config.enable_stream(rs.stream.color, color_size[0], color_size[1], rs.format.rgb8, fps)
+        self.pipeline = rs.pipeline()
+        try:
+            profile = self.pipeline.start(config)
+        except RuntimeError as exc:
+            raise SourceError(f"cannot start the RealSense camera: {exc}") from None
+        self.calibration = calibration_from_profile(profile)
+
+    def next_frameset(self, timeout_s: float) -> rs.composite_frame | None:
+        ok, frames = self.pipeline.try_wait_for_frames(int(timeout_s * 1000))
+        return frames if ok else None
+
+    def close(self) -> None:
+        with contextlib.suppress(RuntimeError):  # already stopped
+            self.pipeline.stop()
+
+
+class _RecordingReader:
+    """Every depth + colour frameset of a recording, through the playback device (see the module docstring)."""
+
+    def __init__(self, path: Path) -> None:
+        if path.suffix.lower() not in RECORDING_SUFFIXES:
+            raise SourceError(f"{path}: not a RealSense recording (expected .db3 or .bag)")
+        if not path.is_file():
+            raise SourceError(f"recording {path} does not exist")
+        try:
+            self.device = rs.context().load_device(str(path))
+        except RuntimeError as exc:
+            raise SourceError(f"cannot read recording {path}: {exc}") from None
+        self.playback = self.device.as_playback()
+        chosen: dict[rs.stream, tuple[rs.sensor, rs.video_stream_profile]] = {}
+        for sensor in self.device.query_sensors():
+            for profile in sensor.get_stream_profiles():
+                kind = profile.stream_type()
+                if kind == rs.stream.depth and profile.format() != rs.format.z16:
+                    continue
+                if kind in (rs.stream.depth, rs.stream.color) and kind not in chosen:
+                    chosen[kind] = (sensor, profile.as_video_stream_profile())
+        missing = [
+            name for kind, name in ((rs.stream.depth, "depth (z16)"), (rs.stream.color, "colour")) if kind not in chosen
+        ]
+        if missing:
+            raise SourceError(f"recording {path} has no {' and no '.join(missing)} stream")
+        (depth_sensor, depth_profile), (_, color_profile) = chosen[rs.stream.depth], chosen[rs.stream.color]
+        try:
+            scale = depth_sensor.as_depth_sensor().get_depth_scale()
+            self.calibration = calibration_from_profiles(depth_profile, color_profile, scale)
+        except RuntimeError as exc:
+            raise SourceError(f"recording {path}: no calibration for the depth and colour streams ({exc})") from None
+        # Frames of the two streams closer in time than half a frame period belong together.
+        self.pair_tolerance_ms = 500.0 / max(depth_profile.fps(), color_profile.fps(), 1)
+        self.syncer = rs.syncer()
+        self.sensors: list[rs.sensor] = []
+        for sensor, _ in chosen.values():
+            if sensor not in self.sensors:
+                self.sensors.append(sensor)
+        for sensor in self.sensors:
+            sensor.open([p for s, p in chosen.values() if s == sensor])
+        # Real-time playback off: librealsense then waits for the reader instead of dropping frames.
+        self.playback.set_real_time(False)
+        for sensor in self.sensors:
+            sensor.start(self.syncer)
+        self.single: dict[rs.stream, rs.frame] = {}
+        self.pending: rs.composite_frame | None = None
+        self.started = False
+
+    def next_frameset(self, timeout_s: float) -> rs.composite_frame | None:
+        """The next frameset; None after ``timeout_s`` without one; StopIteration at the end of the file."""
+        if self.pending is not None:
+            frames, self.pending = self.pending, None
+            return frames
+        deadline = time.monotonic() + timeout_s
+        while True:
+            ok, frames = self.syncer.try_wait_for_frames(_POLL_MS)
+            if ok:
+                self.started = True
+                if frames.get_depth_frame() and frames.get_color_frame():
+                    return frames
+                paired = self._pair(frames)
+                if paired is not None:
+                    return paired
+                continue
+            timed_out = time.monotonic() > deadline
+            # A playback reports "stopped" before its first frame too, so only trust it once frames have come.
+            if (self.started or timed_out) and self.playback.current_status() == rs.playback_status.stopped:
+                raise StopIteration
+            if timed_out:
+                return None
+
+    def _pair(self, frames: rs.composite_frame) -> rs.composite_frame | None:
+        """Hold single frames until the other stream's frame of the same time comes; then bundle the two.
+
+        A held frame that never finds its partner is reported with ``IncompleteFrame``.
+        """
+        orphan = None
+        for frame in frames:
+            kind = frame.get_profile().stream_type()
+            if kind not in (rs.stream.depth, rs.stream.color):
+                continue
+            frame.keep()
+            orphan = orphan or self.single.get(kind)
+            self.single[kind] = frame
+        depth, color = self.single.get(rs.stream.depth), self.single.get(rs.stream.color)
+        if depth is not None and color is not None:
+            if abs(depth.get_timestamp() - color.get_timestamp()) <= self.pair_tolerance_ms:
+                self.single.clear()
+                if orphan is not None:
+                    self.pending = make_frameset([depth, color])
+                    raise IncompleteFrame(_orphan_message(orphan))
+                return make_frameset([depth, color])
+            older = rs.stream.depth if depth.get_timestamp() < color.get_timestamp() else rs.stream.color
+            orphan = orphan or self.single.pop(older)
+        if orphan is not None:
+            raise IncompleteFrame(_orphan_message(orphan))
+        return None
+
+    def close(self) -> None:
+        for sensor in self.sensors:
+            with contextlib.suppress(RuntimeError):
+                sensor.stop()
+            with contextlib.suppress(RuntimeError):
+                sensor.close()

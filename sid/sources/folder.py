@@ -1,0 +1,149 @@
+"""Folder source: colour + depth images on disk with a calibration JSON.
+
+Two layouts (the calibration is ``intrinsics.json`` or ``calibration.json`` in the folder, any form
+``sid.camera.Calibration.from_json`` reads; a flat intrinsics dict means depth registered to colour):
+
+- one frame: ``DIR/color.png`` (or ``.jpg``/``.jpeg``) + ``DIR/depth.png``, as in ../shared/data/rgbd/five_people;
+- a sequence: ``DIR/color/NAME.png|jpg|jpeg`` + ``DIR/depth/NAME.png``, paired by NAME and played in natural order
+  (``frame2`` before ``frame10``).
+
+Depth PNGs are single-channel uint16 in depth units (metres = value * depth_scale; 0 = no reading). Colour is any
+8-bit image OpenCV reads; frames carry it as RGB. A frame whose files are missing, unreadable or of the wrong size
+raises ``FrameReadError`` naming the file, and iteration goes on with the next frame.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from sid.camera import Calibration
+from sid.frame import Frame
+from sid.sources import FrameReadError, SourceError
+
+COLOR_SUFFIXES = (".png", ".jpg", ".jpeg")
+CALIBRATION_NAMES = ("intrinsics.json", "calibration.json")
+
+
+class FolderSource:
+    """Frames from a folder (see the module docstring). ``fps`` only sets timestamps (index / fps seconds).
+
+    ``calibration`` overrides the folder's JSON. ``len(source)`` is the number of frames; ``source.read(i)`` reads
+    frame i; iterating reads them in order.
+    """
+
+    def __init__(self, path: str | Path, *, calibration: Calibration | None = None, fps: float = 30.0) -> None:
+        self.path = Path(path)
+        if not self.path.is_dir():
+            raise SourceError(f"frame folder {self.path} does not exist or is not a directory")
+        if not (np.isfinite(fps) and fps > 0):
+            raise ValueError(f"folder source: fps must be positive, got {fps}")
+        self.fps = float(fps)
+        self.calibration = calibration if calibration is not None else self._read_calibration()
+        self.pairs = self._find_pairs()
+
+    def _read_calibration(self) -> Calibration:
+        for name in CALIBRATION_NAMES:
+            candidate = self.path / name
+            if candidate.is_file():
+                try:
+                    return Calibration.from_json(candidate)
+                except ValueError as exc:
+                    raise SourceError(str(exc)) from None
+        raise SourceError(f"frame folder {self.path}: no {' or '.join(CALIBRATION_NAMES)} with the intrinsics")
+
+    def _find_pairs(self) -> list[tuple[str, Path | None, Path | None]]:
+        """(name, colour file, depth file) per frame; a missing file is None (that frame fails when read)."""
+        single_color = _first_existing(self.path, "color")
+        if single_color is not None or (self.path / "depth.png").exists():
+            depth = self.path / "depth.png"
+            return [("color", single_color, depth if depth.exists() else None)]
+        color_dir, depth_dir = self.path / "color", self.path / "depth"
+        if not (color_dir.is_dir() and depth_dir.is_dir()):
+            raise SourceError(
+                f"frame folder {self.path}: expected color.png + depth.png, or color/ and depth/ subfolders"
+            )
+        colors = {p.stem: p for p in sorted(color_dir.iterdir()) if p.suffix.lower() in COLOR_SUFFIXES}
+        depths = {p.stem: p for p in depth_dir.iterdir() if p.suffix.lower() == ".png"}
+        names = sorted(colors.keys() | depths.keys(), key=_natural_key)
+        if not names:
+            raise SourceError(f"frame folder {self.path}: color/ and depth/ hold no images")
+        return [(name, colors.get(name), depths.get(name)) for name in names]
+
+    def __len__(self) -> int:
+        return len(self.pairs)
+
+    def read(self, index: int) -> Frame:
+        """Frame ``index`` (0-based). Raises FrameReadError naming the file when it cannot be used."""
+        name, color_path, depth_path = self.pairs[index]
+        if color_path is None:
+            raise FrameReadError(f"frame {name!r}: no colour image in {self.path / 'color'}", index, None)
+        if depth_path is None:
+            raise FrameReadError(f"frame {name!r}: no depth image {name}.png next to {color_path}", index, None)
+        bgr = cv2.imread(str(color_path), cv2.IMREAD_COLOR)
+        if bgr is None:
+            raise FrameReadError(f"cannot read colour image {color_path}", index, color_path)
+        raw = cv2.imread(str(depth_path), cv2.IMREAD_UNCHANGED)
+        if raw is None:
+            raise FrameReadError(f"cannot read depth image {depth_path}", index, depth_path)
+        if raw.dtype != np.uint16 or raw.ndim != 2:
+            raise FrameReadError(
+                f"depth image {depth_path} must be single-channel 16-bit (depth units), got {raw.dtype} "
+                f"with shape {raw.shape}",
+                index,
+                depth_path,
+            )
+        calib = self.calibration
+        expected_color = (calib.color.height, calib.color.width)
+        if bgr.shape[:2] != expected_color:
+            raise FrameReadError(
+                f"colour image {color_path} is {bgr.shape[1]}x{bgr.shape[0]}, the calibration says "
+                f"{calib.color.width}x{calib.color.height}",
+                index,
+                color_path,
+            )
+        grid = calib.depth if calib.depth is not None else calib.color
+        if raw.shape != (grid.height, grid.width):
+            raise FrameReadError(
+                f"depth image {depth_path} is {raw.shape[1]}x{raw.shape[0]}, expected {grid.width}x{grid.height}",
+                index,
+                depth_path,
+            )
+        depth = raw.astype(np.float32) * np.float32(calib.depth_scale)
+        return Frame(index, cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB), depth, calib, index / self.fps)
+
+    def __iter__(self) -> _Reader:
+        return _Reader(self)
+
+
+class _Reader:
+    """Sequential iterator over a FolderSource that survives FrameReadError (it has already moved on)."""
+
+    def __init__(self, source: FolderSource) -> None:
+        self.source = source
+        self.index = 0
+
+    def __iter__(self) -> _Reader:
+        return self
+
+    def __next__(self) -> Frame:
+        if self.index >= len(self.source):
+            raise StopIteration
+        index = self.index
+        self.index += 1
+        return self.source.read(index)
+
+
+def _first_existing(folder: Path, stem: str) -> Path | None:
+    for suffix in COLOR_SUFFIXES:
+        candidate = folder / f"{stem}{suffix}"
+        if candidate.is_file():
+            return candidate
+    return None
+
+
+def _natural_key(name: str) -> list[int | str]:
+    return [int(part) if part.isdigit() else part.lower() for part in re.split(r"(\d+)", name)]
