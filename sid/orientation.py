@@ -11,12 +11,15 @@ World frame: REP-103 (x forward, y left, z up, metres); yaw counter-clockwise fr
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from sid.keypoints import LEFT_HIP, LEFT_SHOULDER, NUM_KEYPOINTS, RIGHT_HIP, RIGHT_SHOULDER
 
-# Keypoints whose left/right order resolves the sign of the body normal.
-_LEFT_RIGHT_PAIRS = ((LEFT_SHOULDER, RIGHT_SHOULDER), (LEFT_HIP, RIGHT_HIP))
+# Keypoints whose left/right order resolves the sign of the body normal: (left, right) shoulders and hips.
+_LEFT = np.array([LEFT_SHOULDER, LEFT_HIP])
+_RIGHT = np.array([RIGHT_SHOULDER, RIGHT_HIP])
 # The keypoints are collinear (no plane) when the second principal spread is below 3 % of the first
 # (eigenvalue ratio 1e-3): e.g. under 1.5 cm across for a 1.7 m person, less than depth noise.
 _COLLINEAR_RATIO = 1e-3
@@ -46,32 +49,30 @@ def estimate_orientation(keypoints_world: np.ndarray) -> tuple[float | None, flo
     if points.shape != (NUM_KEYPOINTS, 3):
         raise ValueError(f"orientation: keypoints must be a ({NUM_KEYPOINTS}, 3) array, got shape {points.shape}")
     usable = np.isfinite(points).all(axis=1)
-    if np.count_nonzero(usable) < 3:
+    present = points[usable]
+    if len(present) < 3:
         return None, 0.0
-    centred = points[usable] - points[usable].mean(axis=0)
+    centred = present - present.sum(axis=0) / len(present)
     eigenvalues, eigenvectors = np.linalg.eigh(centred.T @ centred)  # ascending
-    l3, l2, l1 = eigenvalues
+    l3, l2, l1 = eigenvalues.tolist()
     if l2 <= _COLLINEAR_RATIO * l1:
         return None, 0.0
-    normal = eigenvectors[:, 0]
-    horizontal = float(np.hypot(normal[0], normal[1]))
+    nx, ny, _ = eigenvectors[:, 0].tolist()
+    horizontal = math.hypot(nx, ny)
     if horizontal < _MIN_HORIZONTAL_NORMAL:
         return None, 0.0
-    facing = normal[:2] / horizontal
+    fx, fy = nx / horizontal, ny / horizontal
 
-    left_right = np.zeros(2)
-    have_pair = False
-    for left, right in _LEFT_RIGHT_PAIRS:
-        if usable[left] and usable[right]:
-            left_right += points[left, :2] - points[right, :2]
-            have_pair = True
-    if not have_pair:
+    # Left-right vector summed over the shoulder and hip pairs with both keypoints present.
+    both = usable[_LEFT] & usable[_RIGHT]
+    if not both.any():
         return None, 0.0
-    across = facing[0] * left_right[1] - facing[1] * left_right[0]  # left-right extent across the facing axis
+    lx, ly = (points[_LEFT[both], :2] - points[_RIGHT[both], :2]).sum(axis=0).tolist()
+    across = fx * ly - fy * lx  # left-right extent across the facing axis (m)
     if across == 0.0:
         return None, 0.0
     if across < 0:
-        facing = -facing
+        fx, fy = -fx, -fy
     planarity = 1.0 - max(l3, 0.0) / l2
     quality = planarity * horizontal * min(1.0, abs(across) / _FULL_LEFT_RIGHT)
-    return float(np.arctan2(facing[1], facing[0])), float(np.clip(quality, 0.0, 1.0))
+    return math.atan2(fy, fx), min(max(quality, 0.0), 1.0)
