@@ -15,6 +15,7 @@ import argparse
 import dataclasses
 import json
 import math
+import os
 import re
 import sys
 from collections.abc import Iterable, Iterator
@@ -76,7 +77,11 @@ def run(args: argparse.Namespace) -> int:
         print(f"sid groups: cannot read {args.file}: {exc.strerror}", file=sys.stderr)
         return 2
     with stream:
-        return process(stream, sys.stdout, sys.stderr, params, strict=args.strict)
+        try:
+            return process(stream, sys.stdout, sys.stderr, params, strict=args.strict)
+        except BrokenPipeError:  # the reader went away (e.g. `| head`): stop quietly, as Unix tools do
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+            return 0
 
 
 def process(lines: Iterable[str], out: TextIO, err: TextIO, params: GroupParams, strict: bool = False) -> int:
