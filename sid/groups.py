@@ -50,30 +50,34 @@ _DEGENERATE_AREA = 1e-9
 class GroupParams:
     """Parameters of the group detector (metres, square metres, radians).
 
-    Defaults come from the geometry of conversations, checked on the F-formation benchmarks (Synth, CoffeeBreak;
-    F1 at T=2/3 within ~0.03 of the chosen values over a coarse grid, none tuned to one set):
+    Defaults come from the geometry of conversations; the F-formation benchmarks then checked that none sits on a
+    cliff. F1 at T=2/3 (Synth / CoffeeBreak, ``sid eval fformation``) is 0.950 / 0.728 with these defaults; the
+    numbers below are the same scores with one value changed.
 
     eps: DBSCAN neighbourhood radius (m). 2.0: a member of a conversation stands within ~1.5 m of a neighbour, so
-      2 m keeps any group in one cluster; clusters only bound the work, the geometry below splits them.
-      (The authors used 3.0 on (x, y, yaw) jointly.)
+      2 m keeps any group in one cluster; clusters only bound the work, the ray geometry splits them (1.5:
+      0.950 / 0.746, 3.0: unchanged). The authors used 3.0 on (x, y, yaw) jointly.
     min_samples: DBSCAN core size, the person included. 2: a conversation needs two people.
-    area_threshold: largest area (m^2) of a group's crossing polygon. 0.5 (the authors' value): with facing errors
-      of 10-30 degrees the crossings of one conversation scatter over a few tenths of a square metre; crossings
-      of people who look elsewhere spread it further. Rarely binding with short rays.
+    area_threshold: largest area (m^2) of a group's crossing polygon. 0.5, the authors' value: with facing errors
+      of 10-30 degrees the crossings of one conversation scatter over a few tenths of a square metre at most.
+      Rarely binding with short rays (0.25 or 1.0 change F1 by < 0.005).
     spread_threshold: largest D (m), the mean member distance to the interest point, i.e. the o-space radius.
       1.0: n people ~1 m apart on a circle have radius 1 / (2 sin(pi / n)), 1.0 m for six; Hall's personal
-      distance ends at 1.2 m. (The authors used 3.0.) 0.8 and 1.2 score 0.02-0.09 lower on the benchmarks.
-    ray_length: length of each facing ray (m). 1.5: it must reach the o-space centre (<= spread_threshold) with
-      some slack; longer rays mostly add crossings with strangers (the authors used 20 m; 2 m scores 0.03-0.08
-      lower, 20 m with one candidate per cluster below 0.15).
+      distance ends at 1.2 m (0.8: 0.947 / 0.697, 1.2: 0.933 / 0.637). The authors used 3.0, which also accepts
+      people side by side looking at a point 1.5 m ahead (see ``sid.seed_recordings``).
+    ray_length: length of each facing ray (m). 1.5: it must reach the o-space centre (D <= 1 m) with some slack;
+      longer rays mostly add crossings with strangers (1.0: 0.950 / 0.711, 2.0: 0.871 / 0.697). The authors
+      used 20 m.
     facing_tolerance: two people whose rays do not cross but who face each other within this angle (rad) meet at
       their midpoint. 0.6 (~34 degrees): face-to-face rays are nearly anti-parallel and miss each other with any
-      lateral offset; the tolerance covers facing errors of tens of degrees (annotations quantised to 45-90
-      degree bins, estimates of side views) plus an offset of about half the distance between the two.
+      lateral offset; the tolerance covers facing errors of tens of degrees (annotations quantised to 90 degree
+      bins, estimates of side views) plus an offset of about half the distance between the two (0.4: 0.966 /
+      0.709, 0.8: 0.950 / 0.722).
     meeting_radius: crossings closer than this (m, single linkage) belong to one candidate group; each candidate
       is then pruned as in the paper. 0.6: the crossings of one o-space with facing errors of ~30 degrees scatter
-      by ~D tan(30) = 0.6 m. ``math.inf`` makes each DBSCAN cluster one candidate, exactly the paper's Algorithm 1,
-      which fails in crowded scenes (F1 0.32 Synth, 0.38 CoffeeBreak at T=2/3 with the other defaults).
+      by ~D tan(30 deg) = 0.6 m (0.4: 0.858 / 0.732, 0.8: 0.930 / 0.658). ``math.inf`` makes each DBSCAN cluster
+      one candidate, exactly the paper's Algorithm 1, which fails in crowded scenes (0.318 / 0.382; with all of
+      the authors' settings 0.139 / 0.038).
     """
 
     eps: float = 2.0
@@ -187,47 +191,47 @@ def _ray_meetings(positions: np.ndarray, facing: np.ndarray, params: GroupParams
     """Where the rays of each pair meet (see the module docstring). 2D vectors are complex numbers, so that
     conj(a) * b = dot(a, b) + i cross(a, b)."""
     i, j = _pairs(len(positions))
-    d = positions[j] - positions[i]
-    # Rays p_i + s f_i and p_j + t f_j meet where s f_i - t f_j = d: s = cross(d, f_j) / cross(f_i, f_j) and
-    # t = cross(d, f_i) / cross(f_i, f_j).
-    denom = (facing[i].conjugate() * facing[j]).imag
-    along_i = d.conjugate() * facing[i]
-    along_j = d.conjugate() * facing[j]
-    length = params.ray_length
+    pi, pj, fi, fj = positions[i], positions[j], facing[i], facing[j]
+    d_conj = (pj - pi).conjugate()
+    # Rays p_i + s f_i and p_j + t f_j meet where s f_i - t f_j = d = p_j - p_i: s = cross(d, f_j) / cross(f_i, f_j)
+    # and t = cross(d, f_i) / cross(f_i, f_j); the segments meet when both lie in [0, ray_length].
+    denom = (fi.conjugate() * fj).imag
+    along_i = d_conj * fi
+    along_j = d_conj * fj
+    half = 0.5 * params.ray_length
+    distance = np.abs(d_conj)
+    # Face to face: each looks at the other within the tolerance (dot(f, d) >= cos(tol) |d|).
+    reach = math.cos(params.facing_tolerance) * distance
     with np.errstate(divide="ignore", invalid="ignore"):
         s = along_j.imag / denom
         t = along_i.imag / denom
-        crossing = (np.abs(denom) > _PARALLEL) & (s >= 0) & (s <= length) & (t >= 0) & (t <= length)
-        # Face to face: each looks at the other within the tolerance, and the midpoint is within both rays' reach.
-        distance = np.abs(d)
-        cos_tolerance = math.cos(params.facing_tolerance)
-        face_to_face = (along_i.real >= cos_tolerance * distance) & (-along_j.real >= cos_tolerance * distance)
-        points = np.where(crossing, positions[i] + s * facing[i], 0.5 * (positions[i] + positions[j]))
-    face_to_face &= ~crossing & (distance > 0) & (distance <= 2 * length)
+        crossing = (np.abs(denom) > _PARALLEL) & (np.maximum(np.abs(s - half), np.abs(t - half)) <= half)
+        points = np.where(crossing, pi + s * fi, 0.5 * (pi + pj))  # a face-to-face pair meets at its midpoint
+    face_to_face = (along_i.real >= reach) & (-along_j.real >= reach) & (distance > 0) & (distance <= 4 * half)
     meet = crossing | face_to_face
     return _Meetings(i[meet], j[meet], points[meet])
 
 
 def _groups_in_cluster(ids: list[int], positions: np.ndarray, facing: np.ndarray, params: GroupParams) -> list[Group]:
     meetings = _ray_meetings(positions, facing, params)
-    if len(meetings.points) == 0:
-        return []
     points = meetings.points
+    if len(points) == 0:
+        return []
     if math.isinf(params.meeting_radius) or np.abs(points[:, None] - points[None, :]).max() <= params.meeting_radius:
-        spots = np.zeros(len(points), dtype=np.intp)  # all within reach of each other: one spot
+        candidates = [np.ones(len(ids), dtype=bool)]  # all crossings within reach of each other: one spot
     else:
         spots = dbscan_labels(np.column_stack((points.real, points.imag)), params.meeting_radius, 1)
-    candidates = []
-    for spot in range(int(spots.max()) + 1):
-        at_spot = spots == spot
-        mask = np.zeros(len(ids), dtype=bool)
-        mask[meetings.first[at_spot]] = True
-        mask[meetings.second[at_spot]] = True
-        candidates.append((-int(np.count_nonzero(at_spot)), spot, mask))
-    candidates.sort(key=lambda c: (c[0], c[1]))
+        # Candidates in order of their number of crossings, most first (ties: in order of discovery).
+        order = sorted(range(int(spots.max()) + 1), key=lambda spot: -np.count_nonzero(spots == spot))
+        candidates = []
+        for spot in order:
+            mask = np.zeros(len(ids), dtype=bool)
+            mask[meetings.first[spots == spot]] = True
+            mask[meetings.second[spots == spot]] = True
+            candidates.append(mask)
     remaining = np.ones(len(ids), dtype=bool)
     groups = []
-    for _, _, mask in candidates:
+    for mask in candidates:
         found = _prune(mask & remaining, meetings, positions, params)
         if found is None:
             continue
@@ -235,7 +239,7 @@ def _groups_in_cluster(ids: list[int], positions: np.ndarray, facing: np.ndarray
         groups.append(
             Group(
                 members=tuple(ids[i] for i in np.flatnonzero(members)),
-                interest_point=(float(geometry.centre.real), float(geometry.centre.imag)),
+                interest_point=(geometry.centre.real, geometry.centre.imag),
                 area=geometry.area,
                 zone=geometry.zone,
                 spread=geometry.spread,
@@ -267,9 +271,10 @@ def _geometry(members: np.ndarray, meetings: _Meetings, positions: np.ndarray) -
         zone = np.array([(p.real, p.imag) for p in hull])
     else:
         area = 0.0
-        centre = complex(crossings.mean())
+        centre = complex(crossings.sum() / len(crossings))
         zone = _segment_ends(crossings, centre)
-    spread = float(np.abs(positions[members] - centre).mean())
+    member_positions = positions[members]
+    spread = float(np.abs(member_positions - centre).sum() / len(member_positions))
     return _Geometry(area, centre, zone, spread)
 
 

@@ -234,3 +234,24 @@ def test_group_record_fields():
     assert isinstance(group, Group)
     assert isinstance(group.members, tuple) and isinstance(group.interest_point, tuple)
     assert group.zone.shape == (1, 2)
+
+
+# --- speed (run with --benchmark-enable; never asserted) ----------------------------------------------------------
+
+
+def noisy_circles(counts: list[int], seed: int = 0) -> list[Person]:
+    """Conversation circles 3 m apart with 5 cm / 0.1 rad estimation noise."""
+    rng = np.random.default_rng(seed)
+    people: list[Person] = []
+    for k, n in enumerate(counts):
+        for p in circle(n, 0.8, centre=(3.0 * k, 2.0 * (k % 2)), first_id=len(people)):
+            people.append(
+                Person(p.id, p.x + rng.normal(0, 0.05), p.y + rng.normal(0, 0.05), p.theta + rng.normal(0, 0.1))
+            )
+    return people
+
+
+@pytest.mark.parametrize(("counts", "expected"), [([2], 1), ([3], 1), ([4], 1), ([6], 1), ([4, 4, 4, 4, 4], 5)])
+def test_bench_grouping(benchmark, counts, expected):
+    people = noisy_circles(counts)
+    assert len(benchmark(detect_groups, people)) == expected
