@@ -33,7 +33,7 @@ import numpy as np
 
 from costmap.scenario import Scenario, scenario_from_dict
 from planner.demo import DEMO_SCENARIO, Comparison, compare_with_without
-from planner.ompl_planner import resolve_planner
+from planner.ompl_planner import DEFAULT_PLANNER, resolve_planner
 from planner.problem import DEFAULT_COST_WEIGHT, PlanningError
 from sid.synthetic.layouts import LAYOUTS
 
@@ -168,8 +168,8 @@ RUN_KEYS = (
 @dataclass
 class NavigationResult:
     """Runs (one dict per task x planner x costmap), tasks that could not be planned at all (name -> reason),
-    and, for the example picture, the first planner's comparison where the social layer avoided the most o-space
-    intrusion (None when it avoided none)."""
+    and, for the example picture, the comparison where the social layer avoided the most o-space intrusion with the
+    default planner (or the first one given; None when it avoided none)."""
 
     settings: NavSettings
     tasks: int
@@ -188,6 +188,8 @@ def run_navigation(
     result = NavigationResult(settings, len(tasks))
     jobs = [(index, task, planner) for index, task in enumerate(tasks) for planner in settings.planners]
     best_gain = 0.0  # the example must show an intrusion the social layer avoided
+    names = [resolve_planner(p) for p in settings.planners]
+    example_planner = DEFAULT_PLANNER if DEFAULT_PLANNER in names else names[0]
     for done, (index, task, planner) in enumerate(jobs):
         if progress:
             progress(done, len(jobs), f"{task.name}: {planner}")
@@ -218,7 +220,7 @@ def run_navigation(
         without, with_ = comparison.metrics["without"], comparison.metrics["with"]
         if without["success"] and with_["success"]:
             gain = without["ospace_intrusion_m"] - with_["ospace_intrusion_m"]
-            if planner == settings.planners[0] and gain > best_gain:
+            if resolve_planner(planner) == example_planner and gain > best_gain:
                 best_gain, result.example = gain, comparison
     if progress:
         progress(len(jobs), len(jobs), "done")
