@@ -144,6 +144,21 @@ def _registered_patches(depth_m: np.ndarray, pixels: np.ndarray, patch: int) -> 
     return values
 
 
+def _window_blocks(depth_m: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Depth blocks covering each window lo..hi (inclusive (u, v)), all of the largest window's size.
+
+    Returns (N, h, w) readings and their (N, 2) top-left (u, v). A block can exceed its own window (never the
+    image): more candidates than needed, which the caller handles exactly anyway. One fancy index into a sliding-
+    window view copies all blocks at once.
+    """
+    height, width = depth_m.shape
+    w = int(min((hi[:, 0] - lo[:, 0]).max() + 1, width))
+    h = int(min((hi[:, 1] - lo[:, 1]).max() + 1, height))
+    corner = np.minimum(lo, [width - w, height - h])
+    blocks = np.lib.stride_tricks.sliding_window_view(depth_m, (h, w))[corner[:, 1], corner[:, 0]]
+    return blocks, corner
+
+
 @dataclass(frozen=True)
 class _Projection:
     """Colour-image coordinates of depth points: u, v (pixels) and z (metres, colour frame)."""
@@ -173,60 +188,37 @@ def _project_depth_points(
 
 
 def _search_windows(
-    pixels: np.ndarray, patch: int, calib: Calibration, depth_min: float, depth_max: float
-) -> tuple[np.ndarray, np.ndarray, int, int]:
-    """Per colour pixel, the depth-image window (u0, v0, width, height) that can land in its colour patch.
+    pixels: np.ndarray, patch: int, calib: Calibration, depth_min: np.ndarray | float, depth_max: np.ndarray | float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per colour pixel, the inclusive depth-image window (lo, hi as (u, v)) that can land in its colour patch.
 
     The colour patch (a square of ``patch`` pixels, half a pixel beyond the outer centres) seen between depth_min and
     depth_max is a frustum; its image in the depth camera is the convex hull of its 8 projected corners (the
-    epipolar band of the patch), so the window is that hull's bounding box plus one pixel for the splat corners.
+    epipolar band of the patch). A depth pixel reaches half a pixel around its centre, so the window is that hull's
+    bounding box widened by half a pixel and rounded outwards.
     """
     assert calib.depth is not None
     kc, kd = calib.color, calib.depth
-    r, t = calib.depth_to_color.rotation, calib.depth_to_color.translation
     half = patch // 2 + 0.5
     centre = np.floor(pixels + 0.5)
-    corners = np.array([[-half, -half], [half, -half], [-half, half], [half, half]])
-    uv = centre[:, None, :] + corners[None, :, :]  # (N, 4, 2)
-    rays = np.stack([(uv[..., 0] - kc.cx) / kc.fx, (uv[..., 1] - kc.cy) / kc.fy, np.ones(uv.shape[:2])], axis=-1)
-    points = np.concatenate([rays * depth_min, rays * depth_max], axis=1)  # (N, 8, 3) colour frame
-    in_depth = (points - t) @ r  # R^T (p_c - t), row-vector form
-    ud = in_depth[..., 0] / in_depth[..., 2] * kd.fx + kd.cx
-    vd = in_depth[..., 1] / in_depth[..., 2] * kd.fy + kd.cy
-    lo = np.floor(np.stack([ud.min(axis=1), vd.min(axis=1)], axis=1)) - 1
-    hi = np.ceil(np.stack([ud.max(axis=1), vd.max(axis=1)], axis=1)) + 1
+    # Rays through the patch's 4 corners, (4, N) per component; colour-frame point = z * (x, y, 1).
+    x = (centre[:, 0] + np.array([-half, half, -half, half])[:, None] - kc.cx) / kc.fx
+    y = (centre[:, 1] + np.array([-half, -half, half, half])[:, None] - kc.cy) / kc.fy
+    # Depth-frame point R^T (p_c - t) = z * (R^T ray) - R^T t.
+    rt = calib.depth_to_color.rotation.T
+    shift = rt @ calib.depth_to_color.translation
+    ray = [rt[i, 0] * x + rt[i, 1] * y + rt[i, 2] for i in range(3)]
+    ud, vd = [], []
+    for z in (np.asarray(depth_min, dtype=float), np.asarray(depth_max, dtype=float)):
+        px, py, pz = (z * ray[i] - shift[i] for i in range(3))
+        ud.append(px / pz * kd.fx + kd.cx)
+        vd.append(py / pz * kd.fy + kd.cy)
+    ud, vd = np.concatenate(ud), np.concatenate(vd)  # (8, N)
+    lo = np.floor(np.stack([ud.min(axis=0), vd.min(axis=0)], axis=1) - 0.5)
+    hi = np.ceil(np.stack([ud.max(axis=0), vd.max(axis=0)], axis=1) + 0.5)
     lo = np.clip(lo, 0, [kd.width - 1, kd.height - 1]).astype(np.int64)
     hi = np.clip(hi, 0, [kd.width - 1, kd.height - 1]).astype(np.int64)
-    size = hi - lo + 1
-    return lo, hi, int(size[:, 0].max()), int(size[:, 1].max())
-
-
-def _splat_cells(
-    proj_lo: _Projection, proj_hi: _Projection | None
-) -> tuple[list[np.ndarray], list[np.ndarray], list[np.ndarray]]:
-    """Colour pixels each depth point writes: lists of (column, row, mask) arrays, one entry per rectangle offset.
-
-    ``proj_hi`` None: point splat (the centre's pixel). Otherwise the inclusive rectangle between the rounded
-    corners ``proj_lo`` (top-left) and ``proj_hi`` (bottom-right).
-    """
-    with np.errstate(invalid="ignore"):
-        x0 = np.floor(proj_lo.u + 0.5)
-        y0 = np.floor(proj_lo.v + 0.5)
-        ok = np.isfinite(x0) & np.isfinite(y0) & (proj_lo.z > 0)
-        if proj_hi is None:
-            return [x0], [y0], [ok]
-        x1 = np.floor(proj_hi.u + 0.5)
-        y1 = np.floor(proj_hi.v + 0.5)
-        ok &= np.isfinite(x1) & np.isfinite(y1) & (proj_hi.z > 0)
-    span_x = np.where(ok, x1 - x0, -1)
-    span_y = np.where(ok, y1 - y0, -1)
-    cols, rows, masks = [], [], []
-    for oy in range(int(max(span_y.max(initial=-1), -1)) + 1):
-        for ox in range(int(max(span_x.max(initial=-1), -1)) + 1):
-            cols.append(x0 + ox)
-            rows.append(y0 + oy)
-            masks.append((span_x >= ox) & (span_y >= oy))
-    return cols, rows, masks
+    return lo, hi
 
 
 class Aligner:
@@ -451,6 +443,7 @@ def _unregistered_patches(
     if value not in ("z", "depth"):
         raise ValueError(f"unknown stored value {value!r}; use 'z' or 'depth'")
     assert calib.depth is not None
+    kd, kc = calib.depth, calib.color
     n = len(pixels)
     out = np.full((n, patch * patch), np.inf)
     finite = np.all(np.isfinite(pixels), axis=1)
@@ -458,34 +451,65 @@ def _unregistered_patches(
         return np.full((n, patch * patch), np.nan)
     idx = np.flatnonzero(finite)
     px = pixels[idx]
-    lo, hi, ww, wh = _search_windows(px, patch, calib, depth_min, depth_max)
-    gy, gx = np.mgrid[0:wh, 0:ww]
-    u_d = lo[:, :1] + gx.ravel()[None, :]  # (n, M) depth pixel columns
-    v_d = lo[:, 1:] + gy.ravel()[None, :]
-    inside = (u_d <= hi[:, :1]) & (v_d <= hi[:, 1:])
-    d = depth_m[np.minimum(v_d, calib.depth.height - 1), np.minimum(u_d, calib.depth.width - 1)].astype(float)
+    centre_px = np.floor(px + 0.5)
+    # Two passes. The readings in each pixel's window for the whole [depth_min, depth_max] range (a long epipolar
+    # band, mostly for near depths) give the depths actually present there; the window for that range alone is
+    # usually a few pixels wide, and only its pixels are projected.
+    lo, hi = _search_windows(px, patch, calib, depth_min, depth_max)
+    readings = _window_blocks(depth_m, lo, hi)[0].reshape(len(px), -1)
     with np.errstate(invalid="ignore"):
-        inside &= (d >= depth_min) & (d <= depth_max)
-    u_d, v_d, d = u_d[inside], v_d[inside], d[inside]
-    owner = np.broadcast_to(np.arange(len(idx))[:, None], inside.shape)[inside]
-    if mode == "point":
-        centre = _project_depth_points(u_d, v_d, d, calib)
-        cols, rows, masks = _splat_cells(centre, None)
-    else:
-        centre = _project_depth_points(u_d, v_d, d, calib) if value == "z" else None
-        cols, rows, masks = _splat_cells(
-            _project_depth_points(u_d - 0.5, v_d - 0.5, d, calib), _project_depth_points(u_d + 0.5, v_d + 0.5, d, calib)
+        valid = (readings >= depth_min) & (readings <= depth_max)
+    nearest = np.where(valid, readings, np.inf).min(axis=1)
+    farthest = np.where(valid, readings, -np.inf).max(axis=1)
+    present = np.isfinite(nearest)
+    if not present.any():
+        return np.full((n, patch * patch), np.nan)
+    idx, px, centre_px = idx[present], px[present], centre_px[present]
+    lo, hi = _search_windows(px, patch, calib, nearest[present], farthest[present])
+    blocks, corner = _window_blocks(depth_m, lo, hi)
+    grid_v, grid_u = np.indices(blocks.shape[1:]).reshape(2, -1)
+    with np.errstate(invalid="ignore"):
+        owner, cells = np.nonzero(((blocks >= depth_min) & (blocks <= depth_max)).reshape(len(px), -1))
+    u_d = corner[owner, 0] + grid_u[cells]
+    v_d = corner[owner, 1] + grid_v[cells]
+    d = blocks.reshape(len(px), -1)[owner, cells].astype(float)
+    half = float(patch // 2)
+    centre_u, centre_v = centre_px[owner, 0], centre_px[owner, 1]
+    # The centre's projection rules out most candidates (the band holds them for every depth in the range): a
+    # depth pixel's rectangle reaches about fc / fd / 2 colour pixels around its centre, plus rounding.
+    centre = _project_depth_points(u_d, v_d, d, calib)
+    reach = half + 1.0 + max(kc.fx / kd.fx, kc.fy / kd.fy)
+    with np.errstate(invalid="ignore"):
+        near = np.flatnonzero(
+            (centre.z > 0) & (np.abs(centre.u - centre_u) <= reach) & (np.abs(centre.v - centre_v) <= reach)
         )
-    stored = centre.z if value == "z" else d
-    half = patch // 2
-    centre_px = np.floor(px + 0.5)[owner]
-    kc = calib.color
-    for col, row, mask in zip(cols, rows, masks, strict=True):
-        cu = col - centre_px[:, 0] + half
-        cv = row - centre_px[:, 1] + half
-        keep = mask & (cu >= 0) & (cu < patch) & (cv >= 0) & (cv < patch) & (col >= 0) & (col < kc.width)
-        keep &= (row >= 0) & (row < kc.height)
-        cell = (cv[keep] * patch + cu[keep]).astype(np.int64)
-        np.minimum.at(out, (idx[owner[keep]], cell), stored[keep])
-    out[~np.isfinite(out)] = np.nan
-    return out
+    owner, u_d, v_d, d, centre_u, centre_v = (a[near] for a in (owner, u_d, v_d, d, centre_u, centre_v))
+    stored = centre.z[near] if value == "z" else d
+    if mode == "point":
+        u0 = u1 = centre.u[near]
+        v0 = v1 = centre.v[near]
+        ok = np.ones(len(near), dtype=bool)
+    else:
+        corners = _project_depth_points(
+            np.concatenate([u_d - 0.5, u_d + 0.5]), np.concatenate([v_d - 0.5, v_d + 0.5]), np.tile(d, 2), calib
+        )
+        (u0, u1), (v0, v1), (z0, z1) = (np.split(a, 2) for a in (corners.u, corners.v, corners.z))
+        with np.errstate(invalid="ignore"):
+            ok = (z0 > 0) & (z1 > 0)
+    with np.errstate(invalid="ignore"):
+        # Inclusive colour-pixel ranges each depth pixel writes, clipped to its patch and to the image.
+        col_lo = np.maximum(np.floor(u0 + 0.5), np.maximum(centre_u - half, 0.0))
+        col_hi = np.minimum(np.floor(u1 + 0.5), np.minimum(centre_u + half, kc.width - 1.0))
+        row_lo = np.maximum(np.floor(v0 + 0.5), np.maximum(centre_v - half, 0.0))
+        row_hi = np.minimum(np.floor(v1 + 0.5), np.minimum(centre_v + half, kc.height - 1.0))
+        # (patch, S) layouts keep the long axis innermost: numpy loops over short rows are slow.
+        offsets = np.arange(-half, half + 1.0)[:, None]
+        cols = centre_u + offsets  # colour columns of each candidate's patch
+        rows = centre_v + offsets
+        covers_col = (cols >= col_lo) & (cols <= col_hi) & ok
+        covers_row = (rows >= row_lo) & (rows <= row_hi)
+    # Cell (row r, column c) of the patch is r * patch + c, as in _patch_offsets.
+    cell, point = np.nonzero((covers_row[:, None, :] & covers_col[None, :, :]).reshape(patch * patch, -1))
+    # Flat indices: ufunc.at with a tuple of index arrays is several times slower.
+    np.minimum.at(out.reshape(-1), idx[owner[point]] * (patch * patch) + cell, stored[point])
+    return np.where(np.isinf(out), np.nan, out)
