@@ -7,7 +7,7 @@ import importlib
 import sys
 
 # Each module provides ``add_parser(subparsers)``; the parser it adds sets ``func(args) -> int``.
-COMMANDS: tuple[str, ...] = ("costmap", "plan", "demo", "compare", "bench", "groups", "eval", "reproduce")
+COMMANDS: tuple[str, ...] = ("detect", "groups", "eval", "costmap", "plan", "demo", "compare", "reproduce", "bench")
 
 
 def build_parser() -> argparse.ArgumentParser:
