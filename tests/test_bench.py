@@ -225,3 +225,19 @@ def test_pose_stage_on_the_real_models(tmp_path):
     assert total["contract"] == "yolo_pose" and total["people"] == 5
     for part in ("preprocess", "session_run", "postprocess"):
         _check_stage(stages[f"pose/yolo11n-pose-256/{part}"])
+
+
+def test_frame_and_lift_stages_without_shared_data(tmp_path):
+    """Without ../shared the per-frame pipeline still runs, with TruthPose as its pose stage, and says so."""
+    out = tmp_path / "bench"
+    rc = main(["bench", "--quick", "--only", "frame/2,lift/4", "--shared", str(tmp_path / "none"), "--out", str(out)])
+    assert rc == 0
+    report = load_report(out / "bench.json")
+    frame = report["stages"]["frame/2"]
+    _check_stage(frame)
+    assert frame["pose"] == "TruthPose" and frame["people"] == 2 and frame["groups"] == 1
+    assert frame["paper_ms"] == 3.95
+    for part in ("pose", "lift", "group"):
+        _check_stage(report["stages"][f"frame/2/{part}"])
+    assert report["stages"]["lift/4"]["people"] == 4
+    assert any("pose = TruthPose" in note for note in report["notes"])
