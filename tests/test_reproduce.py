@@ -66,9 +66,13 @@ def test_table1_exact_option_removes_all_noise(tmp_path):
     assert settings["keypoint_noise"] == {"sigma_px": 0.0, "drop": 0.0}
 
 
-def test_table1_bad_settings_are_refused(capsys):
+def test_table1_bad_settings_are_refused(tmp_path, capsys):
     assert main(["reproduce", "table1", "--scenarios", "S9", "--out", "unused"]) == 2
     assert "unknown scenario" in capsys.readouterr().err
+    blocker = tmp_path / "a-file"
+    blocker.write_text("")
+    assert main(["reproduce", "table1", "--quick", "--out", str(blocker / "out")]) == 2  # refused before the run
+    assert "cannot create the output folder" in capsys.readouterr().err
     with pytest.raises(ValueError, match="frames"):
         Table1Settings(frames=0)
     with pytest.raises(ValueError, match="variations"):

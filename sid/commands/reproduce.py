@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import shlex
 import sys
+from pathlib import Path
 
 from planner.ompl_planner import PLANNERS
 from planner.problem import DEFAULT_COST_WEIGHT
@@ -114,6 +115,14 @@ def _command() -> str:
     return "sid " + " ".join(shlex.quote(a) for a in sys.argv[1:]) if sys.argv[1:] else "sid reproduce"
 
 
+def _output_folder(path: str) -> None:
+    """Create the output folder (OSError naming it when that is impossible)."""
+    try:
+        Path(path).mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OSError(f"cannot create the output folder {path}: {exc.strerror or exc}") from exc
+
+
 def table1_command(args: argparse.Namespace) -> int:
     # Imported here, not at the top: the pipeline and its lifting load only when a study runs.
     from sid.reproduce.report import ProgressBar, table1_markdown, write_table1_report
@@ -141,10 +150,11 @@ def table1_command(args: argparse.Namespace) -> int:
             depth_noise=depth,
             keypoint_noise=keypoints,
         )
+        _output_folder(args.out)  # fail before the run, not after it
         result = run_table1(settings, progress=ProgressBar("table1"))
         paths = write_table1_report(result, args.out, _command())
     except (ValueError, OSError) as exc:
-        print(f"sid reproduce table1: {exc}", file=sys.stderr)
+        print(f"sid reproduce: {exc}", file=sys.stderr)
         return 2
     print(table1_markdown(result, _command()))
     for path in paths.values():
@@ -163,10 +173,11 @@ def navigation_command(args: argparse.Namespace) -> int:
     try:
         settings = NavSettings(tuple(planners), time_limit, args.iterations, args.cost_weight)
         tasks = navigation_tasks(seeds, layouts)
+        _output_folder(args.out)
         result = run_navigation(tasks, settings, progress=ProgressBar("navigation"))
         paths = write_navigation_report(result, args.out, seeds, _command())
     except (ValueError, OSError) as exc:
-        print(f"sid reproduce navigation: {exc}", file=sys.stderr)
+        print(f"sid reproduce: {exc}", file=sys.stderr)
         return 2
     print(navigation_markdown(result, seeds, _command()))
     for path in paths.values():

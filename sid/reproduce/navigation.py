@@ -118,7 +118,7 @@ def navigation_tasks(
 ) -> list[NavTask]:
     """Tasks for every layout x draw seed 1..``seeds`` x direction."""
     if isinstance(seeds, bool) or int(seeds) != seeds or seeds < 1:
-        raise ValueError(f"seeds must be a whole number >= 1, got {seeds}")
+        raise ValueError(f"navigation: seeds must be a whole number >= 1, got {seeds}")
     names = list(NAV_LAYOUTS) if layouts is None else list(layouts)
     return [
         NavTask(
