@@ -22,6 +22,7 @@ from sid.bench import (
     Stats,
     baseline_groups,
     benchmarks,
+    format_comparison,
     grouping_scene,
     load_report,
     measure_parts,
@@ -93,9 +94,12 @@ def test_compare_prints_change_per_stage(tmp_path, capsys):
     row = next(line for line in printed.splitlines() if line.startswith("dbscan/4 "))
     new_ms = load_report(out / "bench.json")["stages"]["dbscan/4"]["median_ms"]
     assert f"{new_ms / 1000.0:.2f}" in row and "faster" in row
-    assert "only in the old report: retired/stage" in printed
+    assert "1 stage(s) of the old report were not selected by --only" in printed
     assert "different machines" in printed
     assert "Change against the earlier report" in (out / "bench.md").read_text()
+    full_run = load_report(out / "bench.json") | {"settings": {"only": None}}
+    listed = format_comparison(json.loads(old.read_text()), full_run)
+    assert "only in the old report: retired/stage" in listed
 
 
 def test_bad_compare_file_and_unknown_stage_are_clear_errors(tmp_path, capsys):

@@ -193,7 +193,8 @@ def write_report(report: dict[str, Any], out_dir: str | Path, comparison: str | 
 
 def format_comparison(old: dict[str, Any], new: dict[str, Any]) -> str:
     """Per stage present in both: old and new median (ms) and new / old, flagged beyond +-10 %; then the stages
-    found in only one of them, and a warning when the two ran on different CPUs."""
+    found in only one of them (counted, not listed, for old stages left out by ``--only``), and a warning when the
+    two ran on different CPUs."""
     old_stages, new_stages = old["stages"], new["stages"]
     common = [name for name in new_stages if name in old_stages]
     rows = [("stage", "old ms", "new ms", "new/old", "")]
@@ -207,7 +208,9 @@ def format_comparison(old: dict[str, Any], new: dict[str, Any]) -> str:
              .rstrip() for r in rows]  # fmt: skip
     only_old = [n for n in old_stages if n not in new_stages]
     only_new = [n for n in new_stages if n not in old_stages]
-    if only_old:
+    if only_old and new.get("settings", {}).get("only"):
+        lines.append(f"{len(only_old)} stage(s) of the old report were not selected by --only")
+    elif only_old:
         lines.append("only in the old report: " + ", ".join(only_old))
     if only_new:
         lines.append("only in the new report: " + ", ".join(only_new))
