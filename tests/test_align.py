@@ -185,12 +185,13 @@ def test_sparse_unregistered_lookup_equals_full_alignment_then_lookup(mode: str,
     aligned = align_depth_to_color(depth, CALIB, mode=mode)
     rng = np.random.default_rng(1)
     pixels = np.column_stack([rng.uniform(-3, COLOR.width + 3, 200), rng.uniform(-3, COLOR.height + 3, 200)])
+    pixels[7] = np.nan  # a dropped keypoint
     registered = Calibration(COLOR)
     for patch in (1, 3, 5):
         sparse = depth_at_color_pixels(depth, pixels, CALIB, patch, method=method, mode=mode)
         dense = depth_at_color_pixels(aligned, pixels, registered, patch, method=method)
         np.testing.assert_allclose(sparse, dense, atol=2e-6, equal_nan=True)
-    assert np.isfinite(sparse).sum() > 150
+    assert np.isfinite(sparse).sum() > 150 and np.isnan(sparse[7])
 
 
 def test_sparse_lookup_on_a_realistic_d435i_pair() -> None:
