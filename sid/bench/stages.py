@@ -51,6 +51,10 @@ class Context:
     notes: list[str] = field(default_factory=list)
     _cache: dict[str, Any] = field(default_factory=dict, repr=False)
 
+    def __post_init__(self) -> None:
+        if self.plan_runs < 1:
+            raise ValueError(f"bench: plan_runs must be at least 1, got {self.plan_runs}")
+
     def cached(self, key: str, build: Callable[[], Any]) -> Any:
         """``build()`` once per run, shared by the benchmarks that need the same input."""
         if key not in self._cache:
