@@ -51,7 +51,7 @@ def keypoints_of(box: tuple[float, float, float, float], seed: int) -> np.ndarra
     return np.column_stack([u, rng.uniform(v0, v1, 17)])
 
 
-def median_ms(function, repeats: int = 20) -> float:
+def median_ms(function, repeats: int = 50) -> float:
     function()
     times = []
     for _ in range(repeats):
