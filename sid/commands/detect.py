@@ -20,7 +20,7 @@ from sid.lifting import LiftParams
 from sid.overlay import draw_detections
 from sid.pipeline import FrameResult, Pipeline, PoseFn, image_pose
 from sid.pose.contracts import PoseModelError
-from sid.sources import FrameReadError, SourceError, open_source, skip_unreadable
+from sid.sources import RECORDING_SUFFIXES, FrameReadError, SourceError, open_source, skip_unreadable
 
 TOP_VIEW = GridSpec.from_size(0.05, (0.0, -3.5), (7.0, 7.0))  # world frame: 7 m ahead of the camera, 3.5 m each side
 
@@ -38,6 +38,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--contract", help="pose model contract, if it cannot be read from the model")
     parser.add_argument("--frames", type=int, help="stop after this many frames (default: all; synthetic: 30)")
     parser.add_argument("--out", type=Path, help="also write detections.jsonl, overlay and top-view PNGs here")
+    parser.add_argument(
+        "--align",
+        choices=("none", "sid", "librealsense"),
+        default="none",
+        help="RealSense sources: 'none' (default) looks depth up sparsely at the keypoints, the "
+        "cheapest; 'sid' or 'librealsense' align every depth frame to colour first",
+    )
     parser.add_argument("--show", action="store_true", help="show overlays in a window (needs an OpenCV GUI build)")
     parser.add_argument("--camera-height", type=float, default=CameraMount.height, help="metres above the ground")
     parser.add_argument("--camera-tilt", type=float, default=CameraMount.tilt, help="downward pitch, radians")
@@ -61,6 +68,14 @@ def _pose(args: argparse.Namespace) -> PoseFn:
 
         return TruthPose()
     raise SourceError("detect: a real source needs a pose model: --model FILE.onnx (see docs/models.md)")
+
+
+def _source_options(args: argparse.Namespace) -> dict:
+    if args.source.startswith("synthetic:"):
+        return {"frames": args.frames or 30}
+    if args.source == "realsense" or Path(args.source).suffix.lower() in RECORDING_SUFFIXES:
+        return {"align": args.align}
+    return {}
 
 
 def _skip_reason(frame: Frame) -> str | None:
@@ -106,7 +121,7 @@ def run(args: argparse.Namespace) -> int:
         lift = LiftParams() if args.keypoint_threshold is None else LiftParams(min_score=args.keypoint_threshold)
         mount = CameraMount(args.camera_height, args.camera_tilt)
         pipeline = Pipeline(_pose(args), mount, lift, GroupParams())
-        options = {"frames": args.frames or 30} if args.source.startswith("synthetic:") else {}
+        options = _source_options(args)
         source = open_source(args.source, **options)
     except (SourceError, PoseModelError, ValueError, OSError) as exc:
         print(f"detect: {exc}", file=sys.stderr)
