@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from planner.problem import CostField
+from planner.validity import interpolate
 
 _DIRECTIONS = np.array([[1, 0], [0, 1], [-1, 0], [0, -1], [1, 1], [-1, 1], [-1, -1], [1, -1]], float)
 _DIRECTIONS[4:] /= np.sqrt(2.0)
@@ -63,18 +64,6 @@ def dp_shortcut(field: CostField, path: np.ndarray) -> np.ndarray:
     return path[order[::-1]]
 
 
-def subdivide(path: np.ndarray, max_segment: float) -> np.ndarray:
-    """Insert evenly spaced vertices so that no segment is longer than ``max_segment`` metres."""
-    path = np.asarray(path, dtype=float).reshape(-1, 2)
-    if len(path) < 2:
-        return path.copy()
-    d = np.diff(path, axis=0)
-    n = np.maximum(1, np.ceil(np.hypot(d[:, 0], d[:, 1]) / max_segment)).astype(np.int64)
-    seg = np.repeat(np.arange(len(d)), n)
-    t = (np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)) / n[seg]
-    return np.vstack([path[seg] + t[:, None] * d[seg], path[-1:]])
-
-
 def refine(field: CostField, path: np.ndarray, max_step: float, min_step: float, sweeps: int = 4) -> np.ndarray:
     """Move interior vertices downhill in J: at step sizes from ``max_step`` halving to ``min_step`` (metres), try
     the eight compass moves for every other vertex at once (alternate vertices share no segment) and keep each
@@ -117,6 +106,6 @@ def smooth(field: CostField, path: np.ndarray) -> np.ndarray:
         return path.copy()
     res = field.resolution
     short = dp_shortcut(field, greedy_shortcut(field, path))
-    refined = refine(field, subdivide(short, 6 * res), max_step=4 * res, min_step=res / 8)
+    refined = refine(field, interpolate(short, 6 * res), max_step=4 * res, min_step=res / 8)
     result = dp_shortcut(field, refined)
     return result if field.path_cost(result) <= field.path_cost(path) else path.copy()

@@ -12,7 +12,6 @@ optional piece missing on a machine) costs only the benchmarks that need it, rep
 from __future__ import annotations
 
 import math
-import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,6 +22,7 @@ import numpy as np
 from sid.bench.baseline import baseline_groups
 from sid.bench.runner import RunSettings, Stats, measure, measure_parts
 from sid.people import Person
+from sid.pose.bench import timed_call
 
 GROUP_SIZES = (2, 3, 4, 6, 20)
 DBSCAN_SIZES = (4, 20)
@@ -333,16 +333,10 @@ def _bench_pose(path: Path) -> Callable[[Context], Records]:
         found: list[int] = []
 
         def call() -> dict[str, float]:
-            t0 = time.perf_counter_ns()
-            tensor, letterbox = estimator.preprocess(image)
-            t1 = time.perf_counter_ns()
-            output = estimator.infer(tensor)
-            t2 = time.perf_counter_ns()
-            people = estimator.decode(output, letterbox, image_hw)
-            t3 = time.perf_counter_ns()
-            found.append(len(people) if isinstance(people, list) else 1)
-            return {"preprocess": (t1 - t0) / 1e6, "session_run": (t2 - t1) / 1e6, "postprocess": (t3 - t2) / 1e6,
-                    "total": (t3 - t0) / 1e6}  # fmt: skip
+            (pre, run, post), people = timed_call(estimator, image)
+            found.append(people)
+            return {"preprocess": pre / 1e6, "session_run": run / 1e6, "postprocess": post / 1e6,
+                    "total": (pre + run + post) / 1e6}  # fmt: skip
 
         parts = measure_parts(call, ctx.settings)
         name = f"pose/{path.stem}"
