@@ -31,7 +31,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "bench",
         help="time grouping, alignment, lifting, pose models, the per-frame pipeline, costmap and planners",
-        description=__doc__.strip("`"),
+        description=__doc__.replace("``", ""),
     )
     parser.add_argument(
         "--out", default="out/bench", help="output folder for bench.json and bench.md (default %(default)s)"

@@ -21,7 +21,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "compare",
         help="compare the planners on scenarios, with and without the social layer (table and chart)",
-        description=__doc__.strip("`"),
+        description=__doc__.replace("``", ""),
     )
     parser.add_argument("scenarios", nargs="+", metavar="SCENARIO", help="scenario files (.json or .yaml)")
     parser.add_argument("--planners", nargs="+", default=list(PLANNERS), help=f"default: {' '.join(PLANNERS)}")

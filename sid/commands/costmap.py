@@ -15,7 +15,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "costmap",
         help="build a scenario's costmap and write map_server YAML/PGM, .npz, .mcap and a picture",
-        description=__doc__.strip("`"),
+        description=__doc__.replace("``", ""),
     )
     parser.add_argument("scenario", help="scenario file (.json or .yaml); see docs/scenario.md")
     parser.add_argument("--out", required=True, help="output folder (created if missing)")

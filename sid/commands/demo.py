@@ -18,7 +18,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "demo",
         help="the main result: plan past a conversation without and with group recognition (no input needed)",
-        description=__doc__.strip("`"),
+        description=__doc__.replace("``", ""),
     )
     parser.add_argument("--out", default="sid-demo", help="output folder (default ./sid-demo)")
     parser.add_argument("--scenario", default=None, help="a scenario file to use instead of the built-in one")

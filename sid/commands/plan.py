@@ -39,7 +39,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "plan",
         help="plan a scenario's robot task on its costmap (OMPL or grid planner); write path.json and plan.png",
-        description=__doc__.strip("`"),
+        description=__doc__.replace("``", ""),
     )
     parser.add_argument("scenario", help="scenario file (.json or .yaml); see docs/scenario.md")
     parser.add_argument("--out", required=True, help="output folder (created if missing)")

@@ -24,7 +24,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "reproduce",
         help="reproduce the paper: Table 1 accuracy on synthetic S1-S5, and the navigation with/without study",
-        description=__doc__.strip("`"),
+        description=__doc__.replace("``", ""),
     )
     studies = parser.add_subparsers(dest="study", required=True, metavar="STUDY")
     _add_table1(studies)
