@@ -5,11 +5,30 @@ robust to holes and silhouette edges), is deprojected with the colour intrinsics
 to the world frame with the camera mount. Keypoints without a valid depth are dropped, never placed at the camera.
 Position = mean of the lifted keypoints' world x, y; facing = ``sid.orientation.estimate_orientation``.
 
+A depth camera sees the body's surface, not its joints. Two corrections, both along each keypoint's viewing ray
+(its pixel is kept), turn surface readings into points inside the body:
+
+1. **Surface offset** (``LiftParams.surface_offset``): joints lie inside limbs and torso, about half their
+   front-back thickness behind the skin, and the head's centre about half a head length behind the face; every
+   keypoint is pushed that far further along its ray, so that lifted keypoints are points of the body's interior
+   (joint centres, the head's mid-plane), which is what the position (their mean) and the body plane need.
+2. **Far-side completion** (``LiftParams.complete_far_side``): in a side view the far shoulder, hip, ear, ... are
+   hidden behind the person's own body; a pose model still places them (it knows the body's shape) with a lower
+   score, but their pixels show the near side of the body, whose depth is 0.15-0.3 m too near. The body plane then
+   turns towards the camera and the front/back order of left and right collapses. A left/right pair is taken as
+   *collapsed* when its two keypoints lie closer in 3D than ``min_pair_fraction`` of their anthropometric
+   separation W (the joints of a pair cannot come closer than that: the depth of one is wrong), and its lower-score
+   keypoint is then taken as the hidden one when its score is at least ``far_side_score_gap`` below its partner's.
+   That keypoint keeps its ray and is placed behind its partner, at the depth where the pair is W apart in 3D:
+   sqrt(W^2 - w^2) behind the partner's foot point on the ray, with w the partner's distance from the ray. Roots
+   with a fixed separation: shoulders, hips, ears (W from ``sid.orientation``). Elbows and wrists follow the
+   shoulders, knees and ankles the hips: a follower scoring ``far_side_score_gap`` below its partner is put at
+   least as far behind its partner as its root was put behind its own (never pulled nearer). Completed keypoints
+   are reported as inferred to the orientation estimate, which counts them less as left/right evidence. Without a
+   clear score difference a collapsed pair is left alone (and the orientation quality stays low).
+
 Frames: camera optical (x right, y down, z forward) -> world (REP-103: x forward, y left, z up, origin on the
 ground below the camera; see ``sid.frames``). Units: metres, radians.
-
-Note: depth is read on the body's surface, a few centimetres in front of the joints, so positions sit that much
-closer to the camera than the skeleton's centre; the paper does the same.
 """
 
 from __future__ import annotations
@@ -21,11 +40,22 @@ from dataclasses import dataclass
 import numpy as np
 
 from sid.align import depth_at_color_pixels
-from sid.camera import Calibration, deproject
+from sid.camera import Calibration
 from sid.frames import CameraMount
-from sid.keypoints import NUM_KEYPOINTS, PoseDetection
-from sid.orientation import estimate_orientation
+from sid.keypoints import COCO_KEYPOINTS, KP, NUM_KEYPOINTS, PoseDetection
+from sid.orientation import EAR_SEPARATION, HIP_SEPARATION, SHOULDER_SEPARATION, estimate_orientation
 from sid.people import Person
+
+# Far-side completion. Root pairs (left, right) with a fixed separation: shoulders, hips, ears (``widths`` order).
+_ROOT_LEFT = np.array([KP["left_shoulder"], KP["left_hip"], KP["left_ear"]])
+_ROOT_RIGHT = np.array([KP["right_shoulder"], KP["right_hip"], KP["right_ear"]])
+# The other side's keypoint of each keypoint (left <-> right; the nose is its own).
+_MIRROR = np.array([KP[n.replace("left", "@").replace("right", "left").replace("@", "right")] for n in COCO_KEYPOINTS])
+# Followers of each root keypoint (-1: none): the arm hangs from the shoulder, the leg from the hip.
+_FOLLOWERS = np.full((NUM_KEYPOINTS, 2), -1)
+for _side in ("left", "right"):
+    _FOLLOWERS[KP[f"{_side}_shoulder"]] = KP[f"{_side}_elbow"], KP[f"{_side}_wrist"]
+    _FOLLOWERS[KP[f"{_side}_hip"]] = KP[f"{_side}_knee"], KP[f"{_side}_ankle"]
 
 
 @dataclass(frozen=True)
@@ -43,6 +73,25 @@ class LiftParams:
     depth_gate: keypoints whose depth differs from the person's median keypoint depth by more than this (m) are
       dropped. 0.6: a standing body spans ~0.3 m in depth even in side view; a keypoint beyond that read the wall
       or a person behind (a keypoint on the silhouette edge, or a mislocalised wrist).
+    surface_offset: how far (m) a keypoint's point inside the body lies behind the surface the camera sees, added
+      along every keypoint's viewing ray. 0.07: about half the front-back thickness of an adult around the joints:
+      chest depth 0.20-0.25 m puts the hip and shoulder joints ~0.1 m behind the front of the torso, upper arm and
+      thigh diameters (0.09-0.15 m) put elbows and knees 0.05-0.07 m inside, clothes add 1-2 cm; head length
+      (0.18-0.20 m) puts the head's centre ~0.1 m behind the nose and eyes. Measured on the synthetic bodies of
+      ``sid.synthetic`` (joint range minus read range, people within 30 deg of facing the camera): 0.045-0.06 m at
+      shoulders, elbows, wrists, ankles and ears, 0.076 m at knees, 0.09 m at hips, 0.005-0.02 m at nose and eyes
+      (skin landmarks: there the offset moves the point into the head). 0 turns it off.
+    complete_far_side: place the hidden far side of a collapsed left/right pair behind its partner (module
+      docstring). shoulder_separation, hip_separation, ear_separation: the pairs' 3D separation W (m), adult
+      values from ``sid.orientation`` (sources there); lower them for children.
+    min_pair_fraction: a pair closer in 3D than this fraction of W is collapsed. 0.7 (0.24 m for shoulders): the
+      narrowest adults (biacromial breadth 0.325 m, 5th percentile of women) put their shoulder keypoints ~0.26 m
+      apart (at the keypoint-to-bone ratio measured on five_people, where the five show 0.29-0.31 m), and depth
+      noise adds a few centimetres either way. In the Table 1 scenes a self-occluded far shoulder that read the
+      near side's surface leaves the pair 0.07-0.30 m apart (median 0.20 m); pairs seen on both sides, 0.29-0.39 m.
+    far_side_score_gap: the lower-score keypoint of a collapsed pair is the hidden one when its score is at least
+      this much below its partner's. 0.1: real models score both visible shoulders or hips within a few hundredths
+      of each other (YOLO11-pose on five_people: <= 0.03) and a hidden far side tenths lower.
     """
 
     min_score: float = 0.3
@@ -50,6 +99,13 @@ class LiftParams:
     patch: int = 5
     max_range: float = 6.0
     depth_gate: float = 0.6
+    surface_offset: float = 0.07
+    complete_far_side: bool = True
+    shoulder_separation: float = SHOULDER_SEPARATION
+    hip_separation: float = HIP_SEPARATION
+    ear_separation: float = EAR_SEPARATION
+    min_pair_fraction: float = 0.7
+    far_side_score_gap: float = 0.1
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.min_score) and 0 <= self.min_score <= 1):
@@ -58,10 +114,16 @@ class LiftParams:
             raise ValueError(f"lift: min_keypoints must be an integer in 1..{NUM_KEYPOINTS}, got {self.min_keypoints}")
         if int(self.patch) != self.patch or self.patch < 1 or self.patch % 2 == 0:
             raise ValueError(f"lift: patch must be a positive odd number of pixels, got {self.patch}")
-        for name in ("max_range", "depth_gate"):
+        for name in ("max_range", "depth_gate", "shoulder_separation", "hip_separation", "ear_separation"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0):
                 raise ValueError(f"lift: {name} must be a positive number of metres, got {value}")
+        if not (math.isfinite(self.surface_offset) and 0 <= self.surface_offset < 0.5):
+            raise ValueError(f"lift: surface_offset must be in [0, 0.5) metres, got {self.surface_offset}")
+        if not (math.isfinite(self.min_pair_fraction) and 0 < self.min_pair_fraction <= 1):
+            raise ValueError(f"lift: min_pair_fraction must be in (0, 1], got {self.min_pair_fraction}")
+        if not (math.isfinite(self.far_side_score_gap) and 0 <= self.far_side_score_gap <= 1):
+            raise ValueError(f"lift: far_side_score_gap must be in [0, 1], got {self.far_side_score_gap}")
 
 
 def lift_people(
@@ -77,7 +139,8 @@ def lift_people(
     depth_m: the frame's depth in metres (0 or NaN = no reading), registered to colour when ``calib.depth`` is
     None, else in the depth camera's own grid (looked up sparsely, see ``sid.align``). ids: one per detection
     (default: the detection's index). Detections with fewer than ``params.min_keypoints`` lifted keypoints give no
-    Person; the others get theta None when their facing cannot be told (see ``sid.orientation``).
+    Person; the others get theta None when their facing cannot be told (see ``sid.orientation``). Keypoints are
+    corrected from the body's surface to its joints (module docstring).
     """
     if ids is not None and len(ids) != len(detections):
         raise ValueError(f"lift: {len(ids)} ids for {len(detections)} detections")
@@ -101,15 +164,88 @@ def lift_people(
     )
     with np.errstate(invalid="ignore"):
         usable &= np.abs(depth - median[:, None]) <= params.depth_gate
+
+    # Each keypoint's viewing ray (camera frame, through K_c^-1 [u v 1] = (ray_x, ray_y, 1)) and its range along it
+    # (m; NaN where unusable); depth z and range r: r = z * |(ray_x, ray_y, 1)|.
+    intr = calib.color
+    ray_x = (keypoints[..., 0] - intr.cx) / intr.fx
+    ray_y = (keypoints[..., 1] - intr.cy) / intr.fy
+    norm = np.sqrt(ray_x * ray_x + ray_y * ray_y + 1.0)
+    ranges = np.where(usable, depth * norm + params.surface_offset, np.nan)
+    inferred = np.zeros(scores.shape, dtype=bool)
+    if params.complete_far_side:
+        widths = np.array([params.shoulder_separation, params.hip_separation, params.ear_separation])
+        _complete_far_side(ray_x, ray_y, norm, ranges, scores, inferred, widths, params)
+
     world = np.full((*scores.shape, 3), np.nan)
     if usable.any():
-        world[usable] = mount.camera_to_world(deproject(keypoints[usable], depth[usable], calib.color))
+        z = ranges[usable] / norm[usable]
+        camera = np.stack([ray_x[usable] * z, ray_y[usable] * z, z], axis=1)
+        world[usable] = mount.camera_to_world(camera)
     counts = np.count_nonzero(usable, axis=1)
     with np.errstate(invalid="ignore", divide="ignore"):
         positions = np.where(usable[..., None], world[..., :2], 0.0).sum(axis=1) / counts[:, None]
     people = []
     for k in np.flatnonzero(counts >= params.min_keypoints).tolist():
-        theta, quality = estimate_orientation(world[k])
+        theta, quality = estimate_orientation(world[k], inferred[k])
         x, y = positions[k].tolist()
         people.append(Person(int(ids[k]) if ids is not None else k, x, y, theta, quality, world[k]))
     return people
+
+
+def _complete_far_side(
+    ray_x: np.ndarray,
+    ray_y: np.ndarray,
+    norm: np.ndarray,
+    ranges: np.ndarray,
+    scores: np.ndarray,
+    inferred: np.ndarray,
+    widths: np.ndarray,
+    params: LiftParams,
+) -> None:
+    """Far-side completion (module docstring), in place on ``ranges`` (P, 17) and ``inferred`` (P, 17).
+
+    ray_x, ray_y, norm: (P, 17) viewing rays (ray_x, ray_y, 1) in the camera frame and their lengths; ranges:
+    metres along the rays, NaN where unusable; scores: (P, 17); widths: (3,) separations W of the root pairs
+    (shoulders, hips, ears).
+    """
+    gap = params.far_side_score_gap
+    # Candidates: root pairs whose one side scores clearly lower (that side is the hidden one if the pair collapsed).
+    left_score, right_score = scores[:, _ROOT_LEFT], scores[:, _ROOT_RIGHT]
+    left_lower = left_score <= right_score - gap
+    people, pairs = np.nonzero(left_lower | (right_score <= left_score - gap))
+    if len(people) == 0:
+        return
+    lower = left_lower[people, pairs]
+    far = np.where(lower, _ROOT_LEFT[pairs], _ROOT_RIGHT[pairs])
+    near = _MIRROR[far]
+    far_range, near_range = ranges[people, far], ranges[people, near]
+    cosine = (ray_x[people, far] * ray_x[people, near] + ray_y[people, far] * ray_y[people, near] + 1.0) / (
+        norm[people, far] * norm[people, near]
+    )
+    foot = cosine * near_range  # u . P: where the near point's foot lies on the far keypoint's unit ray u
+    width = widths[pairs]
+    # |far - near|^2 = r_far^2 - 2 r_far (u . P) + |P|^2; NaN (a keypoint missing) compares False: never completed.
+    collapsed = far_range * (far_range - 2 * foot) + near_range**2 < (params.min_pair_fraction * width) ** 2
+    if not collapsed.any():
+        return
+    people, far, near, foot, near_range, width = (a[collapsed] for a in (people, far, near, foot, near_range, width))
+    # The hidden keypoint at W from its partner, behind it: t = u . P + sqrt(W^2 - w^2), w^2 = |P|^2 - (u . P)^2.
+    target = foot + np.sqrt(np.maximum(width**2 - near_range**2 + foot**2, 0.0))
+    ranges[people, far] = target
+    inferred[people, far] = True
+
+    # Followers on the hidden side: at least as far behind their partner as the root is behind its own.
+    followers = _FOLLOWERS[far]  # (n, 2), -1 for none
+    people = np.repeat(people, 2)
+    behind = np.repeat(target - near_range, 2)
+    follower = followers.ravel()
+    partner = _MIRROR[follower]
+    move = follower >= 0
+    move &= scores[people, follower] <= scores[people, partner] - gap
+    move &= np.isfinite(ranges[people, follower]) & np.isfinite(ranges[people, partner])
+    people, follower, partner, behind = people[move], follower[move], partner[move], behind[move]
+    current = ranges[people, follower]
+    placed = np.maximum(current, ranges[people, partner] + behind)
+    ranges[people, follower] = placed
+    inferred[people, follower] = placed > current

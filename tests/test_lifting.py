@@ -9,14 +9,17 @@ import pytest
 
 from sid.camera import Calibration, Extrinsics, Intrinsics, project
 from sid.frames import CameraMount
-from sid.keypoints import KP, NUM_KEYPOINTS, PoseDetection
+from sid.keypoints import COCO_KEYPOINTS, KP, NUM_KEYPOINTS, PoseDetection
 from sid.lifting import LiftParams, lift_people
 from sid.orientation import estimate_orientation
 from sid.skeleton import skeleton_world
+from sid.synthetic import Scene, ScenePerson, SyntheticCamera
+from sid.synthetic.pose import TruthPose
 
 COLOR = Intrinsics(640, 480, 600.0, 600.0, 319.5, 239.5)
 REGISTERED = Calibration(COLOR)
 MOUNT = CameraMount(height=0.9, tilt=0.0)
+SURFACE = LiftParams().surface_offset
 
 
 def splat(depth: np.ndarray, pixels: np.ndarray, z: np.ndarray, half: int = 3) -> None:
@@ -28,11 +31,15 @@ def splat(depth: np.ndarray, pixels: np.ndarray, z: np.ndarray, half: int = 3) -
 
 
 def scene(
-    people: list[tuple[float, float, float]], mount: CameraMount = MOUNT, calib: Calibration = REGISTERED
+    people: list[tuple[float, float, float]],
+    mount: CameraMount = MOUNT,
+    calib: Calibration = REGISTERED,
+    surface: float = SURFACE,
 ) -> tuple[list[PoseDetection], np.ndarray, list[np.ndarray]]:
     """Detections, a depth image (in the depth camera's grid when calib.depth is set) and the true keypoints.
 
-    Keypoints outside the colour image get score 0 and a NaN truth row.
+    The depth image shows each joint's surface, ``surface`` metres nearer along its viewing ray (what the default
+    surface offset expects). Keypoints outside the colour image get score 0 and a NaN truth row.
     """
     grid = calib.depth or calib.color
     depth = np.zeros((grid.height, grid.width), dtype=np.float32)
@@ -41,6 +48,7 @@ def scene(
         joints = skeleton_world(x, y, theta)
         camera = mount.world_to_camera(joints)
         pixels = project(camera, calib.color)
+        camera = camera * (1.0 - surface / np.linalg.norm(camera, axis=1))[:, None]
         if calib.depth is None:
             splat(depth, pixels, camera[:, 2])
         else:  # the depth camera sees p_d = R^T (p_c - t)
@@ -124,6 +132,117 @@ def test_tilted_mount_and_unregistered_depth():
     assert estimate_orientation(person.keypoints_world)[0] == pytest.approx(person.theta)
 
 
+def test_the_surface_offset_moves_each_keypoint_exactly_along_its_viewing_ray():
+    detections, depth, _ = scene([(2.3, -0.4, math.radians(160))])
+    [surface] = lift_people(detections, depth, REGISTERED, MOUNT, LiftParams(surface_offset=0.0))
+    [inside] = lift_people(detections, depth, REGISTERED, MOUNT, LiftParams(surface_offset=0.1))
+    optical_centre = np.array([0.0, 0.0, MOUNT.height])  # world frame
+    seen = np.isfinite(surface.keypoints_world[:, 0])
+    assert seen.sum() >= 15
+    ray = surface.keypoints_world[seen] - optical_centre
+    shift = inside.keypoints_world[seen] - surface.keypoints_world[seen]
+    np.testing.assert_allclose(np.linalg.norm(shift, axis=1), 0.1, atol=1e-9)
+    np.testing.assert_allclose(shift, 0.1 * ray / np.linalg.norm(ray, axis=1)[:, None], atol=1e-9)
+
+
+def side_view(facing_deg: float = 90.0, far_score: float = 0.5) -> tuple[list[PoseDetection], np.ndarray, np.ndarray]:
+    """A person 2.4 m ahead turned sideways (facing +y: their left side towards the camera): detections, depth
+    and true joints. The far (right) side is hidden behind the body: at its keypoints the depth image shows the
+    near side's surface (the depth at the left partner's keypoint), and those keypoints score ``far_score``
+    (right eye: 0.05), as a pose model scores what it guesses."""
+    detections, depth, [truth] = scene([(2.4, 0.0, math.radians(facing_deg))])
+    pixels = np.round(detections[0].keypoints).astype(int)
+    for name in COCO_KEYPOINTS:
+        if name.startswith("right"):
+            (u, v), (pu, pv) = pixels[KP[name]], pixels[KP["left" + name[5:]]]
+            depth[v - 3 : v + 4, u - 3 : u + 4] = depth[pv, pu]
+            detections[0].scores[KP[name]] = far_score
+    detections[0].scores[KP["right_eye"]] = 0.05
+    return detections, depth, truth
+
+
+def test_far_side_completion_puts_the_hidden_side_behind_at_the_anthropometric_separation():
+    params = LiftParams()
+    detections, depth, truth = side_view()
+    [raw] = lift_people(detections, depth, REGISTERED, MOUNT, LiftParams(complete_far_side=False))
+    [person] = lift_people(detections, depth, REGISTERED, MOUNT, params)
+    optical_centre = np.array([0.0, 0.0, MOUNT.height])
+
+    def distance(points: np.ndarray, a: str, b: str) -> float:
+        return float(np.linalg.norm(points[KP[a]] - points[KP[b]]))
+
+    def behind(points: np.ndarray, far: str, near: str) -> float:
+        return float(
+            np.linalg.norm(points[KP[far]] - optical_centre) - np.linalg.norm(points[KP[near]] - optical_centre)
+        )
+
+    for part, separation in [
+        ("shoulder", params.shoulder_separation),
+        ("hip", params.hip_separation),
+        ("ear", params.ear_separation),
+    ]:
+        left, right = f"left_{part}", f"right_{part}"
+        assert distance(raw.keypoints_world, left, right) < 0.7 * separation, "precondition: the pair collapsed"
+        assert distance(person.keypoints_world, left, right) == pytest.approx(separation, abs=1e-9)
+        assert behind(person.keypoints_world, right, left) > 0.5 * separation
+        # The hidden keypoint keeps its viewing ray: only its range changed.
+        before, after = (
+            raw.keypoints_world[KP[right]] - optical_centre,
+            person.keypoints_world[KP[right]] - optical_centre,
+        )
+        np.testing.assert_allclose(after / np.linalg.norm(after), before / np.linalg.norm(before), atol=1e-12)
+    # Followers: as far behind their partner as their root is behind its own.
+    for follower, root in [("elbow", "shoulder"), ("wrist", "shoulder"), ("knee", "hip"), ("ankle", "hip")]:
+        gap = behind(person.keypoints_world, f"right_{root}", f"left_{root}")
+        assert behind(person.keypoints_world, f"right_{follower}", f"left_{follower}") == pytest.approx(gap, abs=1e-9)
+    # The completed side is the true far side: every keypoint now lies within 0.1 m of its joint (this skeleton is
+    # wider than the table: shoulders 0.374 m, elbows 0.425 m apart), where the far side was 0.16-0.43 m off.
+    seen = np.isfinite(person.keypoints_world[:, 0])
+    assert np.linalg.norm(raw.keypoints_world[seen] - truth[seen], axis=1).max() > 0.4
+    assert np.linalg.norm(person.keypoints_world[seen] - truth[seen], axis=1).max() < 0.1
+    assert abs(person.theta - math.pi / 2) < math.radians(5)
+    assert abs((raw.theta - math.pi / 2 + math.pi) % (2 * math.pi) - math.pi) > math.radians(10), "without it: off"
+    frontal = lift_people(*scene([(2.4, 0.0, math.pi)])[:2], REGISTERED, MOUNT)[0]
+    assert 0.2 < person.orientation_quality < frontal.orientation_quality, "inferred evidence counts less"
+
+
+def test_far_side_completion_needs_a_collapsed_pair_and_a_clear_score_difference():
+    even, depth, _ = side_view(far_score=0.85)  # scores 0.9 / 0.85: which side is hidden is not clear
+    on = lift_people(even, depth, REGISTERED, MOUNT)[0].keypoints_world
+    off = lift_people(even, depth, REGISTERED, MOUNT, LiftParams(complete_far_side=False))[0].keypoints_world
+    np.testing.assert_array_equal(on, off)
+
+    # Seen from the front every pair shows its full width: a lower score alone moves nothing.
+    detections, depth, [truth] = scene([(2.4, 0.3, math.radians(170))])
+    right = [i for i, name in enumerate(COCO_KEYPOINTS) if name.startswith("right")]
+    detections[0].scores[right] = 0.4
+    [person] = lift_people(detections, depth, REGISTERED, MOUNT)
+    np.testing.assert_allclose(person.keypoints_world, truth, atol=0.005)
+
+
+def test_accuracy_on_rendered_people_at_every_yaw_including_side_views():
+    """One person 2.2 m ahead, rendered by the synthetic D435i (capsule body, default depth and keypoint noise) and
+    reported by the truth pose stand-in, at every yaw in 15 degree steps; 3 frames each.
+
+    Measured (10 frames per yaw): median facing error 0.4-4.4 degrees within 30 degrees of facing toward or away
+    from the camera, 0.6-2.8 degrees in side views (75-105 degrees), 4-10 degrees at 45-60 degrees from facing
+    toward or away (the far side partly hides behind the torso and reads its surface without scoring lower), worst
+    frame 13 degrees, no flips; position error 0.01-0.05 m. Without the corrections (surface offset 0, no
+    completion): the facing flips at +-90 degrees (median error 90-167 degrees), position errors 0.06-0.18 m.
+    """
+    camera = SyntheticCamera(shaded_color=False)
+    pose = TruthPose()
+    for yaw_deg in range(-180, 180, 15):
+        scene_ = Scene(f"yaw{yaw_deg}", (ScenePerson(0, 2.2, 0.0, math.radians(yaw_deg)),), ())
+        for index in range(3):
+            frame = camera.capture(scene_, index)
+            [person] = lift_people(pose(frame), frame.depth, frame.calibration, scene_.mount)
+            assert person.theta is not None
+            error = abs((math.degrees(person.theta) - yaw_deg + 180) % 360 - 180)
+            assert error < 16.0, f"yaw {yaw_deg}: facing off by {error:.1f} deg"
+            assert math.hypot(person.x - 2.2, person.y) < 0.08, f"yaw {yaw_deg}: position off"
+
+
 def test_bad_input_is_rejected():
     detections, depth, _ = scene([(2.0, 0.0, math.pi)])
     with pytest.raises(ValueError, match="1 ids for 0 detections"):
@@ -136,6 +255,12 @@ def test_bad_input_is_rejected():
         ("patch", 4),
         ("max_range", 0.0),
         ("depth_gate", -1),
+        ("surface_offset", -0.01),
+        ("shoulder_separation", 0.0),
+        ("hip_separation", math.nan),
+        ("ear_separation", -0.1),
+        ("min_pair_fraction", 1.5),
+        ("far_side_score_gap", -0.1),
     ]:
         with pytest.raises(ValueError, match=field):
             LiftParams(**{field: value})
