@@ -2,7 +2,9 @@
 
 Per detection: each confident keypoint takes the depth of its colour pixel (``sid.align.depth_at_color_pixels``,
 robust to holes and silhouette edges), is deprojected with the colour intrinsics K_c (d * K_c^-1 [u v 1]) and moved
-to the world frame with the camera mount. Keypoints without a valid depth are dropped, never placed at the camera.
+to the world frame with the camera mount. Keypoints without a valid depth are dropped, never placed at the camera,
+and so are keypoints whose depth is far from their person's (``depth_gate``) or belongs to a person standing in
+front (``occluder_gap``).
 Position = mean of the lifted keypoints' world x, y; facing = ``sid.orientation.estimate_orientation``.
 
 A depth camera sees the body's surface, not its joints. Two corrections, both along each keypoint's viewing ray
@@ -46,9 +48,9 @@ from sid.keypoints import COCO_KEYPOINTS, KP, NUM_KEYPOINTS, PoseDetection
 from sid.orientation import EAR_SEPARATION, HIP_SEPARATION, SHOULDER_SEPARATION, estimate_orientation
 from sid.people import Person
 
-# Far-side completion. Root pairs (left, right) with a fixed separation: shoulders, hips, ears (``widths`` order).
-_ROOT_LEFT = np.array([KP["left_shoulder"], KP["left_hip"], KP["left_ear"]])
-_ROOT_RIGHT = np.array([KP["right_shoulder"], KP["right_hip"], KP["right_ear"]])
+# Far-side completion. Root keypoints, each with its partner a fixed separation away: shoulders, hips, ears
+# (``widths`` order), left then right.
+_FAR = np.array([KP[f"{side}_{part}"] for side in ("left", "right") for part in ("shoulder", "hip", "ear")])
 # The other side's keypoint of each keypoint (left <-> right; the nose is its own).
 _MIRROR = np.array([KP[n.replace("left", "@").replace("right", "left").replace("@", "right")] for n in COCO_KEYPOINTS])
 # Followers of each root keypoint (-1: none): the arm hangs from the shoulder, the leg from the hip.
@@ -73,6 +75,12 @@ class LiftParams:
     depth_gate: keypoints whose depth differs from the person's median keypoint depth by more than this (m) are
       dropped. 0.6: a standing body spans ~0.3 m in depth even in side view; a keypoint beyond that read the wall
       or a person behind (a keypoint on the silhouette edge, or a mislocalised wrist).
+    occluder_gap: a keypoint inside the box of another person whose median keypoint depth is more than this (m)
+      nearer, with a depth closer to that person's median than to its own person's, read the person in front (an
+      arm or leg hidden behind them, a silhouette edge) and is dropped. 0.2: about a body's depth (chest depth
+      0.20-0.25 m); people whose medians differ less stand side by side, where the closer median would be a coin
+      toss. On ../shared/data/rgbd/five_people it drops one elbow each of the two partly hidden people (their
+      median depths differ by 0.31 and 0.22 m from the person in front). ``math.inf`` turns it off.
     surface_offset: how far (m) a keypoint's point inside the body lies behind the surface the camera sees, added
       along every keypoint's viewing ray. 0.07: about half the front-back thickness of an adult around the joints:
       chest depth 0.20-0.25 m puts the hip and shoulder joints ~0.1 m behind the front of the torso, upper arm and
@@ -99,6 +107,7 @@ class LiftParams:
     patch: int = 5
     max_range: float = 6.0
     depth_gate: float = 0.6
+    occluder_gap: float = 0.2
     surface_offset: float = 0.07
     complete_far_side: bool = True
     shoulder_separation: float = SHOULDER_SEPARATION
@@ -114,6 +123,10 @@ class LiftParams:
             raise ValueError(f"lift: min_keypoints must be an integer in 1..{NUM_KEYPOINTS}, got {self.min_keypoints}")
         if int(self.patch) != self.patch or self.patch < 1 or self.patch % 2 == 0:
             raise ValueError(f"lift: patch must be a positive odd number of pixels, got {self.patch}")
+        if not (self.occluder_gap >= 0):  # math.inf allowed: off
+            raise ValueError(
+                f"lift: occluder_gap must be a non-negative number of metres (or inf), got {self.occluder_gap}"
+            )
         for name in ("max_range", "depth_gate", "shoulder_separation", "hip_separation", "ear_separation"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0):
@@ -148,12 +161,10 @@ def lift_people(
         return []
     keypoints = np.stack([d.keypoints for d in detections])  # (P, 17, 2) colour pixels
     scores = np.stack([d.scores for d in detections])  # (P, 17)
-    with np.errstate(invalid="ignore"):
-        confident = (scores >= params.min_score) & np.isfinite(keypoints).all(axis=2)
+    confident = (scores >= params.min_score) & np.isfinite(keypoints).all(axis=2)  # (comparisons with NaN: False)
     depth = np.full(scores.shape, np.nan)
     depth[confident] = depth_at_color_pixels(depth_m, keypoints[confident], calib, patch=params.patch)
-    with np.errstate(invalid="ignore"):
-        usable = confident & (depth > 0) & (depth <= params.max_range)
+    usable = confident & (depth > 0) & (depth <= params.max_range)
     # Median depth per person over its usable keypoints (unusable ones sort last as +inf; np.nanmedian is ~30x
     # slower on arrays this small).
     ordered = np.sort(np.where(usable, depth, np.inf), axis=1)
@@ -162,8 +173,10 @@ def lift_people(
     median = 0.5 * (
         ordered[rows, np.maximum(count - 1, 0) // 2] + ordered[rows, np.minimum(count // 2, ordered.shape[1] - 1)]
     )
-    with np.errstate(invalid="ignore"):
-        usable &= np.abs(depth - median[:, None]) <= params.depth_gate
+    usable &= np.abs(depth - median[:, None]) <= params.depth_gate
+    if len(detections) > 1 and math.isfinite(params.occluder_gap):
+        boxes = np.stack([d.box for d in detections])
+        usable &= ~_reads_someone_in_front(keypoints, depth, median, boxes, params.occluder_gap)
 
     # Each keypoint's viewing ray (camera frame, through K_c^-1 [u v 1] = (ray_x, ray_y, 1)) and its range along it
     # (m; NaN where unusable); depth z and range r: r = z * |(ray_x, ray_y, 1)|.
@@ -193,6 +206,23 @@ def lift_people(
     return people
 
 
+def _reads_someone_in_front(
+    keypoints: np.ndarray, depth: np.ndarray, median: np.ndarray, boxes: np.ndarray, gap: float
+) -> np.ndarray:
+    """(P, 17) bool: keypoints that read a person in front of theirs (``LiftParams.occluder_gap``).
+
+    keypoints: (P, 17, 2) colour pixels; depth: (P, 17) m (NaN: none); median: (P,) each person's median keypoint
+    depth (m); boxes: (P, 4) (u_min, v_min, u_max, v_max). Pairs (i, j) below: keypoints of i, person j.
+    """
+    u, v = keypoints[:, None, :, 0], keypoints[:, None, :, 1]  # (P, 1, 17)
+    box = boxes[None, :, :, None]  # (1, P, 4, 1)
+    inside = (u >= box[:, :, 0]) & (u <= box[:, :, 2]) & (v >= box[:, :, 1]) & (v <= box[:, :, 3])  # (P, P, 17)
+    in_front = median[None, :] < median[:, None] - gap  # (P, P): j stands in front of i
+    own = np.abs(depth - median[:, None])  # (P, 17)
+    closer_to_them = np.abs(depth[:, None, :] - median[None, :, None]) < own[:, None, :]  # (P, P, 17)
+    return (inside & in_front[:, :, None] & closer_to_them).any(axis=1)
+
+
 def _complete_far_side(
     ray_x: np.ndarray,
     ray_y: np.ndarray,
@@ -207,45 +237,40 @@ def _complete_far_side(
 
     ray_x, ray_y, norm: (P, 17) viewing rays (ray_x, ray_y, 1) in the camera frame and their lengths; ranges:
     metres along the rays, NaN where unusable; scores: (P, 17); widths: (3,) separations W of the root pairs
-    (shoulders, hips, ears).
+    (shoulders, hips, ears). Keypoints are addressed by flat index person * 17 + keypoint.
     """
     gap = params.far_side_score_gap
-    # Candidates: root pairs whose one side scores clearly lower (that side is the hidden one if the pair collapsed).
-    left_score, right_score = scores[:, _ROOT_LEFT], scores[:, _ROOT_RIGHT]
-    left_lower = left_score <= right_score - gap
-    people, pairs = np.nonzero(left_lower | (right_score <= left_score - gap))
+    # Candidates: a root keypoint scoring clearly lower than its partner (the hidden one, if the pair collapsed).
+    people, k = np.nonzero(scores[:, _FAR] <= scores[:, _MIRROR[_FAR]] - gap)
     if len(people) == 0:
         return
-    lower = left_lower[people, pairs]
-    far = np.where(lower, _ROOT_LEFT[pairs], _ROOT_RIGHT[pairs])
-    near = _MIRROR[far]
-    far_range, near_range = ranges[people, far], ranges[people, near]
-    cosine = (ray_x[people, far] * ray_x[people, near] + ray_y[people, far] * ray_y[people, near] + 1.0) / (
-        norm[people, far] * norm[people, near]
-    )
-    foot = cosine * near_range  # u . P: where the near point's foot lies on the far keypoint's unit ray u
-    width = widths[pairs]
+    base = people * NUM_KEYPOINTS
+    far, near = base + _FAR[k], base + _MIRROR[_FAR[k]]
+    r, x, y, n = ranges.reshape(-1), ray_x.reshape(-1), ray_y.reshape(-1), norm.reshape(-1)  # views
+    far_range, near_range = r[far], r[near]
+    foot = (x[far] * x[near] + y[far] * y[near] + 1.0) / (n[far] * n[near]) * near_range  # u . P, u the far unit ray
+    width = widths[k % len(widths)]
     # |far - near|^2 = r_far^2 - 2 r_far (u . P) + |P|^2; NaN (a keypoint missing) compares False: never completed.
     collapsed = far_range * (far_range - 2 * foot) + near_range**2 < (params.min_pair_fraction * width) ** 2
     if not collapsed.any():
         return
-    people, far, near, foot, near_range, width = (a[collapsed] for a in (people, far, near, foot, near_range, width))
+    k, base, far, foot, near_range, width = (a[collapsed] for a in (k, base, far, foot, near_range, width))
     # The hidden keypoint at W from its partner, behind it: t = u . P + sqrt(W^2 - w^2), w^2 = |P|^2 - (u . P)^2.
     target = foot + np.sqrt(np.maximum(width**2 - near_range**2 + foot**2, 0.0))
-    ranges[people, far] = target
-    inferred[people, far] = True
+    r[far] = target
+    inferred.reshape(-1)[far] = True
 
-    # Followers on the hidden side: at least as far behind their partner as the root is behind its own.
-    followers = _FOLLOWERS[far]  # (n, 2), -1 for none
-    people = np.repeat(people, 2)
+    # Followers on the hidden side scoring clearly lower than their partner: at least as far behind their partner
+    # as the root is behind its own (np.fmax keeps the keypoint's own range where its partner has none; a follower
+    # without a range of its own stays unusable whatever its range).
+    follower = _FOLLOWERS[_FAR[k]].reshape(-1)  # -1: none
+    base = np.repeat(base, 2)
     behind = np.repeat(target - near_range, 2)
-    follower = followers.ravel()
-    partner = _MIRROR[follower]
-    move = follower >= 0
-    move &= scores[people, follower] <= scores[people, partner] - gap
-    move &= np.isfinite(ranges[people, follower]) & np.isfinite(ranges[people, partner])
-    people, follower, partner, behind = people[move], follower[move], partner[move], behind[move]
-    current = ranges[people, follower]
-    placed = np.maximum(current, ranges[people, partner] + behind)
-    ranges[people, follower] = placed
-    inferred[people, follower] = placed > current
+    own, partner = base + follower, base + _MIRROR[follower]
+    flat_scores = scores.reshape(-1)
+    move = (follower >= 0) & (flat_scores[own] <= flat_scores[partner] - gap)
+    own, partner, behind = own[move], partner[move], behind[move]
+    current = r[own]
+    placed = np.fmax(current, r[partner] + behind)
+    r[own] = placed
+    inferred.reshape(-1)[own] = placed > current

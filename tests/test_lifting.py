@@ -132,6 +132,30 @@ def test_tilted_mount_and_unregistered_depth():
     assert estimate_orientation(person.keypoints_world)[0] == pytest.approx(person.theta)
 
 
+def test_a_keypoint_reading_the_person_in_front_is_dropped():
+    """The back person's left elbow lies inside the front person's box and reads their depth (0.4 m nearer, within
+    the depth gate): it is dropped, and the back person's facing stays right."""
+    detections, depth, [front, back] = scene([(2.0, 0.1, math.pi), (2.4, 0.45, math.pi)])
+    u, v = np.round(detections[1].keypoints[KP["left_elbow"]]).astype(int)
+    box = detections[0].box
+    assert box[0] <= u <= box[2] and box[1] <= v <= box[3], "precondition: the elbow is inside the front person's box"
+    depth[v - 3 : v + 4, u - 3 : u + 4] = np.nanmedian(mount_depths(front))
+    people = lift_people(detections, depth, REGISTERED, MOUNT)
+    kept = lift_people(detections, depth, REGISTERED, MOUNT, LiftParams(occluder_gap=math.inf))
+    assert np.isnan(people[1].keypoints_world[KP["left_elbow"]]).all()
+    assert np.isfinite(kept[1].keypoints_world[KP["left_elbow"]]).all()
+    np.testing.assert_allclose(people[0].keypoints_world, front, atol=0.005)  # the front person keeps everything
+    seen = np.isfinite(people[1].keypoints_world[:, 0])
+    np.testing.assert_allclose(people[1].keypoints_world[seen], back[seen], atol=0.005)
+    assert abs(people[1].theta % (2 * math.pi) - math.pi) < math.radians(3)
+
+
+def mount_depths(joints: np.ndarray) -> np.ndarray:
+    """Optical depths (m) at which the camera of ``scene`` sees the surfaces of world-frame joints."""
+    camera = MOUNT.world_to_camera(joints)
+    return camera[:, 2] * (1.0 - SURFACE / np.linalg.norm(camera, axis=1))
+
+
 def test_the_surface_offset_moves_each_keypoint_exactly_along_its_viewing_ray():
     detections, depth, _ = scene([(2.3, -0.4, math.radians(160))])
     [surface] = lift_people(detections, depth, REGISTERED, MOUNT, LiftParams(surface_offset=0.0))
@@ -256,6 +280,7 @@ def test_bad_input_is_rejected():
         ("max_range", 0.0),
         ("depth_gate", -1),
         ("surface_offset", -0.01),
+        ("occluder_gap", -0.1),
         ("shoulder_separation", 0.0),
         ("hip_separation", math.nan),
         ("ear_separation", -0.1),
