@@ -5,9 +5,7 @@ interaction zone are those the group detector (``sid.groups.detect_groups``) com
 group (true positions and facing directions, only the members, the same parameters), so the reference follows the
 detector's own definition of the zone (ray crossings, shoelace area and centroid) and an error measured against it
 comes from perception alone. In the S1-S5 layouts without jitter every member faces the formation centre, so the
-area is 0 and the interest point is the centre, except in S4: its two outer members face each other within the
-detector's ``facing_tolerance``, the detector lets such a pair meet at their midpoint, and the interest point (the
-mean of the collinear crossings) lies 5 cm behind the centre.
+area is 0 and the interest point is the centre (S4 included: its two outer members' rays cross at the centre too).
 """
 
 from __future__ import annotations
