@@ -217,10 +217,10 @@ def _reads_someone_in_front(
     u, v = keypoints[:, None, :, 0], keypoints[:, None, :, 1]  # (P, 1, 17)
     box = boxes[None, :, :, None]  # (1, P, 4, 1)
     inside = (u >= box[:, :, 0]) & (u <= box[:, :, 2]) & (v >= box[:, :, 1]) & (v <= box[:, :, 3])  # (P, P, 17)
-    in_front = median[None, :] < median[:, None] - gap  # (P, P): j stands in front of i
-    own = np.abs(depth - median[:, None])  # (P, 17)
-    closer_to_them = np.abs(depth[:, None, :] - median[None, :, None]) < own[:, None, :]  # (P, P, 17)
-    return (inside & in_front[:, :, None] & closer_to_them).any(axis=1)
+    # Closer to j's median than to i's, j in front: nearer than the midpoint of the two medians (-inf: j not in front).
+    in_front = median[None, :] < median[:, None] - gap  # (P, P)
+    limit = np.where(in_front, 0.5 * (median[:, None] + median[None, :]), -np.inf)
+    return (inside & (depth[:, None, :] < limit[:, :, None])).any(axis=1)
 
 
 def _complete_far_side(
