@@ -99,7 +99,9 @@ class LiftParams:
       near side's surface leaves the pair 0.07-0.30 m apart (median 0.20 m); pairs seen on both sides, 0.29-0.39 m.
     far_side_score_gap: the lower-score keypoint of a collapsed pair is the hidden one when its score is at least
       this much below its partner's. 0.1: real models score both visible shoulders or hips within a few hundredths
-      of each other (YOLO11-pose on five_people: <= 0.03) and a hidden far side tenths lower.
+      of each other (YOLO11-pose on five_people: <= 0.03) and a hidden far side tenths lower (its hidden ear there:
+      0.36 against 0.97). A model that scores its guesses as high as what it sees gets no completion: side views
+      then fail as without it (docs/reproduction.md, sensitivity).
     """
 
     min_score: float = 0.3
