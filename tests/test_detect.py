@@ -127,3 +127,22 @@ def test_pipeline_on_a_realsense_recording_matches_the_scene(tmp_path):
         assert len(result.people) == len(expected.people) == 2
         for got, want in zip(result.people, expected.people, strict=True):
             assert abs(got.x - want.x) < 0.02 and abs(got.y - want.y) < 0.02
+
+
+def test_ctrl_c_stops_cleanly_and_keeps_what_was_written(tmp_path, capsys, monkeypatch):
+    import sid.commands.detect as detect_command
+
+    frames = SyntheticSource("S1", frames=5, seed=0)
+
+    def interrupted_source(spec, **options):
+        yield frames[0]
+        yield frames[1]
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(detect_command, "open_source", interrupted_source)
+    out = tmp_path / "out"
+    assert main(["detect", "--source", "synthetic:S1", "--out", str(out), "--no-keypoints"]) == 130
+    captured = capsys.readouterr()
+    assert [r["frame"] for r in _lines(captured.out)] == [0, 1]
+    assert len((out / "detections.jsonl").read_text().splitlines()) == 2
+    assert "interrupted" in captured.err
