@@ -39,15 +39,20 @@ def _pt(uv: np.ndarray) -> tuple[int, int]:
 
 
 def _labels(image: np.ndarray, lines: Sequence[str], left: int, bottom: int, scale: float) -> None:
-    """Lines of text on dark bands, stacked upwards from baseline ``bottom`` (first line lowest), inside the image."""
+    """Lines of text on dark bands, stacked upwards from baseline ``bottom`` (first line lowest), inside the image.
+
+    The block is moved as a whole (never line by line, which would stack lines on top of each other at the edge).
+    """
     h, w = image.shape[:2]
-    for text in lines:
-        (tw, th), base = cv2.getTextSize(text, FONT, scale, 1)
+    sizes = [cv2.getTextSize(text, FONT, scale, 1) for text in lines]
+    # Baseline of the first line such that the last line's band starts at row 0 or below it.
+    lowest = sum(th + base + 3 for (_, th), base in sizes[:-1]) + sizes[-1][0][1] + 2
+    bottom = int(np.clip(bottom, lowest, h - sizes[0][1] - 1))
+    for text, ((tw, th), base) in zip(lines, sizes, strict=True):
         x = int(np.clip(left, 0, max(0, w - tw - 2)))
-        y = int(np.clip(bottom, th + 2, h - base - 1))
-        cv2.rectangle(image, (x, y - th - 2), (x + tw + 2, y + base), (0, 0, 0), cv2.FILLED)
-        cv2.putText(image, text, (x + 1, y - 1), FONT, scale, (255, 255, 255), 1, cv2.LINE_AA)
-        bottom = y - th - base - 3
+        cv2.rectangle(image, (x, bottom - th - 2), (x + tw + 2, bottom + base), (0, 0, 0), cv2.FILLED)
+        cv2.putText(image, text, (x + 1, bottom - 1), FONT, scale, (255, 255, 255), 1, cv2.LINE_AA)
+        bottom -= th + base + 3
 
 
 def person_label(person: Person) -> tuple[str, str]:
