@@ -7,14 +7,11 @@ docs/scenario.md ("Scenario file"). A malformed file raises ``ScenarioError`` na
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
-
-import yaml
 
 from costmap.grid import GridSpec
 from costmap.inflation import InflationParams
@@ -22,6 +19,7 @@ from costmap.lidar import ObstacleParams
 from costmap.mapfile import MapFileError, read_map
 from costmap.obstacles import BoxObstacle, CircleObstacle, Obstacle, SegmentObstacle
 from costmap.social import SocialParams
+from sid.documents import load_document
 from sid.groups import GroupParams
 from sid.people import Person
 
@@ -296,18 +294,12 @@ def scenario_from_dict(data: Any, base_dir: Path | None = None, default_name: st
 
 
 def load_scenario(path: str | Path) -> Scenario:
-    """Read a scenario file (.json, or .yaml/.yml); errors name the file and the field."""
+    """Read a scenario file (.json, or YAML for any other suffix); errors name the file and the field."""
     path = Path(path)
     try:
-        text = path.read_text()
-    except OSError as exc:
-        raise ScenarioError(f"{path}: cannot read scenario file ({exc.strerror or exc})") from exc
-    try:
-        data = json.loads(text) if path.suffix.lower() == ".json" else yaml.safe_load(text)
-    except (json.JSONDecodeError, yaml.YAMLError) as exc:
-        raise ScenarioError(
-            f"{path}: not valid {'JSON' if path.suffix.lower() == '.json' else 'YAML'} ({exc})"
-        ) from exc
+        data = load_document(path, "scenario file")
+    except ValueError as exc:
+        raise ScenarioError(str(exc)) from None
     try:
         return scenario_from_dict(data, base_dir=path.parent, default_name=path.stem)
     except ScenarioError as exc:

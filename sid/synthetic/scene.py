@@ -11,14 +11,13 @@ its obstacles are not rendered.
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
+from sid.documents import load_document
 from sid.frames import CameraMount
 from sid.people import Person
 
@@ -85,16 +84,12 @@ class Scene:
 
     @classmethod
     def from_file(cls, path: str | Path) -> Scene:
-        """Read a scene or costmap scenario file (JSON or YAML; see the module docstring)."""
+        """Read a scene or costmap scenario file (.json, or YAML for any other suffix; see the module docstring)."""
         path = Path(path)
         try:
-            text = path.read_text()
-        except OSError as exc:
-            raise ValueError(f"scene {path}: cannot read ({exc.strerror})") from None
-        try:
-            data = yaml.safe_load(text) if path.suffix.lower() in (".yaml", ".yml") else json.loads(text)
-        except (json.JSONDecodeError, yaml.YAMLError) as exc:
-            raise ValueError(f"scene {path}: not valid {path.suffix.lstrip('.').upper() or 'JSON'} ({exc})") from None
+            data = load_document(path)
+        except ValueError as exc:
+            raise ValueError(f"scene {exc}") from None
         try:
             return cls.from_dict(data, default_name=path.stem, base_dir=path.parent)
         except ValueError as exc:
