@@ -11,9 +11,8 @@ from costmap.layered import LayeredCostmap
 from costmap.mapfile import write_map
 from costmap.npz import save_npz
 from costmap.occupancy import OccupancyGrid, cost_to_occupancy, costmap_to_occupancy
-from costmap.render import render_costmap
+from costmap.render import RobotTask, render_costmap
 from costmap.rosbag import write_occupancy_mcap
-from costmap.scenario import RobotSpec
 
 NAMES = ("costmap.yaml", "costmap.pgm", "costmap.npz", "costmap.mcap", "costmap.png")
 
@@ -22,7 +21,7 @@ def export_costmap(
     layered: LayeredCostmap,
     out_dir: str | Path,
     *,
-    robot: RobotSpec | None = None,
+    robot: RobotTask | None = None,
     title: str | None = None,
     stamp_ns: int | None = None,
 ) -> dict[str, Path]:

@@ -1,4 +1,4 @@
-"""The one place where layers are combined (Nav2's LayeredCostmap), and ``build_costmap`` for a scenario.
+"""The one place where layers are combined (Nav2's LayeredCostmap).
 
 Order and combination, as in a Nav2 global costmap: the master grid is reset to NO_INFORMATION (or FREE when
 unknown space is not tracked); the static map is written with true overwrite; the LiDAR layer with max; the
@@ -18,35 +18,27 @@ current position; a mark at an old position that the new scan hits again stays (
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from costmap.combine import update_with_max, update_with_true_overwrite
-from costmap.grid import FREE_SPACE, NO_INFORMATION, Costmap2D, GridSpec
-from costmap.inflation import InflationLayer
-from costmap.lidar import ObstacleLayer
-from costmap.mapfile import read_map
-from costmap.occupancy import OccupancyGrid, occupancy_to_cost
-from costmap.scan import LaserScan, simulate_scan
-from costmap.scenario import CostmapParams, Scenario
-from costmap.social import SocialLayer
-from sid.groups import Group
-from sid.people import Person
+from costmap.grid import FREE_SPACE, Costmap2D, GridSpec
+from costmap.layers.inflation import InflationLayer, InflationParams
+from costmap.layers.obstacle import ObstacleLayer, ObstacleParams
+from costmap.layers.social import SocialLayer, SocialParams
+from costmap.scan import LaserScan
+from sid.perception.groups import Group
+from sid.perception.people import Person
 
 
-def static_costs(grid: OccupancyGrid, spec: GridSpec, track_unknown_space: bool = True) -> np.ndarray:
-    """A static map interpreted as Nav2's static layer does, sampled (nearest cell) onto ``spec``.
+@dataclass(frozen=True)
+class CostmapParams:
+    """Parameters of the costmap layers (a scenario file's optional "layers" block)."""
 
-    Cells of ``spec`` outside the map read NO_INFORMATION (or FREE when unknown space is not tracked).
-    """
-    costs = occupancy_to_cost(grid.data, track_unknown_space=track_unknown_space)
-    if grid.spec == spec:
-        return costs
-    cells = grid.spec.world_to_cell(np.stack([a.ravel() for a in spec.cell_centres()], axis=1))
-    inside = grid.spec.in_bounds(cells)
-    out = np.full(spec.height * spec.width, NO_INFORMATION if track_unknown_space else 0, dtype=np.uint8)
-    out[inside] = costs[cells[inside, 0], cells[inside, 1]]
-    return out.reshape(spec.shape)
+    obstacle: ObstacleParams = field(default_factory=ObstacleParams)
+    inflation: InflationParams = field(default_factory=InflationParams)
+    social: SocialParams = field(default_factory=SocialParams)
 
 
 def _check_people(people: Sequence[Person]) -> list[Person]:
@@ -131,47 +123,3 @@ class LayeredCostmap:
         if self.social is not None:
             update_with_max(master, self.social.costs, no_opinion=FREE_SPACE)
         self.inflation.apply(master)
-
-
-def build_costmap(
-    scenario: Scenario,
-    social: bool = True,
-    groups: list[Group] | None = None,
-    params: CostmapParams | None = None,
-) -> LayeredCostmap:
-    """The costmap of a scenario: a simulated scan from the robot's start pose, people, groups and layers.
-
-    ``groups`` None: detect them with ``sid.groups.detect_groups`` (only when ``social``). ``params`` None: the
-    scenario's "layers" block.
-    """
-    params = params or scenario.layers
-    static = None
-    if scenario.static_map is not None:
-        static = static_costs(read_map(scenario.static_map), scenario.grid, params.obstacle.track_unknown_space)
-    layered = LayeredCostmap(
-        scenario.grid,
-        params,
-        robot_radius=scenario.robot.radius,
-        body_radius=scenario.lidar.body_radius,
-        social=social,
-        static=static,
-    )
-    lidar = scenario.lidar
-    scan = simulate_scan(
-        scenario.robot.start,
-        scenario.obstacles,
-        scenario.people,
-        beams=lidar.beams,
-        range_max=lidar.range_max,
-        body_radius=lidar.body_radius,
-        static=None if static is None else Costmap2D(scenario.grid, static),
-    )
-    if groups is None:
-        if social:
-            from sid.groups import detect_groups  # the group detector is only needed with recognition
-
-            groups = detect_groups(scenario.people, scenario.group_params)
-        else:
-            groups = []
-    layered.update(scenario.people, groups, scan)
-    return layered

@@ -8,19 +8,32 @@ points to pixel coordinates of that layout so other modules (the planner) can dr
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Protocol
 
 import cv2
 import numpy as np
 
 from costmap.grid import INSCRIBED, LETHAL, MAX_NON_OBSTACLE, NO_INFORMATION, Costmap2D, GridSpec
 from costmap.layered import LayeredCostmap
+from costmap.layers.social import SocialParams, group_zone_polygon
 from costmap.scan import LaserScan
-from costmap.scenario import RobotSpec
-from costmap.social import SocialParams, group_zone_polygon
-from sid.groups import Group
-from sid.people import Person
+from sid.perception.groups import Group
+from sid.perception.people import Person
 
 MARGIN_LEFT, MARGIN_TOP, MARGIN_BOTTOM, PANEL_WIDTH, PANEL_HEIGHT = 56, 40, 44, 190, 450
+
+
+class RobotTask(Protocol):
+    """What a picture shows of a robot's task: start and goal poses (x, y, yaw; world frame) and disc radius (m)."""
+
+    @property
+    def start(self) -> tuple[float, float, float]: ...
+    @property
+    def goal(self) -> tuple[float, float, float]: ...
+    @property
+    def radius(self) -> float: ...
+
+
 FONT = cv2.FONT_HERSHEY_SIMPLEX
 TEXT = (40, 40, 40)
 PERSON = (200, 110, 20)  # BGR: blue
@@ -147,7 +160,7 @@ def _draw_groups(img, spec, scale, groups: Sequence[Group], people: Sequence[Per
         cv2.drawMarker(img, tuple(centre), ZONE, cv2.MARKER_CROSS, 10, 2, cv2.LINE_AA)
 
 
-def _draw_robot(img: np.ndarray, spec: GridSpec, scale: int, robot: RobotSpec) -> None:
+def _draw_robot(img: np.ndarray, spec: GridSpec, scale: int, robot: RobotTask) -> None:
     x, y, yaw = robot.start
     r = int(round(robot.radius * scale / spec.resolution * 16))
     centre = _px([[x, y]], spec, scale)[0]
@@ -164,7 +177,7 @@ def render_costmap(
     groups: Sequence[Group] | None = None,
     *,
     scale: int | None = None,
-    robot: RobotSpec | None = None,
+    robot: RobotTask | None = None,
     scan: LaserScan | None = None,
     title: str | None = None,
     body_radius: float | None = None,

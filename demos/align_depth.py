@@ -11,8 +11,8 @@ import time
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from sid.align import Aligner, depth_at_color_pixels
-from sid.camera import Calibration, Extrinsics, Intrinsics, deproject, project
+from sid.perception.align import Aligner, depth_at_color_pixels
+from sid.perception.camera import Calibration, Extrinsics, Intrinsics, deproject, project
 
 # D435i-like streams at the paper's resolutions; depth camera -> colour camera: 1.5 cm right, ~0.3 degree skew.
 DEPTH = Intrinsics(848, 480, 426.0, 426.0, 423.5, 239.8)

@@ -6,10 +6,10 @@ counter-clockwise from x). Run: python demos/detect_groups.py
 
 import math
 
-from sid.groups import GroupParams, detect_groups
-from sid.orientation import estimate_orientation
-from sid.people import Person
-from sid.skeleton import skeleton_world
+from sid.perception.groups import GroupParams, detect_groups
+from sid.perception.orientation import estimate_orientation
+from sid.perception.people import Person
+from sid.perception.skeleton import skeleton_world
 
 
 def facing(x: float, y: float, tx: float, ty: float) -> float:

@@ -10,12 +10,12 @@ from __future__ import annotations
 
 from costmap.grid import GridSpec
 from costmap.layered import LayeredCostmap
-from costmap.scan import simulate_scan
+from planner.facade import plan
 from planner.metrics import path_metrics
-from planner.ompl_planner import plan
 from planner.problem import PlanningProblem
-from sid.frames import CameraMount
-from sid.pipeline import Pipeline
+from sid.perception.mount import CameraMount
+from sid.perception.pipeline import Pipeline
+from sid.scenario.lidar import simulate_scan
 from sid.sources.synthetic import SyntheticSource
 from sid.synthetic.pose import TruthPose
 

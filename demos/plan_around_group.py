@@ -7,13 +7,12 @@ from __future__ import annotations
 
 import cv2
 
-from costmap.layered import build_costmap
-from planner.demo import demo_scenario
+from planner.facade import plan
 from planner.metrics import path_metrics
-from planner.ompl_planner import plan
-from planner.problem import PlanningProblem
 from planner.render import WITH_COLOUR, WITHOUT_COLOUR, PathStyle, render_paths
-from sid.groups import detect_groups
+from sid.experiments.demo import demo_scenario
+from sid.perception.groups import detect_groups
+from sid.scenario.build import build_costmap, planning_problem
 
 # The built-in scenario: a corridor, the robot at (0, 0), its goal at (9, 0) behind a conversation of three.
 scenario = demo_scenario()
@@ -24,7 +23,7 @@ paths = []
 for social, colour in ((False, WITHOUT_COLOUR), (True, WITH_COLOUR)):
     # The costmap the robot sees: LiDAR only, or LiDAR plus the social layer from the recognised groups.
     costmap = build_costmap(scenario, social=social, groups=groups if social else [])
-    problem = PlanningProblem.from_scenario(scenario, costmap.master)
+    problem = planning_problem(scenario, costmap.master)
     # BIT* with a fixed seed and iteration cap: the same path on every run.
     result = plan(problem, "bitstar", time_limit=5.0, seed=1, max_iterations=5000)
     m = path_metrics(result.path, scenario.people, groups)

@@ -13,9 +13,9 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from sid.keypoints import KP
-from sid.overlay import draw_detections
-from sid.pose import load_pose_estimator
+from sid.perception.keypoints import KP
+from sid.perception.overlay import draw_detections
+from sid.perception.pose import load_pose_estimator
 
 SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 
@@ -31,7 +31,7 @@ def real_inputs(shared: Path) -> tuple[Path, np.ndarray] | None:
 
 def stand_in_inputs(folder: Path) -> tuple[Path, np.ndarray]:
     """A tiny MultiPose-signature model (needs the `onnx` package) and a grey image with a red blob at (400, 100)."""
-    from sid.pose.testing import build_multipose_model
+    from sid.testing import build_multipose_model
 
     # A stick figure facing the camera (its left on the image's right): (dy, dx) of each keypoint from the blob
     # on the nose, normalised to the model input.

@@ -2,7 +2,7 @@
 
 Loads examples/conversation.json (a robot, a goal behind three people in conversation, walls), builds the
 LiDAR + inflation costmap a robot without recognition would have, and the same with the social layer (groups
-found by sid.groups.detect_groups), prints what cutting through the conversation would cost in each, and
+found by sid.perception.groups.detect_groups), prints what cutting through the conversation would cost in each, and
 writes one picture of both into a temporary folder.
 """
 
@@ -14,10 +14,10 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from costmap.layered import build_costmap
+from costmap.layers.social import group_zone_polygon
 from costmap.render import render_costmap
-from costmap.scenario import load_scenario
-from costmap.social import group_zone_polygon
+from sid.scenario.build import build_costmap
+from sid.scenario.loader import load_scenario
 
 SCENARIO = Path(__file__).resolve().parents[1] / "examples" / "conversation.json"
 

@@ -11,8 +11,8 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from sid.camera import project
-from sid.keypoints import KP
+from sid.perception.camera import project
+from sid.perception.keypoints import KP
 from sid.sources.synthetic import SyntheticSource
 from sid.synthetic.layouts import LAYOUTS
 from sid.synthetic.pose import TruthPose

@@ -4,7 +4,7 @@ Same cost model as the OMPL planners (``planner.problem``): an edge between neig
 length times (1 + the mean of the two cells' w c / 252), the exact integral of the piecewise-constant cost along
 it. Diagonal steps need all four cells around them plannable, so no edge cuts a corner. scipy's csgraph Dijkstra
 does the search in C. 8-connected paths are about 6 % longer than any-angle ones, so the facade
-(``planner.ompl_planner.plan``) passes this path through the same smoothing as every planner, whose first step is
+(``planner.facade.plan``) passes this path through the same smoothing as every planner, whose first step is
 the any-angle shortcut pass; the result is the yardstick for the sampling planners' cost.
 """
 

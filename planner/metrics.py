@@ -2,7 +2,7 @@
 
 All inputs are in the world frame (metres). Distances to people are to their centres. Band fractions count path
 samples spaced at most ``spacing`` apart along the path (every vertex included). Group zones are
-``costmap.social.group_zone_polygon``, the same polygons the social layer paints, so "the path stays out of the
+``costmap.layers.social.group_zone_polygon``, the same polygons the social layer paints, so "the path stays out of the
 zone" and "the planner avoided the zone's cost" mean the same thing.
 
 Fixed keys of ``path_metrics`` (others may be added): success, path_length_m, planning_time_s,
@@ -23,13 +23,13 @@ from shapely.geometry import LineString, Point
 from shapely.ops import unary_union
 
 from costmap.grid import LETHAL, MAX_NON_OBSTACLE, NO_INFORMATION, Costmap2D
-from costmap.social import group_zone_polygon
+from costmap.layers.social import group_zone_polygon
 from planner.validity import interpolate
-from sid.groups import Group
-from sid.people import Person
+from sid.perception.groups import Group
+from sid.perception.people import Person
 
 if TYPE_CHECKING:
-    from planner.ompl_planner import PlanResult
+    from planner.facade import PlanResult
 
 HALL_BANDS: dict[str, tuple[float, float]] = {"intimate": (0.0, 0.45), "personal": (0.45, 1.2), "social": (1.2, 3.6)}
 PERSONAL_DISTANCE_M = 1.2

@@ -31,7 +31,6 @@ import numpy as np
 from scipy import ndimage
 
 from costmap.grid import INSCRIBED, LETHAL, MAX_NON_OBSTACLE, NO_INFORMATION, Costmap2D
-from costmap.scenario import Scenario
 
 _LOOP_MAX = 20
 
@@ -67,14 +66,6 @@ class PlanningProblem:
             raise PlanningError(f"robot_radius must be a non-negative number of metres, got {self.robot_radius}")
         if not (math.isfinite(self.cost_weight) and self.cost_weight >= 0):
             raise PlanningError(f"cost_weight must be a non-negative number, got {self.cost_weight}")
-
-    @classmethod
-    def from_scenario(
-        cls, scenario: Scenario, costmap: Costmap2D, cost_weight: float = DEFAULT_COST_WEIGHT
-    ) -> PlanningProblem:
-        """The scenario's robot task (start and goal positions, disc radius) on ``costmap``."""
-        robot = scenario.robot
-        return cls(costmap, robot.start[:2], robot.goal[:2], robot.radius, cost_weight)
 
 
 @dataclass

@@ -1,4 +1,4 @@
-"""Frame sources: everything that yields ``sid.frame.Frame`` (colour + depth + calibration).
+"""Frame sources: everything that yields ``sid.perception.frame.Frame`` (colour + depth + calibration).
 
 ``open_source(spec)`` picks one from a string, as ``sid detect --source`` does:
 
@@ -18,7 +18,7 @@ from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
-from sid.frame import Frame
+from sid.perception.frame import Frame
 
 RECORDING_SUFFIXES = (".db3", ".bag")
 

@@ -1,7 +1,7 @@
 """Folder source: colour + depth images on disk with a calibration JSON.
 
 Two layouts (the calibration is ``intrinsics.json`` or ``calibration.json`` in the folder, any form
-``sid.camera.Calibration.from_json`` reads; a flat intrinsics dict means depth registered to colour):
+``sid.perception.camera.Calibration.from_json`` reads; a flat intrinsics dict means depth registered to colour):
 
 - one frame: ``DIR/color.png`` (or ``.jpg``/``.jpeg``) + ``DIR/depth.png``, as in ../shared/data/rgbd/five_people;
 - a sequence: ``DIR/color/NAME.png|jpg|jpeg`` + ``DIR/depth/NAME.png``, paired by NAME and played in natural order
@@ -20,8 +20,8 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from sid.camera import Calibration
-from sid.frame import Frame
+from sid.perception.camera import Calibration
+from sid.perception.frame import Frame
 from sid.sources import FrameReadError, SourceError
 
 COLOR_SUFFIXES = (".png", ".jpg", ".jpeg")

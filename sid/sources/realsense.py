@@ -7,11 +7,11 @@
 Calibration (colour and depth intrinsics, depth-to-colour extrinsics, depth scale) is read from the device or the
 recording. Depth alignment (``align=``):
 
-- ``"sid"`` (default): our ``sid.align.Aligner`` (librealsense-style rectangle splat, colour-frame z); the frame's
-  depth is registered to colour and ``frame.calibration.depth`` is None.
+- ``"sid"`` (default): our ``sid.perception.align.Aligner`` (librealsense-style rectangle splat, colour-frame z); the
+  frame's depth is registered to colour and ``frame.calibration.depth`` is None.
 - ``"librealsense"``: ``rs.align(rs.stream.color)``; registered as above (it stores the depth reading, not z).
 - ``"none"``: the raw depth image in the depth camera's grid with the full calibration. The cheapest option when only
-  keypoints need depth: ``sid.align.depth_at_color_pixels`` looks them up sparsely.
+  keypoints need depth: ``sid.perception.align.depth_at_color_pixels`` looks them up sparsely.
 
 Recordings play as fast as they are read (real-time playback off, so no frame is dropped for a slow reader) and
 stop at the end of the file. They are read from the playback device (``rs.context().load_device``) through a syncer,
@@ -35,17 +35,17 @@ from typing import Literal
 import numpy as np
 import pyrealsense2 as rs
 
-from sid.align import Aligner
-from sid.camera import Calibration, Extrinsics
-from sid.frame import Frame
-from sid.realsense import (
+from sid.perception.align import Aligner
+from sid.perception.camera import Calibration, Extrinsics
+from sid.perception.frame import Frame
+from sid.sources import RECORDING_SUFFIXES, FrameReadError, SourceError
+from sid.sources.librealsense import (
     RealSenseFrames,
     calibration_from_profile,
     calibration_from_profiles,
     make_frameset,
     read_frameset,
 )
-from sid.sources import RECORDING_SUFFIXES, FrameReadError, SourceError
 
 AlignMode = Literal["sid", "librealsense", "none"]
 _POLL_MS = 100

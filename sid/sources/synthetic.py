@@ -14,7 +14,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-from sid.frame import Frame
+from sid.perception.frame import Frame
 from sid.sources import SourceError
 from sid.synthetic.layouts import LAYOUTS, layout
 from sid.synthetic.noise import DepthNoise, KeypointNoise
@@ -49,7 +49,7 @@ def scene_from_spec(spec: str) -> Scene:
 class SyntheticSource:
     """Iterable of ``frames`` synthetic ``Frame``s of one scene, ground truth in ``frame.truth``.
 
-    scene_or_spec: a ``Scene``, a ``costmap.scenario.Scenario`` (seen from the robot's start pose, see
+    scene_or_spec: a ``Scene``, a ``sid.scenario.loader.Scenario`` (seen from the robot's start pose, see
     ``Scene.from_scenario``) or a spec string (see ``scene_from_spec``). seed: noise seed. noise / keypoint_noise:
     depth and 2D keypoint noise (defaults: ``DepthNoise()``, ``KeypointNoise()``; ``DepthNoise.exact()`` and
     ``KeypointNoise(0, 0)`` for perfect data). Further keyword options go to ``SyntheticCamera`` (``registered``,

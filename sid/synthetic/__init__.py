@@ -11,11 +11,11 @@ Modules, in the order data flows:
 
 - ``scene``: ``Scene`` / ``ScenePerson`` records and scene files (JSON/YAML, costmap scenario people).
 - ``layouts``: the paper's S1-S5 as parameterised formations, and their documented variations.
-- ``body``: 15 capsules (torso, head, limbs) around each person's COCO skeleton (``sid.skeleton``).
+- ``body``: 15 capsules (torso, head, limbs) around each person's COCO skeleton (``sid.perception.skeleton``).
 - ``render``: exact depth / label / shading images by analytic ray-capsule intersection (ground, back wall).
 - ``noise``: D435 depth noise (Intel's RMS model, quantisation, holes, stereo shadow), keypoint noise.
 - ``sensor``: ``SyntheticCamera``, the virtual D435i (colour 1280x720, depth 848x480, 15 mm apart) that turns a
-  scene into a ``sid.frame.Frame`` with ``FrameTruth``.
+  scene into a ``sid.perception.frame.Frame`` with ``FrameTruth``.
 - ``truth``: ground-truth groups (interest point and area as the group detector defines them on exact data).
 - ``pose``: ``TruthPose``, the pose stand-in.
 """

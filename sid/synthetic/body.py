@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from sid.keypoints import KP, NUM_KEYPOINTS
+from sid.perception.keypoints import KP, NUM_KEYPOINTS
 from sid.synthetic.render import Capsule
 
 REFERENCE_HEIGHT = 1.70  # m: the body sizes below are for this height

@@ -35,7 +35,7 @@ from typing import Any
 
 import numpy as np
 
-from sid.frames import CameraMount
+from sid.perception.mount import CameraMount
 from sid.synthetic.scene import Scene, ScenePerson
 
 

@@ -19,8 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sid.frame import Frame
-from sid.keypoints import KP, NUM_KEYPOINTS, PoseDetection
+from sid.perception.frame import Frame
+from sid.perception.keypoints import KP, NUM_KEYPOINTS, PoseDetection
 from sid.synthetic.sensor import FrameTruth
 
 _FACE = np.isin(np.arange(NUM_KEYPOINTS), [KP["nose"], KP["left_eye"], KP["right_eye"]])

@@ -3,7 +3,8 @@
 A vectorised numpy ray caster: every shape is intersected analytically with the rays of the pixels inside its
 projected bounding box, and a z-buffer keeps the nearest hit. Rays are built as ``K^-1 [u, v, 1]``, so the ray
 parameter of a hit *is* its depth z in the camera's optical frame (x right, y down, z forward, metres), which is
-what a RealSense depth image stores. Pixel centres follow ``sid.camera``: (0, 0) is the centre of the top-left
+what a RealSense depth image stores. Pixel centres follow ``sid.perception.camera``: (0, 0) is the centre of the
+top-left
 pixel.
 
 Why not a library renderer: OpenGL/pyrender/Open3D would add heavy dependencies (and a display or EGL context)
@@ -17,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sid.camera import Extrinsics, Intrinsics
+from sid.perception.camera import Extrinsics, Intrinsics
 
 # Label image values that are not a body index.
 LABEL_NONE = -1  # nothing hit (sky / beyond every surface)

@@ -1,11 +1,12 @@
 """What a synthetic scene holds: people standing on the ground, the groups they form, the camera mount and the
-background. World frame (REP-103, ``sid.frames``): origin on the ground below the camera, x forward, y left, z up;
+background. World frame (REP-103, ``sid.perception.mount``): origin on the ground below the camera, x forward, y left,
+z up;
 metres and radians.
 
 Scene files (JSON or YAML) hold ``{"name": ..., "people": [{"x", "y", "theta"[, "id", "height"]}, ...],
 "groups": [[id, ...], ...], "camera": {"height": 0.9, "tilt": 0.0}, "wall_distance": 5.0}``; only ``people`` is
 required (``yaw`` is accepted for ``theta``). A costmap scenario file (it has a ``robot`` section) works too: it is
-read by ``costmap.scenario`` and its people are seen from the robot's start pose (see ``Scene.from_scenario``);
+read by ``sid.scenario.loader`` and its people are seen from the robot's start pose (see ``Scene.from_scenario``);
 its obstacles are not rendered.
 """
 
@@ -18,8 +19,9 @@ from typing import Any
 import numpy as np
 
 from sid.documents import load_document
-from sid.frames import CameraMount
-from sid.people import Person
+from sid.perception.mount import CameraMount
+from sid.perception.people import Person
+from sid.scenario.loader import Scenario, scenario_from_dict
 
 
 @dataclass(frozen=True)
@@ -40,7 +42,7 @@ class ScenePerson:
             raise ValueError(f"scene person {self.id}: height {self.height} m is not a standing person (0.5-2.5 m)")
 
     def as_person(self) -> Person:
-        """The ``sid.people.Person`` record (exact position and facing, orientation quality 1)."""
+        """The ``sid.perception.people.Person`` record (exact position and facing, orientation quality 1)."""
         return Person(self.id, self.x, self.y, self.theta, 1.0)
 
 
@@ -99,8 +101,6 @@ class Scene:
     def from_dict(cls, data: Any, default_name: str = "scene", base_dir: Path | None = None) -> Scene:
         """Build a scene from the parsed file content (see the module docstring)."""
         if isinstance(data, dict) and "robot" in data:
-            from costmap.scenario import scenario_from_dict  # costmap builds on sid: import it only when needed
-
             return cls.from_scenario(scenario_from_dict(data, base_dir, default_name))
         if not isinstance(data, dict) or not isinstance(data.get("people"), list) or not data["people"]:
             raise ValueError('expected an object with a non-empty "people" list')
@@ -122,15 +122,16 @@ class Scene:
     def from_people(
         cls, name: str, people: list[Person], groups: tuple[tuple[int, ...], ...] = (), **options: Any
     ) -> Scene:
-        """A scene of ``sid.people.Person`` records (e.g. a costmap Scenario's ``people``); theta must be known."""
+        """A scene of ``sid.perception.people.Person`` records (e.g. a costmap Scenario's ``people``); theta must be
+        known."""
         unknown = [p.id for p in people if p.theta is None]
         if unknown:
             raise ValueError(f"scene {name}: people {unknown} have no facing direction (theta is None)")
         return cls(name, tuple(ScenePerson(p.id, p.x, p.y, float(p.theta)) for p in people), groups, **options)
 
     @classmethod
-    def from_scenario(cls, scenario: Any, mount: CameraMount | None = None) -> Scene:
-        """The people of a ``costmap.scenario.Scenario`` as the robot's camera sees them from its start pose.
+    def from_scenario(cls, scenario: Scenario, mount: CameraMount | None = None) -> Scene:
+        """The people of a ``sid.scenario.loader.Scenario`` as the robot's camera sees them from its start pose.
 
         Positions and facings are moved from the map frame into the frame of the robot's start pose (x along its
         heading), the camera's world frame. No groups are declared; a wall stands 1 m behind the farthest person

@@ -19,12 +19,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from sid.camera import Calibration, Extrinsics, Intrinsics, project
-from sid.frame import Frame
-from sid.frames import CameraMount
-from sid.groups import GroupParams
-from sid.keypoints import NUM_KEYPOINTS
-from sid.skeleton import skeleton_world
+from sid.perception.camera import Calibration, Extrinsics, Intrinsics, project
+from sid.perception.frame import Frame
+from sid.perception.groups import GroupParams
+from sid.perception.keypoints import NUM_KEYPOINTS
+from sid.perception.mount import CameraMount
+from sid.perception.skeleton import skeleton_world
 from sid.synthetic.body import body_capsules
 from sid.synthetic.noise import DepthNoise, KeypointNoise
 from sid.synthetic.render import LABEL_GROUND, LABEL_NONE, LABEL_WALL, Background, RayCaster, Rendering

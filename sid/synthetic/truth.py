@@ -1,18 +1,18 @@
 """Ground-truth groups of a synthetic scene.
 
 Membership comes from the scene (the layout says who talks with whom). The interest point and the area of the
-interaction zone are those the group detector (``sid.groups.detect_groups``) computes on the *exact* people of the
-group (true positions and facing directions, only the members, the same parameters), so the reference follows the
-detector's own definition of the zone (ray crossings, shoelace area and centroid) and an error measured against it
-comes from perception alone. In the S1-S5 layouts without jitter every member faces the formation centre, so the
-area is 0 and the interest point is the centre (S4 included: its two outer members' rays cross at the centre too).
+interaction zone are those the group detector (``sid.perception.groups.detect_groups``) computes on the *exact* people
+of the group (true positions and facing directions, only the members, the same parameters), so the reference follows the
+detector's own definition of the zone (ray crossings, shoelace area and centroid) and an error measured against it comes
+from perception alone. In the S1-S5 layouts without jitter every member faces the formation centre, so the area is 0 and
+the interest point is the centre (S4 included: its two outer members' rays cross at the centre too).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from sid.groups import GroupParams, detect_groups
+from sid.perception.groups import GroupParams, detect_groups
 from sid.synthetic.scene import Scene
 
 

@@ -1,1 +1,0 @@
-"""Subcommands of the ``sid`` command line, one module each."""

@@ -1,0 +1,1 @@
+"""Experiments on top of the library: the with/without comparison, the demo, reproductions, benchmarks."""

@@ -1,0 +1,569 @@
+"""The stages ``sid bench`` times, each on a fixed, seeded input, and what each corresponds to in the paper.
+
+Every benchmark returns one or more stage records ``{"median_ms", "min_ms", "max_ms", "runs", ...extra}``
+keyed by stage name. Extra fields: ``paper_ms`` (the paper's Jetson Orin NX figure for the same step, NOTES
+section 6, another machine), ``ratio_to`` (the stage this one is compared with: ``sid.experiments.bench.suite`` adds
+``ratio`` = this median / that median), and counts or checks that show the stage did its work.
+
+Each benchmark imports what it times inside its own function, so that a module that fails to import (or an
+optional piece missing on a machine) costs only the benchmarks that need it, reported as such, not the run.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from sid.experiments.bench.baseline import baseline_groups
+from sid.experiments.bench.pose import timed_call
+from sid.experiments.bench.runner import RunSettings, Stats, measure, measure_parts
+from sid.perception.people import Person
+
+GROUP_SIZES = (2, 3, 4, 6, 20)
+DBSCAN_SIZES = (4, 20)
+FRAME_SIZES = (2, 3, 4, 6)
+PLAN_BUDGET_S = 0.5
+
+# The paper's Table 2 (ms per frame on a Jetson Orin NX, NOTES section 6) for 2 / 3 / 4 people.
+PAPER_POSE_MS = {2: 3.15, 3: 2.86, 4: 3.32}
+PAPER_LIFT_MS = {2: 0.55, 3: 0.52, 4: 0.55}  # "depth alignment + 3D"
+PAPER_GROUP_MS = {2: 0.25, 3: 0.14, 4: 0.15}  # "DBSCAN + groups"
+PAPER_TOTAL_MS = {2: 3.95, 3: 3.52, 4: 4.02}
+
+Records = dict[str, dict[str, Any]]
+
+
+@dataclass
+class Context:
+    """What every benchmark may use: timing settings, where ../shared is, shared set-ups and notes for the report.
+
+    plan_runs: seeds per sampling planner (each run takes the whole 0.5 s budget).
+    """
+
+    settings: RunSettings
+    shared: Path
+    plan_runs: int
+    notes: list[str] = field(default_factory=list)
+    _cache: dict[str, Any] = field(default_factory=dict, repr=False)
+
+    def __post_init__(self) -> None:
+        if self.plan_runs < 1:
+            raise ValueError(f"bench: plan_runs must be at least 1, got {self.plan_runs}")
+
+    def cached(self, key: str, build: Callable[[], Any]) -> Any:
+        """``build()`` once per run, shared by the benchmarks that need the same input."""
+        if key not in self._cache:
+            self._cache[key] = build()
+        return self._cache[key]
+
+    def note(self, text: str) -> None:
+        if text not in self.notes:
+            self.notes.append(text)
+
+
+@dataclass(frozen=True)
+class Benchmark:
+    """One unit of ``sid bench``: its name (also the prefix of the stages it writes), a one-line description, the
+    function that times it, and the benchmarks whose stages its ratios refer to (run with it)."""
+
+    name: str
+    what: str
+    run: Callable[[Context], Records]
+    needs: tuple[str, ...] = ()
+
+
+def record(stats: Stats, **extra: Any) -> dict[str, Any]:
+    """A stage record: the fixed fields plus extras (None values are left out)."""
+    return stats.to_dict() | {k: v for k, v in extra.items() if v is not None}
+
+
+# --- scenes -------------------------------------------------------------------------------------------------------
+
+
+def grouping_scene(n: int, seed: int = 0) -> list[Person]:
+    """``n`` people in conversation circles facing their centre, world frame (metres, radians).
+
+    Up to 6 people stand in one circle (radius 0.4 m for 2, i.e. 0.8 m apart as the paper's S1; 0.69 m for 3;
+    0.8 m for 4-5; 0.85 m for 6: neighbours 0.8-0.85 m apart); more are split into circles of 4 whose centres lie
+    6 m apart on a grid, farther than either detector's DBSCAN eps. Positions get 3 cm and facings 3 degrees of
+    seeded Gaussian noise, so that rays cross at distinct points as they do on real estimates (exact rays all meet
+    in one point).
+    """
+    if n < 1:
+        raise ValueError(f"bench: a grouping scene needs at least one person, got {n}")
+    sizes = [n] if n <= 6 else [4] * (n // 4) + ([n % 4] if n % 4 else [])
+    radius = {1: 0.4, 2: 0.4, 3: 0.69, 4: 0.8, 5: 0.8, 6: 0.85}
+    rng = np.random.default_rng(seed)
+    people: list[Person] = []
+    for k, size in enumerate(sizes):
+        cx, cy = 2.5 + 6.0 * (k % 3), 6.0 * (k // 3)
+        for j in range(size):
+            angle = 2 * math.pi * j / size + 0.3
+            x = cx + radius[size] * math.cos(angle) + rng.normal(0.0, 0.03)
+            y = cy + radius[size] * math.sin(angle) + rng.normal(0.0, 0.03)
+            theta = math.atan2(cy - y, cx - x) + rng.normal(0.0, math.radians(3.0))
+            people.append(Person(len(people), x, y, theta, 1.0))
+    return people
+
+
+def _frame_scene(n: int):
+    """The synthetic scene of the per-frame pipeline: the paper's S1 (2 people), S3 (3), S5 (4), or 6 people on a
+    1 m circle 3 m in front of the camera, facing its centre."""
+    from sid.synthetic import Scene, ScenePerson, layout
+
+    if n in (2, 3, 4):
+        return layout({2: "S1", 3: "S3", 4: "S5"}[n])
+    angles = [2 * math.pi * k / n + math.pi / n for k in range(n)]
+    people = tuple(
+        ScenePerson(k, 3.0 + math.cos(a), math.sin(a), math.atan2(-math.sin(a), -math.cos(a)))
+        for k, a in enumerate(angles)
+    )
+    return Scene(f"circle{n}", people, (tuple(range(n)),))
+
+
+def _frames(ctx: Context, n: int, count: int = 4) -> list:
+    """``count`` synthetic RGB-D frames (D435i depth 848x480 with noise, colour grid 1280x720) of ``n`` people."""
+
+    def build() -> list:
+        from sid.synthetic import SyntheticCamera
+
+        camera = SyntheticCamera(shaded_color=False)  # the colour image is not used: faster rendering
+        scene = _frame_scene(n)
+        return [camera.capture(scene, index=i, seed=0) for i in range(count)]
+
+    return ctx.cached(f"frames/{n}", build)
+
+
+def _truth_detections(frame) -> list:
+    from sid.synthetic.pose import TruthPose
+
+    return TruthPose()(frame)
+
+
+# --- grouping -----------------------------------------------------------------------------------------------------
+
+# The grouping stages run with native thread pools (OpenMP, BLAS) limited to one thread. The work is tiny, and
+# scikit-learn's OpenMP pool (used by DBSCAN's brute-force neighbour search below ~20 points) turned 0.46 ms into
+# 64 ms per call on this 2-core machine while other processes kept both cores busy (measured, median of 30 calls);
+# one thread is how such a step runs next to a camera driver and a planner. threadpoolctl is a dependency of
+# scikit-learn, not an extra one.
+GROUPING_THREADS = 1
+
+
+def _measure_one_thread(fn: Callable[[], object], settings: RunSettings) -> Stats:
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=GROUPING_THREADS):
+        return measure(fn, settings)
+
+
+def _member_sets(groups) -> set[tuple[int, ...]]:
+    return {tuple(sorted(g.members)) for g in groups}
+
+
+def _bench_group(n: int) -> Callable[[Context], Records]:
+    def run(ctx: Context) -> Records:
+        from sid.perception.groups import detect_groups
+
+        people = grouping_scene(n)
+        stats = _measure_one_thread(lambda: detect_groups(people), ctx.settings)
+        return {
+            f"group/{n}": record(
+                stats, groups=len(detect_groups(people)), threads=GROUPING_THREADS, paper_ms=PAPER_GROUP_MS.get(n)
+            )
+        }
+
+    return run
+
+
+def _bench_baseline(n: int) -> Callable[[Context], Records]:
+    def run(ctx: Context) -> Records:
+        from sid.perception.groups import detect_groups
+
+        people = grouping_scene(n)
+        stats = _measure_one_thread(lambda: baseline_groups(people), ctx.settings)
+        found = baseline_groups(people)
+        same = _member_sets(found) == _member_sets(detect_groups(people))
+        return {
+            f"group_baseline/{n}": record(
+                stats,
+                groups=len(found),
+                same_groups=same,
+                threads=GROUPING_THREADS,
+                ratio_to=f"group/{n}",
+                paper_ms=PAPER_GROUP_MS.get(n),
+            )
+        }
+
+    return run
+
+
+def _dbscan_points(n: int) -> np.ndarray:
+    return np.array([[p.x, p.y] for p in grouping_scene(n)])
+
+
+def _bench_dbscan(n: int) -> Callable[[Context], Records]:
+    def run(ctx: Context) -> Records:
+        from sid.perception.cluster import dbscan_labels
+        from sid.perception.groups import GroupParams
+
+        params, points = GroupParams(), _dbscan_points(n)
+        stats = _measure_one_thread(lambda: dbscan_labels(points, params.eps, params.min_samples), ctx.settings)
+        return {f"dbscan/{n}": record(stats, eps=params.eps, threads=GROUPING_THREADS)}
+
+    return run
+
+
+def _bench_dbscan_sklearn(n: int) -> Callable[[Context], Records]:
+    def run(ctx: Context) -> Records:
+        from sklearn.cluster import DBSCAN
+
+        from sid.perception.cluster import dbscan_labels
+        from sid.perception.groups import GroupParams
+
+        params, points = GroupParams(), _dbscan_points(n)
+
+        def fit() -> np.ndarray:
+            return DBSCAN(eps=params.eps, min_samples=params.min_samples).fit_predict(points)
+
+        same = bool(np.array_equal(fit(), dbscan_labels(points, params.eps, params.min_samples)))
+        stats = _measure_one_thread(fit, ctx.settings)
+        return {
+            f"dbscan_sklearn/{n}": record(
+                stats, eps=params.eps, same_labels=same, threads=GROUPING_THREADS, ratio_to=f"dbscan/{n}"
+            )
+        }
+
+    return run
+
+
+# --- alignment, lifting, orientation ------------------------------------------------------------------------------
+
+
+def _bench_align(mode: str) -> Callable[[Context], Records]:
+    def run(ctx: Context) -> Records:
+        from sid.perception.align import Aligner
+
+        frame = _frames(ctx, 4)[0]
+        aligner = Aligner(frame.calibration, mode)  # built once per stream, as a user does
+        stats = measure(lambda: aligner(frame.depth), ctx.settings)
+        kd, kc = frame.calibration.depth, frame.calibration.color
+        filled = float(np.count_nonzero(aligner(frame.depth)) / (kc.width * kc.height))
+        size = f"{kd.width}x{kd.height} -> {kc.width}x{kc.height}"
+        return {f"align/{mode}": record(stats, size=size, filled_fraction=round(filled, 3))}
+
+    return run
+
+
+def _bench_sparse_depth(ctx: Context) -> Records:
+    from sid.perception.align import depth_at_color_pixels
+
+    frame = _frames(ctx, 4)[0]
+    pixels = np.concatenate([d.keypoints for d in _truth_detections(frame)])
+    stats = measure(lambda: depth_at_color_pixels(frame.depth, pixels, frame.calibration), ctx.settings)
+    found = int(np.count_nonzero(np.isfinite(depth_at_color_pixels(frame.depth, pixels, frame.calibration))))
+    return {"align/sparse_4x17": record(stats, keypoints=len(pixels), with_depth=found)}
+
+
+def _bench_lift(ctx: Context) -> Records:
+    from sid.perception.lifting import LiftParams, lift_people
+    from sid.perception.mount import CameraMount
+
+    frame = _frames(ctx, 4)[0]
+    detections, mount, params = _truth_detections(frame), CameraMount(), LiftParams()
+    stats = measure(lambda: lift_people(detections, frame.depth, frame.calibration, mount, params), ctx.settings)
+    people = lift_people(detections, frame.depth, frame.calibration, mount, params)
+    facing = sum(p.theta is not None for p in people)
+    return {"lift/4": record(stats, people=len(people), with_facing=facing, paper_ms=PAPER_LIFT_MS[4])}
+
+
+def _bench_pca(ctx: Context) -> Records:
+    from sid.perception.orientation import estimate_orientation
+
+    frame = _frames(ctx, 4)[0]
+    keypoints = [p.keypoints_world for p in frame.truth.people]
+    stats = measure(lambda: [estimate_orientation(k) for k in keypoints], ctx.settings)
+    return {"pca/4": record(stats, people=len(keypoints))}
+
+
+# --- pose models and the per-frame pipeline -----------------------------------------------------------------------
+
+
+def pose_models(shared: Path) -> list[Path]:
+    """The ONNX pose models in ``shared``/models, sorted by name (none when the folder is absent)."""
+    folder = shared / "models"
+    return sorted(folder.glob("*.onnx")) if folder.is_dir() else []
+
+
+def _pose_image(ctx: Context) -> tuple[np.ndarray, str]:
+    """The real five-people frame (RGB) when ../shared has it, else a rendered synthetic frame of 4 people."""
+
+    def build() -> tuple[np.ndarray, str]:
+        import cv2
+
+        path = ctx.shared / "data" / "rgbd" / "five_people" / "color.png"
+        image = cv2.imread(str(path), cv2.IMREAD_COLOR) if path.is_file() else None
+        if image is not None:
+            return cv2.cvtColor(image, cv2.COLOR_BGR2RGB), f"five_people/color.png {image.shape[1]}x{image.shape[0]}"
+        from sid.synthetic import SyntheticCamera
+
+        ctx.note(f"{path} is absent: pose models run on a rendered synthetic frame (S5, 1280x720)")
+        frame = SyntheticCamera().capture(_frame_scene(4))
+        return frame.color, "synthetic S5 1280x720"
+
+    return ctx.cached("pose_image", build)
+
+
+def _estimator(ctx: Context, path: Path):
+    from sid.perception.pose import load_pose_estimator
+
+    return ctx.cached(f"estimator/{path}", lambda: load_pose_estimator(path))
+
+
+def _bench_pose(path: Path) -> Callable[[Context], Records]:
+    def run(ctx: Context) -> Records:
+        estimator = _estimator(ctx, path)
+        image, image_name = _pose_image(ctx)
+        image_hw = image.shape[:2]
+        found: list[int] = []
+
+        def call() -> dict[str, float]:
+            (pre, run, post), people = timed_call(estimator, image)
+            found.append(people)
+            return {"preprocess": pre / 1e6, "session_run": run / 1e6, "postprocess": post / 1e6,
+                    "total": (pre + run + post) / 1e6}  # fmt: skip
+
+        parts = measure_parts(call, ctx.settings)
+        name = f"pose/{path.stem}"
+        input_size = estimator.input_size or estimator.input_size_for(image_hw)
+        out = {
+            name: record(
+                parts["total"],
+                contract=estimator.contract,
+                input_size=list(input_size) if isinstance(input_size, tuple) else input_size,
+                threads=estimator.model.threads,
+                image=image_name,
+                people=found[-1],
+            )
+        }
+        for part in ("preprocess", "session_run", "postprocess"):
+            out[f"{name}/{part}"] = record(parts[part])
+        return out
+
+    return run
+
+
+def _pipeline_pose(ctx: Context) -> tuple[Callable, str]:
+    """The pose stage of the per-frame pipeline: the YOLO-pose model on the real image when ../shared has both (its
+    detections are then replaced by the synthetic frame's TruthPose detections, which match the synthetic depth),
+    else TruthPose alone."""
+    from sid.synthetic.pose import TruthPose
+
+    truth = TruthPose()
+    models = [p for p in pose_models(ctx.shared) if p.stem.startswith("yolo")]
+    image, image_name = _pose_image(ctx) if models else (None, "")
+    if not models or not image_name.startswith("five_people"):
+        ctx.note("per-frame pipeline: no YOLO-pose model or real image in ../shared, pose = TruthPose (no network)")
+        return truth, "TruthPose"
+    estimator = _estimator(ctx, models[0])
+
+    def pose(frame) -> list:
+        estimator(image)
+        return truth(frame)
+
+    return pose, f"{models[0].name} on {image_name} + TruthPose keypoints"
+
+
+def _bench_frame(n: int) -> Callable[[Context], Records]:
+    def run(ctx: Context) -> Records:
+        from sid.perception.pipeline import Pipeline
+
+        frames = _frames(ctx, n)
+        pose, pose_name = _pipeline_pose(ctx)
+        pipeline = Pipeline(pose)
+        counter = iter(range(10**9))
+        results = []
+
+        def call() -> dict[str, float]:
+            result = pipeline(frames[next(counter) % len(frames)])
+            results.append(result)
+            return result.timing_ms
+
+        parts = measure_parts(call, ctx.settings)
+        last = results[-1]
+        name = f"frame/{n}"
+        out = {
+            name: record(
+                parts["total"],
+                pose=pose_name,
+                people=len(last.people),
+                groups=len(last.groups),
+                paper_ms=PAPER_TOTAL_MS.get(n),
+            )
+        }
+        for part, paper in (("pose", PAPER_POSE_MS), ("lift", PAPER_LIFT_MS), ("group", PAPER_GROUP_MS)):
+            out[f"{name}/{part}"] = record(parts[part], paper_ms=paper.get(n))
+        return out
+
+    return run
+
+
+# --- costmap and planning -----------------------------------------------------------------------------------------
+
+
+def _costmap_setup(ctx: Context) -> dict[str, Any]:
+    """``sid.experiments.bench.scenes``' scene: a 20 m x 20 m map at 5 cm (400 x 400), a 720-beam scan, 3 groups of
+    3-4 people,
+    as two frames in which everyone moved 5 cm."""
+
+    def build() -> dict[str, Any]:
+        from costmap.grid import GridSpec
+        from sid.experiments.bench.scenes import bench_scene
+        from sid.scenario.lidar import simulate_scan
+
+        spec = GridSpec.from_size(0.05, (-10.0, -10.0), (20.0, 20.0))
+        frames = []
+        for shift in (0.0, 0.05):
+            obstacles, people, groups = bench_scene(20.0, shift=shift)
+            frames.append((people, groups, simulate_scan((0.0, 0.0, 0.0), obstacles, people, beams=720)))
+        return {"spec": spec, "frames": frames}
+
+    return ctx.cached("costmap", build)
+
+
+def _bench_costmap_update(social: bool) -> Callable[[Context], Records]:
+    def run(ctx: Context) -> Records:
+        from costmap.layered import LayeredCostmap
+
+        setup = _costmap_setup(ctx)
+        layered = LayeredCostmap(setup["spec"], social=social)
+        frames, counter = setup["frames"], iter(range(10**9))
+        stats = measure(lambda: layered.update(*frames[next(counter) % 2]), ctx.settings)
+        name = "costmap/update" if social else "costmap/update_no_social"
+        people, groups, _ = frames[0]
+        return {name: record(stats, cells=setup["spec"].width * setup["spec"].height, beams=720,
+                             people=len(people), groups=len(groups))}  # fmt: skip
+
+    return run
+
+
+def _bench_inflation(ctx: Context) -> Records:
+    from costmap.layered import LayeredCostmap
+
+    setup = _costmap_setup(ctx)
+    layered = LayeredCostmap(setup["spec"])
+    layered.update(*setup["frames"][0])
+    master = layered.master.costs.copy()  # walls and bodies (and their inflation, which does not change the result)
+    work = master.copy()
+
+    def inflate() -> None:
+        np.copyto(work, master)  # apply() writes in place; the 160 kB copy is part of the timing (~10 us)
+        layered.inflation.apply(work)
+
+    stats = measure(inflate, ctx.settings)
+    return {"costmap/inflation": record(stats, cells=master.size, method="opencv")}
+
+
+def _planning_setup(ctx: Context) -> dict[str, Any]:
+    """The demo scenario (``sid.experiments.demo``) with the social layer, as ``sid demo`` plans it, and the grid
+    planner's any-angle path as the cost reference."""
+
+    def build() -> dict[str, Any]:
+        from planner.facade import plan
+        from planner.problem import DEFAULT_COST_WEIGHT
+        from sid.experiments.demo import demo_scenario
+        from sid.perception.groups import detect_groups
+        from sid.scenario.build import build_costmap, planning_problem
+
+        scenario = demo_scenario()
+        groups = detect_groups(scenario.people, scenario.group_params)
+        layered = build_costmap(scenario, social=True, groups=groups)
+        problem = planning_problem(scenario, layered.master, DEFAULT_COST_WEIGHT)
+        return {"problem": problem, "reference_cost": plan(problem, "grid").cost}
+
+    return ctx.cached("planning", build)
+
+
+def _bench_plan(planner: str) -> Callable[[Context], Records]:
+    def run(ctx: Context) -> Records:
+        from planner.facade import plan
+
+        setup = _planning_setup(ctx)
+        problem, reference = setup["problem"], setup["reference_cost"]
+        if planner == "grid":  # deterministic: timed like any other stage
+            stats = measure(lambda: plan(problem, "grid"), ctx.settings)
+            return {"plan/grid": record(stats, cost_ratio=1.0, success_rate=1.0)}
+        results = [plan(problem, planner, time_limit=PLAN_BUDGET_S, seed=seed) for seed in range(1, ctx.plan_runs + 1)]
+        ok = [r for r in results if r.success]
+        ratios = [r.cost / reference for r in ok]
+        stats = Stats.of([r.planning_time_s * 1e3 for r in results])
+        return {
+            f"plan/{planner}": record(
+                stats,
+                budget_s=PLAN_BUDGET_S,
+                success_rate=len(ok) / len(results),
+                cost_ratio=float(np.median(ratios)) if ratios else None,
+                worst_cost_ratio=max(ratios) if ratios else None,
+            )
+        }
+
+    return run
+
+
+# --- the suite ----------------------------------------------------------------------------------------------------
+
+
+def benchmarks(ctx: Context) -> list[Benchmark]:
+    """Every benchmark of ``sid bench`` in report order: pose benchmarks for the models found under ``ctx.shared``
+    (a note when there are none), planning benchmarks for every registered planner."""
+    try:
+        from planner.facade import PLANNERS as planners
+    except ImportError as exc:  # OMPL missing: the rest of the suite still runs
+        ctx.note(f"planning benchmarks skipped: the planner cannot be imported ({exc})")
+        planners = ()
+    models = pose_models(ctx.shared)
+    if not models:
+        ctx.note(f"pose benchmarks skipped: no .onnx model in {ctx.shared / 'models'}")
+    items = [
+        Benchmark(f"group/{n}", f"sid.perception.groups.detect_groups, {n} people", _bench_group(n))
+        for n in GROUP_SIZES
+    ]
+    items += [
+        Benchmark(
+            f"group_baseline/{n}",
+            f"authors' approach (sid.experiments.bench.baseline), {n} people",
+            _bench_baseline(n),
+            needs=(f"group/{n}",),
+        )  # fmt: skip
+        for n in GROUP_SIZES
+    ]
+    for n in DBSCAN_SIZES:
+        items.append(Benchmark(f"dbscan/{n}", f"sid.perception.cluster.dbscan_labels, {n} points", _bench_dbscan(n)))
+        items.append(
+            Benchmark(
+                f"dbscan_sklearn/{n}", f"sklearn DBSCAN, {n} points", _bench_dbscan_sklearn(n), needs=(f"dbscan/{n}",)
+            )  # fmt: skip
+        )
+    items += [
+        Benchmark(f"align/{mode}", f"Aligner ({mode} splat), full frame", _bench_align(mode))
+        for mode in ("rectangle", "point")
+    ]
+    items += [
+        Benchmark("align/sparse_4x17", "depth_at_color_pixels, 4 x 17 keypoints", _bench_sparse_depth),
+        Benchmark("lift/4", "lift_people (keypoint depth, 3D, position, PCA facing), 4 people", _bench_lift),
+        Benchmark("pca/4", "estimate_orientation, 4 people", _bench_pca),
+    ]
+    items += [Benchmark(f"pose/{p.stem}", f"pose model {p.name}", _bench_pose(p)) for p in models]
+    items += [Benchmark(f"frame/{n}", f"Pipeline per frame, {n} people", _bench_frame(n)) for n in FRAME_SIZES]
+    items += [
+        Benchmark("costmap/update", "LayeredCostmap.update, 400x400, 720 beams, 3 groups", _bench_costmap_update(True)),
+        Benchmark("costmap/update_no_social", "the same without the social layer", _bench_costmap_update(False)),
+        Benchmark("costmap/inflation", "InflationLayer.apply alone, 400x400", _bench_inflation),
+    ]
+    items += [Benchmark(f"plan/{p}", f"planner {p} on the demo scenario", _bench_plan(p)) for p in planners]
+    return items

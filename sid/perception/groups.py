@@ -1,0 +1,351 @@
+"""Conversational groups (the paper's Algorithm 1): records and detection.
+
+All coordinates are in the world frame (metres, REP-103, see ``sid.perception.people``); angles in radians.
+
+Per frame: DBSCAN on the people's positions; per cluster, each person with a known facing casts a ray (a segment
+of ``ray_length``) from their position along their facing; where two rays cross, the two people look at a common
+point. The convex hull of the crossings is the interaction zone (area A, centroid = interest point), and D is the
+mean distance of the members to the interest point. While A or D exceed their thresholds, the member whose
+removal helps most is dropped; a cluster that ends under both thresholds is a group.
+
+Choices the paper leaves open, decided here:
+- People with unknown facing (theta None) count in DBSCAN (they are there, and link neighbours) but cast no ray,
+  so they are never members: a ray is the only evidence of taking part in a conversation.
+- A member whose ray meets no other member's ray is dropped before the geometry (it contributes no crossing, so
+  it could only pass the thresholds by standing close, e.g. someone just behind a group facing away).
+- Two people facing each other: their rays are (nearly) anti-parallel and often miss each other (parallel, or
+  crossing behind one of them). When they do not cross but each faces the other within ``facing_tolerance``,
+  the pair meets at the midpoint between them.
+- The polygon is the convex hull of the crossings (as the authors' code does), vertices counter-clockwise; area
+  and centroid by the shoelace formula. When the hull is degenerate (one crossing, coinciding or
+  collinear crossings; area below 1e-9 m^2) the area is 0 and the interest point is the mean of the crossings.
+- Pruning removes, at each step, the member whose removal minimises max(A / A_thr, D / D_thr); it stops with no
+  group when no removal lowers that value or fewer than two members would remain.
+- A DBSCAN cluster may hold several conversations side by side (a coffee break), and pruning one big set of
+  people member by member then fails. So the crossings of a cluster are first grouped by proximity
+  (``meeting_radius``, single linkage); the people whose rays meet at one spot form a candidate, candidates are
+  pruned in order of their number of crossings (most first), and a person joins at most one group. With one
+  spot (any single conversation) this is exactly the paper's algorithm; ``meeting_radius=math.inf`` forces it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from sid.perception.cluster import dbscan_labels
+from sid.perception.people import Person
+
+# |sin| of the angle between two rays below which they count as parallel (their crossing is rounding noise).
+_PARALLEL = 1e-9
+# Hull area (m^2) below which the polygon of crossings is treated as degenerate (a point or a segment).
+_DEGENERATE_AREA = 1e-9
+
+
+@dataclass(frozen=True)
+class GroupParams:
+    """Parameters of the group detector (metres, square metres, radians).
+
+    Defaults come from the geometry of conversations; the F-formation benchmarks then checked that none sits on a
+    cliff. F1 at T=2/3 (Synth / CoffeeBreak, ``sid eval fformation``) is 0.950 / 0.728 with these defaults; the
+    numbers below are the same scores with one value changed.
+
+    eps: DBSCAN neighbourhood radius (m). 2.0: a member of a conversation stands within ~1.5 m of a neighbour, so
+      2 m keeps any group in one cluster; clusters only bound the work, the ray geometry splits them (1.5:
+      0.950 / 0.746, 3.0: unchanged). The authors used 3.0 on (x, y, yaw) jointly.
+    min_samples: DBSCAN core size, the person included. 2: a conversation needs two people.
+    area_threshold: largest area (m^2) of a group's crossing polygon. 0.5, the authors' value: with facing errors
+      of 10-30 degrees the crossings of one conversation scatter over a few tenths of a square metre at most.
+      Rarely binding with short rays (0.25 or 1.0 change F1 by < 0.005).
+    spread_threshold: largest D (m), the mean member distance to the interest point, i.e. the o-space radius.
+      1.0: n people ~1 m apart on a circle have radius 1 / (2 sin(pi / n)), 1.0 m for six; Hall's personal
+      distance ends at 1.2 m (0.8: 0.947 / 0.697, 1.2: 0.933 / 0.637). The authors used 3.0, which also accepts
+      people side by side looking at a point 1.5 m ahead (see ``sid.experiments.seed_recordings``).
+    ray_length: length of each facing ray (m). 1.5: it must reach the o-space centre (D <= 1 m) with some slack;
+      longer rays mostly add crossings with strangers (1.0: 0.950 / 0.711, 2.0: 0.871 / 0.697). The authors
+      used 20 m.
+    facing_tolerance: two people whose rays do not cross but who face each other within this angle (rad) meet at
+      their midpoint. 0.6 (~34 degrees): face-to-face rays are nearly anti-parallel and miss each other with any
+      lateral offset; the tolerance covers facing errors of tens of degrees (annotations quantised to 90 degree
+      bins, estimates of side views) plus an offset of about half the distance between the two (0.4: 0.966 /
+      0.709, 0.8: 0.950 / 0.722).
+    meeting_radius: crossings closer than this (m, single linkage) belong to one candidate group; each candidate
+      is then pruned as in the paper. 0.6: the crossings of one o-space with facing errors of ~30 degrees scatter
+      by ~D tan(30 deg) = 0.6 m (0.4: 0.858 / 0.732, 0.8: 0.930 / 0.658). ``math.inf`` makes each DBSCAN cluster
+      one candidate, exactly the paper's Algorithm 1, which fails in crowded scenes (0.318 / 0.382; with all of
+      the authors' settings 0.139 / 0.038).
+    """
+
+    eps: float = 2.0
+    min_samples: int = 2
+    area_threshold: float = 0.5
+    spread_threshold: float = 1.0
+    ray_length: float = 1.5
+    facing_tolerance: float = 0.6
+    meeting_radius: float = 0.6
+
+    def __post_init__(self) -> None:
+        for name in ("eps", "spread_threshold", "ray_length"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(f"groups: {name} must be a positive number of metres, got {value}")
+        if not (math.isfinite(self.area_threshold) and self.area_threshold >= 0):
+            raise ValueError(f"groups: area_threshold must be >= 0 square metres, got {self.area_threshold}")
+        if isinstance(self.min_samples, bool) or int(self.min_samples) != self.min_samples or self.min_samples < 1:
+            raise ValueError(f"groups: min_samples must be an integer >= 1, got {self.min_samples}")
+        if not (self.meeting_radius > 0):  # math.inf allowed: one candidate per cluster, as in the paper
+            raise ValueError(f"groups: meeting_radius must be positive metres (or inf), got {self.meeting_radius}")
+        if not (math.isfinite(self.facing_tolerance) and 0 <= self.facing_tolerance < math.pi / 2):
+            raise ValueError(f"groups: facing_tolerance must be in [0, pi/2) radians, got {self.facing_tolerance}")
+
+
+@dataclass
+class Group:
+    """An interacting group.
+
+    members: person ids; interest_point: (x, y) of the o-space centre; area: interaction-zone area (m^2);
+    zone: (K, 2) polygon of ray crossings, counter-clockwise (one vertex for a pair); spread: D, the mean
+    member distance to the interest point (m).
+    """
+
+    members: tuple[int, ...]
+    interest_point: tuple[float, float]
+    area: float
+    zone: np.ndarray
+    spread: float
+
+
+@dataclass(frozen=True)
+class _Geometry:
+    """Area (m^2), centre (complex x + iy), (K, 2) zone and spread D (m) of a candidate's crossings."""
+
+    area: float
+    centre: complex
+    zone: np.ndarray
+    spread: float
+
+    def excess(self, params: GroupParams) -> float:
+        """max(A / A_thr, D / D_thr): <= 1 when both are under their thresholds."""
+        area_ratio = self.area / params.area_threshold if params.area_threshold > 0 else (math.inf if self.area else 0)
+        return max(area_ratio, self.spread / params.spread_threshold)
+
+
+def detect_groups(people: Sequence[Person], params: GroupParams = GroupParams()) -> list[Group]:
+    """Interacting groups among ``people`` (world frame), in the order of their DBSCAN clusters.
+
+    Members are listed in input order. Raises ValueError naming the person for a non-finite position or yaw,
+    and for duplicate ids. Fewer than two people give no group.
+    """
+    people = list(people)
+    ids, positions, facing = _as_arrays(people)
+    if len(people) < 2:
+        return []
+    labels = dbscan_labels(np.column_stack((positions.real, positions.imag)), params.eps, params.min_samples)
+    has_ray = ~np.isnan(facing)
+    groups: list[Group] = []
+    for label in range(int(labels.max()) + 1):
+        cluster = np.flatnonzero((labels == label) & has_ray)
+        if len(cluster) >= 2:
+            groups.extend(_groups_in_cluster([ids[i] for i in cluster], positions[cluster], facing[cluster], params))
+    return groups
+
+
+def _as_arrays(people: list[Person]) -> tuple[list[int], np.ndarray, np.ndarray]:
+    """Ids, positions and unit facing vectors as complex numbers x + iy (NaN facing = unknown), validated."""
+    ids = [p.id for p in people]
+    if len(set(ids)) != len(ids):
+        duplicates = sorted({i for i in ids if ids.count(i) > 1})
+        raise ValueError(f"groups: person ids must be unique, repeated: {duplicates}")
+    positions = np.empty(len(people), dtype=complex)
+    facing = np.full(len(people), np.nan, dtype=complex)
+    for k, person in enumerate(people):
+        if not (math.isfinite(person.x) and math.isfinite(person.y)):
+            raise ValueError(f"groups: person {person.id} has a non-finite position ({person.x}, {person.y})")
+        positions[k] = complex(person.x, person.y)
+        if person.theta is not None:
+            if not math.isfinite(person.theta):
+                raise ValueError(f"groups: person {person.id} has a non-finite theta {person.theta} (use None)")
+            facing[k] = complex(math.cos(person.theta), math.sin(person.theta))
+    return ids, positions, facing
+
+
+@dataclass(frozen=True)
+class _Meetings:
+    """Pairs of people (indices into the cluster) whose rays meet, and where (complex x + iy)."""
+
+    first: np.ndarray
+    second: np.ndarray
+    points: np.ndarray
+
+
+@lru_cache(maxsize=64)
+def _pairs(k: int) -> tuple[np.ndarray, np.ndarray]:
+    return np.triu_indices(k, 1)
+
+
+def _ray_meetings(positions: np.ndarray, facing: np.ndarray, params: GroupParams) -> _Meetings:
+    """Where the rays of each pair meet (see the module docstring). 2D vectors are complex numbers, so that
+    conj(a) * b = dot(a, b) + i cross(a, b)."""
+    i, j = _pairs(len(positions))
+    pi, pj, fi, fj = positions[i], positions[j], facing[i], facing[j]
+    d_conj = (pj - pi).conjugate()
+    # Rays p_i + s f_i and p_j + t f_j meet where s f_i - t f_j = d = p_j - p_i: s = cross(d, f_j) / cross(f_i, f_j)
+    # and t = cross(d, f_i) / cross(f_i, f_j); the segments meet when both lie in [0, ray_length].
+    denom = (fi.conjugate() * fj).imag
+    along_i = d_conj * fi
+    along_j = d_conj * fj
+    half = 0.5 * params.ray_length
+    distance = np.abs(d_conj)
+    # Face to face: each looks at the other within the tolerance (dot(f, d) >= cos(tol) |d|).
+    reach = math.cos(params.facing_tolerance) * distance
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = along_j.imag / denom
+        t = along_i.imag / denom
+        crossing = (np.abs(denom) > _PARALLEL) & (np.maximum(np.abs(s - half), np.abs(t - half)) <= half)
+        points = np.where(crossing, pi + s * fi, 0.5 * (pi + pj))  # a face-to-face pair meets at its midpoint
+    face_to_face = (along_i.real >= reach) & (-along_j.real >= reach) & (distance > 0) & (distance <= 4 * half)
+    meet = crossing | face_to_face
+    return _Meetings(i[meet], j[meet], points[meet])
+
+
+def _groups_in_cluster(ids: list[int], positions: np.ndarray, facing: np.ndarray, params: GroupParams) -> list[Group]:
+    meetings = _ray_meetings(positions, facing, params)
+    points = meetings.points
+    if len(points) == 0:
+        return []
+    if math.isinf(params.meeting_radius) or np.abs(points[:, None] - points[None, :]).max() <= params.meeting_radius:
+        candidates = [np.ones(len(ids), dtype=bool)]  # all crossings within reach of each other: one spot
+    else:
+        spots = dbscan_labels(np.column_stack((points.real, points.imag)), params.meeting_radius, 1)
+        # Candidates in order of their number of crossings, most first (ties: in order of discovery).
+        order = sorted(range(int(spots.max()) + 1), key=lambda spot: -np.count_nonzero(spots == spot))
+        candidates = []
+        for spot in order:
+            mask = np.zeros(len(ids), dtype=bool)
+            mask[meetings.first[spots == spot]] = True
+            mask[meetings.second[spots == spot]] = True
+            candidates.append(mask)
+    remaining = np.ones(len(ids), dtype=bool)
+    groups = []
+    for mask in candidates:
+        found = _prune(mask & remaining, meetings, positions, params)
+        if found is None:
+            continue
+        members, geometry = found
+        groups.append(
+            Group(
+                members=tuple(ids[i] for i in np.flatnonzero(members)),
+                interest_point=(geometry.centre.real, geometry.centre.imag),
+                area=geometry.area,
+                zone=geometry.zone,
+                spread=geometry.spread,
+            )
+        )
+        remaining &= ~members
+    return groups
+
+
+def _active(members: np.ndarray, meetings: _Meetings) -> np.ndarray:
+    """Which meetings are between two members."""
+    return members[meetings.first] & members[meetings.second]
+
+
+def _with_meetings(members: np.ndarray, meetings: _Meetings) -> np.ndarray:
+    """The members whose ray meets another member's ray."""
+    active = _active(members, meetings)
+    result = np.zeros_like(members)
+    result[meetings.first[active]] = True
+    result[meetings.second[active]] = True
+    return result
+
+
+def _geometry(members: np.ndarray, meetings: _Meetings, positions: np.ndarray) -> _Geometry:
+    crossings = meetings.points[_active(members, meetings)]
+    hull = _convex_hull(crossings.tolist()) if len(crossings) >= 3 else []
+    area, centre = _shoelace(hull) if len(hull) >= 3 else (0.0, 0j)
+    if area > _DEGENERATE_AREA:
+        zone = np.array([(p.real, p.imag) for p in hull])
+    else:
+        area = 0.0
+        centre = complex(crossings.sum() / len(crossings))
+        zone = _segment_ends(crossings, centre)
+    member_positions = positions[members]
+    spread = float(np.abs(member_positions - centre).sum() / len(member_positions))
+    return _Geometry(area, centre, zone, spread)
+
+
+def _convex_hull(points: list[complex]) -> list[complex]:
+    """Counter-clockwise convex hull (Andrew's monotone chain), collinear points dropped.
+
+    Hand-written rather than shapely's: the pruning loop builds several hulls of a handful of points per call, and
+    this costs a few microseconds where a shapely round trip costs ~40 (measured on the project's machine).
+    """
+    ordered = sorted(set(points), key=lambda p: (p.real, p.imag))
+    if len(ordered) < 3:
+        return ordered
+
+    def chain(sequence: list[complex]) -> list[complex]:
+        kept: list[complex] = []
+        for p in sequence:
+            while len(kept) >= 2 and ((kept[-1] - kept[-2]).conjugate() * (p - kept[-2])).imag <= 0:
+                kept.pop()
+            kept.append(p)
+        return kept[:-1]
+
+    return chain(ordered) + chain(ordered[::-1])
+
+
+def _shoelace(polygon: list[complex]) -> tuple[float, complex]:
+    """Area and centroid of a counter-clockwise polygon (shoelace formula); the centroid is 0 for zero area."""
+    twice_area = 0.0
+    moment = 0j
+    for a, b in zip(polygon, polygon[1:] + polygon[:1], strict=True):
+        cross = (a.conjugate() * b).imag
+        twice_area += cross
+        moment += cross * (a + b)
+    if twice_area <= 0:
+        return 0.0, 0j
+    return 0.5 * twice_area, moment / (3.0 * twice_area)
+
+
+def _segment_ends(crossings: np.ndarray, centre: complex) -> np.ndarray:
+    """(K, 2) zone of a degenerate hull: the centre when the crossings coincide, else the two extreme crossings."""
+    offsets = crossings - centre
+    far = offsets[int(np.argmax(np.abs(offsets)))]
+    if abs(far) < 1e-6:
+        ends = np.array([centre])
+    else:
+        along = (offsets * far.conjugate()).real
+        ends = crossings[[int(np.argmin(along)), int(np.argmax(along))]]
+    return np.column_stack((ends.real, ends.imag))
+
+
+def _prune(
+    candidates: np.ndarray, meetings: _Meetings, positions: np.ndarray, params: GroupParams
+) -> tuple[np.ndarray, _Geometry] | None:
+    """The group left after pruning ``candidates`` (bool mask), with its geometry, or None."""
+    members = _with_meetings(candidates, meetings)
+    if np.count_nonzero(members) < 2:
+        return None
+    geometry = _geometry(members, meetings, positions)
+    excess = geometry.excess(params)
+    while excess > 1.0:
+        best: tuple[float, np.ndarray, _Geometry] | None = None
+        for i in np.flatnonzero(members):
+            trial = members.copy()
+            trial[i] = False
+            trial = _with_meetings(trial, meetings)
+            if np.count_nonzero(trial) < 2:
+                continue
+            trial_geometry = _geometry(trial, meetings, positions)
+            trial_excess = trial_geometry.excess(params)
+            if best is None or trial_excess < best[0]:
+                best = (trial_excess, trial, trial_geometry)
+        if best is None or best[0] >= excess:
+            return None
+        excess, members, geometry = best
+    return members, geometry

@@ -1,0 +1,279 @@
+"""From 2D pose detections and depth to people in the world frame (the paper's steps 2-4).
+
+Per detection: each confident keypoint takes the depth of its colour pixel
+(``sid.perception.align.depth_at_color_pixels``,
+robust to holes and silhouette edges), is deprojected with the colour intrinsics K_c (d * K_c^-1 [u v 1]) and moved
+to the world frame with the camera mount. Keypoints without a valid depth are dropped, never placed at the camera,
+and so are keypoints whose depth is far from their person's (``depth_gate``) or belongs to a person standing in front
+(``occluder_gap``). Position = mean of the lifted keypoints' world x, y; facing =
+``sid.perception.orientation.estimate_orientation``.
+
+A depth camera sees the body's surface, not its joints. Two corrections, both along each keypoint's viewing ray
+(its pixel is kept), turn surface readings into points inside the body:
+
+1. **Surface offset** (``LiftParams.surface_offset``): joints lie inside limbs and torso, about half their
+   front-back thickness behind the skin, and the head's centre about half a head length behind the face; every
+   keypoint is pushed that far further along its ray, so that lifted keypoints are points of the body's interior
+   (joint centres, the head's mid-plane), which is what the position (their mean) and the body plane need.
+2. **Far-side completion** (``LiftParams.complete_far_side``): in a side view the far shoulder, hip, ear, ... are
+   hidden behind the person's own body; a pose model still places them (it knows the body's shape) with a lower
+   score, but their pixels show the near side of the body, whose depth is 0.15-0.3 m too near. The body plane then
+   turns towards the camera and the front/back order of left and right collapses. A left/right pair is taken as
+   *collapsed* when its two keypoints lie closer in 3D than ``min_pair_fraction`` of their anthropometric
+   separation W (the joints of a pair cannot come closer than that: the depth of one is wrong), and its lower-score
+   keypoint is then taken as the hidden one when its score is at least ``far_side_score_gap`` below its partner's.
+   That keypoint keeps its ray and is placed behind its partner, at the depth where the pair is W apart in 3D:
+   sqrt(W^2 - w^2) behind the partner's foot point on the ray, with w the partner's distance from the ray. Roots
+   with a fixed separation: shoulders, hips, ears (W from ``sid.perception.orientation``). Elbows and wrists follow the
+   shoulders, knees and ankles the hips: a follower scoring ``far_side_score_gap`` below its partner is put at
+   least as far behind its partner as its root was put behind its own (never pulled nearer). Completed keypoints
+   are reported as inferred to the orientation estimate, which counts them less as left/right evidence. Without a
+   clear score difference a collapsed pair is left alone (and the orientation quality stays low).
+
+Frames: camera optical (x right, y down, z forward) -> world (REP-103: x forward, y left, z up, origin on the
+ground below the camera; see ``sid.perception.mount``). Units: metres, radians.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from sid.perception.align import depth_at_color_pixels
+from sid.perception.camera import Calibration
+from sid.perception.keypoints import COCO_KEYPOINTS, KP, NUM_KEYPOINTS, PoseDetection
+from sid.perception.mount import CameraMount
+from sid.perception.orientation import EAR_SEPARATION, HIP_SEPARATION, SHOULDER_SEPARATION, estimate_orientation
+from sid.perception.people import Person
+
+# Far-side completion. Root keypoints, each with its partner a fixed separation away: shoulders, hips, ears
+# (``widths`` order), left then right.
+_FAR = np.array([KP[f"{side}_{part}"] for side in ("left", "right") for part in ("shoulder", "hip", "ear")])
+# The other side's keypoint of each keypoint (left <-> right; the nose is its own).
+_MIRROR = np.array([KP[n.replace("left", "@").replace("right", "left").replace("@", "right")] for n in COCO_KEYPOINTS])
+# Followers of each root keypoint (-1: none): the arm hangs from the shoulder, the leg from the hip.
+_FOLLOWERS = np.full((NUM_KEYPOINTS, 2), -1)
+for _side in ("left", "right"):
+    _FOLLOWERS[KP[f"{_side}_shoulder"]] = KP[f"{_side}_elbow"], KP[f"{_side}_wrist"]
+    _FOLLOWERS[KP[f"{_side}_hip"]] = KP[f"{_side}_knee"], KP[f"{_side}_ankle"]
+
+
+@dataclass(frozen=True)
+class LiftParams:
+    """How keypoints become 3D points.
+
+    min_score: a keypoint is used when its score is at least this. 0.3 is a common visibility cut for MoveNet and
+      YOLO-pose keypoints, but scores are model-specific (our float ONNX conversions differ from the int8 TFLite
+      originals by up to 0.35): set it per model.
+    min_keypoints: a detection with fewer lifted keypoints gives no Person. 3: fewer cannot be placed reliably
+      (one occluded limb at a wrong depth would decide the position) and cannot give a facing direction.
+    patch: side (pixels, odd) of the depth window read around each keypoint. 5, as the paper's authors did.
+    max_range: keypoints farther than this from the camera (m, optical z) are dropped. 6.0: D435-class depth
+      noise grows with range squared (~2 % at 2 m, ~20 cm at 6 m), beyond which body orientation is noise.
+    depth_gate: keypoints whose depth differs from the person's median keypoint depth by more than this (m) are
+      dropped. 0.6: a standing body spans ~0.3 m in depth even in side view; a keypoint beyond that read the wall
+      or a person behind (a keypoint on the silhouette edge, or a mislocalised wrist).
+    occluder_gap: a keypoint inside the box of another person whose median keypoint depth is more than this (m)
+      nearer, with a depth closer to that person's median than to its own person's, read the person in front (an
+      arm or leg hidden behind them, a silhouette edge) and is dropped. 0.2: about a body's depth (chest depth
+      0.20-0.25 m); people whose medians differ less stand side by side, where the closer median would be a coin
+      toss. On ../shared/data/rgbd/five_people it drops one elbow each of the two partly hidden people (their
+      median depths differ by 0.31 and 0.22 m from the person in front). ``math.inf`` turns it off.
+    surface_offset: how far (m) a keypoint's point inside the body lies behind the surface the camera sees, added
+      along every keypoint's viewing ray. 0.07: about half the front-back thickness of an adult around the joints:
+      chest depth 0.20-0.25 m puts the hip and shoulder joints ~0.1 m behind the front of the torso, upper arm and
+      thigh diameters (0.09-0.15 m) put elbows and knees 0.05-0.07 m inside, clothes add 1-2 cm; head length
+      (0.18-0.20 m) puts the head's centre ~0.1 m behind the nose and eyes. Measured on the synthetic bodies of
+      ``sid.synthetic`` (joint range minus read range, people within 30 deg of facing the camera): 0.045-0.06 m at
+      shoulders, elbows, wrists, ankles and ears, 0.076 m at knees, 0.09 m at hips, 0.005-0.02 m at nose and eyes
+      (skin landmarks: there the offset moves the point into the head). 0 turns it off.
+    complete_far_side: place the hidden far side of a collapsed left/right pair behind its partner (module
+      docstring). shoulder_separation, hip_separation, ear_separation: the pairs' 3D separation W (m), adult
+      values from ``sid.perception.orientation`` (sources there); lower them for children.
+    min_pair_fraction: a pair closer in 3D than this fraction of W is collapsed. 0.7 (0.24 m for shoulders): the
+      narrowest adults (biacromial breadth 0.325 m, 5th percentile of women) put their shoulder keypoints ~0.26 m
+      apart (at the keypoint-to-bone ratio measured on five_people, where the five show 0.29-0.31 m), and depth
+      noise adds a few centimetres either way. In the Table 1 scenes a self-occluded far shoulder that read the
+      near side's surface leaves the pair 0.07-0.30 m apart (median 0.20 m); pairs seen on both sides, 0.29-0.39 m.
+    far_side_score_gap: the lower-score keypoint of a collapsed pair is the hidden one when its score is at least
+      this much below its partner's. 0.1: real models score both visible shoulders or hips within a few hundredths
+      of each other (YOLO11-pose on five_people: <= 0.03) and a hidden far side tenths lower (its hidden ear there:
+      0.36 against 0.97). A model that scores its guesses as high as what it sees gets no completion: side views
+      then fail as without it (docs/reproduction.md, sensitivity).
+    """
+
+    min_score: float = 0.3
+    min_keypoints: int = 3
+    patch: int = 5
+    max_range: float = 6.0
+    depth_gate: float = 0.6
+    occluder_gap: float = 0.2
+    surface_offset: float = 0.07
+    complete_far_side: bool = True
+    shoulder_separation: float = SHOULDER_SEPARATION
+    hip_separation: float = HIP_SEPARATION
+    ear_separation: float = EAR_SEPARATION
+    min_pair_fraction: float = 0.7
+    far_side_score_gap: float = 0.1
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.min_score) and 0 <= self.min_score <= 1):
+            raise ValueError(f"lift: min_score must be in [0, 1], got {self.min_score}")
+        if int(self.min_keypoints) != self.min_keypoints or not 1 <= self.min_keypoints <= NUM_KEYPOINTS:
+            raise ValueError(f"lift: min_keypoints must be an integer in 1..{NUM_KEYPOINTS}, got {self.min_keypoints}")
+        if int(self.patch) != self.patch or self.patch < 1 or self.patch % 2 == 0:
+            raise ValueError(f"lift: patch must be a positive odd number of pixels, got {self.patch}")
+        if not (self.occluder_gap >= 0):  # math.inf allowed: off
+            raise ValueError(
+                f"lift: occluder_gap must be a non-negative number of metres (or inf), got {self.occluder_gap}"
+            )
+        for name in ("max_range", "depth_gate", "shoulder_separation", "hip_separation", "ear_separation"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(f"lift: {name} must be a positive number of metres, got {value}")
+        if not (math.isfinite(self.surface_offset) and 0 <= self.surface_offset < 0.5):
+            raise ValueError(f"lift: surface_offset must be in [0, 0.5) metres, got {self.surface_offset}")
+        if not (math.isfinite(self.min_pair_fraction) and 0 < self.min_pair_fraction <= 1):
+            raise ValueError(f"lift: min_pair_fraction must be in (0, 1], got {self.min_pair_fraction}")
+        if not (math.isfinite(self.far_side_score_gap) and 0 <= self.far_side_score_gap <= 1):
+            raise ValueError(f"lift: far_side_score_gap must be in [0, 1], got {self.far_side_score_gap}")
+
+
+def lift_people(
+    detections: Sequence[PoseDetection],
+    depth_m: np.ndarray,
+    calib: Calibration,
+    mount: CameraMount,
+    params: LiftParams = LiftParams(),
+    ids: Sequence[int] | None = None,
+) -> list[Person]:
+    """People in the world frame from one frame's pose detections.
+
+    depth_m: the frame's depth in metres (0 or NaN = no reading), registered to colour when ``calib.depth`` is
+    None, else in the depth camera's own grid (looked up sparsely, see ``sid.perception.align``). ids: one per detection
+    (default: the detection's index). Detections with fewer than ``params.min_keypoints`` lifted keypoints give no
+    Person; the others get theta None when their facing cannot be told (see ``sid.perception.orientation``). Keypoints
+    are corrected from the body's surface to its joints (module docstring).
+    """
+    if ids is not None and len(ids) != len(detections):
+        raise ValueError(f"lift: {len(ids)} ids for {len(detections)} detections")
+    if not detections:
+        return []
+    keypoints = np.stack([d.keypoints for d in detections])  # (P, 17, 2) colour pixels
+    scores = np.stack([d.scores for d in detections])  # (P, 17)
+    confident = (scores >= params.min_score) & np.isfinite(keypoints).all(axis=2)  # (comparisons with NaN: False)
+    depth = np.full(scores.shape, np.nan)
+    depth[confident] = depth_at_color_pixels(depth_m, keypoints[confident], calib, patch=params.patch)
+    usable = confident & (depth > 0) & (depth <= params.max_range)
+    # Median depth per person over its usable keypoints (unusable ones sort last as +inf; np.nanmedian is ~30x
+    # slower on arrays this small).
+    ordered = np.sort(np.where(usable, depth, np.inf), axis=1)
+    count = np.count_nonzero(usable, axis=1)
+    rows = np.arange(len(detections))
+    median = 0.5 * (
+        ordered[rows, np.maximum(count - 1, 0) // 2] + ordered[rows, np.minimum(count // 2, ordered.shape[1] - 1)]
+    )
+    usable &= np.abs(depth - median[:, None]) <= params.depth_gate
+    if len(detections) > 1 and math.isfinite(params.occluder_gap):
+        boxes = np.stack([d.box for d in detections])
+        usable &= ~_reads_someone_in_front(keypoints, depth, median, boxes, params.occluder_gap)
+
+    # Each keypoint's viewing ray (camera frame, through K_c^-1 [u v 1] = (ray_x, ray_y, 1)) and its range along it
+    # (m; NaN where unusable); depth z and range r: r = z * |(ray_x, ray_y, 1)|.
+    intr = calib.color
+    ray_x = (keypoints[..., 0] - intr.cx) / intr.fx
+    ray_y = (keypoints[..., 1] - intr.cy) / intr.fy
+    norm = np.sqrt(ray_x * ray_x + ray_y * ray_y + 1.0)
+    ranges = np.where(usable, depth * norm + params.surface_offset, np.nan)
+    inferred = np.zeros(scores.shape, dtype=bool)
+    if params.complete_far_side:
+        widths = np.array([params.shoulder_separation, params.hip_separation, params.ear_separation])
+        _complete_far_side(ray_x, ray_y, norm, ranges, scores, inferred, widths, params)
+
+    world = np.full((*scores.shape, 3), np.nan)
+    if usable.any():
+        z = ranges[usable] / norm[usable]
+        camera = np.stack([ray_x[usable] * z, ray_y[usable] * z, z], axis=1)
+        world[usable] = mount.camera_to_world(camera)
+    counts = np.count_nonzero(usable, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        positions = np.where(usable[..., None], world[..., :2], 0.0).sum(axis=1) / counts[:, None]
+    people = []
+    for k in np.flatnonzero(counts >= params.min_keypoints).tolist():
+        theta, quality = estimate_orientation(world[k], inferred[k])
+        x, y = positions[k].tolist()
+        people.append(Person(int(ids[k]) if ids is not None else k, x, y, theta, quality, world[k]))
+    return people
+
+
+def _reads_someone_in_front(
+    keypoints: np.ndarray, depth: np.ndarray, median: np.ndarray, boxes: np.ndarray, gap: float
+) -> np.ndarray:
+    """(P, 17) bool: keypoints that read a person in front of theirs (``LiftParams.occluder_gap``).
+
+    keypoints: (P, 17, 2) colour pixels; depth: (P, 17) m (NaN: none); median: (P,) each person's median keypoint
+    depth (m); boxes: (P, 4) (u_min, v_min, u_max, v_max). Pairs (i, j) below: keypoints of i, person j.
+    """
+    u, v = keypoints[:, None, :, 0], keypoints[:, None, :, 1]  # (P, 1, 17)
+    box = boxes[None, :, :, None]  # (1, P, 4, 1)
+    inside = (u >= box[:, :, 0]) & (u <= box[:, :, 2]) & (v >= box[:, :, 1]) & (v <= box[:, :, 3])  # (P, P, 17)
+    # Closer to j's median than to i's, j in front: nearer than the midpoint of the two medians (-inf: j not in front).
+    in_front = median[None, :] < median[:, None] - gap  # (P, P)
+    limit = np.where(in_front, 0.5 * (median[:, None] + median[None, :]), -np.inf)
+    return (inside & (depth[:, None, :] < limit[:, :, None])).any(axis=1)
+
+
+def _complete_far_side(
+    ray_x: np.ndarray,
+    ray_y: np.ndarray,
+    norm: np.ndarray,
+    ranges: np.ndarray,
+    scores: np.ndarray,
+    inferred: np.ndarray,
+    widths: np.ndarray,
+    params: LiftParams,
+) -> None:
+    """Far-side completion (module docstring), in place on ``ranges`` (P, 17) and ``inferred`` (P, 17).
+
+    ray_x, ray_y, norm: (P, 17) viewing rays (ray_x, ray_y, 1) in the camera frame and their lengths; ranges:
+    metres along the rays, NaN where unusable; scores: (P, 17); widths: (3,) separations W of the root pairs
+    (shoulders, hips, ears). Keypoints are addressed by flat index person * 17 + keypoint.
+    """
+    gap = params.far_side_score_gap
+    # Candidates: a root keypoint scoring clearly lower than its partner (the hidden one, if the pair collapsed).
+    people, k = np.nonzero(scores[:, _FAR] <= scores[:, _MIRROR[_FAR]] - gap)
+    if len(people) == 0:
+        return
+    base = people * NUM_KEYPOINTS
+    far, near = base + _FAR[k], base + _MIRROR[_FAR[k]]
+    r, x, y, n = ranges.reshape(-1), ray_x.reshape(-1), ray_y.reshape(-1), norm.reshape(-1)  # views
+    far_range, near_range = r[far], r[near]
+    foot = (x[far] * x[near] + y[far] * y[near] + 1.0) / (n[far] * n[near]) * near_range  # u . P, u the far unit ray
+    width = widths[k % len(widths)]
+    # |far - near|^2 = r_far^2 - 2 r_far (u . P) + |P|^2; NaN (a keypoint missing) compares False: never completed.
+    collapsed = far_range * (far_range - 2 * foot) + near_range**2 < (params.min_pair_fraction * width) ** 2
+    if not collapsed.any():
+        return
+    k, base, far, foot, near_range, width = (a[collapsed] for a in (k, base, far, foot, near_range, width))
+    # The hidden keypoint at W from its partner, behind it: t = u . P + sqrt(W^2 - w^2), w^2 = |P|^2 - (u . P)^2.
+    target = foot + np.sqrt(np.maximum(width**2 - near_range**2 + foot**2, 0.0))
+    r[far] = target
+    inferred.reshape(-1)[far] = True
+
+    # Followers on the hidden side scoring clearly lower than their partner: at least as far behind their partner
+    # as the root is behind its own (np.fmax keeps the keypoint's own range where its partner has none; a follower
+    # without a range of its own stays unusable whatever its range).
+    follower = _FOLLOWERS[_FAR[k]].reshape(-1)  # -1: none
+    base = np.repeat(base, 2)
+    behind = np.repeat(target - near_range, 2)
+    own, partner = base + follower, base + _MIRROR[follower]
+    flat_scores = scores.reshape(-1)
+    move = (follower >= 0) & (flat_scores[own] <= flat_scores[partner] - gap)
+    own, partner, behind = own[move], partner[move], behind[move]
+    current = r[own]
+    placed = np.fmax(current, r[partner] + behind)
+    r[own] = placed
+    inferred.reshape(-1)[own] = placed > current

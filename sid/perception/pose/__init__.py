@@ -1,0 +1,81 @@
+"""2D pose estimation: an ONNX pose model behind one call, RGB image in, people with COCO-17 keypoints out.
+
+>>> estimator = load_pose_estimator("yolo11n-pose-256.onnx")
+>>> detections = estimator(color_rgb)  # list[PoseDetection], keypoints in colour-image pixels (u, v)
+
+The model contract (MoveNet MultiPose, MoveNet SinglePose, YOLO-pose) is read from the model's own signature;
+see ``sid.perception.pose.contracts`` and docs/models.md.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+from sid.perception.pose.base import Letterbox, PoseEstimator
+from sid.perception.pose.contracts import (
+    CONTRACTS,
+    MOVENET_MULTIPOSE,
+    MOVENET_SINGLEPOSE,
+    YOLO_POSE,
+    PoseModelError,
+    detect_contract,
+    supported_contracts_text,
+)
+from sid.perception.pose.movenet import MoveNetMultiPose, MoveNetSinglePose, multipose_input_size
+from sid.perception.pose.session import OnnxModel
+from sid.perception.pose.yolo import YoloPose
+
+__all__ = [
+    "CONTRACTS",
+    "Letterbox",
+    "MoveNetMultiPose",
+    "MoveNetSinglePose",
+    "OnnxModel",
+    "PoseEstimator",
+    "PoseModelError",
+    "YoloPose",
+    "load_pose_estimator",
+    "multipose_input_size",
+    "supported_contracts_text",
+]
+
+
+def load_pose_estimator(
+    path: str | Path,
+    contract: str | None = None,
+    threads: int | None = None,
+    score_threshold: float | None = None,
+    input_size: int | tuple[int, int] | str | None = None,
+    iou_threshold: float | None = None,
+    providers: Sequence[str] | None = None,
+) -> MoveNetMultiPose | MoveNetSinglePose | YoloPose:
+    """Open a pose model and wrap it in the estimator its contract needs.
+
+    path: an .onnx file. contract: ``movenet_multipose``, ``movenet_singlepose`` or ``yolo_pose``; None reads it
+    from the model's signature. threads: onnxruntime intra-op threads (default: physical cores).
+    score_threshold: minimum person score (default per model: 0.2 MoveNet, 0.25 YOLO; scores of converted models
+    differ from the originals, so tune it per model file). input_size: only for models with dynamic height and
+    width (MultiPose: long side in px, (h, w) or "paper"; SinglePose: side; YOLO: side or (h, w)).
+    iou_threshold: YOLO NMS overlap (default 0.7). providers: onnxruntime execution providers (default: TensorRT,
+    CUDA when available, then CPU).
+
+    Raises PoseModelError (missing file, not ONNX, unsupported signature; the message lists the contracts and
+    where such models come from) and ValueError for options the model cannot take.
+    """
+    model = OnnxModel(path, threads=threads, providers=providers)
+    name = detect_contract(model.signature, contract, source=str(model.path))
+    if iou_threshold is not None and name != YOLO_POSE:
+        raise ValueError(f"pose: iou_threshold applies to yolo_pose models only, this one is {name}")
+    options = {} if score_threshold is None else {"score_threshold": score_threshold}
+    if name == MOVENET_MULTIPOSE:
+        return MoveNetMultiPose(model, size=input_size, **options)
+    if name == MOVENET_SINGLEPOSE:
+        if isinstance(input_size, (str, tuple)):
+            raise ValueError(f"pose: a SinglePose input size is one side in pixels, got {input_size!r}")
+        return MoveNetSinglePose(model, size=input_size, **options)
+    if isinstance(input_size, str):
+        raise ValueError(f"pose: a YOLO input size is a side or (height, width) in pixels, got {input_size!r}")
+    if iou_threshold is not None:
+        options["iou_threshold"] = iou_threshold
+    return YoloPose(model, size=input_size, **options)

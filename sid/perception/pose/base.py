@@ -1,0 +1,163 @@
+"""What every pose estimator offers, and the letterbox arithmetic that maps model inputs back to image pixels.
+
+Pixel convention (as in ``sid.perception.camera``): ``(u, v) = (0, 0)`` is the centre of the top-left pixel, u grows to
+the right, v downwards, so the image's outer edge runs from -0.5 to ``width - 0.5``. Models report positions in
+continuous *edge* coordinates of their input (0 = the left edge of the first pixel; a normalised coordinate ``n`` is ``n
+* width``), which is why the maps below carry the half-pixel terms.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Protocol, runtime_checkable
+
+import cv2
+import numpy as np
+
+from sid.perception.keypoints import PoseDetection
+
+
+@runtime_checkable
+class PoseEstimator(Protocol):
+    """A pose model behind one call: RGB uint8 image in, people with 17 COCO keypoints in image pixels out."""
+
+    contract: str
+    """Name of the model contract (``movenet_multipose``, ``movenet_singlepose``, ``yolo_pose``)."""
+
+    @property
+    def input_size(self) -> tuple[int, int] | None:
+        """Model input (height, width) in pixels, or None when it depends on the image (dynamic MultiPose)."""
+        ...
+
+    def __call__(self, color_rgb: np.ndarray) -> list[PoseDetection]: ...
+
+
+@dataclass(frozen=True)
+class Letterbox:
+    """Uniform scale plus shift from colour-image pixels to model-input pixels (no rotation, no shear).
+
+    In edge coordinates ``x_input = scale * x_image + pad_x`` (same for y). ``pad_x, pad_y`` place the image's
+    top-left corner in the model input (model-input pixels): positive for the padding bands of a letterbox,
+    negative when a crop starts inside the image. ``input_size`` is the model input (height, width).
+    """
+
+    scale: float
+    pad_x: float
+    pad_y: float
+    input_size: tuple[int, int]
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.scale) and self.scale > 0):
+            raise ValueError(f"letterbox: scale must be positive and finite, got {self.scale}")
+        if not (np.isfinite(self.pad_x) and np.isfinite(self.pad_y)):
+            raise ValueError(f"letterbox: padding must be finite, got ({self.pad_x}, {self.pad_y})")
+        if min(self.input_size) <= 0:
+            raise ValueError(f"letterbox: input size must be positive, got {self.input_size}")
+
+    @classmethod
+    def fit(cls, image_hw: Sequence[int], input_hw: Sequence[int]) -> Letterbox:
+        """Fit a whole image into the input keeping its aspect ratio, centred, with whole-pixel padding bands."""
+        (h, w), (in_h, in_w) = _size(image_hw, "image"), _size(input_hw, "input")
+        scale = min(in_w / w, in_h / h)
+        pad_x = (in_w - round(w * scale)) // 2
+        pad_y = (in_h - round(h * scale)) // 2
+        return cls(scale, float(pad_x), float(pad_y), (in_h, in_w))
+
+    @classmethod
+    def crop(cls, box: Sequence[float], input_hw: Sequence[int], expand: float = 1.2) -> Letterbox:
+        """A square crop centred on ``box`` (u_min, v_min, u_max, v_max; pixels), its side ``expand`` times the
+        box's longer side, scaled to fill the input. Parts of the crop outside the image are padding."""
+        in_h, in_w = _size(input_hw, "input")
+        u0, v0, u1, v1 = (float(x) for x in np.asarray(box, dtype=float).reshape(4))
+        if not np.all(np.isfinite([u0, v0, u1, v1])) or u1 <= u0 or v1 <= v0:
+            raise ValueError(f"letterbox: box must be finite with u_max > u_min and v_max > v_min, got {box}")
+        if not expand > 0:
+            raise ValueError(f"letterbox: expand must be positive, got {expand}")
+        side = expand * max(u1 - u0, v1 - v0)
+        scale = min(in_w, in_h) / side
+        # Box centre in edge coordinates is (u + 0.5); it must land on the input's centre.
+        centre_x, centre_y = (u0 + u1) / 2 + 0.5, (v0 + v1) / 2 + 0.5
+        return cls(scale, in_w / 2 - scale * centre_x, in_h / 2 - scale * centre_y, (in_h, in_w))
+
+    def to_input(self, uv: np.ndarray) -> np.ndarray:
+        """Image pixels (..., 2) as (u, v) -> model-input pixels (u, v), both pixel-centre convention."""
+        uv = np.asarray(uv, dtype=float)
+        return (uv + 0.5) * self.scale + np.array([self.pad_x, self.pad_y]) - 0.5
+
+    def to_image(self, uv: np.ndarray) -> np.ndarray:
+        """Model-input pixels (..., 2) as (u, v) -> image pixels (u, v), both pixel-centre convention."""
+        uv = np.asarray(uv, dtype=float)
+        return (uv + 0.5 - np.array([self.pad_x, self.pad_y])) / self.scale - 0.5
+
+    def normalised_to_image(self, xy: np.ndarray) -> np.ndarray:
+        """Model outputs normalised to the input, (..., 2) as (x, y) in [0, 1] -> image pixels (u, v)."""
+        in_h, in_w = self.input_size
+        xy = np.asarray(xy, dtype=float)
+        return (xy * np.array([in_w, in_h]) - np.array([self.pad_x, self.pad_y])) / self.scale - 0.5
+
+    def matrix(self) -> np.ndarray:
+        """2x3 affine matrix of ``to_input`` (pixel-centre convention), as ``cv2.warpAffine`` takes it."""
+        offset = 0.5 * self.scale - 0.5
+        return np.array(
+            [[self.scale, 0.0, self.pad_x + offset], [0.0, self.scale, self.pad_y + offset]], dtype=np.float64
+        )
+
+    def warp(self, color: np.ndarray, fill: int) -> np.ndarray:
+        """Resample ``color`` (H, W, 3) uint8 into the model input (bilinear, ``fill`` grey outside the image).
+
+        One ``cv2.warpAffine`` both resizes and pads, so the pixels follow exactly the map of ``to_input``
+        (``cv2.resize`` would round the resized size and scale the two axes slightly differently).
+        """
+        in_h, in_w = self.input_size
+        return cv2.warpAffine(
+            color,
+            self.matrix(),
+            (in_w, in_h),
+            flags=cv2.INTER_LINEAR,
+            borderMode=cv2.BORDER_CONSTANT,
+            borderValue=(fill, fill, fill),
+        )
+
+
+def check_color_image(color_rgb: np.ndarray) -> np.ndarray:
+    """Validate a colour image: (H, W, 3) uint8 RGB, non-empty. Returns it as a C-contiguous array."""
+    if not isinstance(color_rgb, np.ndarray):
+        raise TypeError(f"pose: colour image must be a numpy array, got {type(color_rgb).__name__}")
+    if color_rgb.ndim != 3 or color_rgb.shape[2] != 3:
+        raise ValueError(f"pose: colour image must have shape (H, W, 3) RGB, got {color_rgb.shape}")
+    if color_rgb.shape[0] == 0 or color_rgb.shape[1] == 0:
+        raise ValueError(f"pose: colour image is empty, shape {color_rgb.shape}")
+    if color_rgb.dtype != np.uint8:
+        raise ValueError(f"pose: colour image must be uint8 (0-255), got {color_rgb.dtype}")
+    return np.ascontiguousarray(color_rgb)
+
+
+def check_boxes(boxes: np.ndarray | Sequence[Sequence[float]]) -> np.ndarray:
+    """Validate person boxes: (N, 4) finite (u_min, v_min, u_max, v_max) with positive width and height."""
+    boxes = np.asarray(boxes, dtype=float)
+    if boxes.size == 0:
+        return boxes.reshape(0, 4)
+    if boxes.ndim != 2 or boxes.shape[1] != 4:
+        raise ValueError(f"pose: boxes must have shape (N, 4) as (u_min, v_min, u_max, v_max), got {boxes.shape}")
+    if not np.all(np.isfinite(boxes)):
+        raise ValueError("pose: boxes contain NaN or infinite values")
+    if np.any(boxes[:, 2] <= boxes[:, 0]) or np.any(boxes[:, 3] <= boxes[:, 1]):
+        raise ValueError("pose: every box needs u_max > u_min and v_max > v_min")
+    return boxes
+
+
+def clip_boxes(boxes: np.ndarray, image_hw: Sequence[int]) -> np.ndarray:
+    """Clip (N, 4) boxes to the image's outer edge, -0.5 .. size - 0.5 (pixel-centre convention)."""
+    h, w = image_hw
+    out = boxes.copy()
+    out[:, [0, 2]] = np.clip(out[:, [0, 2]], -0.5, w - 0.5)
+    out[:, [1, 3]] = np.clip(out[:, [1, 3]], -0.5, h - 0.5)
+    return out
+
+
+def _size(hw: Sequence[int], what: str) -> tuple[int, int]:
+    h, w = (int(x) for x in hw)
+    if h <= 0 or w <= 0:
+        raise ValueError(f"letterbox: {what} size must be positive, got {tuple(hw)}")
+    return h, w

@@ -1,0 +1,148 @@
+"""The per-frame pipeline (pose -> people -> groups) and ``sid detect`` end to end."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from sid.cli import main
+from sid.perception.frame import Frame
+from sid.perception.pipeline import Pipeline
+from sid.sources.synthetic import SyntheticSource
+from sid.synthetic.pose import TruthPose
+from tests.conftest import shared_path
+
+
+def test_pipeline_finds_the_s1_pair_where_the_truth_puts_it():
+    frame = SyntheticSource("S1", frames=1, seed=3)[0]
+    result = Pipeline(TruthPose())(frame)
+    truth = frame.truth
+    assert len(result.people) == 2
+    assert len(result.groups) == 1
+    assert sorted(result.groups[0].members) == sorted(p.id for p in result.people)
+    found = np.array(result.groups[0].interest_point)
+    expected = np.array(truth.groups[0].interest_point)
+    assert np.linalg.norm(found - expected) < 0.25
+    assert set(result.timing_ms) == {"pose", "lift", "group", "total"}
+    assert result.timing_ms["total"] >= result.timing_ms["lift"] >= 0
+
+
+def test_frame_result_json_has_the_documented_fields():
+    frame = SyntheticSource("S3", frames=1, seed=0)[0]
+    record = Pipeline(TruthPose())(frame).to_json()
+    assert set(record) == {"frame", "timestamp", "people", "groups", "timing_ms"}
+    person = record["people"][0]
+    assert set(person) == {"id", "x", "y", "theta", "keypoints", "orientation_quality"}
+    assert len(person["keypoints"]) == 17
+    json.dumps(record)  # plain JSON types only
+
+
+def test_frame_without_depth_gives_no_people():
+    frame = SyntheticSource("S1", frames=1, seed=0)[0]
+    empty = Frame(frame.index, frame.color, np.zeros_like(frame.depth), frame.calibration, truth=frame.truth)
+    result = Pipeline(TruthPose())(empty)
+    assert result.people == [] and result.groups == []
+
+
+def _lines(text: str) -> list[dict]:
+    return [json.loads(line) for line in text.splitlines() if line.startswith("{")]
+
+
+def test_detect_streams_json_lines_and_writes_pictures(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["detect", "--source", "synthetic:S5", "--frames", "3", "--out", str(out)]) == 0
+    captured = capsys.readouterr()
+    records = _lines(captured.out)
+    assert [r["frame"] for r in records] == [0, 1, 2]
+    assert all(len(r["people"]) == 4 for r in records)
+    assert all(r["timing_ms"]["total"] > 0 for r in records)
+    assert len((out / "detections.jsonl").read_text().splitlines()) == 3
+    assert len(list(out.glob("overlay_*.png"))) == 3 and len(list(out.glob("topview_*.png"))) == 3
+    assert "3 frames with people" in captured.err
+
+
+def test_detect_needs_a_model_for_real_sources(tmp_path, capsys):
+    assert main(["detect", "--source", str(tmp_path)]) == 2
+    assert "--model" in capsys.readouterr().err
+
+
+def test_detect_reports_a_missing_model_file(tmp_path, capsys):
+    code = main(["detect", "--source", "synthetic:S1", "--model", str(tmp_path / "missing.onnx")])
+    assert code == 2
+    assert "missing.onnx" in capsys.readouterr().err
+
+
+def test_detect_reports_an_unknown_source(capsys):
+    assert main(["detect", "--source", "synthetic:S9"]) == 2
+    assert "S9" in capsys.readouterr().err
+
+
+def test_show_explains_the_headless_build(capsys):
+    assert main(["detect", "--source", "synthetic:S1", "--show"]) == 2
+    assert "--out" in capsys.readouterr().err
+
+
+def test_five_people_walking_in_a_file(capsys):
+    """The real PCL frame: five people 1.8-3 m away, backs to the camera (world yaw near 0)."""
+    folder = shared_path("data", "rgbd", "five_people")
+    model = shared_path("models", "yolo11n-pose-256.onnx")
+    assert main(["detect", "--source", str(folder), "--model", str(model), "--no-keypoints"]) == 0
+    (record,) = _lines(capsys.readouterr().out)
+    people = record["people"]
+    assert len(people) == 5
+    assert all(1.7 < p["x"] < 3.1 for p in people)
+    facing_away = [p for p in people if p["theta"] is not None and abs(p["theta"]) < np.radians(60)]
+    assert len(facing_away) == 5
+
+
+@pytest.mark.parametrize("threshold", ["-1", "2"])
+def test_bad_keypoint_threshold_is_reported(threshold, capsys):
+    code = main(["detect", "--source", "synthetic:S1", "--keypoint-threshold", threshold])
+    assert code == 2
+    assert "min_score" in capsys.readouterr().err
+
+
+def test_pipeline_on_a_realsense_recording_matches_the_scene(tmp_path):
+    """Synthetic frames recorded through librealsense (.db3), played back unaligned, lifted sparsely."""
+    from sid.sources import open_source, skip_unreadable
+    from sid.sources.librealsense import record_synthetic
+
+    frames = list(SyntheticSource("S1", frames=3, seed=1))
+    calib = frames[0].calibration
+    depth_units = [np.round(f.depth / calib.depth_scale).astype(np.uint16) for f in frames]
+    path = record_synthetic(
+        tmp_path / "s1.db3", [(f.color, d) for f, d in zip(frames, depth_units, strict=True)], calib
+    )
+    truth_pose = TruthPose()
+    # librealsense playback sometimes loses one stream of the first frameset: skipped, as sid detect does.
+    played = list(skip_unreadable(open_source(str(path), align="none"), lambda error: None))
+    assert played, "the recording played back no frame"
+    for frame in played:
+        assert frame.calibration.depth is not None  # unaligned: depth stays in the depth camera's grid
+        original = frames[frame.index]
+        result = Pipeline(lambda _f, o=original: truth_pose(o))(frame)
+        expected = Pipeline(truth_pose)(original)
+        assert len(result.people) == len(expected.people) == 2
+        for got, want in zip(result.people, expected.people, strict=True):
+            assert abs(got.x - want.x) < 0.02 and abs(got.y - want.y) < 0.02
+
+
+def test_ctrl_c_stops_cleanly_and_keeps_what_was_written(tmp_path, capsys, monkeypatch):
+    import sid.cli.detect as detect_command
+
+    frames = SyntheticSource("S1", frames=5, seed=0)
+
+    def interrupted_source(spec, **options):
+        yield frames[0]
+        yield frames[1]
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(detect_command, "open_source", interrupted_source)
+    out = tmp_path / "out"
+    assert main(["detect", "--source", "synthetic:S1", "--out", str(out), "--no-keypoints"]) == 130
+    captured = capsys.readouterr()
+    assert [r["frame"] for r in _lines(captured.out)] == [0, 1]
+    assert len((out / "detections.jsonl").read_text().splitlines()) == 2
+    assert "interrupted" in captured.err

@@ -1,0 +1,133 @@
+"""``sid groups`` and ``sid eval fformation`` on the command line."""
+
+from __future__ import annotations
+
+import io
+import json
+import math
+import subprocess
+import sys
+
+import pytest
+
+from sid.cli import main
+from tests.conftest import REPO_ROOT, shared_path
+from tests.experiments.test_fformation import tiny_frames, write_sequence
+
+PAIR = {
+    "frame": 0,
+    "people": [{"id": 1, "x": 2.0, "y": 0.0, "theta": 0.0}, {"id": 2, "x": 2.8, "y": 0.0, "theta": math.pi}],
+}
+APART = {"frame": 2, "people": [{"id": 5, "x": 1.0, "y": 0.0, "theta": None}, {"id": 6, "x": 1.0, "y": 1.0}]}
+
+
+def run_sid(argv: list[str], capsys) -> tuple[int, list[str], str]:
+    code = main(argv)
+    captured = capsys.readouterr()
+    return code, captured.out.splitlines(), captured.err
+
+
+def test_groups_reads_json_lines_and_writes_one_line_per_frame(tmp_path, capsys):
+    source = tmp_path / "frames.jsonl"
+    source.write_text(json.dumps(PAIR) + "\n\n" + json.dumps(APART) + "\n")
+    code, out, err = run_sid(["groups", str(source)], capsys)
+    assert code == 0 and err == ""
+    first, second = (json.loads(line) for line in out)
+    assert first["frame"] == 0 and len(first["groups"]) == 1
+    group = first["groups"][0]
+    assert group["members"] == [1, 2] and group["area"] == 0.0
+    assert group["interest_point"] == pytest.approx([2.4, 0.0]) and group["spread"] == pytest.approx(0.4)
+    assert group["zone"] == [pytest.approx([2.4, 0.0])]
+    assert second == {"frame": 2, "groups": []}
+
+
+def test_malformed_lines_are_reported_with_their_number_and_skipped(tmp_path, capsys):
+    lines = [
+        json.dumps(PAIR),
+        "{not json",
+        json.dumps({"frame": 1, "people": [{"id": 1, "x": "far", "y": 0.0, "theta": 0.0}]}),
+        json.dumps({"frame": 1, "people": [{"id": 1, "x": 0.0, "y": 0.0}, {"id": 1, "x": 1.0, "y": 0.0}]}),
+        '{"frame": 1, "people": [{"id": 3, "x": NaN, "y": 0.0}]}',
+        json.dumps([1, 2]),
+        json.dumps({"frame": 9, "people": []}),
+    ]
+    source = tmp_path / "frames.jsonl"
+    source.write_text("\n".join(lines) + "\n")
+    code, out, err = run_sid(["groups", str(source)], capsys)
+    assert code == 0
+    assert [json.loads(line)["frame"] for line in out] == [0, 9]
+    assert "line 2: not valid JSON" in err
+    assert "line 3: people[0] (id 1): x must be a finite number, got 'far'" in err
+    assert "line 4: groups: person ids must be unique" in err
+    assert "line 5: not valid JSON (NaN is not a number)" in err
+    assert "line 6: expected a JSON object" in err
+    assert "skipped 5 malformed line(s)" in err
+
+
+def test_strict_stops_at_the_first_bad_line_keeping_earlier_output(tmp_path, capsys):
+    source = tmp_path / "frames.jsonl"
+    source.write_text(json.dumps(PAIR) + "\n" + '{"people": 3}\n' + json.dumps(PAIR) + "\n")
+    code, out, err = run_sid(["groups", "--strict", str(source)], capsys)
+    assert code == 1
+    assert len(out) == 1 and json.loads(out[0])["frame"] == 0
+    assert "line 2: 'people' must be a list" in err
+
+
+def test_group_params_come_from_the_options(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(sys, "stdin", io.StringIO(json.dumps(PAIR) + "\n"))
+    code, out, _ = run_sid(["groups", "-", "--spread-threshold", "0.3"], capsys)
+    assert code == 0 and json.loads(out[0])["groups"] == []  # D = 0.4 m > 0.3 m
+    code, _, err = run_sid(["groups", "-", "--eps", "-1"], capsys)
+    assert code == 2 and "eps must be a positive" in err
+    code, _, err = run_sid(["groups", str(tmp_path / "missing.jsonl")], capsys)
+    assert code == 2 and "cannot read" in err
+
+
+def test_output_is_flushed_line_by_line_through_a_pipe():
+    # A consumer reading the first output line must get it before the input ends.
+    process = subprocess.Popen(
+        [sys.executable, "-m", "sid", "groups", "-"],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        text=True,
+        cwd=REPO_ROOT,
+    )
+    assert process.stdin and process.stdout
+    process.stdin.write(json.dumps(PAIR) + "\n")
+    process.stdin.flush()
+    first = process.stdout.readline()
+    process.stdin.close()
+    assert json.loads(first)["groups"][0]["members"] == [1, 2]
+    assert process.wait(timeout=30) == 0
+
+
+def test_eval_fformation_prints_json_and_a_table(tmp_path, capsys):
+    tiny = write_sequence(tmp_path / "Tiny", tiny_frames(), {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]})
+    code, out, _ = run_sid(["eval", "fformation", str(tiny), "--scale", "0.01"], capsys)
+    assert code == 0
+    report = json.loads("\n".join(out))
+    assert report["scores"]["Tiny"]["2/3"] == pytest.approx({"precision": 1.0, "recall": 2 / 3, "f1": 0.8, "frames": 3})
+    assert report["params"]["eps"] == 2.0
+    code, out, _ = run_sid(["eval", "fformation", str(tiny), "--scale", "0.01", "--table", "--T", "0.5"], capsys)
+    assert code == 0 and out[0].split() == ["dataset", "T", "frames", "precision", "recall", "F1"]
+    assert out[1].split() == ["Tiny", "1/2", "3", "1.000", "0.667", "0.800"]
+
+
+def test_eval_fformation_reports_malformed_data(tmp_path, capsys):
+    (tmp_path / "Bad").mkdir()
+    (tmp_path / "Bad" / "features.mat").write_text("garbage")
+    code, _, err = run_sid(["eval", "fformation", str(tmp_path / "Bad")], capsys)
+    assert code == 2 and "cannot read" in err and "features.mat" in err
+    with pytest.raises(SystemExit):
+        main(["eval", "fformation", str(tmp_path / "Bad"), "--T", "3/2"])
+    assert "must lie in (0, 1]" in capsys.readouterr().err
+
+
+def test_eval_fformation_on_the_real_datasets(capsys):
+    synth = shared_path("data", "fformation", "Synth")
+    coffee = shared_path("data", "fformation", "CoffeeBreak")
+    code, out, _ = run_sid(["eval", "fformation", str(synth), str(coffee), "--scale", "0.01", "--table"], capsys)
+    assert code == 0
+    rows = {(line.split()[0], line.split()[1]): float(line.split()[-1]) for line in out[1:]}
+    assert set(rows) == {(d, t) for d in ("Synth", "CoffeeBreak", "pooled") for t in ("2/3", "1")}
+    assert rows[("Synth", "2/3")] > 0.9

@@ -1,0 +1,77 @@
+"""``sid plan`` and ``sid demo`` end to end (in process): outputs, exit codes and error messages."""
+
+from __future__ import annotations
+
+import copy
+import json
+
+import pytest
+
+from planner.metrics import FIXED_KEYS
+from sid.cli import main
+from sid.experiments.demo import DEMO_SCENARIO
+
+
+def write_scenario(tmp_path, **robot) -> str:
+    data = copy.deepcopy(DEMO_SCENARIO)
+    data["robot"].update(robot)
+    path = tmp_path / "scenario.json"
+    path.write_text(json.dumps(data))
+    return str(path)
+
+
+def test_plan_writes_path_and_picture(tmp_path, capsys):
+    out = tmp_path / "out"
+    code = main(["plan", write_scenario(tmp_path), "--out", str(out), "--seed", "3", "--iterations", "3000"])
+    assert code == 0
+    record = json.loads((out / "path.json").read_text())
+    assert set(FIXED_KEYS) <= set(record) and record["success"] is True
+    assert record["waypoints"][0] == [0.0, 0.0] and record["waypoints"][-1] == [9.0, 0.0]
+    assert record["social_layer"] is True and record["ospace_intrusion_m"] == 0.0
+    assert (out / "plan.png").stat().st_size > 10_000
+    printed = capsys.readouterr().out
+    assert "repeat exactly: --seed 3 --iterations" in printed and "wrote" in printed
+
+
+def test_plan_without_social_layer_crosses_the_conversation(tmp_path):
+    out = tmp_path / "out"
+    assert main(["plan", write_scenario(tmp_path), "--out", str(out), "--no-social", "--planner", "grid"]) == 0
+    record = json.loads((out / "path.json").read_text())
+    assert record["social_layer"] is False and record["crosses_group"] is True
+
+
+@pytest.mark.parametrize(
+    ("robot", "args", "message"),
+    [
+        ({"goal": [5.0, -2.9, 0.0]}, [], "goal (5.00, -2.90) is in collision"),
+        ({}, ["--planner", "prmstar"], "PRM* is not available"),
+        ({}, ["--planner", "dstar"], "unknown planner 'dstar'"),
+        ({}, ["--time", "-1"], "time_limit must be a positive number"),
+    ],
+)
+def test_plan_refuses_impossible_or_bad_requests(tmp_path, capsys, robot, args, message):
+    code = main(["plan", write_scenario(tmp_path, **robot), "--out", str(tmp_path / "out"), *args])
+    assert code == 2
+    assert message in capsys.readouterr().err
+
+
+def test_plan_that_finds_nothing_exits_1_and_says_so(tmp_path, capsys):
+    out = tmp_path / "out"
+    args = ["plan", write_scenario(tmp_path), "--out", str(out), "--planner", "rrtstar", "--iterations", "2"]
+    assert main([*args, "--seed", "1"]) == 1
+    assert "rrtstar found no path" in capsys.readouterr().out
+    record = json.loads((out / "path.json").read_text())
+    assert record["success"] is False and record["waypoints"] == [] and record["ospace_intrusion_m"] is None
+
+
+def test_plan_warns_when_the_goal_is_inside_a_group_zone(tmp_path, capsys):
+    scenario = write_scenario(tmp_path, goal=[4.5, 0.0, 0.0])
+    assert main(["plan", scenario, "--out", str(tmp_path / "out"), "--planner", "grid"]) == 0
+    assert "inside the interaction zone of group (1, 2, 3)" in capsys.readouterr().err
+
+
+def test_demo_command_prints_the_table(tmp_path, capsys):
+    assert main(["demo", "--out", str(tmp_path / "demo"), "--iterations", "3000"]) == 0
+    printed = capsys.readouterr().out
+    assert "[1/2]" in printed and "in group zone" in printed and "comparison.png" in printed
+    assert set(json.loads((tmp_path / "demo" / "metrics.json").read_text())) == {"without", "with"}

@@ -1,0 +1,373 @@
+"""Costmap layers: Nav2 inflation, LiDAR marking/clearing, the social layer, combination and people updates."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import shapely
+
+from costmap.combine import combine, update_with_max
+from costmap.grid import FREE_SPACE, INSCRIBED, LETHAL, NO_INFORMATION, Costmap2D, GridSpec
+from costmap.layered import CostmapParams, LayeredCostmap
+from costmap.layers.inflation import InflationLayer, InflationParams, distance_to_lethal_cells
+from costmap.layers.obstacle import ObstacleLayer, ObstacleParams
+from costmap.layers.social import SocialLayer, SocialParams, group_zone_polygon
+from costmap.scan import LaserScan
+from sid.perception.groups import Group
+from sid.perception.people import Person
+from sid.scenario.lidar import simulate_scan
+from sid.scenario.obstacles import BoxObstacle, CircleObstacle, SegmentObstacle
+
+SPEC = GridSpec.from_size(0.05, (-1.0, -4.0), (10.0, 8.0))
+
+
+def nav2_cost(d_m: float, inscribed: float, k: float) -> int:
+    """Nav2's InflationLayer::computeCost written out by hand for one distance."""
+    if d_m == 0:
+        return 254
+    if d_m <= inscribed:
+        return 253
+    return int(252 * np.exp(-k * (d_m - inscribed)))
+
+
+def triad() -> tuple[list[Person], Group]:
+    """Three people 0.6 m around (4, 0), facing the centre, and their group (o-space = small triangle)."""
+    angles = np.deg2rad([90, 210, 330])
+    people = [Person(i + 1, 4 + 0.6 * np.cos(a), 0.6 * np.sin(a), float(a + np.pi), 1.0) for i, a in enumerate(angles)]
+    zone = np.array([[4.0, 0.2], [3.83, -0.1], [4.17, -0.1]])
+    return people, Group((1, 2, 3), (4.0, 0.0), 0.05, zone, 0.6)
+
+
+# --- inflation --------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("radius,k,resolution", [(0.55, 10.0, 0.05), (1.0, 3.0, 0.1), (0.3, 25.0, 0.025)])
+def test_inflation_around_one_lethal_cell_is_nav2_formula_everywhere_within_radius(radius, k, resolution):
+    spec = GridSpec(resolution, 0.0, 0.0, 81, 81)
+    master = np.zeros(spec.shape, dtype=np.uint8)
+    master[40, 40] = LETHAL
+    layer = InflationLayer(spec, InflationParams(radius, k), inscribed_radius=0.25)
+    layer.apply(master)
+    rows, cols = np.indices(spec.shape)
+    d = np.hypot(rows - 40, cols - 40) * resolution
+    within = d <= radius
+    expected = np.array([nav2_cost(v, 0.25, k) for v in d[within]])
+    assert within.sum() > 20
+    np.testing.assert_array_equal(master[within], expected)
+    np.testing.assert_array_equal(layer.costs[within], expected)
+    # Nav2 reaches ceil(radius / resolution) cells; nothing beyond that.
+    reach = np.hypot(rows - 40, cols - 40) > layer.cell_radius
+    assert not master[reach].any()
+
+
+def test_inflation_reach_rounds_up_like_nav2_cell_distance():
+    spec = GridSpec(0.05, 0.0, 0.0, 41, 41)
+    master = np.zeros(spec.shape, dtype=np.uint8)
+    master[20, 20] = LETHAL
+    layer = InflationLayer(spec, InflationParams(inflation_radius=0.53), inscribed_radius=0.25)
+    layer.apply(master)
+    assert layer.cell_radius == 11  # ceil(0.53 / 0.05): the reach is 0.55 m, beyond the 0.53 m asked for
+    assert master[20, 31] == nav2_cost(0.55, 0.25, 10.0) > 0
+    assert master[20, 32] == 0
+
+
+def test_opencv_and_scipy_distances_agree():
+    rng = np.random.default_rng(0)
+    lethal = rng.random((120, 90)) < 0.01
+    a = distance_to_lethal_cells(lethal, "opencv")
+    b = distance_to_lethal_cells(lethal, "scipy")
+    np.testing.assert_allclose(a, b, atol=1e-4)
+    with pytest.raises(ValueError, match="distance method"):
+        distance_to_lethal_cells(lethal, "manhattan")
+
+
+def test_inflation_keeps_the_larger_cost_and_nav2_unknown_rule():
+    spec = GridSpec(0.05, 0.0, 0.0, 41, 41)
+    master = np.zeros(spec.shape, dtype=np.uint8)
+    master[20, 20] = LETHAL
+    master[20, 30] = 250  # already more than inflation gives 10 cells away
+    master[20, 22] = NO_INFORMATION  # 0.10 m away: inscribed, replaces unknown
+    master[20, 28] = NO_INFORMATION  # 0.40 m away: graded, unknown stays unknown
+    InflationLayer(spec, InflationParams(0.55), inscribed_radius=0.25).apply(master)
+    assert master[20, 30] == 250
+    assert master[20, 22] == INSCRIBED
+    assert master[20, 28] == NO_INFORMATION
+    master2 = np.zeros(spec.shape, dtype=np.uint8)
+    master2[20, 20], master2[20, 28] = LETHAL, NO_INFORMATION
+    InflationLayer(spec, InflationParams(0.55, inflate_unknown=True), 0.25).apply(master2)
+    assert master2[20, 28] == nav2_cost(0.40, 0.25, 10.0)
+
+
+def test_inflation_without_lethal_cells_is_zero():
+    layer = InflationLayer(SPEC, InflationParams(), inscribed_radius=0.25)
+    master = np.full(SPEC.shape, 100, dtype=np.uint8)
+    layer.apply(master)
+    assert (master == 100).all() and not layer.costs.any()
+
+
+# --- combination ------------------------------------------------------------------------------------------
+
+
+def test_combination_methods_follow_nav2():
+    master = np.array([0, 100, 255, 200, 250], dtype=np.uint8)
+    layer = np.array([50, 255, 30, 100, 10], dtype=np.uint8)
+    out = master.copy()
+    combine(out, layer, "max")
+    assert out.tolist() == [50, 100, 30, 200, 250]
+    out = master.copy()
+    combine(out, layer, "overwrite")
+    assert out.tolist() == [50, 100, 30, 100, 10]
+    out = master.copy()
+    combine(out, layer, "true_overwrite")
+    assert out.tolist() == layer.tolist()
+    out = master.copy()
+    combine(out, layer, "addition")
+    assert out.tolist() == [50, 100, 30, 252, 252]
+    with pytest.raises(ValueError, match="combination method"):
+        combine(out, layer, "min")
+
+
+def test_max_can_skip_a_layer_value_that_carries_no_opinion():
+    master = np.array([255, 255, 10, 10], dtype=np.uint8)
+    update_with_max(master, np.array([0, 40, 0, 40], dtype=np.uint8), no_opinion=FREE_SPACE)
+    assert master.tolist() == [255, 40, 10, 40]  # a zero social cell does not turn unknown into free
+
+
+# --- simulated scan and the LiDAR layer ---------------------------------------------------------------------
+
+
+def test_simulated_scan_hits_walls_circles_boxes_and_people_at_the_right_range():
+    obstacles = [
+        SegmentObstacle(((3.0, -5.0), (3.0, 5.0))),
+        CircleObstacle((0.0, 2.0), 0.5),
+        BoxObstacle((-3.0, -1.0), (-2.0, 1.0)),
+    ]
+    people = [Person(1, 0.0, -1.5)]
+    scan = simulate_scan((0.0, 0.0, 0.0), obstacles, people, beams=360, range_max=10.0, body_radius=0.2)
+    angles = scan.angles
+    r = dict(zip(np.round(np.rad2deg(angles)).astype(int), scan.ranges, strict=True))
+    assert r[0] == pytest.approx(3.0)  # the wall
+    assert r[45] == pytest.approx(3.0 * np.sqrt(2))
+    assert r[90] == pytest.approx(1.5)  # circle surface
+    assert r[-180] == pytest.approx(2.0)  # box face
+    assert r[-90] == pytest.approx(1.3)  # body surface
+
+
+def test_simulated_scan_reports_no_return_as_inf():
+    scan = simulate_scan((0.0, 0.0, 0.0), [SegmentObstacle(((5.0, -1.0), (5.0, 1.0)))], beams=8, range_max=4.0)
+    assert np.isinf(scan.ranges).all()
+
+
+def test_lidar_layer_marks_hits_and_clears_the_rays():
+    spec = GridSpec(0.05, 0.0, 0.0, 100, 100)
+    layer = ObstacleLayer(spec, ObstacleParams(track_unknown_space=True))
+    scan = LaserScan(np.array([2.0, np.inf, np.nan]), 0.0, np.pi / 2, 4.0, (1.0, 1.0, 0.0))
+    layer.apply_scan(scan)
+    hit = spec.world_to_cell([[3.0, 1.0]])[0]
+    assert layer.costs[hit[0], hit[1]] == LETHAL
+    ray = spec.world_to_cell([[1.0 + t, 1.0] for t in np.arange(0.0, 1.95, 0.05)])
+    assert (layer.costs[ray[:, 0], ray[:, 1]] == FREE_SPACE).all()
+    up = spec.world_to_cell([[1.0, 1.0 + t] for t in np.arange(0.1, 3.9, 0.05)])  # inf beam: cleared, not marked
+    assert (layer.costs[up[:, 0], up[:, 1]] == FREE_SPACE).all()
+    left = spec.world_to_cell([[0.5, 1.0]])[0]  # nan beam (pointing -x... here +pi): untouched
+    assert layer.costs[left[0], left[1]] == NO_INFORMATION
+    assert (layer.costs == LETHAL).sum() == 1
+
+
+def test_lidar_layer_respects_obstacle_and_raytrace_ranges():
+    spec = GridSpec(0.05, 0.0, 0.0, 200, 40)
+    layer = ObstacleLayer(
+        spec, ObstacleParams(obstacle_max_range=2.5, raytrace_max_range=3.0, track_unknown_space=True)
+    )
+    layer.apply_scan(LaserScan(np.array([5.0]), 0.0, 0.01, 10.0, (0.5, 1.0, 0.0)))
+    assert not (layer.costs == LETHAL).any()  # 5 m > obstacle_max_range
+    row = layer.costs[20]
+    assert (row[10:69] == FREE_SPACE).all() and (row[75:] == NO_INFORMATION).all()
+
+
+def test_lidar_layer_rejects_a_sensor_outside_the_map():
+    layer = ObstacleLayer(SPEC)
+    with pytest.raises(ValueError, match="outside the costmap"):
+        layer.apply_scan(LaserScan(np.array([1.0]), 0.0, 0.1, 5.0, (50.0, 0.0, 0.0)))
+
+
+def test_scan_rejects_nan_pose():
+    with pytest.raises(ValueError, match="pose"):
+        LaserScan(np.array([1.0]), 0.0, 0.1, 5.0, (np.nan, 0.0, 0.0))
+    with pytest.raises(ValueError, match="pose"):
+        simulate_scan((0.0, np.nan, 0.0), [])
+
+
+# --- social layer ------------------------------------------------------------------------------------------
+
+
+def test_group_zone_covers_members_and_the_space_between_them():
+    people, group = triad()
+    poly = group_zone_polygon(group, people)
+    for a in people:
+        assert poly.contains(shapely.Point(a.x, a.y))
+        for b in people:  # the segment between two members lies inside (p-space)
+            for t in np.linspace(0, 1, 11):
+                assert poly.covers(shapely.Point(a.x + t * (b.x - a.x), a.y + t * (b.y - a.y)))
+    assert poly.contains(shapely.Point(*group.interest_point))
+    assert group_zone_polygon(group, {p.id: p for p in people}).equals(poly)
+
+
+def test_group_zone_of_a_pair_is_a_proper_polygon_and_missing_members_are_named():
+    people = [Person(1, 0.0, 0.0, 0.0), Person(2, 1.0, 0.0, np.pi)]
+    pair = Group((1, 2), (0.5, 0.0), 0.0, np.array([[0.5, 0.0]]), 0.5)
+    assert group_zone_polygon(pair, people).area > 0
+    with pytest.raises(ValueError, match="degenerate"):
+        group_zone_polygon(pair, people, margin=0.0)
+    with pytest.raises(ValueError, match=r"members \[2\]"):
+        group_zone_polygon(pair, people[:1])
+
+
+def test_every_cell_inside_the_group_zone_costs_at_least_group_cost():
+    people, group = triad()
+    params = SocialParams()
+    layer = SocialLayer(SPEC, params)
+    layer.update(people, [group])
+    xs, ys = SPEC.cell_centres()
+    inside = shapely.contains_xy(group_zone_polygon(group, people, params.group_margin), xs, ys)
+    assert inside.sum() > 300
+    assert (layer.costs[inside] >= params.group_cost).all()
+    assert layer.costs.max() == LETHAL  # bodies only
+    assert not np.isin(layer.costs, [INSCRIBED, NO_INFORMATION]).any()
+    assert (layer.costs[layer.costs != LETHAL] <= 252).all()
+
+
+def test_personal_space_is_larger_in_front_and_circular_without_orientation():
+    layer = SocialLayer(SPEC, SocialParams())
+    layer.update([Person(1, 2.0, 0.0, 0.0), Person(2, 6.0, 0.0, None)], [])
+    costmap = Costmap2D(SPEC, layer.costs)
+    front, back = costmap.cost_at([[2.8, 0.0], [1.2, 0.0]])
+    assert front > back > 0
+    left, right = costmap.cost_at([[2.0, 0.6], [2.0, -0.6]])
+    assert left == right
+    around = costmap.cost_at([[6.6, 0.0], [5.4, 0.0], [6.0, 0.6], [6.0, -0.6]])
+    assert len(set(around.tolist())) == 1 and around[0] > 0
+
+
+def test_social_layer_clips_people_outside_the_map():
+    layer = SocialLayer(SPEC, SocialParams())
+    layer.update([Person(1, 9.3, 0.0, np.pi)], [])  # 0.3 m beyond the right edge, facing into the map
+    assert layer.costs[:, -1].max() > 0
+    assert not (layer.costs == LETHAL).any()  # the body itself is outside
+
+
+# --- the layered costmap and people updates -------------------------------------------------------------------
+
+
+def scan_of(people, pose=(0.0, 0.0, 0.0)):
+    return simulate_scan(pose, [SegmentObstacle(((-1.0, 2.5), (9.0, 2.5)))], people, beams=720, range_max=10.0)
+
+
+def lethal_near(costs: np.ndarray, xy, radius: float) -> int:
+    xs, ys = SPEC.cell_centres()
+    return int(((np.hypot(xs - xy[0], ys - xy[1]) <= radius) & (costs == LETHAL)).sum())
+
+
+def test_without_social_layer_only_lidar_marks_and_their_inflation_remain():
+    people, group = triad()
+    layered = LayeredCostmap(SPEC, social=False)
+    layered.update(people, [group], scan_of(people))
+    assert set(layered.layers) == {"lidar", "inflation"}
+    expected = layered.lidar.costs.copy()
+    layered.inflation.apply(expected)
+    np.testing.assert_array_equal(layered.master.costs, expected)
+    assert layered.master.cost_at([group.interest_point])[0] < 240  # the o-space is not protected
+
+
+def test_with_social_layer_the_group_zone_is_high_cost_in_the_master():
+    people, group = triad()
+    layered = LayeredCostmap(SPEC)
+    layered.update(people, [group], scan_of(people))
+    xs, ys = SPEC.cell_centres()
+    inside = shapely.contains_xy(group_zone_polygon(group, people), xs, ys)
+    assert (layered.master.costs[inside] >= 240).all()
+    # between two members, where the baseline lets the robot through
+    a, b = people[1], people[2]
+    assert layered.master.cost_at([[(a.x + b.x) / 2, (a.y + b.y) / 2]])[0] >= 240
+
+
+def test_a_moved_person_leaves_no_stale_marks_with_or_without_a_new_scan():
+    old = [Person(1, 4.0, 0.0, np.pi)]
+    new = [Person(1, 4.0, 1.5, np.pi)]
+    for new_scan in (None, scan_of(new)):
+        layered = LayeredCostmap(SPEC)
+        layered.update(old, [], scan_of(old))
+        assert lethal_near(layered.master.costs, (4.0, 0.0), 0.3) > 0
+        layered.update(new, [], new_scan)
+        assert lethal_near(layered.master.costs, (4.0, 0.0), 0.3) == 0
+        assert lethal_near(layered.lidar.costs, (4.0, 1.5), 0.3) == 0  # the person is the social layer's, once
+        assert lethal_near(layered.master.costs, (4.0, 1.5), 0.2) > 0
+        assert layered.master.cost_at([[4.0, 0.0]])[0] < 50  # only the new position's fading personal space
+
+
+def test_baseline_keeps_people_marks_where_no_new_beam_passes():
+    old = [Person(1, 4.0, 0.0, np.pi)]
+    layered = LayeredCostmap(SPEC, social=False)
+    layered.update(old, [], scan_of(old))
+    layered.update([Person(1, 4.0, 1.5, np.pi)], [], None)
+    assert lethal_near(layered.master.costs, (4.0, 0.0), 0.3) > 0  # Nav2 behaviour without recognition
+
+
+def test_something_left_at_a_person_old_position_is_kept_when_the_scan_sees_it():
+    old = [Person(1, 4.0, 0.0, np.pi)]
+    layered = LayeredCostmap(SPEC)
+    layered.update(old, [], scan_of(old))
+    pillar = simulate_scan((0.0, 0.0, 0.0), [CircleObstacle((4.0, 0.0), 0.2)], [], beams=720)
+    layered.update([Person(1, 4.0, 1.5, np.pi)], [], pillar)
+    assert lethal_near(layered.master.costs, (4.0, 0.0), 0.3) > 0
+
+
+def test_update_rejects_nan_people_duplicate_ids_and_a_sensor_off_the_map_before_changing_anything():
+    layered = LayeredCostmap(SPEC)
+    layered.update([Person(1, 4.0, 0.0)], [], scan_of([Person(1, 4.0, 0.0)]))
+    before = layered.master.costs.copy()
+    with pytest.raises(ValueError, match="outside the costmap"):
+        layered.update([Person(1, 5.0, 0.0)], [], scan_of([], pose=(20.0, 0.0, 0.0)))
+    np.testing.assert_array_equal(layered.master.costs, before)
+    with pytest.raises(ValueError, match="person 3"):
+        layered.update([Person(3, np.nan, 0.0)], [])
+    with pytest.raises(ValueError, match="twice"):
+        layered.update([Person(1, 0.0, 0.0), Person(1, 1.0, 0.0)], [])
+
+
+def test_unknown_space_stays_unknown_around_people_when_tracked():
+    spec = GridSpec(0.05, 0.0, 0.0, 100, 100)
+    layered = LayeredCostmap(spec, CostmapParams(obstacle=ObstacleParams(track_unknown_space=True)))
+    layered.update([Person(1, 2.5, 2.5, 0.0)], [])  # no scan: everything unknown except the social costs
+    costs = layered.master.costs
+    assert costs[0, 0] == NO_INFORMATION
+    assert costs[50, 50] == LETHAL and costs[50, 62] not in (0, NO_INFORMATION)
+
+
+def test_static_map_walls_survive_and_lidar_adds_to_them(tmp_path):
+    from costmap.mapfile import write_map
+    from costmap.occupancy import OccupancyGrid
+    from sid.scenario.build import build_costmap
+    from sid.scenario.loader import scenario_from_dict
+
+    spec = GridSpec(0.05, 0.0, 0.0, 100, 60)
+    data = np.zeros(spec.shape, dtype=np.int8)
+    data[50, :] = 100  # a wall along y = 2.525 in the static map
+    data[56:, :5] = -1  # unknown, behind the static wall as seen from the robot
+    write_map(tmp_path / "static.yaml", OccupancyGrid(spec, data))
+    scenario = scenario_from_dict(
+        {
+            "static_map": "static.yaml",
+            "obstacles": [{"type": "segment", "points": [[4.0, 0.5], [4.0, 2.0]]}],
+            "robot": {"start": [1.0, 1.0], "goal": [4.5, 1.0]},
+            "layers": {"obstacle": {"track_unknown_space": True}},
+        },
+        base_dir=tmp_path,
+    )
+    layered = build_costmap(scenario, social=False)
+    assert list(layered.layers) == ["static", "lidar", "inflation"]
+    master = layered.master.costs
+    assert (master[50, :] == LETHAL).all()  # static wall, also where the LiDAR saw nothing
+    assert (layered.lidar.costs[10:40, 80] == LETHAL).any()  # the LiDAR-only wall at x = 4.0
+    assert (master[56:, :5] == NO_INFORMATION).all()  # unknown in the static map, never seen
+    assert layered.scan.ranges[np.argmin(np.abs(layered.scan.angles - np.pi / 2))] == pytest.approx(1.5, abs=0.05)

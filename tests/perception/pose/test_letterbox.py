@@ -1,0 +1,118 @@
+"""Letterbox arithmetic: image pixels <-> model-input pixels, exactly, in the pixel-centre convention."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from sid.perception.pose import multipose_input_size
+from sid.perception.pose.base import Letterbox
+
+sizes = st.tuples(st.integers(1, 2000), st.integers(1, 2000))
+
+
+@given(image=sizes, model=sizes, uv=st.lists(st.floats(-1e4, 1e4), min_size=2, max_size=2))
+def test_fit_forward_then_inverse_is_identity(image, model, uv):
+    letterbox = Letterbox.fit(image, model)
+    point = np.array(uv)
+    np.testing.assert_allclose(letterbox.to_image(letterbox.to_input(point)), point, rtol=1e-9, atol=1e-6)
+
+
+@given(
+    box=st.tuples(st.floats(-100, 700), st.floats(-100, 500), st.floats(1, 400), st.floats(1, 400)),
+    expand=st.floats(0.5, 2.0),
+    uv=st.lists(st.floats(-1e3, 1e3), min_size=2, max_size=2),
+)
+def test_crop_forward_then_inverse_is_identity(box, expand, uv):
+    u0, v0, bw, bh = box
+    letterbox = Letterbox.crop((u0, v0, u0 + bw, v0 + bh), (192, 192), expand)
+    point = np.array(uv)
+    np.testing.assert_allclose(letterbox.to_image(letterbox.to_input(point)), point, rtol=1e-9, atol=1e-6)
+
+
+def test_fit_640x480_into_256_square_puts_corners_on_the_padding_bands():
+    letterbox = Letterbox.fit((480, 640), (256, 256))
+    assert (letterbox.scale, letterbox.pad_x, letterbox.pad_y) == (0.4, 0.0, 32.0)
+    # The image's outer corners (pixel-centre convention: -0.5 and size - 0.5) land on the band edges.
+    np.testing.assert_allclose(letterbox.to_input([-0.5, -0.5]), [-0.5, 31.5])
+    np.testing.assert_allclose(letterbox.to_input([639.5, 479.5]), [255.5, 223.5])
+    # The centre of the top-left pixel is 0.2 input pixels inside that corner.
+    np.testing.assert_allclose(letterbox.to_input([0.0, 0.0]), [-0.3, 31.7])
+    # Normalised model outputs: (0, 0) is the input's top-left edge, here on the padding band above the image.
+    np.testing.assert_allclose(letterbox.normalised_to_image([0.0, 32 / 256]), [-0.5, -0.5])
+    np.testing.assert_allclose(letterbox.normalised_to_image([1.0, 224 / 256]), [639.5, 479.5])
+
+
+def test_fit_portrait_pads_left_and_right():
+    letterbox = Letterbox.fit((400, 200), (256, 256))
+    assert (letterbox.scale, letterbox.pad_x, letterbox.pad_y) == (0.64, 64.0, 0.0)
+    np.testing.assert_allclose(letterbox.to_input([-0.5, -0.5]), [63.5, -0.5])
+
+
+def test_crop_centres_the_box_and_scales_its_long_side():
+    letterbox = Letterbox.crop((100.0, 200.0, 140.0, 300.0), (192, 192), expand=1.2)
+    assert letterbox.scale == pytest.approx(192 / 120)
+    np.testing.assert_allclose(letterbox.normalised_to_image([0.5, 0.5]), [120.0, 250.0])
+    # Square crop 1.2 x 100 = 120 px: the input's top edge is 60 px above the box centre.
+    np.testing.assert_allclose(letterbox.normalised_to_image([0.5, 0.0]), [120.0, 190.0])
+
+
+@pytest.mark.parametrize(
+    "letterbox",
+    [
+        Letterbox.fit((480, 640), (256, 256)),
+        Letterbox.fit((480, 640), (96, 128)),
+        Letterbox.crop((300, 80, 380, 400), (192, 192)),
+    ],
+)
+def test_warp_resamples_exactly_where_the_map_says(letterbox):
+    """On linear ramps bilinear sampling is exact, so each input pixel holds the ramp at ``to_image`` of it."""
+    h, w = 480, 640
+    v, u = np.mgrid[0:h, 0:w].astype(float)
+    image = np.stack([u * 250 / (w - 1), v * 250 / (h - 1), np.zeros_like(u)], axis=-1).round().astype(np.uint8)
+    warped = letterbox.warp(image, fill=0).astype(float)
+    in_h, in_w = letterbox.input_size
+    rows, cols = np.mgrid[0:in_h, 0:in_w]
+    source = letterbox.to_image(np.stack([cols, rows], axis=-1).astype(float))
+    inside = (source[..., 0] >= 1) & (source[..., 0] <= w - 2) & (source[..., 1] >= 1) & (source[..., 1] <= h - 2)
+    assert inside.sum() > 1000
+    expected_u = source[..., 0] * 250 / (w - 1)
+    expected_v = source[..., 1] * 250 / (h - 1)
+    assert np.abs(warped[..., 0] - expected_u)[inside].max() <= 1.0
+    assert np.abs(warped[..., 1] - expected_v)[inside].max() <= 1.0
+    outside = (source[..., 0] < -1) | (source[..., 0] > w) | (source[..., 1] < -1) | (source[..., 1] > h)
+    assert np.all(warped[outside] == 0)
+
+
+def test_bad_letterbox_arguments_are_named():
+    with pytest.raises(ValueError, match="scale"):
+        Letterbox(0.0, 0.0, 0.0, (10, 10))
+    with pytest.raises(ValueError, match="u_max > u_min"):
+        Letterbox.crop((10, 10, 5, 20), (192, 192))
+    with pytest.raises(ValueError, match="finite"):
+        Letterbox.crop((np.nan, 10, 50, 20), (192, 192))
+    with pytest.raises(ValueError, match="image size"):
+        Letterbox.fit((0, 640), (256, 256))
+
+
+@pytest.mark.parametrize(
+    ("image_hw", "size", "expected"),
+    [
+        ((480, 640), 256, (192, 256)),
+        ((720, 1280), 256, (160, 256)),
+        ((480, 640), "paper", (96, 128)),
+        ((720, 1280), "paper", (96, 128)),
+        ((640, 480), 256, (256, 192)),
+        ((480, 640), (256, 256), (256, 256)),
+    ],
+)
+def test_multipose_input_size(image_hw, size, expected):
+    assert multipose_input_size(image_hw, size) == expected
+
+
+@pytest.mark.parametrize("size", [100, 0, "huge", (250, 256)])
+def test_multipose_input_size_rejects_sizes_that_are_not_multiples_of_32(size):
+    with pytest.raises(ValueError, match="multiple|paper"):
+        multipose_input_size((480, 640), size)

@@ -1,0 +1,102 @@
+"""Camera records, pinhole (de)projection and the camera -> world mount transform."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from sid.perception.camera import Calibration, Extrinsics, Intrinsics, deproject, project
+from sid.perception.mount import CameraMount
+
+D435_COLOR = Intrinsics(1280, 720, 910.0, 910.0, 640.0, 360.0)
+
+
+@given(u=st.floats(0, 1279), v=st.floats(0, 719), z=st.floats(0.2, 10.0))
+def test_project_inverts_deproject(u, v, z):
+    point = deproject(np.array([[u, v]]), np.array([z]), D435_COLOR)
+    assert point[0, 2] == pytest.approx(z)
+    np.testing.assert_allclose(project(point, D435_COLOR), [[u, v]], atol=1e-9)
+
+
+def test_principal_point_lies_on_the_optical_axis():
+    np.testing.assert_allclose(deproject([[640.0, 360.0]], [2.0], D435_COLOR), [[0.0, 0.0, 2.0]])
+
+
+def test_points_behind_the_camera_project_to_nan():
+    assert np.isnan(project([[0.0, 0.0, -1.0]], D435_COLOR)).all()
+
+
+def test_scaled_intrinsics_keep_pixel_centres():
+    half = D435_COLOR.scaled(640, 360)
+    point = np.array([[0.3, -0.2, 2.0]])
+    full_px, half_px = project(point, D435_COLOR), project(point, half)
+    np.testing.assert_allclose((half_px + 0.5) * 2 - 0.5, full_px, atol=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "message"),
+    [("fx", -1.0, "focal"), ("cx", float("nan"), "cx"), ("width", 0, "size")],
+)
+def test_bad_intrinsics_are_named(field, value, message):
+    data = D435_COLOR.to_dict() | {field: value}
+    with pytest.raises(ValueError, match=message):
+        Intrinsics.from_dict(data)
+
+
+def test_extrinsics_reject_non_rotation():
+    with pytest.raises(ValueError, match="orthonormal"):
+        Extrinsics(np.diag([1.0, 2.0, 1.0]), np.zeros(3))
+
+
+def test_calibration_json_round_trip(tmp_path):
+    angle = 0.02
+    rotation = np.array([[np.cos(angle), 0, np.sin(angle)], [0, 1, 0], [-np.sin(angle), 0, np.cos(angle)]])
+    calib = Calibration(
+        D435_COLOR, Intrinsics(848, 480, 420.0, 420.0, 424.0, 240.0), Extrinsics(rotation, [0.015, 0.0, 0.0]), 0.001
+    )
+    path = tmp_path / "calib.json"
+    path.write_text(json.dumps(calib.to_dict()))
+    loaded = Calibration.from_json(path)
+    assert loaded.color == calib.color and loaded.depth == calib.depth
+    np.testing.assert_allclose(loaded.depth_to_color.rotation, rotation)
+
+
+def test_flat_intrinsics_json_means_registered_depth(tmp_path):
+    path = tmp_path / "intrinsics.json"
+    path.write_text(json.dumps({"fx": 525, "fy": 525, "cx": 319.5, "cy": 239.5, "width": 640, "height": 480}))
+    calib = Calibration.from_json(path)
+    assert calib.depth is None and calib.color.fx == 525
+
+
+@pytest.mark.parametrize("text", ["not json", "[1, 2]", '{"fx": 1}'])
+def test_malformed_calibration_names_the_file(tmp_path, text):
+    path = tmp_path / "bad.json"
+    path.write_text(text)
+    with pytest.raises(ValueError, match="bad.json"):
+        Calibration.from_json(path)
+
+
+def test_level_mount_maps_optical_axes_to_rep103():
+    mount = CameraMount(height=0.9)
+    # 2 m ahead, 0.5 m to the camera's right, 0.4 m below the optical centre.
+    world = mount.camera_to_world([[0.5, 0.4, 2.0]])
+    np.testing.assert_allclose(world, [[2.0, -0.5, 0.5]])
+
+
+@given(tilt=st.floats(-1.2, 1.2), height=st.floats(0.1, 2.0))
+def test_mount_round_trip_and_ground_plane(tilt, height):
+    mount = CameraMount(height=height, tilt=tilt)
+    points = np.array([[0.3, -0.1, 2.0], [-1.0, 0.5, 4.0]])
+    np.testing.assert_allclose(mount.world_to_camera(mount.camera_to_world(points)), points, atol=1e-9)
+    # The optical axis points down by `tilt`.
+    axis = mount.camera_to_world([[0.0, 0.0, 1.0]])[0] - [0.0, 0.0, height]
+    assert np.arctan2(-axis[2], axis[0]) == pytest.approx(tilt)
+
+
+def test_mount_rejects_vertical_tilt():
+    with pytest.raises(ValueError, match="tilt"):
+        CameraMount(tilt=np.pi / 2)

@@ -1,0 +1,261 @@
+"""Group detection (Algorithm 1): hand-computed scenes, pruning, invariance, bad input."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import shapely
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from sid.perception.groups import Group, GroupParams, _convex_hull, _shoelace, detect_groups
+from sid.perception.people import Person
+
+
+def circle(n: int, radius: float, centre=(0.0, 0.0), start_deg: float = 0.0, first_id: int = 0) -> list[Person]:
+    """n people evenly on a circle, each facing its centre."""
+    people = []
+    for k in range(n):
+        a = math.radians(start_deg) + 2 * math.pi * k / n
+        people.append(
+            Person(first_id + k, centre[0] + radius * math.cos(a), centre[1] + radius * math.sin(a), a + math.pi)
+        )
+    return people
+
+
+def signed_area(polygon: np.ndarray) -> float:
+    x, y = polygon[:, 0], polygon[:, 1]
+    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
+
+
+# --- hand-computed scenes from the issue ------------------------------------------------------------------------
+
+
+def test_two_people_facing_each_other_meet_at_the_midpoint():
+    groups = detect_groups([Person(1, 2.0, 0.3, 0.0), Person(2, 2.8, 0.3, math.pi)])
+    assert len(groups) == 1
+    group = groups[0]
+    assert group.members == (1, 2)
+    assert group.interest_point == pytest.approx((2.4, 0.3))
+    assert group.area == 0.0 and group.spread == pytest.approx(0.4)
+    np.testing.assert_allclose(group.zone, [[2.4, 0.3]])
+
+
+def test_four_people_on_a_circle_facing_its_centre():
+    groups = detect_groups(circle(4, 0.8, centre=(3.0, -1.0)))
+    assert len(groups) == 1
+    assert groups[0].members == (0, 1, 2, 3)
+    assert groups[0].interest_point == pytest.approx((3.0, -1.0), abs=1e-9)
+    assert groups[0].area == 0.0 and groups[0].spread == pytest.approx(0.8)
+
+
+def test_three_side_by_side_facing_the_same_way_are_no_group():
+    assert detect_groups([Person(i, 2.0, -0.6 + 0.6 * i, 0.0) for i in range(3)]) == []
+
+
+def test_circle_of_three_plus_a_fourth_behind_facing_away_is_a_group_of_three():
+    people = circle(3, 0.8, start_deg=90)
+    people.append(Person(9, 0.0, 1.8, math.pi / 2))  # 1 m behind the member at (0, 0.8), facing away
+    groups = detect_groups(people)
+    assert [g.members for g in groups] == [(0, 1, 2)]
+    assert groups[0].interest_point == pytest.approx((0.0, 0.0), abs=1e-9)
+
+
+# --- geometry computed by hand ----------------------------------------------------------------------------------
+
+
+def test_perpendicular_pair_meets_where_the_rays_cross():
+    # A at (0, 0) faces +x, B at (1, 1) faces -y: the rays cross at (1, 0); D = (1 + 1) / 2.
+    groups = detect_groups(
+        [Person(1, 0.0, 0.0, 0.0), Person(2, 1.0, 1.0, -math.pi / 2)], GroupParams(spread_threshold=1.2)
+    )
+    assert len(groups) == 1
+    assert groups[0].interest_point == pytest.approx((1.0, 0.0))
+    assert groups[0].spread == pytest.approx(1.0)
+
+
+def test_three_rays_bounding_a_triangle_give_its_area_and_centroid():
+    # Rays 3 m long (C is 1.7 m from its crossings) so that all three meet.
+    # y = 0 (A facing +x), x = 0 (B facing +y) and x - y = 0.4 (C facing (-1, -1)) bound the triangle
+    # (0, 0), (0.4, 0), (0, -0.4): area 0.08 m^2, centroid (0.4/3, -0.4/3).
+    people = [Person(1, -1.0, 0.0, 0.0), Person(2, 0.0, -1.0, math.pi / 2), Person(3, 1.2, 0.8, -3 * math.pi / 4)]
+    params = GroupParams(eps=3.0, spread_threshold=1.5, area_threshold=0.5, ray_length=3.0)
+    [group] = detect_groups(people, params)
+    assert group.members == (1, 2, 3)
+    assert group.area == pytest.approx(0.08)
+    assert group.interest_point == pytest.approx((0.4 / 3, -0.4 / 3))
+    assert len(group.zone) == 3 and signed_area(group.zone) == pytest.approx(0.08), "zone is counter-clockwise"
+    centre = np.array(group.interest_point)
+    expected_spread = np.mean([np.hypot(*(np.array([p.x, p.y]) - centre)) for p in people])
+    assert group.spread == pytest.approx(expected_spread)
+    # The same scene with a smaller area threshold is pruned to a pair (area 0).
+    [pair] = detect_groups(people, GroupParams(eps=3.0, spread_threshold=1.5, area_threshold=0.05, ray_length=3.0))
+    assert pair.members == (1, 2) and pair.area == 0.0  # dropping C leaves the smallest D (1.0 m)
+
+
+def test_collinear_crossings_give_area_zero_and_their_mean():
+    # A, B, C all face +x from x = 0 at y = 0, 0.5, 1 would be parallel; instead three people whose pairwise
+    # crossings lie on the line y = 0: A on it facing +x, B and C crossing it at x = 1 and x = 2.
+    people = [Person(1, 0.0, 0.0, 0.0), Person(2, 1.0, -0.5, math.pi / 2), Person(3, 2.0, 0.5, -math.pi / 2)]
+    [group] = detect_groups(
+        people, GroupParams(spread_threshold=2.0, facing_tolerance=0.0, ray_length=3.0, meeting_radius=math.inf)
+    )
+    assert group.area == 0.0
+    assert group.interest_point == pytest.approx((1.5, 0.0))
+    np.testing.assert_allclose(sorted(group.zone.tolist()), [[1.0, 0.0], [2.0, 0.0]])
+
+
+def test_pruning_removes_the_member_whose_crossings_spread_the_zone():
+    # A triangle of three facing its centre, and a fourth at (2.5, 0.6) facing 200 degrees whose ray crosses the
+    # three members' rays at (0.90, 0.10), (0, -0.31) and (0.33, -0.19): with the centre, a 0.153 m^2 zone.
+    # Dropping the fourth leaves area 0 and D = 0.8 m, the best of the four removals.
+    people = [*circle(3, 0.8, start_deg=90), Person(7, 2.5, 0.6, math.radians(200))]
+    loose = GroupParams(eps=3.0, area_threshold=1.0, spread_threshold=1.5, ray_length=3.0, meeting_radius=math.inf)
+    [group] = detect_groups(people, loose)
+    assert group.members == (0, 1, 2, 7) and group.area == pytest.approx(0.153, abs=0.001)
+    [group] = detect_groups(
+        people, GroupParams(eps=3.0, area_threshold=0.05, spread_threshold=1.5, ray_length=3.0, meeting_radius=math.inf)
+    )
+    assert group.members == (0, 1, 2)
+    assert group.interest_point == pytest.approx((0.0, 0.0), abs=1e-9) and group.area == 0.0
+
+
+def test_two_conversations_in_one_cluster_are_both_found():
+    # A triangle and, 1.5 m away, a pair facing each other across the x axis: one DBSCAN cluster, two groups.
+    people = circle(3, 0.7, centre=(0.0, 0.0)) + circle(2, 0.5, centre=(2.2, 0.0), start_deg=90, first_id=10)
+    groups = detect_groups(people, GroupParams(eps=3.0))
+    assert sorted(g.members for g in groups) == [(0, 1, 2), (10, 11)]
+
+
+def test_people_with_unknown_facing_cast_no_ray_and_are_not_members():
+    people = [*circle(3, 0.8), Person(5, 0.3, 0.2, None)]
+    assert [g.members for g in detect_groups(people)] == [(0, 1, 2)]
+    assert detect_groups([Person(1, 0.0, 0.0, None), Person(2, 0.8, 0.0, None)]) == []
+
+
+def test_far_apart_people_are_not_clustered():
+    assert detect_groups([Person(1, 0.0, 0.0, 0.0), Person(2, 5.0, 0.0, math.pi)]) == []
+
+
+# Crossing coordinates on a millimetre grid within +-5 m (subnormal floats make GEOS itself disagree with exact hulls).
+MILLIMETRES = st.integers(-5000, 5000).map(lambda v: v / 1000)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.tuples(MILLIMETRES, MILLIMETRES), min_size=3, max_size=30))
+def test_hull_area_and_centroid_match_shapely(coords):
+    points = [complex(x, y) for x, y in coords]
+    hull = _convex_hull(points)
+    reference = shapely.convex_hull(shapely.multipoints(np.array(coords)))
+    if reference.geom_type != "Polygon" or reference.area < 1e-6:
+        return  # degenerate sets are handled apart (area 0, mean of crossings)
+    area, centre = _shoelace(hull)
+    assert area == pytest.approx(reference.area, rel=1e-9, abs=1e-9)
+    assert (centre.real, centre.imag) == pytest.approx(reference.centroid.coords[0], abs=1e-6)
+
+
+# --- invariance -------------------------------------------------------------------------------------------------
+
+
+def random_scene(seed: int) -> list[Person]:
+    """A few noisy conversation circles and some lone people, from a seeded generator (continuous values)."""
+    rng = np.random.default_rng(seed)
+    people: list[Person] = []
+    for _ in range(rng.integers(1, 4)):
+        centre = rng.uniform(-4, 4, 2)
+        n = int(rng.integers(2, 6))
+        radius = rng.uniform(0.4, 1.0)
+        for k in range(n):
+            a = 2 * math.pi * k / n + rng.normal(0, 0.2)
+            x, y = centre + radius * np.array([math.cos(a), math.sin(a)])
+            people.append(Person(len(people), float(x), float(y), float(a + math.pi + rng.normal(0, 0.2))))
+    for _ in range(rng.integers(0, 4)):
+        x, y = rng.uniform(-5, 5, 2)
+        people.append(Person(len(people), float(x), float(y), float(rng.uniform(-math.pi, math.pi))))
+    return people
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.floats(-math.pi, math.pi), st.floats(-20, 20), st.floats(-20, 20))
+def test_rotating_and_translating_the_scene_moves_the_groups_with_it(seed, angle, tx, ty):
+    people = random_scene(seed)
+    c, s = math.cos(angle), math.sin(angle)
+    moved = [Person(p.id, c * p.x - s * p.y + tx, s * p.x + c * p.y + ty, p.theta + angle) for p in people]
+    before, after = detect_groups(people), detect_groups(moved)
+    assert [g.members for g in after] == [g.members for g in before]
+    for g, h in zip(before, after, strict=True):
+        x, y = g.interest_point
+        assert h.interest_point == pytest.approx((c * x - s * y + tx, s * x + c * y + ty), abs=1e-6)
+        assert h.area == pytest.approx(g.area, abs=1e-6)
+        assert h.spread == pytest.approx(g.spread, abs=1e-6)
+
+
+# --- bad input --------------------------------------------------------------------------------------------------
+
+
+def test_empty_and_single_person_give_no_group():
+    assert detect_groups([]) == []
+    assert detect_groups([Person(1, 1.0, 0.0, 0.0)]) == []
+
+
+@pytest.mark.parametrize(
+    ("people", "message"),
+    [
+        ([Person(1, 0.0, 0.0, 0.0), Person(7, float("nan"), 0.0, 0.0)], "person 7 has a non-finite position"),
+        ([Person(3, float("inf"), 0.0, 0.0)], "person 3 has a non-finite position"),
+        ([Person(1, 0.0, 0.0, 0.0), Person(2, 1.0, 0.0, float("nan"))], "person 2 has a non-finite theta"),
+        ([Person(1, 0.0, 0.0, 0.0), Person(1, 1.0, 0.0, 0.0)], r"ids must be unique, repeated: \[1\]"),
+    ],
+)
+def test_bad_people_are_rejected_naming_the_person(people, message):
+    with pytest.raises(ValueError, match=message):
+        detect_groups(people)
+
+
+@pytest.mark.parametrize(
+    ("field", "value"),
+    [
+        ("eps", 0.0),
+        ("eps", float("nan")),
+        ("min_samples", 0),
+        ("min_samples", 1.5),
+        ("area_threshold", -1.0),
+        ("spread_threshold", 0.0),
+        ("ray_length", -2.0),
+        ("facing_tolerance", 2.0),
+        ("meeting_radius", 0.0),
+    ],
+)
+def test_bad_params_are_rejected(field, value):
+    with pytest.raises(ValueError, match=field):
+        GroupParams(**{field: value})
+
+
+def test_group_record_fields():
+    [group] = detect_groups(circle(2, 0.5))
+    assert isinstance(group, Group)
+    assert isinstance(group.members, tuple) and isinstance(group.interest_point, tuple)
+    assert group.zone.shape == (1, 2)
+
+
+# --- speed (run with --benchmark-enable; never asserted) ----------------------------------------------------------
+
+
+def noisy_circles(counts: list[int], seed: int = 0) -> list[Person]:
+    """Conversation circles 3 m apart with 5 cm / 0.1 rad estimation noise."""
+    rng = np.random.default_rng(seed)
+    people: list[Person] = []
+    for k, n in enumerate(counts):
+        for p in circle(n, 0.8, centre=(3.0 * k, 2.0 * (k % 2)), first_id=len(people)):
+            people.append(
+                Person(p.id, p.x + rng.normal(0, 0.05), p.y + rng.normal(0, 0.05), p.theta + rng.normal(0, 0.1))
+            )
+    return people
+
+
+@pytest.mark.parametrize(("counts", "expected"), [([2], 1), ([3], 1), ([4], 1), ([6], 1), ([4, 4, 4, 4, 4], 5)])
+def test_bench_grouping(benchmark, counts, expected):
+    people = noisy_circles(counts)
+    assert len(benchmark(detect_groups, people)) == expected

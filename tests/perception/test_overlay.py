@@ -1,0 +1,90 @@
+"""Overlay drawing: skeleton, boxes, scores and facing arrows land where the records say."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from sid.perception.keypoints import KP, PoseDetection
+from sid.perception.overlay import (
+    ARROW_COLOUR,
+    BOX_COLOUR,
+    CENTRE_COLOUR,
+    LEFT_COLOUR,
+    RIGHT_COLOUR,
+    draw_detections,
+    person_label,
+)
+from sid.perception.people import Person
+
+
+def _standing(u: float, scores: float = 0.9) -> PoseDetection:
+    """A stick figure seen from the front, centred on column u (its left side on the image's right)."""
+    keypoints = np.zeros((17, 2))
+    rows = {"nose": 160, "eye": 155, "ear": 158, "shoulder": 200, "elbow": 250, "wrist": 300}
+    rows |= {"hip": 310, "knee": 390, "ankle": 470}
+    for name, index in KP.items():
+        part = name.split("_")[-1]
+        side = 0 if name == "nose" else (25 if name.startswith("left") else -25)
+        keypoints[index] = (u + side, rows[part])
+    return PoseDetection(keypoints, np.full(17, scores), (u - 50, 140, u + 50, 480), 0.87)
+
+
+def _has(image: np.ndarray, colour, v: int, u: int, radius: int = 2) -> bool:
+    patch = image[v - radius : v + radius + 1, u - radius : u + radius + 1].reshape(-1, 3)
+    return bool(np.any(np.all(patch == colour, axis=1)))
+
+
+def test_keypoints_bones_and_boxes_are_drawn_in_their_colours():
+    color = np.zeros((500, 600, 3), np.uint8)
+    person = _standing(200)
+    picture = draw_detections(color, [person])
+    assert picture.shape == color.shape and picture.dtype == np.uint8
+    u, v = person.keypoints[KP["left_knee"]].astype(int)
+    assert _has(picture, LEFT_COLOUR, v, u)
+    u, v = person.keypoints[KP["right_knee"]].astype(int)
+    assert _has(picture, RIGHT_COLOUR, v, u)
+    assert _has(picture, CENTRE_COLOUR, 200, 200)  # the shoulder line between two sides
+    assert _has(picture, BOX_COLOUR, 300, 150, radius=1)  # the box's left edge
+    assert _has(picture, LEFT_COLOUR, 350, 225)  # the left thigh, halfway from hip to knee
+    assert np.all(color == 0)  # the input is not drawn on
+
+
+def test_low_score_keypoints_are_left_out():
+    person = _standing(300, scores=0.1)
+    picture = draw_detections(np.zeros((500, 600, 3), np.uint8), [person], keypoint_threshold=0.3)
+    u, v = person.keypoints[KP["left_knee"]].astype(int)
+    assert not _has(picture, LEFT_COLOUR, v, u)
+    assert _has(picture, BOX_COLOUR, 300, 250, radius=1)  # the box is still drawn
+
+
+def test_output_is_bgr():
+    color = np.zeros((100, 100, 3), np.uint8)
+    color[..., 0] = 255  # pure red in RGB
+    picture = draw_detections(color, [])
+    assert np.all(picture[..., 2] == 255) and np.all(picture[..., 0] == 0)
+
+
+@pytest.mark.parametrize(("theta", "direction"), [(0.0, (0, -1)), (np.pi, (0, 1)), (np.pi / 2, (-1, 0))])
+def test_facing_arrow_points_along_theta_in_a_top_view(theta, direction):
+    person = _standing(300)
+    picture = draw_detections(np.zeros((500, 600, 3), np.uint8), [person], [Person(4, 2.0, 0.0, theta)])
+    anchor = np.array([300, 200])  # between the shoulders
+    tip = anchor + 0.25 * 340 * 0.8 * np.array(direction)  # 80 % along the arrow
+    assert _has(picture, ARROW_COLOUR, int(tip[1]), int(tip[0]))
+    opposite = anchor - 0.25 * 340 * 0.8 * np.array(direction)
+    assert not _has(picture, ARROW_COLOUR, int(opposite[1]), int(opposite[0]))
+
+
+def test_person_labels_and_unknown_facing():
+    assert person_label(Person(3, 3.0, 4.0, np.pi / 2)) == ("id 3", "5.00 m +90 deg")
+    assert person_label(Person(1, 2.0, 0.0, None)) == ("id 1", "2.00 m ?")
+    picture = draw_detections(np.zeros((500, 600, 3), np.uint8), [_standing(300)], [Person(1, 2.0, 0.0, None)])
+    assert not np.any(np.all(picture == ARROW_COLOUR, axis=-1))
+
+
+def test_people_must_match_detections():
+    with pytest.raises(ValueError, match="match 1:1"):
+        draw_detections(np.zeros((10, 10, 3), np.uint8), [], [Person(0, 1.0, 0.0)])
+    picture = draw_detections(np.zeros((500, 600, 3), np.uint8), [_standing(300)], [None])
+    assert not np.any(np.all(picture == ARROW_COLOUR, axis=-1))

@@ -1,0 +1,259 @@
+"""Planner core on hand-made costmaps: validity, cost model, every planner, impossible problems, repeatability."""
+
+from __future__ import annotations
+
+import math
+import re
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy import ndimage
+
+from costmap.grid import INSCRIBED, LETHAL, NO_INFORMATION, Costmap2D, GridSpec
+from planner.facade import OMPL_PLANNERS, PLANNERS, plan, resolve_planner
+from planner.problem import CostField, PlanningError, PlanningProblem
+from planner.smoothing import smooth
+from planner.validity import check_path, interpolate
+
+RADIUS = 0.25
+
+
+def inflate(lethal: np.ndarray, spec: GridSpec, radius: float = RADIUS) -> np.ndarray:
+    """Nav2-style inflation of a lethal mask (254 / 253 within radius / exponential fall-off to 0.55 m)."""
+    d = ndimage.distance_transform_edt(~lethal) * spec.resolution
+    cost = np.where(d <= 0.55, 252 * np.exp(-10 * (d - radius)), 0).astype(np.uint8)
+    cost[d <= radius] = INSCRIBED
+    cost[lethal] = LETHAL
+    return cost
+
+
+def walled_map(blob_cost: int = 0) -> Costmap2D:
+    """10 x 8 m at 5 cm: two staggered walls, and optionally a graded blob (peak ``blob_cost``) at (5, 4)."""
+    spec = GridSpec.from_size(0.05, (0.0, 0.0), (10.0, 8.0))
+    x, y = spec.cell_centres()
+    lethal = ((x > 3.0) & (x < 3.2) & (y < 5.0)) | ((x > 6.5) & (x < 6.7) & (y > 3.0))
+    costs = inflate(lethal, spec)
+    if blob_cost:
+        blob = (blob_cost * np.exp(-(np.hypot(x - 5, y - 4) ** 2) / (2 * 0.6**2))).astype(np.uint8)
+        costs = np.maximum(costs, blob)
+    return Costmap2D(spec, costs)
+
+
+def independent_collisions(costmap: Costmap2D, path: np.ndarray, radius: float = RADIUS) -> int:
+    """Samples (every 1 cm) whose cell is inscribed/lethal/unknown or whose centre is within radius of a lethal
+    cell centre: computed without the planner's own lookups."""
+    samples = interpolate(path, 0.01)
+    costs = costmap.cost_at(samples)
+    lethal_xy = costmap.spec.cell_to_world(np.argwhere(costmap.costs == LETHAL))
+    cells = costmap.spec.cell_to_world(costmap.spec.world_to_cell(samples))
+    near = np.zeros(len(samples), bool)
+    for chunk in np.array_split(np.arange(len(samples)), max(1, len(samples) // 200)):
+        d = np.hypot(*(cells[chunk, None, :] - lethal_xy[None]).transpose(2, 0, 1)).min(axis=1)
+        near[chunk] = d <= radius
+    return int(((costs >= INSCRIBED) | near).sum())
+
+
+@pytest.fixture(scope="module")
+def walls() -> PlanningProblem:
+    return PlanningProblem(walled_map(), (1.0, 2.0), (9.0, 6.0), RADIUS)
+
+
+# ---- validity and cost model ----------------------------------------------------------------------------------
+
+
+def test_free_mask_follows_footprint_inscribed_and_unknown():
+    spec = GridSpec.from_size(0.05, (0.0, 0.0), (2.0, 2.0))
+    costs = np.zeros(spec.shape, np.uint8)
+    costs[20, 20] = LETHAL  # no inflation at all: the footprint check must still keep the disc off it
+    costs[5, 30] = INSCRIBED
+    costs[35, 5] = NO_INFORMATION
+    field = CostField(PlanningProblem(Costmap2D(spec, costs), (0.3, 0.3), (1.7, 1.7), RADIUS))
+    assert not field.free[20, 25] and field.free[20, 26]  # 5 cells = 0.25 m: inside the disc; 6 cells: outside
+    assert not field.free[5, 30] and not field.free[35, 5]
+    assert field.plannable.sum() < field.free.sum()  # the planners' mask is one cell stricter
+    lenient = CostField(PlanningProblem(Costmap2D(spec, costs), (0.3, 0.3), (1.7, 1.7), RADIUS, allow_unknown=True))
+    assert lenient.free[35, 5]
+
+
+def test_validity_checker_returns_python_bool(walls):
+    from planner.validity import state_validity_checker
+
+    field = CostField(walls)
+    checker = state_validity_checker(field)
+    assert checker([1.0, 2.0]) is True
+    assert checker([3.1, 1.0]) is False
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.floats(0.01, 9.99), min_size=4, max_size=4))
+def test_scalar_and_vectorised_segment_costs_agree(coords):
+    field = CostField(PlanningProblem(walled_map(blob_cost=200), (1.0, 2.0), (9.0, 6.0), RADIUS))
+    x0, y0, x1, y1 = coords
+    y0, y1 = y0 * 0.8, y1 * 0.8
+    vectorised = field.segments(np.array([[x0, y0]]), np.array([[x1, y1]]))[0][0]
+    assert field.segment_cost(x0, y0, x1, y1) == pytest.approx(vectorised, rel=1e-9, abs=1e-9)
+
+
+def test_zero_weight_cost_is_length():
+    problem = PlanningProblem(walled_map(blob_cost=200), (1.0, 2.0), (9.0, 6.0), RADIUS, cost_weight=0.0)
+    field = CostField(problem)
+    assert field.segment_cost(1.0, 1.0, 5.0, 4.0) == pytest.approx(5.0)
+
+
+def test_cost_grows_with_the_cells_crossed():
+    field = CostField(PlanningProblem(walled_map(blob_cost=200), (1.0, 2.0), (9.0, 6.0), RADIUS))
+    through_blob = field.segment_cost(4.0, 4.0, 6.0, 4.0)
+    beside_blob = field.segment_cost(4.0, 6.5, 6.0, 6.5)
+    assert through_blob > 2.0 * 2.0 and beside_blob == pytest.approx(2.0, abs=0.01)
+
+
+# ---- planners ------------------------------------------------------------------------------------------------
+
+
+# Iteration caps (not time) bound the runs so that results do not depend on the machine's speed.
+CAPS = {"rrtstar": 300, "informed_rrtstar": 300, "bitstar": 3000, "rrtconnect": 1000, "fmtstar": 300, "grid": None}
+
+
+@pytest.mark.parametrize("name", PLANNERS)
+def test_every_planner_finds_a_collision_free_path(walls, name):
+    result = plan(walls, name, time_limit=30.0, seed=5, max_iterations=CAPS[name])
+    assert result.success, result.message
+    assert np.allclose(result.path[0], walls.start) and np.allclose(result.path[-1], walls.goal)
+    assert independent_collisions(walls.costmap, result.path) == 0
+    assert check_path(CostField(walls), result.path).valid
+    assert result.cost <= result.raw_cost + 1e-9  # smoothing never raises the cost
+    straight = math.dist(walls.start, walls.goal)
+    assert straight < result.length_m < 2.0 * straight
+
+
+def test_graded_cost_bends_the_path():
+    costmap = walled_map(blob_cost=250)
+    start, goal = (4.0, 4.0), (6.0, 4.0)  # the blob (peak 250, not an obstacle) sits between them
+    shortest = plan(PlanningProblem(costmap, start, goal, RADIUS, cost_weight=0.0), "grid")
+    social = plan(PlanningProblem(costmap, start, goal, RADIUS), "grid")
+    assert shortest.length_m == pytest.approx(2.0, abs=0.01)
+    assert social.length_m > 2.2
+    on_path = costmap.cost_at(interpolate(social.path, 0.02))
+    assert on_path.max() < 250
+
+
+def test_sampling_planner_matches_grid_reference_on_graded_map():
+    problem = PlanningProblem(walled_map(blob_cost=250), (1.0, 2.0), (9.0, 6.0), RADIUS)
+    reference = plan(problem, "grid")
+    result = plan(problem, "bitstar", time_limit=30.0, seed=2, max_iterations=5000)
+    assert result.success and result.cost <= 1.05 * reference.cost
+
+
+def test_smoothing_keeps_paths_valid_and_never_raises_cost(walls):
+    field = CostField(walls)
+    rng = np.random.default_rng(0)
+    for seed in range(3):
+        raw = plan(walls, "rrtconnect", seed=seed + 1, simplify=False).path
+        jittered = raw.copy()
+        jittered[1:-1] += rng.normal(0, 0.01, jittered[1:-1].shape)
+        for path in (raw, jittered):
+            smoothed = smooth(field, path)
+            assert field.path_cost(smoothed) <= field.path_cost(path) + 1e-9
+            if check_path(field, path).valid:
+                assert check_path(field, smoothed).valid
+
+
+# ---- impossible problems and bad input -----------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("start", "goal", "message"),
+    [
+        ((-1.0, 2.0), (9.0, 6.0), "start (-1.00, 2.00) is outside the map"),
+        ((1.0, 2.0), (9.0, 60.0), "goal (9.00, 60.00) is outside the map"),
+        ((3.1, 2.0), (9.0, 6.0), "start (3.10, 2.00) is in collision"),
+        ((1.0, 2.0), (6.6, 6.0), "goal (6.60, 6.00) is in collision"),
+        ((1.0, 2.0), (6.4, 6.0), "goal (6.40, 6.00) is in collision"),  # inscribed, not lethal
+    ],
+)
+@pytest.mark.parametrize("name", ["grid", "bitstar"])
+def test_impossible_endpoints_raise_clear_errors(start, goal, message, name):
+    with pytest.raises(PlanningError, match=re.escape(message)):
+        plan(PlanningProblem(walled_map(), start, goal, RADIUS), name, time_limit=0.2, seed=1)
+
+
+@pytest.mark.parametrize("name", ["grid", "rrtstar"])
+def test_disconnected_goal_fails_fast_with_reason(name):
+    costmap = walled_map()
+    x, _ = costmap.spec.cell_centres()
+    costmap.costs[(x > 4.9) & (x < 5.1)] = LETHAL  # a wall across the whole map
+    with pytest.raises(PlanningError, match="separate free regions"):
+        plan(PlanningProblem(costmap, (1.0, 2.0), (9.0, 6.0), RADIUS), name, time_limit=5.0, seed=1)
+
+
+def test_budget_exhausted_reports_failure_without_path(walls):
+    result = plan(walls, "rrtstar", time_limit=5.0, seed=1, max_iterations=3)
+    assert not result.success and len(result.path) == 0
+    assert "found no path" in result.message
+
+
+def test_planner_names_and_prm_exclusion():
+    assert resolve_planner("BITstar") == "bitstar" and resolve_planner("informed-rrtstar") == "informed_rrtstar"
+    with pytest.raises(ValueError, match="PRM\\* is not available: .*deadlocks"):
+        resolve_planner("prmstar")
+    with pytest.raises(ValueError, match="unknown planner 'astar'"):
+        resolve_planner("astar")
+
+
+@pytest.mark.parametrize("bad", [dict(start=(math.nan, 1.0)), dict(robot_radius=-0.1), dict(cost_weight=math.inf)])
+def test_bad_problem_values_are_rejected(bad):
+    args = dict(costmap=walled_map(), start=(1.0, 2.0), goal=(9.0, 6.0), robot_radius=RADIUS) | bad
+    with pytest.raises(PlanningError):
+        PlanningProblem(**args)
+
+
+# ---- repeatability -------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", sorted(OMPL_PLANNERS))
+def test_seed_and_iteration_cap_repeat_exactly(walls, name):
+    runs = [plan(walls, name, time_limit=30.0, seed=11, max_iterations=400) for _ in range(2)]
+    assert runs[0].success == runs[1].success
+    assert runs[0].iterations == runs[1].iterations
+    assert np.array_equal(runs[0].raw_path, runs[1].raw_path)
+    assert np.array_equal(runs[0].path, runs[1].path)
+
+
+def test_unseeded_run_reports_the_seed_that_repeats_it(walls):
+    first = plan(walls, "rrtstar", time_limit=30.0, max_iterations=200)
+    again = plan(walls, "rrtstar", time_limit=30.0, seed=first.seed, max_iterations=200)
+    assert first.seed is not None and np.array_equal(first.raw_path, again.raw_path)
+
+
+@pytest.mark.parametrize("name", ["rrtstar", "bitstar"])
+def test_a_timed_run_is_replayed_by_its_seed_and_iteration_count(walls, name):
+    timed = plan(walls, name, time_limit=0.2, seed=21)
+    replay = plan(walls, name, time_limit=30.0, seed=21, max_iterations=timed.iterations)
+    assert timed.success and np.array_equal(timed.raw_path, replay.raw_path)
+
+
+@settings(max_examples=12, deadline=None)
+@given(
+    st.lists(st.tuples(st.floats(0.5, 9.5), st.floats(0.5, 7.5), st.floats(0.1, 0.6)), min_size=3, max_size=12),
+    st.tuples(st.floats(0.2, 9.8), st.floats(0.2, 7.8), st.floats(0.2, 9.8), st.floats(0.2, 7.8)),
+    st.sampled_from(["grid", "rrtconnect", "bitstar"]),
+)
+def test_random_maps_give_a_valid_path_or_a_clear_refusal(discs, ends, name):
+    spec = GridSpec.from_size(0.05, (0.0, 0.0), (10.0, 8.0))
+    x, y = spec.cell_centres()
+    lethal = np.zeros(spec.shape, bool)
+    for cx, cy, r in discs:
+        lethal |= np.hypot(x - cx, y - cy) <= r
+    costmap = Costmap2D(spec, inflate(lethal, spec))
+    problem = PlanningProblem(costmap, ends[:2], ends[2:], RADIUS)
+    try:
+        result = plan(problem, name, time_limit=30.0, seed=1, max_iterations=CAPS[name])
+    except PlanningError as exc:
+        assert "in collision" in str(exc) or "separate free regions" in str(exc)
+        return
+    if result.success:
+        assert independent_collisions(costmap, result.path) == 0
+    else:
+        assert len(result.path) == 0 and result.message

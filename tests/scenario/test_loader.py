@@ -1,0 +1,147 @@
+"""Scenario files: the documented fields and defaults, and errors that name the offending field."""
+
+from __future__ import annotations
+
+import copy
+import json
+import math
+
+import numpy as np
+import pytest
+import yaml
+
+from costmap.grid import GridSpec
+from costmap.layers.obstacle import ObstacleParams
+from costmap.mapfile import write_map
+from costmap.occupancy import OccupancyGrid
+from sid.perception.groups import GroupParams
+from sid.scenario.loader import ScenarioError, load_scenario, scenario_from_dict
+from sid.scenario.obstacles import BoxObstacle, CircleObstacle, SegmentObstacle
+from tests.conftest import REPO_ROOT
+
+EXAMPLE = REPO_ROOT / "examples" / "conversation.json"
+BASE = {
+    "map": {"resolution": 0.05, "origin": [-1.0, -4.0], "size": [10.0, 8.0]},
+    "people": [{"id": 1, "x": 4.0, "y": 0.5, "theta": -1.57}, {"id": 2, "x": 4.0, "y": -0.5, "theta": None}],
+    "robot": {"start": [0, 0, 0], "goal": [8, 0, 0]},
+}
+
+
+def with_change(path: str, value) -> dict:
+    """BASE with one field replaced; path like 'people.1.theta'."""
+    data = copy.deepcopy(BASE)
+    node = data
+    keys = [int(k) if k.isdigit() else k for k in path.split(".")]
+    for key in keys[:-1]:
+        node = node[key]
+    node[keys[-1]] = value
+    return data
+
+
+def test_example_scenario_loads_with_its_fields():
+    s = load_scenario(EXAMPLE)
+    assert s.name == "conversation"
+    assert (s.grid.width, s.grid.height, s.grid.resolution) == (200, 160, 0.05)
+    assert (s.grid.origin_x, s.grid.origin_y) == (-1.0, -4.0)
+    assert {type(o) for o in s.obstacles} == {SegmentObstacle, CircleObstacle, BoxObstacle}
+    assert [p.id for p in s.people] == [1, 2, 3, 4]
+    assert s.robot.start == (0.0, 0.0, 0.0) and s.robot.goal == (8.0, 0.0, 0.0) and s.robot.radius == 0.25
+    assert s.lidar.beams == 720 and s.lidar.range_max == 10.0
+
+
+def test_defaults_apply_when_fields_are_left_out():
+    s = scenario_from_dict({"map": {"size": [4, 3]}, "robot": {"start": [1, 1], "goal": [3, 2]}})
+    assert s.name == "scenario" and s.grid.resolution == 0.05 and (s.grid.origin_x, s.grid.origin_y) == (0, 0)
+    assert s.robot.start == (1.0, 1.0, 0.0) and s.robot.radius == 0.25
+    assert s.people == [] and s.obstacles == [] and s.static_map is None
+    assert s.group_params == GroupParams() and s.layers.obstacle == ObstacleParams()
+    assert s.lidar.body_radius == 0.2
+
+
+def test_unknown_orientation_and_parameter_blocks():
+    data = copy.deepcopy(BASE)
+    data["groups"] = {"eps": 1.5, "min_samples": 3}
+    data["layers"] = {"inflation": {"inflation_radius": 0.8}, "obstacle": {"track_unknown_space": True}}
+    s = scenario_from_dict(data)
+    assert s.people[1].theta is None and s.people[1].orientation_quality == 0.0
+    assert s.people[0].orientation_quality == 1.0
+    assert s.group_params.eps == 1.5 and s.group_params.min_samples == 3
+    assert s.layers.inflation.inflation_radius == 0.8 and s.layers.obstacle.track_unknown_space
+
+
+def test_yaml_files_load_too(tmp_path):
+    path = tmp_path / "s.yaml"
+    path.write_text(yaml.safe_dump(BASE))
+    assert load_scenario(path).name == "s"
+
+
+@pytest.mark.parametrize(
+    "path,value,message",
+    [
+        ("people.1.theta", "north", r"people\[1\]\.theta: expected a finite number"),
+        ("people.0.x", math.nan, r"people\[0\]\.x: expected a finite number"),
+        ("people.0.x", 42.0, r"people\[0\]: \(42.0, 0.5\) is outside the map"),
+        ("people.1.id", 1, r"people\[1\]\.id: 1 is already used by people\[0\]"),
+        ("map.resolution", 0, r"map\.resolution: expected a positive number"),
+        ("map.size", [10], r"map\.size: expected a list of 2 numbers"),
+        ("map.origin", [0, 0, 0.5], r"map\.origin: a rotated map is not supported"),
+        ("robot.start", [0, math.inf, 0], r"robot\.start\[1\]: expected a finite number"),
+        ("robot.goal", [20, 0, 0], r"robot\.goal: .* outside the map"),
+        ("robot.radius", -0.1, r"robot\.radius: expected a positive number"),
+        ("obstacles", [{"type": "wall"}], r"obstacles\[0\]\.type"),
+        ("obstacles", [{"type": "circle", "center": [1, 1]}], r"obstacles\[0\]\.radius: required"),
+        ("obstacles", [{"type": "box", "min": [1, 1], "max": [0, 2]}], r"obstacles\[0\]: min"),
+        ("obstacles", [{"type": "segment", "points": [[0, 0]]}], r"obstacles\[0\]\.points: expected at least 2"),
+        ("lidar", {"beams": 0}, r"lidar\.beams: expected an integer >= 1"),
+        ("groups", {"epsilon": 1}, r"groups\.epsilon: unknown field"),
+        ("layers", {"inflation": {"inflation_radius": -1}}, r"layers\.inflation: inflation_radius"),
+        ("layers", {"social": {"group_cost": 300}}, r"layers\.social: social\.group_cost"),
+        ("peple", [], r"scenario\.peple: unknown field"),
+    ],
+)
+def test_malformed_fields_are_named(path, value, message):
+    with pytest.raises(ScenarioError, match=message):
+        scenario_from_dict(with_change(path, value))
+
+
+def test_missing_map_and_robot_are_named():
+    with pytest.raises(ScenarioError, match="map: required"):
+        scenario_from_dict({"robot": {"start": [0, 0], "goal": [1, 1]}})
+    with pytest.raises(ScenarioError, match="scenario.robot: required"):
+        scenario_from_dict({"map": {"size": [2, 2]}})
+
+
+def test_file_errors_name_the_file(tmp_path):
+    with pytest.raises(ScenarioError, match="cannot read scenario file"):
+        load_scenario(tmp_path / "missing.json")
+    bad = tmp_path / "bad.json"
+    bad.write_text("{not json")
+    with pytest.raises(ScenarioError, match="bad.json: not valid JSON"):
+        load_scenario(bad)
+    nan = tmp_path / "nan.json"
+    nan.write_text(json.dumps(with_change("people.0.y", math.nan)))  # JSON's NaN literal
+    with pytest.raises(ScenarioError, match=r"nan.json: people\[0\]\.y"):
+        load_scenario(nan)
+
+
+def test_static_map_path_is_relative_to_the_scenario_and_gives_the_geometry(tmp_path):
+    spec = GridSpec(0.1, -2.0, -1.0, 30, 20)
+    write_map(tmp_path / "maps" / "room.yaml", OccupancyGrid(spec, np.zeros(spec.shape, dtype=np.int8)))
+    path = tmp_path / "s.json"
+    path.write_text(json.dumps({"static_map": "maps/room.yaml", "robot": {"start": [0, 0], "goal": [0.5, 0.5]}}))
+    s = load_scenario(path)
+    assert s.static_map == tmp_path / "maps" / "room.yaml" and s.grid == spec
+
+
+def test_unreadable_static_map_is_named(tmp_path):
+    path = tmp_path / "s.json"
+    path.write_text(json.dumps({**BASE, "static_map": "nowhere.yaml"}))
+    with pytest.raises(ScenarioError, match=r"static_map: .*nowhere.yaml: cannot read map YAML"):
+        load_scenario(path)
+    (tmp_path / "broken.yaml").write_text(
+        "image: broken.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.25\n"
+    )
+    (tmp_path / "broken.pgm").write_bytes(b"not an image")
+    path.write_text(json.dumps({**BASE, "static_map": "broken.yaml"}))
+    with pytest.raises(ScenarioError, match="cannot read map image"):
+        load_scenario(path)

@@ -1,0 +1,154 @@
+"""The paper's layouts S1-S5 and scene files."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from sid.perception.people import Person
+from sid.synthetic.layouts import LAYOUTS, VARIATIONS, layout, variations
+from sid.synthetic.scene import Scene
+from tests.conftest import REPO_ROOT
+
+
+def _xy(scene: Scene) -> np.ndarray:
+    return np.array([[p.x, p.y] for p in scene.people])
+
+
+@pytest.mark.parametrize("name", list(LAYOUTS))
+def test_everyone_faces_the_formation_centre_in_one_group(name: str) -> None:
+    scene = layout(name)
+    spec = LAYOUTS[name]
+    assert len(scene.people) == len(spec.angles_deg)
+    assert scene.groups == (tuple(range(len(scene.people))),)
+    centre = np.array([spec.centre_distance, 0.0])
+    for person in scene.people:
+        towards = centre - np.array([person.x, person.y])
+        assert np.linalg.norm(towards) == pytest.approx(spec.radius)
+        facing = np.array([np.cos(person.theta), np.sin(person.theta)])
+        assert facing @ towards / np.linalg.norm(towards) == pytest.approx(1.0)
+
+
+def test_layout_shapes_match_the_paper() -> None:
+    s1 = _xy(layout("S1"))
+    assert np.linalg.norm(s1[0] - s1[1]) == pytest.approx(0.8)
+    s3 = _xy(layout("S3"))
+    sides = [np.linalg.norm(s3[i] - s3[(i + 1) % 3]) for i in range(3)]
+    np.testing.assert_allclose(sides, 1.2)
+    for name in ("S2", "S4"):  # semicircles open towards the camera: everyone behind the centre, facing it
+        scene = layout(name)
+        assert all(p.x >= LAYOUTS[name].centre_distance for p in scene.people)
+        assert all(np.cos(p.theta) < 0 for p in scene.people)
+
+
+@pytest.mark.parametrize("name", list(LAYOUTS))
+def test_all_variations_stand_1_5_to_3_m_in_front_of_the_camera(name: str) -> None:
+    scenes = variations(name)
+    assert len(scenes) == len(VARIATIONS)
+    for scene in scenes:
+        x = _xy(scene)[:, 0]
+        assert x.min() >= 1.5 and x.max() <= 3.05
+    assert len({tuple(map(tuple, _xy(s).round(6))) for s in scenes}) == len(VARIATIONS)  # all different
+
+
+def test_focus_offset_opens_the_group_towards_the_camera() -> None:
+    scene = layout("S1", focus_offset=0.4)
+    for person in scene.people:  # both face (1.8, 0): 45 deg from each other, towards the camera
+        assert np.degrees(person.theta) == pytest.approx(np.sign(person.theta) * 135.0)
+    with pytest.raises(ValueError, match="stands on the point"):
+        layout("S1", rotation=np.pi / 2, focus_offset=0.4)  # person 0 at (1.8, 0), the focus
+
+
+def test_jitter_is_seeded() -> None:
+    first = layout("S4", jitter_xy=0.05, jitter_theta=0.1, seed=3)
+    assert first == layout("S4", jitter_xy=0.05, jitter_theta=0.1, seed=3)
+    assert first != layout("S4", jitter_xy=0.05, jitter_theta=0.1, seed=4)
+    assert layout("s4") == layout("S4")
+
+
+def test_rotation_turns_the_formation_about_its_centre() -> None:
+    turned = layout("S3", rotation=np.pi / 2)
+    xy = _xy(turned)
+    np.testing.assert_allclose(xy[0], [2.2, 1.2 / np.sqrt(3)], atol=1e-12)
+
+
+def test_bad_layout_requests_are_rejected() -> None:
+    with pytest.raises(ValueError, match="unknown layout"):
+        layout("S9")
+    with pytest.raises(ValueError, match="radius"):
+        layout("S1", radius=-1.0)
+    with pytest.raises(ValueError, match="jitter_xy"):
+        layout("S1", jitter_xy=-0.1)
+    with pytest.raises(ValueError, match="apart"):
+        layout("S5", radius=0.1)
+
+
+def test_scene_files_round_trip(tmp_path: Path) -> None:
+    scene = layout("S2", height=1.8)
+    json_path = tmp_path / "scene.json"
+    json_path.write_text(json.dumps(scene.to_dict()))
+    assert Scene.from_file(json_path) == scene
+    yaml_path = tmp_path / "scene.yaml"
+    yaml_path.write_text(yaml.safe_dump(scene.to_dict()))
+    assert Scene.from_file(yaml_path) == scene
+
+
+def test_yaw_defaults_and_people_records(tmp_path: Path) -> None:
+    path = tmp_path / "people.yaml"
+    path.write_text("people:\n  - {x: 2.0, y: 0.5, yaw: 3.0}\n  - {x: 2.0, y: -0.5, yaw: -3.0}\n")
+    scene = Scene.from_file(path)
+    assert [p.id for p in scene.people] == [0, 1] and scene.people[0].theta == 3.0
+    assert scene.groups == () and scene.mount.height == 0.9 and scene.name == "people"
+    from_people = Scene.from_people("p", [Person(5, 2.0, 0.0, 0.0)])
+    assert from_people.people[0].id == 5
+    with pytest.raises(ValueError, match="theta is None"):
+        Scene.from_people("p", [Person(5, 2.0, 0.0, None)])
+
+
+def test_scenario_files_are_seen_from_the_robot_start(tmp_path: Path) -> None:
+    scenario = {
+        "name": "turned",
+        "map": {"resolution": 0.1, "origin": [-5.0, -5.0], "size": [10.0, 10.0]},
+        "people": [{"id": 7, "x": 1.0, "y": 3.0, "theta": 0.0}, {"id": 8, "x": 1.0, "y": 4.0, "theta": np.pi}],
+        "robot": {"start": [1.0, 1.0, np.pi / 2], "goal": [1.0, -1.0, 0.0]},
+    }
+    path = tmp_path / "scenario.json"
+    path.write_text(json.dumps(scenario))
+    scene = Scene.from_file(path)
+    assert scene.name == "turned" and [p.id for p in scene.people] == [7, 8]
+    # The robot at (1, 1) looks along +y: person 7 is 2 m straight ahead, facing the robot's right (-pi/2).
+    assert (scene.people[0].x, scene.people[0].y) == pytest.approx((2.0, 0.0))
+    assert scene.people[0].theta == pytest.approx(-np.pi / 2)
+    assert scene.wall_distance == pytest.approx(5.0)
+    scenario["people"][0].pop("theta")
+    path.write_text(json.dumps(scenario))
+    with pytest.raises(ValueError, match="person 7 has no facing"):
+        Scene.from_file(path)
+    examples = REPO_ROOT / "examples" / "conversation.json"
+    if examples.is_file():  # the repository's example scenario renders as is (person 4 stands 6 m away)
+        assert len(Scene.from_file(examples).people) == 4
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("{not json", "not valid JSON"),
+        ('{"people": []}', "non-empty"),
+        ('{"people": [{"x": 1, "y": 0}]}', "theta"),
+        ('{"people": [{"x": "a", "y": 0, "theta": 0}]}', "people\\[0\\]"),
+        ('{"people": [{"x": 2, "y": 0, "theta": 0, "height": 9}]}', "standing person"),
+        ('{"people": [{"x": 2, "y": 0, "theta": 0}], "groups": [[0, 7]]}', "unknown people"),
+        ('{"people": [{"x": 6, "y": 0, "theta": 0}]}', "wall"),
+    ],
+)
+def test_malformed_scene_files_name_the_problem(tmp_path: Path, text: str, message: str) -> None:
+    path = tmp_path / "bad.json"
+    path.write_text(text)
+    with pytest.raises(ValueError, match=message):
+        Scene.from_file(path)
+    with pytest.raises(ValueError, match="cannot read"):
+        Scene.from_file(tmp_path / "missing.json")
