@@ -3,18 +3,8 @@
 Every planner solves the same problem (``planner.problem``): a disc robot on a costmap, states checked against the
 precomputed plannable mask, motions checked at the costmap resolution, cost J = integral of (1 + w c / 252) ds.
 Each returned path has been smoothed (``planner.smoothing``, never raising J) and checked at every quarter-cell
-sample against the exact free mask; a path that fails that check is never returned.
-
-Repeatability: ``seed`` seeds OMPL's random numbers before anything of the problem is built, and ``max_iterations``
-caps the number of times the planner checks its termination condition (about once per iteration; BIT* checks it
-once per edge it processes; for FMT* it is the number of samples). A run with the same seed that stops on the
-cap, not on ``time_limit``, is repeated exactly; a run without a seed draws one and reports it in
-``PlanResult.seed``.
-
-PRM* is not offered: it grows its roadmap in a worker thread, and with this cost objective (a Python ``motionCost``)
-ompl 2.0.1's bindings deadlock there (measured: a 0.5 s solve had not returned after 10 s). With OMPL's C++ path-length
-objective it does run, but then it plans a different problem (the social costs ignored), so it would not be
-comparable. No other thread runs Python here: every planner below calls back into Python from ``solve()``'s thread.
+sample against the exact free mask; a path that fails that check is never returned. Seeds and iteration caps:
+see ``planner.ompl_planners``.
 """
 
 from __future__ import annotations
@@ -22,46 +12,19 @@ from __future__ import annotations
 import math
 import secrets
 import time
-from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-from ompl import base as ob
-from ompl import geometric as og
-from ompl import util as ou
 from scipy import ndimage
 
 from planner.grid_planner import grid_search
-from planner.objective import CostmapObjective
+from planner.ompl_planners import OMPL_PLANNERS, seed_ompl, solve_ompl
 from planner.problem import CostField, PlanningError, PlanningProblem
 from planner.smoothing import smooth
-from planner.validity import check_path, state_validity_checker
+from planner.validity import check_path
 
-ou.setLogLevel(ou.LOG_WARN)  # the default level prints OMPL's debug messages to stdout
-
-FMT_SAMPLES_PER_SECOND = 250
-"""FMT* is not anytime: it plans on a fixed sample set and returns nothing if stopped early. With this objective it
-takes 1.2-1.6 ms per sample on the demo scenario (measured: 100 samples 0.14 s, 300 0.49 s, 600 0.74 s), so its
-sample count follows the time budget with a margin of about two for a busy machine, or equals ``max_iterations``
-when that is given."""
-
-
-def _fmt(si: ob.SpaceInformation, time_limit: float, max_iterations: int | None) -> ob.Planner:
-    planner = og.FMT(si)
-    samples = max_iterations if max_iterations is not None else int(FMT_SAMPLES_PER_SECOND * time_limit)
-    planner.setNumSamples(max(50, samples))
-    return planner
-
-
-OMPL_PLANNERS: dict[str, Callable[[ob.SpaceInformation, float, int | None], ob.Planner]] = {
-    "rrtstar": lambda si, *_: og.RRTstar(si),
-    "informed_rrtstar": lambda si, *_: og.InformedRRTstar(si),
-    "bitstar": lambda si, *_: og.BITstar(si),
-    "rrtconnect": lambda si, *_: og.RRTConnect(si),
-    "fmtstar": _fmt,
-}
-"""Planner factories (space information, time budget in s, iteration cap or None) by name."""
 PLANNERS: tuple[str, ...] = (*OMPL_PLANNERS, "grid")
+"""Every planner ``plan`` offers: OMPL's (``planner.ompl_planners``) and the grid planner."""
 DEFAULT_PLANNER = "bitstar"
 UNAVAILABLE: dict[str, str] = {
     "prmstar": (
@@ -133,67 +96,6 @@ def check_endpoints(field: CostField) -> None:
         )
 
 
-def _seed_ompl(seed: int) -> None:
-    # OMPL logs an error when reseeding after its first random number; reseeding still makes every generator
-    # created afterwards deterministic (measured), which is all a plan needs since it creates its own.
-    level = ou.getLogLevel()
-    ou.setLogLevel(ou.LOG_NONE)
-    ou.RNG.setSeed(seed)
-    ou.setLogLevel(level)
-
-
-def _solve_ompl(
-    field: CostField, name: str, time_limit: float, max_iterations: int | None
-) -> tuple[np.ndarray | None, int, float]:
-    """Run one OMPL planner; (path or None, termination checks, solve seconds)."""
-    problem, spec = field.problem, field.spec
-    space = ob.RealVectorStateSpace(2)
-    bounds = ob.RealVectorBounds(2)
-    bounds.setLow(0, spec.origin_x)
-    bounds.setHigh(0, spec.origin_x + spec.size_m[0])
-    bounds.setLow(1, spec.origin_y)
-    bounds.setHigh(1, spec.origin_y + spec.size_m[1])
-    space.setBounds(bounds)
-    space.setLongestValidSegmentFraction(spec.resolution / space.getMaximumExtent())
-    si = ob.SpaceInformation(space)
-    si.setStateValidityChecker(state_validity_checker(field))
-    si.setup()
-    pdef = ob.ProblemDefinition(si)
-    start, goal = space.allocState(), space.allocState()
-    start[0], start[1] = problem.start
-    goal[0], goal[1] = problem.goal
-    pdef.setStartAndGoalStates(start, goal)
-    objective = CostmapObjective(si, field)
-    pdef.setOptimizationObjective(objective)
-    planner = OMPL_PLANNERS[name](si, time_limit, max_iterations)
-    planner.setProblemDefinition(pdef)
-    planner.setup()
-
-    # ``checks`` counts the termination checks answered "go on", so a rerun capped at that count stops at the same
-    # point. FMT* stops by itself after its samples, which ``max_iterations`` sets (see FMT_SAMPLES_PER_SECOND).
-    checks = 0
-    cap = math.inf if max_iterations is None or name == "fmtstar" else max_iterations
-    deadline = time.perf_counter() + time_limit
-
-    def stop() -> bool:
-        nonlocal checks
-        if checks >= cap or time.perf_counter() > deadline:
-            return True
-        checks += 1
-        return False
-
-    t0 = time.perf_counter()
-    planner.solve(ob.PlannerTerminationCondition(stop))
-    solve_time = time.perf_counter() - t0
-    path = None
-    if pdef.hasExactSolution():
-        states = pdef.getSolutionPath().getStates()
-        path = np.array([(s[0], s[1]) for s in states], dtype=float)
-    planner.clear()
-    pdef.clearSolutionPaths()
-    return path, checks, solve_time
-
-
 def plan(
     problem: PlanningProblem,
     planner: str = DEFAULT_PLANNER,
@@ -219,7 +121,7 @@ def plan(
         seed = secrets.randbelow(2**31 - 1) + 1 if seed is None else int(seed)
         if seed <= 0:
             raise ValueError(f"seed must be a positive integer (OMPL ignores 0), got {seed}")
-        _seed_ompl(seed)
+        seed_ompl(seed)
     else:
         seed = None
     field = CostField(problem)
@@ -229,7 +131,7 @@ def plan(
         t_solve = time.perf_counter()
         raw, iterations, solve_time = grid_search(field), 0, time.perf_counter() - t_solve
     else:
-        raw, iterations, solve_time = _solve_ompl(field, name, time_limit, max_iterations)
+        raw, iterations, solve_time = solve_ompl(field, name, time_limit, max_iterations)
     path = raw
     raw_cost = math.inf if path is None else field.path_cost(raw)
     result = PlanResult(name, False, np.zeros((0, 2)), math.inf, 0.0, 0.0, solve_time, raw_cost, iterations, seed, "")

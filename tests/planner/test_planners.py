@@ -12,7 +12,8 @@ from hypothesis import strategies as st
 from scipy import ndimage
 
 from costmap.grid import INSCRIBED, LETHAL, NO_INFORMATION, Costmap2D, GridSpec
-from planner.facade import OMPL_PLANNERS, PLANNERS, plan, resolve_planner
+from planner.facade import PLANNERS, plan, resolve_planner
+from planner.ompl_planners import OMPL_PLANNERS
 from planner.problem import CostField, PlanningError, PlanningProblem
 from planner.smoothing import smooth
 from planner.validity import check_path, interpolate

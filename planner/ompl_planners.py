@@ -1,0 +1,117 @@
+"""OMPL's planners on a ``planner.problem`` costmap problem: the registry, seeding and one solve.
+
+States are checked against the problem's precomputed plannable mask, motions at the costmap resolution; the
+objective is ``planner.objective.CostmapObjective``. ``planner.facade.plan`` is the entry point that calls these.
+
+Repeatability: ``seed`` seeds OMPL's random numbers before anything of the problem is built, and ``max_iterations``
+caps the number of times the planner checks its termination condition (about once per iteration; BIT* checks it
+once per edge it processes; for FMT* it is the number of samples). A run with the same seed that stops on the
+cap, not on ``time_limit``, is repeated exactly; a run without a seed draws one and reports it in
+``PlanResult.seed``.
+
+PRM* is not offered: it grows its roadmap in a worker thread, and with this cost objective (a Python ``motionCost``)
+ompl 2.0.1's bindings deadlock there (measured: a 0.5 s solve had not returned after 10 s). With OMPL's C++ path-length
+objective it does run, but then it plans a different problem (the social costs ignored), so it would not be
+comparable. No other thread runs Python here: every planner below calls back into Python from ``solve()``'s thread.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+
+import numpy as np
+from ompl import base as ob
+from ompl import geometric as og
+from ompl import util as ou
+
+from planner.objective import CostmapObjective
+from planner.problem import CostField
+from planner.validity import state_validity_checker
+
+ou.setLogLevel(ou.LOG_WARN)  # the default level prints OMPL's debug messages to stdout
+
+FMT_SAMPLES_PER_SECOND = 250
+"""FMT* is not anytime: it plans on a fixed sample set and returns nothing if stopped early. With this objective it
+takes 1.2-1.6 ms per sample on the demo scenario (measured: 100 samples 0.14 s, 300 0.49 s, 600 0.74 s), so its
+sample count follows the time budget with a margin of about two for a busy machine, or equals ``max_iterations``
+when that is given."""
+
+
+def _fmt(si: ob.SpaceInformation, time_limit: float, max_iterations: int | None) -> ob.Planner:
+    planner = og.FMT(si)
+    samples = max_iterations if max_iterations is not None else int(FMT_SAMPLES_PER_SECOND * time_limit)
+    planner.setNumSamples(max(50, samples))
+    return planner
+
+
+OMPL_PLANNERS: dict[str, Callable[[ob.SpaceInformation, float, int | None], ob.Planner]] = {
+    "rrtstar": lambda si, *_: og.RRTstar(si),
+    "informed_rrtstar": lambda si, *_: og.InformedRRTstar(si),
+    "bitstar": lambda si, *_: og.BITstar(si),
+    "rrtconnect": lambda si, *_: og.RRTConnect(si),
+    "fmtstar": _fmt,
+}
+"""Planner factories (space information, time budget in s, iteration cap or None) by name."""
+
+
+def seed_ompl(seed: int) -> None:
+    # OMPL logs an error when reseeding after its first random number; reseeding still makes every generator
+    # created afterwards deterministic (measured), which is all a plan needs since it creates its own.
+    level = ou.getLogLevel()
+    ou.setLogLevel(ou.LOG_NONE)
+    ou.RNG.setSeed(seed)
+    ou.setLogLevel(level)
+
+
+def solve_ompl(
+    field: CostField, name: str, time_limit: float, max_iterations: int | None
+) -> tuple[np.ndarray | None, int, float]:
+    """Run one OMPL planner; (path or None, termination checks, solve seconds)."""
+    problem, spec = field.problem, field.spec
+    space = ob.RealVectorStateSpace(2)
+    bounds = ob.RealVectorBounds(2)
+    bounds.setLow(0, spec.origin_x)
+    bounds.setHigh(0, spec.origin_x + spec.size_m[0])
+    bounds.setLow(1, spec.origin_y)
+    bounds.setHigh(1, spec.origin_y + spec.size_m[1])
+    space.setBounds(bounds)
+    space.setLongestValidSegmentFraction(spec.resolution / space.getMaximumExtent())
+    si = ob.SpaceInformation(space)
+    si.setStateValidityChecker(state_validity_checker(field))
+    si.setup()
+    pdef = ob.ProblemDefinition(si)
+    start, goal = space.allocState(), space.allocState()
+    start[0], start[1] = problem.start
+    goal[0], goal[1] = problem.goal
+    pdef.setStartAndGoalStates(start, goal)
+    objective = CostmapObjective(si, field)
+    pdef.setOptimizationObjective(objective)
+    planner = OMPL_PLANNERS[name](si, time_limit, max_iterations)
+    planner.setProblemDefinition(pdef)
+    planner.setup()
+
+    # ``checks`` counts the termination checks answered "go on", so a rerun capped at that count stops at the same
+    # point. FMT* stops by itself after its samples, which ``max_iterations`` sets (see FMT_SAMPLES_PER_SECOND).
+    checks = 0
+    cap = math.inf if max_iterations is None or name == "fmtstar" else max_iterations
+    deadline = time.perf_counter() + time_limit
+
+    def stop() -> bool:
+        nonlocal checks
+        if checks >= cap or time.perf_counter() > deadline:
+            return True
+        checks += 1
+        return False
+
+    t0 = time.perf_counter()
+    planner.solve(ob.PlannerTerminationCondition(stop))
+    solve_time = time.perf_counter() - t0
+    path = None
+    if pdef.hasExactSolution():
+        states = pdef.getSolutionPath().getStates()
+        path = np.array([(s[0], s[1]) for s in states], dtype=float)
+    planner.clear()
+    pdef.clearSolutionPaths()
+    return path, checks, solve_time
