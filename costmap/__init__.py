@@ -1,1 +1,1 @@
-"""Layered 2D costmap in Nav2's conventions: a LiDAR base, inflation and social zones, with exports."""
+"""Layered 2D costmap in Nav2's conventions: a Layer interface, static, LiDAR, social and inflation layers, exports."""

@@ -1,10 +1,16 @@
-"""How a layer's grid is written into the combined (master) grid: Nav2's combination methods, in place.
+"""How a layer's grid is written into the combined (master) grid: Nav2's combination methods and two of ours, in place.
 
 - max: keep the larger value; an unknown (255) layer cell is ignored, an unknown master cell is overwritten.
+- max_nonzero: max, and a free (0) layer cell is ignored too: it carries no opinion, so unknown space stays unknown
+  (the social layer).
+- max_keep_unknown: max, but an unknown master cell stays unknown unless the layer value is >= 253 (Nav2's inflation
+  rule).
 - overwrite: copy the layer value unless it is unknown.
 - true_overwrite: copy every value, unknown included.
 - addition: sum, capped at 252 (MAX_NON_OBSTACLE); unknown layer cells are ignored and an unknown master cell
   takes the layer value.
+
+Every function also works on views (a window of the grids).
 """
 
 from __future__ import annotations
@@ -14,9 +20,9 @@ from typing import Literal
 
 import numpy as np
 
-from costmap.grid import INSCRIBED, NO_INFORMATION
+from costmap.grid import FREE_SPACE, INSCRIBED, NO_INFORMATION
 
-CombinationMethod = Literal["max", "overwrite", "true_overwrite", "addition"]
+CombinationMethod = Literal["max", "max_nonzero", "max_keep_unknown", "overwrite", "true_overwrite", "addition"]
 
 
 def update_with_max(master: np.ndarray, layer: np.ndarray, no_opinion: int = NO_INFORMATION) -> None:
@@ -25,6 +31,16 @@ def update_with_max(master: np.ndarray, layer: np.ndarray, no_opinion: int = NO_
     larger = np.maximum(master, layer)
     np.copyto(larger, layer, where=master_unknown)
     np.copyto(master, larger, where=layer != no_opinion)
+
+
+def update_with_max_nonzero(master: np.ndarray, layer: np.ndarray) -> None:
+    update_with_max(master, layer, no_opinion=FREE_SPACE)
+
+
+def update_with_max_keep_unknown(master: np.ndarray, layer: np.ndarray) -> None:
+    replace = (master == NO_INFORMATION) & (layer >= INSCRIBED)
+    np.maximum(master, layer, out=master)  # an unknown master cell stays 255 here
+    np.copyto(master, layer, where=replace)
 
 
 def update_with_overwrite(master: np.ndarray, layer: np.ndarray) -> None:
@@ -47,16 +63,23 @@ def update_with_addition(master: np.ndarray, layer: np.ndarray) -> None:
 
 COMBINE: dict[str, Callable[[np.ndarray, np.ndarray], None]] = {
     "max": update_with_max,
+    "max_nonzero": update_with_max_nonzero,
+    "max_keep_unknown": update_with_max_keep_unknown,
     "overwrite": update_with_overwrite,
     "true_overwrite": update_with_true_overwrite,
     "addition": update_with_addition,
 }
 
 
-def combine(master: np.ndarray, layer: np.ndarray, method: CombinationMethod = "max") -> None:
-    """Write ``layer`` into ``master`` (same shape, uint8) with one of Nav2's combination methods."""
-    if master.shape != layer.shape:
-        raise ValueError(f"combine: layer shape {layer.shape} differs from the master's {master.shape}")
+def check_method(method: str) -> None:
+    """Raise ValueError unless ``method`` is one of the combination methods above."""
     if method not in COMBINE:
         raise ValueError(f"unknown combination method {method!r}; use one of {sorted(COMBINE)}")
+
+
+def combine(master: np.ndarray, layer: np.ndarray, method: CombinationMethod = "max") -> None:
+    """Write ``layer`` into ``master`` (same shape, uint8) with one of the combination methods above."""
+    if master.shape != layer.shape:
+        raise ValueError(f"combine: layer shape {layer.shape} differs from the master's {master.shape}")
+    check_method(method)
     COMBINE[method](master, layer)

@@ -39,8 +39,9 @@ def export_costmap(
     paths["pgm"] = write_map(paths["yaml"], costmap_to_occupancy(layered.master))
     paths["npz"] = save_npz(out / "costmap.npz", layered)
     topics = {"/costmap": costmap_to_occupancy(layered.master)}
-    if layered.social is not None:
-        topics["/social_costmap"] = OccupancyGrid(layered.spec, cost_to_occupancy(layered.social.costs))
+    social = layered.layer("social")
+    if social is not None:
+        topics["/social_costmap"] = OccupancyGrid(layered.spec, cost_to_occupancy(social.costs))
     stamp = time.time_ns() if stamp_ns is None else stamp_ns
     paths["mcap"] = write_occupancy_mcap(out / "costmap.mcap", topics, stamp_ns=stamp)
     paths["png"] = out / "costmap.png"

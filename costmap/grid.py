@@ -18,6 +18,56 @@ NO_INFORMATION = 255
 
 
 @dataclass(frozen=True)
+class Window:
+    """A rectangle of cells: rows [row0, row1) and columns [col0, col1) of a grid (half-open, like slices)."""
+
+    row0: int
+    row1: int
+    col0: int
+    col1: int
+
+    @property
+    def slices(self) -> tuple[slice, slice]:
+        """(rows, cols) slices that index the window in a (rows, cols) array."""
+        return slice(self.row0, self.row1), slice(self.col0, self.col1)
+
+    def union(self, other: Window | None) -> Window:
+        """The smallest window holding both."""
+        if other is None:
+            return self
+        return Window(
+            min(self.row0, other.row0),
+            max(self.row1, other.row1),
+            min(self.col0, other.col0),
+            max(self.col1, other.col1),
+        )
+
+    def grown(self, cells: int, spec: GridSpec) -> Window:
+        """This window with ``cells`` more on every side, clipped to the grid of ``spec``."""
+        return Window(
+            max(self.row0 - cells, 0),
+            min(self.row1 + cells, spec.height),
+            max(self.col0 - cells, 0),
+            min(self.col1 + cells, spec.width),
+        )
+
+    def clipped(self, spec: GridSpec) -> Window | None:
+        """The part inside the grid of ``spec``; None when nothing is."""
+        r0, r1 = max(self.row0, 0), min(self.row1, spec.height)
+        c0, c1 = max(self.col0, 0), min(self.col1, spec.width)
+        return Window(r0, r1, c0, c1) if r0 < r1 and c0 < c1 else None
+
+
+def union(*windows: Window | None) -> Window | None:
+    """The smallest window holding every given window; None when none is given."""
+    out = None
+    for window in windows:
+        if window is not None:
+            out = window.union(out)
+    return out
+
+
+@dataclass(frozen=True)
 class GridSpec:
     """Grid geometry: resolution (m/cell), origin (world x, y of the lower-left corner), size in cells."""
 
@@ -90,29 +140,35 @@ class GridSpec:
         """Whole cells covering a world distance, rounded up as Nav2's ``Costmap2D::cellDistance`` does."""
         return max(0, int(np.ceil(metres / self.resolution)))
 
-    def window(self, xy_min: tuple[float, float], xy_max: tuple[float, float]) -> tuple[slice, slice] | None:
-        """(row, col) slices of the cells overlapping the world box [xy_min, xy_max], clipped; None when outside."""
+    def window(self, xy_min: tuple[float, float], xy_max: tuple[float, float]) -> Window | None:
+        """The cells overlapping the world box [xy_min, xy_max], clipped to the grid; None when outside."""
         (r0, c0), (r1, c1) = self.world_to_cell(np.array([xy_min, xy_max], dtype=float))
-        r0, c0 = max(r0, 0), max(c0, 0)
-        r1, c1 = min(r1 + 1, self.height), min(c1 + 1, self.width)
-        if r0 >= r1 or c0 >= c1:
-            return None
-        return slice(int(r0), int(r1)), slice(int(c0), int(c1))
+        return Window(int(r0), int(r1) + 1, int(c0), int(c1) + 1).clipped(self)
 
-    def cell_axes(self, window: tuple[slice, slice] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    def window_around(self, xy: np.ndarray) -> Window | None:
+        """The cells of the bounding box of world points (N, 2), clipped to the grid; None when empty or outside."""
+        xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+        if len(xy) == 0:
+            return None
+        return self.window(tuple(xy.min(axis=0)), tuple(xy.max(axis=0)))
+
+    @property
+    def whole(self) -> Window:
+        """Every cell of the grid."""
+        return Window(0, self.height, 0, self.width)
+
+    def cell_axes(self, window: Window | None = None) -> tuple[np.ndarray, np.ndarray]:
         """World x (1, cols) and y (rows, 1) of the cell centres of the grid or a ``window``; they broadcast to
         (rows, cols) without the copies ``cell_centres`` makes."""
-        rows, cols = window if window is not None else (slice(0, self.height), slice(0, self.width))
+        rows, cols = (window or self.whole).slices
         xs = self.origin_x + (np.arange(cols.start, cols.stop) + 0.5) * self.resolution
         ys = self.origin_y + (np.arange(rows.start, rows.stop) + 0.5) * self.resolution
         return xs[None, :], ys[:, None]
 
-    def cell_centres(self, window: tuple[slice, slice] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    def cell_centres(self, window: Window | None = None) -> tuple[np.ndarray, np.ndarray]:
         """World x and y of every cell centre (of the whole grid or of a ``window``), each (rows, cols)."""
-        rows, cols = window if window is not None else (slice(0, self.height), slice(0, self.width))
-        xs = self.origin_x + (np.arange(cols.start, cols.stop) + 0.5) * self.resolution
-        ys = self.origin_y + (np.arange(rows.start, rows.stop) + 0.5) * self.resolution
-        return np.meshgrid(xs, ys)
+        xs, ys = self.cell_axes(window)
+        return np.meshgrid(xs[0], ys[:, 0])
 
 
 @dataclass

@@ -126,7 +126,7 @@ def write_map(path: str | Path, grid: OccupancyGrid) -> Path:
     if path.suffix not in (".yaml", ".yml"):
         raise MapFileError(f"{path}: a map description must end in .yaml")
     image_path = path.with_suffix(".pgm")
-    pixels = np.where(grid.data < 0, 255, grid.data).astype(np.uint8)
+    pixels = np.where(grid.data < 0, np.uint8(255), grid.data.astype(np.uint8))  # unknown (-1) -> 255
     path.parent.mkdir(parents=True, exist_ok=True)
     if not cv2.imwrite(str(image_path), np.flipud(pixels)):
         raise MapFileError(f"{image_path}: cannot write the map image")

@@ -29,7 +29,7 @@ def save_npz(path: str | Path, layered: LayeredCostmap) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     spec = layered.spec
-    layers = layered.layers
+    layers = layered.grids
     np.savez_compressed(
         path,
         costmap=layered.master.costs,

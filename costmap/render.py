@@ -1,13 +1,15 @@
 """Pictures of costmaps (OpenCV, BGR uint8): costs, walls, people with facing arrows, group zones, a colour scale.
 
 Image layout: world x to the right, world y up; the map sits at (MARGIN_LEFT, MARGIN_TOP) with ``scale`` pixels
-per cell, axes in metres below and left of it, the colour scale to its right. ``world_to_image`` maps world
-points to pixel coordinates of that layout so other modules (the planner) can draw on top.
+per cell, axes in metres below and left of it, the colour scale and a legend of what is drawn to its right.
+``world_to_image`` maps world points to pixel coordinates of that layout so other modules (the planner) can draw on
+top.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Protocol
 
 import cv2
@@ -15,7 +17,7 @@ import numpy as np
 
 from costmap.grid import INSCRIBED, LETHAL, MAX_NON_OBSTACLE, NO_INFORMATION, Costmap2D, GridSpec
 from costmap.layered import LayeredCostmap
-from costmap.layers.social import SocialParams, group_zone_polygon
+from costmap.layers.social import SocialLayer, SocialParams, group_zone_polygon
 from costmap.scan import LaserScan
 from sid.perception.groups import Group
 from sid.perception.people import Person
@@ -34,6 +36,17 @@ class RobotTask(Protocol):
     def radius(self) -> float: ...
 
 
+@dataclass(frozen=True)
+class CameraView:
+    """A camera seen from above (world frame): position (m), yaw of its optical axis and horizontal field of view
+    (rad)."""
+
+    x: float
+    y: float
+    yaw: float
+    fov: float
+
+
 FONT = cv2.FONT_HERSHEY_SIMPLEX
 TEXT = (40, 40, 40)
 PERSON = (200, 110, 20)  # BGR: blue
@@ -41,6 +54,7 @@ ZONE = (40, 150, 0)  # green
 START = (60, 140, 0)
 GOAL = (30, 30, 220)  # red
 SCAN = (60, 60, 230)
+CAMERA = (90, 60, 60)  # dark slate
 INSCRIBED_COLOUR = (200, 140, 110)  # RGB (110, 140, 200), steel blue
 UNKNOWN_COLOUR = (205, 205, 205)  # map_saver's unknown grey
 # Graded costs 1..252: ColorBrewer YlOrBr anchors (RGB), light to dark, clear of black walls and grey unknown.
@@ -96,40 +110,86 @@ def _axes(img: np.ndarray, spec: GridSpec, scale: int) -> None:
     _text(img, "y (m)", (4, MARGIN_TOP - 8), 0.45)
 
 
-def _panel(img: np.ndarray, spec: GridSpec, scale: int) -> None:
-    """The colour scale (0..252 graded, then the three special values) and a legend, right of the map."""
-    left = MARGIN_LEFT + spec.width * scale + 22
-    top, height, width = MARGIN_TOP + 10, 200, 22
-    values = np.linspace(MAX_NON_OBSTACLE, 0, height).round().astype(np.uint8)
-    img[top : top + height, left : left + width] = COST_COLOURS[values][:, None, :]
-    cv2.rectangle(img, (left, top), (left + width, top + height), TEXT, 1)
-    _text(img, "cost", (left, top - 6), 0.45)
-    for value in (0, 50, 100, 150, 200, 252):
-        v = top + int(round((MAX_NON_OBSTACLE - value) / MAX_NON_OBSTACLE * (height - 1)))
-        cv2.line(img, (left + width, v), (left + width + 4, v), TEXT, 1)
-        _text(img, str(value), (left + width + 7, v + 4), 0.4)
-    y = top + height + 24
+def _legend_person(img: np.ndarray, u: int, v: int) -> None:
+    cv2.circle(img, (u, v), 6, PERSON, -1, cv2.LINE_AA)
+    cv2.arrowedLine(img, (u, v), (u + 15, v), PERSON, 2, cv2.LINE_AA, tipLength=0.4)
+
+
+def _legend_camera(img: np.ndarray, u: int, v: int) -> None:
+    cv2.line(img, (u - 6, v), (u + 16, v - 8), CAMERA, 1, cv2.LINE_AA)
+    cv2.line(img, (u - 6, v), (u + 16, v + 8), CAMERA, 1, cv2.LINE_AA)
+    _camera_glyph(img, np.array([u - 6, v]), 0.0)
+
+
+LEGEND = {  # name -> swatch drawn centred at (u, v)
+    "person, facing": _legend_person,
+    "group zone": lambda img, u, v: cv2.rectangle(img, (u - 9, v - 6), (u + 9, v + 6), ZONE, 2),
+    "interest point": lambda img, u, v: cv2.drawMarker(img, (u, v), ZONE, cv2.MARKER_CROSS, 10, 2, cv2.LINE_AA),
+    "LiDAR hits": lambda img, u, v: cv2.circle(img, (u, v), 2, SCAN, -1),
+    "robot start": lambda img, u, v: cv2.circle(img, (u, v), 6, START, 2, cv2.LINE_AA),
+    "goal": lambda img, u, v: cv2.drawMarker(img, (u, v), GOAL, cv2.MARKER_TILTED_CROSS, 12, 2, cv2.LINE_AA),
+    "camera, field of view": _legend_camera,
+}
+
+
+def _panel(img: np.ndarray, spec: GridSpec, scale: int, costs: np.ndarray, legend: Sequence[str]) -> None:
+    """Right of the map: the colour scale if any cost is graded, the special values present, then ``legend``."""
+    left, y = MARGIN_LEFT + spec.width * scale + 22, MARGIN_TOP + 10
+    width = 22
+    if np.any((costs > 0) & (costs <= MAX_NON_OBSTACLE)):
+        height = 200
+        values = np.linspace(MAX_NON_OBSTACLE, 0, height).round().astype(np.uint8)
+        img[y : y + height, left : left + width] = COST_COLOURS[values][:, None, :]
+        cv2.rectangle(img, (left, y), (left + width, y + height), TEXT, 1)
+        _text(img, "cost", (left, y - 6), 0.45)
+        for value in (0, 50, 100, 150, 200, 252):
+            v = y + int(round((MAX_NON_OBSTACLE - value) / MAX_NON_OBSTACLE * (height - 1)))
+            cv2.line(img, (left + width, v), (left + width + 4, v), TEXT, 1)
+            _text(img, str(value), (left + width + 7, v + 4), 0.4)
+        y += height + 24
+    else:
+        y += 14
     for value, label in ((INSCRIBED, "253 inscribed"), (LETHAL, "254 lethal"), (NO_INFORMATION, "255 unknown")):
-        cv2.rectangle(img, (left, y - 11), (left + width, y + 3), tuple(int(c) for c in COST_COLOURS[value]), -1)
-        cv2.rectangle(img, (left, y - 11), (left + width, y + 3), TEXT, 1)
-        _text(img, label, (left + width + 7, y), 0.4)
-        y += 22
+        if np.any(costs == value):
+            cv2.rectangle(img, (left, y - 11), (left + width, y + 3), tuple(int(c) for c in COST_COLOURS[value]), -1)
+            cv2.rectangle(img, (left, y - 11), (left + width, y + 3), TEXT, 1)
+            _text(img, label, (left + width + 7, y), 0.4)
+            y += 22
     y += 8
-    cv2.circle(img, (left + 11, y - 4), 6, PERSON, -1, cv2.LINE_AA)
-    cv2.arrowedLine(img, (left + 11, y - 4), (left + 26, y - 4), PERSON, 2, cv2.LINE_AA, tipLength=0.4)
-    _text(img, "person, facing", (left + 34, y), 0.4)
-    y += 22
-    cv2.rectangle(img, (left + 2, y - 10), (left + 20, y + 2), ZONE, 2)
-    _text(img, "group zone", (left + 34, y), 0.4)
-    y += 22
-    cv2.circle(img, (left + 11, y - 4), 2, SCAN, -1)
-    _text(img, "LiDAR hits", (left + 34, y), 0.4)
-    y += 22
-    cv2.circle(img, (left + 11, y - 4), 6, START, 2, cv2.LINE_AA)
-    _text(img, "robot start", (left + 34, y), 0.4)
-    y += 22
-    cv2.drawMarker(img, (left + 11, y - 4), GOAL, cv2.MARKER_TILTED_CROSS, 12, 2, cv2.LINE_AA)
-    _text(img, "goal", (left + 34, y), 0.4)
+    for name in legend:
+        LEGEND[name](img, left + 11, y - 4)
+        _text(img, name, (left + 34, y), 0.4)
+        y += 22
+
+
+def _camera_glyph(img: np.ndarray, apex: np.ndarray, yaw: float) -> None:
+    """A small filled wedge (16 px) with its apex at pixel ``apex``, opening along world ``yaw``."""
+    forward, side = np.array([np.cos(yaw), -np.sin(yaw)]), np.array([np.sin(yaw), np.cos(yaw)])
+    corners = [apex, apex + 16 * forward + 7 * side, apex + 16 * forward - 7 * side]
+    cv2.fillConvexPoly(img, np.rint(np.array(corners) * 16).astype(np.int32), CAMERA, cv2.LINE_AA, shift=4)
+
+
+def _draw_camera(img: np.ndarray, spec: GridSpec, scale: int, camera: CameraView) -> None:
+    """The field of view, shaded and edged up to the map's border, and the camera on top of it."""
+    x0, y0, x1, y1 = spec.bounds
+    reach = float(np.hypot(x1 - x0, y1 - y0))
+    edges = [camera.yaw + camera.fov / 2, camera.yaw - camera.fov / 2]
+    origin = np.array([camera.x, camera.y])
+    wedge = [origin] + [origin + reach * np.array([np.cos(a), np.sin(a)]) for a in np.linspace(*edges, 16)]
+    rows, cols = (
+        slice(MARGIN_TOP, MARGIN_TOP + spec.height * scale),
+        slice(MARGIN_LEFT, MARGIN_LEFT + spec.width * scale),
+    )
+    shaded = img.copy()
+    cv2.fillPoly(shaded, [_px(np.array(wedge), spec, scale)], CAMERA, cv2.LINE_AA, shift=4)
+    img[rows, cols] = cv2.addWeighted(img[rows, cols], 0.9, shaded[rows, cols], 0.1, 0)
+    for end in (wedge[1], wedge[-1]):
+        (u0, v0), (u1, v1) = world_to_image(np.array([origin, end]), spec, scale).astype(int)
+        box = (MARGIN_LEFT, MARGIN_TOP, spec.width * scale, spec.height * scale)
+        inside, a, b = cv2.clipLine(box, (u0, v0), (u1, v1))
+        if inside:
+            cv2.line(img, a, b, CAMERA, 1, cv2.LINE_AA)
+    _camera_glyph(img, world_to_image(origin[None], spec, scale)[0], camera.yaw)
 
 
 def _draw_people(img: np.ndarray, spec: GridSpec, scale: int, people: Sequence[Person], body_radius: float) -> None:
@@ -182,19 +242,22 @@ def render_costmap(
     title: str | None = None,
     body_radius: float | None = None,
     zone_margin: float | None = None,
+    camera: CameraView | None = None,
 ) -> np.ndarray:
-    """A readable BGR picture of a costmap (world y up) with people, group zones, robot task and colour scale.
+    """A readable BGR picture of a costmap (world y up) with people, group zones, robot task, camera and colour scale.
 
-    With a LayeredCostmap, people, groups, scan, body radius and zone margin default to its own; its combined
-    grid is drawn. ``scale``: pixels per cell (default: a map about 800 px wide).
+    With a LayeredCostmap, its combined grid is drawn; people, groups and scan default to the inputs it last applied,
+    body radius and zone margin to its social layer's. ``scale``: pixels per cell (default: a map about 800 px wide).
     """
     if isinstance(source, LayeredCostmap):
         costmap = source.master
-        people = source.people if people is None else people
-        groups = source.groups if groups is None else groups
-        scan = source.scan if scan is None else scan
-        body_radius = source.body_radius if body_radius is None else body_radius
-        zone_margin = source.params.social.group_margin if zone_margin is None else zone_margin
+        people = source.inputs.people if people is None else people
+        groups = source.inputs.groups if groups is None else groups
+        scan = source.inputs.scan if scan is None else scan
+        social = next((layer for layer in source.layers if isinstance(layer, SocialLayer)), None)
+        if social is not None:
+            body_radius = social.body_radius if body_radius is None else body_radius
+            zone_margin = social.params.group_margin if zone_margin is None else zone_margin
     else:
         costmap = source
     spec = costmap.spec
@@ -213,6 +276,8 @@ def render_costmap(
         tiles, (w_px, h_px), interpolation=cv2.INTER_NEAREST
     )
     cv2.rectangle(img, (MARGIN_LEFT - 1, MARGIN_TOP - 1), (MARGIN_LEFT + w_px, MARGIN_TOP + h_px), TEXT, 1)
+    if camera is not None:
+        _draw_camera(img, spec, scale, camera)
     if scan is not None:
         for u, v in (world_to_image(scan.hit_points(), spec, scale)).astype(int):
             cv2.circle(img, (int(u), int(v)), 1, SCAN, -1)
@@ -221,7 +286,16 @@ def render_costmap(
     if robot is not None:
         _draw_robot(img, spec, scale, robot)
     _axes(img, spec, scale)
-    _panel(img, spec, scale)
+    drawn = {
+        "person, facing": bool(people),
+        "group zone": bool(groups),
+        "interest point": bool(groups),
+        "LiDAR hits": scan is not None,
+        "robot start": robot is not None,
+        "goal": robot is not None,
+        "camera, field of view": camera is not None,
+    }
+    _panel(img, spec, scale, costmap.costs, [name for name in LEGEND if drawn[name]])
     if title:
         _text(img, title, (MARGIN_LEFT, 26), 0.6, TEXT, 1)
     return img

@@ -6,11 +6,10 @@ splat); then the depth of 17 keypoints per person is looked up on the aligned im
 raw depth frame. Run: python demos/align_depth.py
 """
 
-import time
-
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from sid.experiments.bench.runner import RunSettings, measure
 from sid.perception.align import Aligner, depth_at_color_pixels
 from sid.perception.camera import Calibration, Extrinsics, Intrinsics, deproject, project
 
@@ -51,14 +50,9 @@ def keypoints_of(box: tuple[float, float, float, float], seed: int) -> np.ndarra
     return np.column_stack([u, rng.uniform(v0, v1, 17)])
 
 
-def median_ms(function, repeats: int = 50) -> float:
-    function()
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        function()
-        times.append(time.perf_counter() - start)
-    return 1000 * float(np.median(times))
+def median_ms(function) -> float:
+    """Median milliseconds of 50 calls after one untimed call (``sid bench``'s timing harness)."""
+    return measure(function, RunSettings(warmup=1, min_runs=50, max_runs=50, budget_s=1.0)).median_ms
 
 
 def main() -> None:

@@ -87,7 +87,9 @@ def check_endpoints(field: CostField) -> None:
                 f"unknown) or an obstacle within the robot radius {problem.robot_radius:.2f} m"
             )
         cells.append(cell)
-    labels, _ = ndimage.label(field.plannable, structure=np.ones((3, 3), bool))
+    # 4-connected regions: a diagonal step between plannable cells needs the two cells beside it plannable too (no
+    # corner cutting, as in the grid planner), so cells that touch only at a corner are not connected.
+    labels, _ = ndimage.label(field.plannable)
     (sr, sc), (gr, gc) = cells
     if labels[sr, sc] != labels[gr, gc]:
         raise PlanningError(
@@ -127,19 +129,19 @@ def plan(
     field = CostField(problem)
     check_endpoints(field)
 
+    raw: np.ndarray | None
     if name == "grid":
         t_solve = time.perf_counter()
         raw, iterations, solve_time = grid_search(field), 0, time.perf_counter() - t_solve
     else:
         raw, iterations, solve_time = solve_ompl(field, name, time_limit, max_iterations)
-    path = raw
-    raw_cost = math.inf if path is None else field.path_cost(raw)
+    raw_cost = math.inf if raw is None else field.path_cost(raw)
     result = PlanResult(name, False, np.zeros((0, 2)), math.inf, 0.0, 0.0, solve_time, raw_cost, iterations, seed, "")
-    if path is None:
+    if raw is None:
         result.message = f"{name} found no path in {solve_time:.2f} s ({iterations} termination checks)"
         result.planning_time_s = time.perf_counter() - t0
         return result
-    result.raw_path = raw
+    result.raw_path = path = raw
     if simplify:
         path = smooth(field, raw)
     check = check_path(field, path)

@@ -1,4 +1,4 @@
-"""Social-navigation metrics of a path (definitions: ../shared/NOTES.md section 4; HuNavSim / SEAN conventions).
+"""Social-navigation metrics of a path, in the conventions of the HuNavSim and SEAN benchmarks.
 
 All inputs are in the world frame (metres). Distances to people are to their centres. Band fractions count path
 samples spaced at most ``spacing`` apart along the path (every vertex included). Group zones are

@@ -10,7 +10,7 @@ C++ and stays correct for J because J >= path length:
   superset of the states that can improve J, so no improving state is excluded.
 ``motionCostHeuristic`` must be overridden: PathLength's own returns ``motionCost``, which under J is no lower bound
 (the straight line through a social zone costs more than the detour around it), and BIT* then stops after its
-first solution, believing it optimal (measured: it quit after 15 iterations on the demo scenario).
+first solution, believing it optimal (docs/parameters.md).
 (``StateCostIntegralObjective`` subclasses are not an option: ompl 2.0.1 ignores their Python ``stateCost``.)
 """
 

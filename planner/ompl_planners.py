@@ -10,7 +10,7 @@ cap, not on ``time_limit``, is repeated exactly; a run without a seed draws one 
 ``PlanResult.seed``.
 
 PRM* is not offered: it grows its roadmap in a worker thread, and with this cost objective (a Python ``motionCost``)
-ompl 2.0.1's bindings deadlock there (measured: a 0.5 s solve had not returned after 10 s). With OMPL's C++ path-length
+ompl 2.0.1's bindings deadlock there (docs/parameters.md). With OMPL's C++ path-length
 objective it does run, but then it plans a different problem (the social costs ignored), so it would not be
 comparable. No other thread runs Python here: every planner below calls back into Python from ``solve()``'s thread.
 """
@@ -33,10 +33,9 @@ from planner.validity import state_validity_checker
 ou.setLogLevel(ou.LOG_WARN)  # the default level prints OMPL's debug messages to stdout
 
 FMT_SAMPLES_PER_SECOND = 250
-"""FMT* is not anytime: it plans on a fixed sample set and returns nothing if stopped early. With this objective it
-takes 1.2-1.6 ms per sample on the demo scenario (measured: 100 samples 0.14 s, 300 0.49 s, 600 0.74 s), so its
-sample count follows the time budget with a margin of about two for a busy machine, or equals ``max_iterations``
-when that is given."""
+"""Samples of FMT* per second of time budget. FMT* is not anytime: it plans on a fixed sample set and returns nothing
+if stopped early, so its sample count follows the time budget, at about half the rate it reaches on the demo scenario
+(a margin for a busy machine; docs/parameters.md), or equals ``max_iterations`` when that is given."""
 
 
 def _fmt(si: ob.SpaceInformation, time_limit: float, max_iterations: int | None) -> ob.Planner:
@@ -58,7 +57,8 @@ OMPL_PLANNERS: dict[str, Callable[[ob.SpaceInformation, float, int | None], ob.P
 
 def seed_ompl(seed: int) -> None:
     # OMPL logs an error when reseeding after its first random number; reseeding still makes every generator
-    # created afterwards deterministic (measured), which is all a plan needs since it creates its own.
+    # created afterwards deterministic (the seed tests in tests/planner check it), which is all a plan needs since
+    # it creates its own.
     level = ou.getLogLevel()
     ou.setLogLevel(ou.LOG_NONE)
     ou.RNG.setSeed(seed)

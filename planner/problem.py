@@ -31,13 +31,14 @@ import numpy as np
 from scipy import ndimage
 
 from costmap.grid import INSCRIBED, LETHAL, MAX_NON_OBSTACLE, NO_INFORMATION, Costmap2D
+from sid.checks import check_number
 
-_LOOP_MAX = 20
+_LOOP_MAX = 20  # segment_cost sums this many samples or fewer in a Python loop, more with numpy (docs/parameters.md)
 
 DEFAULT_COST_WEIGHT = 4.0
-"""w in J = integral of (1 + w c / 252) ds; see the module docstring. Measured on the demo scenario (grid planner):
-w = 0.5 still cuts through the conversation, w = 1 goes around it passing 1.11 m from a member, w = 4 keeps every
-path sample beyond Hall's personal distance (1.28 m) for a path 0.9 % longer than with w = 1."""
+"""w in J = integral of (1 + w c / 252) ds; see the module docstring. 4: on the demo scenario the smallest weight
+tried that keeps the whole path beyond Hall's personal distance (1.2 m) of every member, for a few per cent of
+length; smaller weights cut through the conversation or graze it (docs/parameters.md)."""
 
 
 class PlanningError(ValueError):
@@ -62,10 +63,8 @@ class PlanningProblem:
             if len(xy) != 2 or not all(math.isfinite(v) for v in xy):
                 raise PlanningError(f"{name} must be two finite world coordinates (x, y) in metres, got {xy}")
             object.__setattr__(self, name, xy)
-        if not (math.isfinite(self.robot_radius) and self.robot_radius >= 0):
-            raise PlanningError(f"robot_radius must be a non-negative number of metres, got {self.robot_radius}")
-        if not (math.isfinite(self.cost_weight) and self.cost_weight >= 0):
-            raise PlanningError(f"cost_weight must be a non-negative number, got {self.cost_weight}")
+        check_number("planning problem", "robot_radius", self.robot_radius, low=0, unit="metres", error=PlanningError)
+        check_number("planning problem", "cost_weight", self.cost_weight, low=0, error=PlanningError)
 
 
 @dataclass
@@ -135,7 +134,7 @@ class CostField:
         inv = self._inv_res
         cx, cy = (x0 + 0.5 * dx / n - self._ox) * inv, (y0 + 0.5 * dy / n - self._oy) * inv
         sx, sy = dx / n * inv, dy / n * inv
-        if n > _LOOP_MAX:  # numpy's fixed overhead pays off on long segments (measured crossover ~20 samples)
+        if n > _LOOP_MAX:  # numpy's fixed overhead pays off on long segments
             k = np.arange(n)
             total = float(self._weight_padded[(cy + k * sy).astype(np.intp), (cx + k * sx).astype(np.intp)].sum())
         else:
@@ -158,10 +157,6 @@ class CostField:
         """Exact validity (N,) of robot centres at world points (N, 2); outside the map is not free."""
         rows, cols, inside = self.cells(xy)
         return self.free[rows, cols] & inside
-
-    def plannable_at(self, xy: np.ndarray) -> np.ndarray:
-        rows, cols, inside = self.cells(xy)
-        return self.plannable[rows, cols] & inside
 
     def segments(self, p: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """J (M,) of straight segments p[i] -> q[i] (each (M, 2)) and whether each is plannable over its length.

@@ -12,9 +12,11 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from costmap.grid import GridSpec
-from costmap.render import default_scale, render_costmap, world_to_image
+from costmap.grid import Costmap2D, GridSpec
+from costmap.layered import LayeredCostmap
+from costmap.render import RobotTask, default_scale, render_costmap, world_to_image
 from planner.validity import interpolate
+from sid.perception.groups import Group
 
 FONT = cv2.FONT_HERSHEY_SIMPLEX
 TEXT = (40, 40, 40)
@@ -94,11 +96,11 @@ def add_header(img: np.ndarray, title: str, subtitle: str = "") -> np.ndarray:
 
 
 def render_paths(
-    layered,
+    layered: LayeredCostmap | Costmap2D,
     paths: Sequence[tuple[np.ndarray, PathStyle]],
     *,
-    robot=None,
-    groups=None,
+    robot: RobotTask | None = None,
+    groups: Sequence[Group] | None = None,
     title: str | None = None,
     scale: int | None = None,
 ) -> tuple[np.ndarray, int]:

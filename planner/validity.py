@@ -10,17 +10,18 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from planner.problem import CostField
 
 
-def state_validity_checker(field: CostField) -> Callable[[object], bool]:
+def state_validity_checker(field: CostField) -> Callable[[Any], bool]:
     """A callable for ``SpaceInformation.setStateValidityChecker``: state -> plannable (Python bool)."""
     is_plannable = field.is_plannable
 
-    def is_valid(state: object) -> bool:
+    def is_valid(state: Any) -> bool:  # an OMPL RealVectorStateSpace state
         return is_plannable(state[0], state[1])
 
     return is_valid

@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeGuard
 
 import yaml
 
@@ -24,3 +25,8 @@ def load_document(path: str | Path, kind: str = "file") -> Any:
         return json.loads(text) if is_json else yaml.safe_load(text)
     except (json.JSONDecodeError, yaml.YAMLError) as exc:
         raise ValueError(f"{path}: not valid {'JSON' if is_json else 'YAML'} ({exc})") from None
+
+
+def is_number(value: Any) -> TypeGuard[int | float]:
+    """Whether a parsed JSON / YAML value is a finite number (an int or a float; booleans do not count)."""
+    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)

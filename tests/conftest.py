@@ -2,9 +2,18 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
+from hypothesis import settings
+
+# In CI (CI=true, as .ci/run is run) property tests draw the same examples on every run and every Python version,
+# with no per-example deadline (the machine is shared); `HYPOTHESIS_PROFILE=ci` selects the same locally.
+settings.register_profile("ci", derandomize=True, deadline=None, database=None, print_blob=True)
+_profile = os.environ.get("HYPOTHESIS_PROFILE") or ("ci" if os.environ.get("CI") else None)
+if _profile:
+    settings.load_profile(_profile)
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 SHARED = REPO_ROOT.parent / "shared"

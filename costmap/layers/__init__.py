@@ -1,1 +1,2 @@
-"""Costmap layers, one class each (Nav2's plugins): static map, obstacles (LiDAR), inflation, social zones."""
+"""Costmap layers, one ``costmap.layer.Layer`` class each (Nav2's plugins): static map, obstacles (LiDAR), social
+zones, inflation."""

@@ -21,7 +21,8 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
-from costmap.grid import FREE_SPACE, INSCRIBED, LETHAL, MAX_NON_OBSTACLE, NO_INFORMATION, GridSpec
+from costmap.grid import FREE_SPACE, INSCRIBED, LETHAL, MAX_NON_OBSTACLE, GridSpec, Window
+from costmap.layer import Layer, LayerInputs
 
 DistanceMethod = Literal["opencv", "scipy"]
 
@@ -65,10 +66,12 @@ def distance_to_lethal_cells(lethal: np.ndarray, method: DistanceMethod = "openc
     raise ValueError(f"unknown distance method {method!r}; use 'opencv' or 'scipy'")
 
 
-class InflationLayer:
-    """Inflates the lethal cells of the combined grid; keeps its own grid of inflation costs.
+class InflationLayer(Layer):
+    """Inflates the lethal cells of the combined grid (it reads the master, as Nav2's does); keeps its own grid of
+    inflation costs. Put it last.
 
-    ``inscribed_radius`` is the robot's radius (metres): Nav2's inscribed radius of a circular footprint.
+    ``inscribed_radius`` is the robot's radius (metres): Nav2's inscribed radius of a circular footprint. Combined by
+    max with Nav2's rule for unknown cells (``max_keep_unknown``), or ``max_nonzero`` with ``inflate_unknown``.
     """
 
     name = "inflation"
@@ -76,7 +79,8 @@ class InflationLayer:
     def __init__(self, spec: GridSpec, params: InflationParams, inscribed_radius: float) -> None:
         if not (np.isfinite(inscribed_radius) and inscribed_radius >= 0):
             raise ValueError(f"robot.radius (inscribed radius) must be a finite number >= 0, got {inscribed_radius}")
-        self.spec = spec
+        self.combination = "max_nonzero" if params.inflate_unknown else "max_keep_unknown"
+        super().__init__(spec)
         self.params = params
         self.inscribed_radius = float(inscribed_radius)
         self.cell_radius = spec.cell_distance(params.inflation_radius)
@@ -84,28 +88,28 @@ class InflationLayer:
         d2 = np.arange(self.cell_radius**2 + 2)
         self._cost_by_d2 = inflation_cost(np.sqrt(d2) * spec.resolution, inscribed_radius, params.cost_scaling_factor)
         self._cost_by_d2[-1] = FREE_SPACE
-        self.costs = np.zeros(spec.shape, dtype=np.uint8)
 
-    def compute(self, master: np.ndarray, method: DistanceMethod = "opencv") -> np.ndarray:
-        """This layer's own grid for the lethal cells of ``master``: Nav2's cost within reach, 0 beyond."""
-        lethal = master == LETHAL
+    def update(self, inputs: LayerInputs, changed: Window | None) -> Window | None:
+        """Costs change within reach of whatever the layers before this one changed."""
+        return None if changed is None else changed.grown(self.cell_radius, self.spec)
+
+    def write(self, master: np.ndarray, window: Window) -> None:
+        """Inflate the lethal cells of ``master`` over ``window`` (from those within reach of it) and combine."""
+        source = window.grown(self.cell_radius, self.spec)
+        inner = slice(window.row0 - source.row0, window.row1 - source.row0)
+        inner_cols = slice(window.col0 - source.col0, window.col1 - source.col0)
+        rows, cols = window.slices
+        self.costs[rows, cols] = self._inflate(master[source.slices] == LETHAL)[inner, inner_cols]
+        super().write(master, window)
+
+    def _inflate(self, lethal: np.ndarray) -> np.ndarray:
+        """Nav2's cost for every cell of ``lethal`` (bool) within reach of a True cell, 0 beyond."""
         if self.cell_radius == 0 or not lethal.any():
-            self.costs = np.where(lethal, LETHAL, FREE_SPACE).astype(np.uint8)
-            return self.costs
-        distance = distance_to_lethal_cells(lethal, method)
+            return np.where(lethal, LETHAL, FREE_SPACE).astype(np.uint8)
+        distance = distance_to_lethal_cells(lethal)
         far = len(self._cost_by_d2) - 1  # index of the "beyond reach" entry
         np.minimum(distance, np.float32(np.sqrt(far)), out=distance)  # clip first: the squares stay small
         d2 = np.rint(np.square(distance, out=distance))
         if far < 256:  # the usual case (reach <= 15 cells): OpenCV's table lookup is ~4x faster (measured)
-            self.costs = cv2.LUT(d2.astype(np.uint8), np.pad(self._cost_by_d2, (0, 255 - far)))
-        else:
-            self.costs = self._cost_by_d2[d2.astype(np.int32)]
-        return self.costs
-
-    def apply(self, master: np.ndarray, method: DistanceMethod = "opencv") -> None:
-        """Compute the inflation of ``master`` and write it in place: Nav2's max, with its rule for unknown cells."""
-        cost = self.compute(master, method)
-        threshold = 1 if self.params.inflate_unknown else INSCRIBED
-        replace = (master == NO_INFORMATION) & (cost >= threshold)
-        np.maximum(master, cost, out=master)  # an unknown master cell stays 255 here
-        np.copyto(master, cost, where=replace)
+            return cv2.LUT(d2.astype(np.uint8), np.pad(self._cost_by_d2, (0, 255 - far)))
+        return self._cost_by_d2[d2.astype(np.int32)]

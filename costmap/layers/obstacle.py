@@ -17,7 +17,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from costmap.grid import FREE_SPACE, LETHAL, NO_INFORMATION, GridSpec
+from costmap.combine import CombinationMethod
+from costmap.grid import FREE_SPACE, LETHAL, NO_INFORMATION, GridSpec, Window, union
+from costmap.layer import Layer, LayerInputs
 from costmap.scan import LaserScan
 
 
@@ -74,21 +76,36 @@ def trace_cells(spec: GridSpec, origin: np.ndarray, ends: np.ndarray) -> np.ndar
     return rows[keep].astype(np.int64) * spec.width + cols[keep]
 
 
-class ObstacleLayer:
-    """A persistent grid of LiDAR marks: FREE where beams passed, LETHAL at hits, the default elsewhere."""
+class ObstacleLayer(Layer):
+    """A persistent grid of LiDAR marks: FREE where beams passed, LETHAL at hits, the default elsewhere.
+
+    People. With ``people_clear_radius`` > 0 (m; set when another layer draws the people), the marks within that
+    radius of the current people are cleared after every update: they are the people's, not the map's, so a person
+    is counted once and one who moves leaves nothing behind, even where no new beam reaches. A mark at an old
+    position that a new scan hits again stays (something is really there). With 0 (no recognition) people are plain
+    obstacles, cleared only by beams, as in Nav2.
+    """
 
     name = "lidar"
+    combination: CombinationMethod = "max"
 
-    def __init__(self, spec: GridSpec, params: ObstacleParams | None = None) -> None:
-        self.spec = spec
+    def __init__(self, spec: GridSpec, params: ObstacleParams | None = None, people_clear_radius: float = 0.0) -> None:
+        if not (np.isfinite(people_clear_radius) and people_clear_radius >= 0):
+            raise ValueError(f"people clear radius must be a number of metres >= 0, got {people_clear_radius}")
         self.params = params or ObstacleParams()
-        self.costs = np.full(spec.shape, self.params.default_value, dtype=np.uint8)
+        super().__init__(spec, self.params.default_value)
+        self.people_clear_radius = float(people_clear_radius)
 
-    def reset(self) -> None:
-        self.costs.fill(self.params.default_value)
+    def update(self, inputs: LayerInputs, changed: Window | None) -> Window | None:
+        """Apply the scan (if any), then clear the people's marks."""
+        scanned = None if inputs.scan is None else self.apply_scan(inputs.scan)
+        if self.people_clear_radius == 0:
+            return scanned
+        people = np.array([(p.x, p.y) for p in inputs.people], dtype=float)
+        return union(scanned, self.clear_discs(people, self.people_clear_radius))
 
-    def apply_scan(self, scan: LaserScan) -> None:
-        """Clear along every beam, then mark every hit (Nav2's raytraceFreespace + marking)."""
+    def apply_scan(self, scan: LaserScan) -> Window | None:
+        """Clear along every beam, then mark every hit (Nav2's raytraceFreespace + marking); returns the window."""
         p = self.params
         origin = np.asarray(scan.pose[:2])
         if not self.spec.contains(origin[None])[0]:
@@ -103,21 +120,24 @@ class ObstacleLayer:
 
         with np.errstate(invalid="ignore"):
             marking = np.isfinite(r) & (r >= p.obstacle_min_range) & (r <= p.obstacle_max_range)
-        hits = self.spec.world_to_cell(origin + dirs[marking] * r[marking, None])
+        hit_xy = origin + dirs[marking] * r[marking, None]
+        hits = self.spec.world_to_cell(hit_xy)
         hits = hits[self.spec.in_bounds(hits)]
         self.costs[hits[:, 0], hits[:, 1]] = LETHAL
+        return self.spec.window_around(np.vstack([origin[None], ends, hit_xy]))
 
-    def clear_discs(self, centres: np.ndarray, radius: float) -> None:
-        """Turn LETHAL marks whose cell centre lies within ``radius`` metres of any centre (N, 2) into FREE.
-
-        Used for tracked people: their marks are theirs, not the map's (see ``costmap.layered``).
-        """
+    def clear_discs(self, centres: np.ndarray, radius: float) -> Window | None:
+        """Turn LETHAL marks whose cell centre lies within ``radius`` metres of any centre (N, 2) into FREE; returns
+        the window of the discs."""
         centres = np.asarray(centres, dtype=float).reshape(-1, 2)
+        cleared = None
         for cx, cy in centres:
             window = self.spec.window((cx - radius, cy - radius), (cx + radius, cy + radius))
             if window is None:
                 continue
             xs, ys = self.spec.cell_axes(window)
-            view = self.costs[window]
+            view = self.costs[window.slices]
             inside = ((xs - cx) ** 2 + (ys - cy) ** 2 <= radius**2) & (view == LETHAL)
             view[inside] = FREE_SPACE
+            cleared = window.union(cleared)
+        return cleared

@@ -3,7 +3,7 @@
 All geometry is in the world frame (metres, radians). Costs follow Nav2 (uint8):
 
 - body: every cell within ``body_radius`` of a person is LETHAL (254). A person is a physical obstacle, like the
-  LiDAR marks this layer replaces (see ``costmap.layered``), so the inflation layer inflates bodies as any other
+  LiDAR marks this layer replaces (see ``costmap.layers.obstacle``), so the inflation layer inflates bodies as any other
   obstacle. This is the only lethal value the layer writes.
 - personal space: an asymmetric Gaussian in the person's frame, ``amplitude * exp(-(u^2 / 2 su^2 + v^2 / 2 sv^2))``
   with u along the facing direction (su = sigma_front ahead, sigma_rear behind) and v sideways (sigma_side);
@@ -29,7 +29,9 @@ import shapely.affinity
 from shapely.geometry import MultiPoint, Polygon
 from shapely.geometry.polygon import orient
 
-from costmap.grid import FREE_SPACE, LETHAL, MAX_NON_OBSTACLE, GridSpec
+from costmap.combine import CombinationMethod
+from costmap.grid import FREE_SPACE, LETHAL, MAX_NON_OBSTACLE, GridSpec, Window, union
+from costmap.layer import Layer, LayerInputs
 from sid.perception.groups import Group
 from sid.perception.people import Person
 
@@ -147,18 +149,18 @@ def _person_box(person: Person, params: SocialParams) -> tuple[tuple[float, floa
     return (xs.min(), ys.min()), (xs.max(), ys.max())
 
 
-def _local_axes(spec: GridSpec, window: tuple[slice, slice], x: float, y: float) -> tuple[np.ndarray, np.ndarray]:
+def _local_axes(spec: GridSpec, window: Window, x: float, y: float) -> tuple[np.ndarray, np.ndarray]:
     """Cell-centre offsets from (x, y) in a window as float32 (1, cols) and (rows, 1): float32 halves the time of
     the per-cell arithmetic (measured) and is exact to ~1e-6 m over a few metres."""
     xs, ys = spec.cell_axes(window)
     return (xs - x).astype(np.float32), (ys - y).astype(np.float32)
 
 
-def paint_person(costs: np.ndarray, spec: GridSpec, person: Person, params: SocialParams) -> None:
-    """Max the person's personal-space Gaussian into ``costs`` (in place; only the cells it reaches)."""
+def paint_person(costs: np.ndarray, spec: GridSpec, person: Person, params: SocialParams) -> Window | None:
+    """Max the person's personal-space Gaussian into ``costs`` (in place; only the cells it reaches); returns them."""
     window = spec.window(*_person_box(person, params))
     if window is None:
-        return
+        return None
     dx, dy = _local_axes(spec, window, person.x, person.y)
     if person.theta is None:
         exponent = (dx * dx + dy * dy) * np.float32(0.5 / params.sigma_unknown**2)
@@ -168,62 +170,73 @@ def paint_person(costs: np.ndarray, spec: GridSpec, person: Person, params: Soci
         ku = np.where(u >= 0, np.float32(0.5 / params.sigma_front**2), np.float32(0.5 / params.sigma_rear**2))
         exponent = u * u * ku + v * v * np.float32(0.5 / params.sigma_side**2)
     cost = (np.float32(params.amplitude) * np.exp(-exponent)).astype(np.uint8)  # truncation = floor here
-    np.maximum(costs[window], cost, out=costs[window])
+    view = costs[window.slices]
+    np.maximum(view, cost, out=view)
+    return window
 
 
-def paint_group(
-    costs: np.ndarray, spec: GridSpec, group: Group, people: Mapping[int, Person], params: SocialParams
-) -> None:
-    """Max the group's zone cost and its fall-off into ``costs`` (in place).
+def paint_group(costs: np.ndarray, spec: GridSpec, hull: shapely.Geometry, params: SocialParams) -> Window | None:
+    """Max a group's zone cost and its fall-off into ``costs`` (in place); returns the window it reaches.
+
+    ``hull``: the group's ``_zone_hull``.
 
     Distances within 1e-6 m of the zone edge count as inside, so rounding never drops a cell that lies in
     ``group_zone_polygon`` below ``group_cost``.
     """
-    hull = _zone_hull(group, people)
     reach = params.group_margin + _reach(params.group_cost, params.group_sigma)
     x0, y0, x1, y1 = hull.bounds
     window = spec.window((x0 - reach, y0 - reach), (x1 + reach, y1 + reach))
     if window is None:
-        return
+        return None
     ox, oy = (x0 + x1) / 2, (y0 + y1) / 2
     dx, dy = _local_axes(spec, window, ox, oy)
     local = shapely.affinity.translate(hull, -ox, -oy)
     outside = np.maximum(_distance_to_hull(dx, dy, local) - np.float32(params.group_margin + 1e-6), 0)
     falloff = np.exp(-(outside * outside) * np.float32(0.5 / params.group_sigma**2))
-    np.maximum(costs[window], (np.float32(params.group_cost) * falloff).astype(np.uint8), out=costs[window])
+    view = costs[window.slices]
+    np.maximum(view, (np.float32(params.group_cost) * falloff).astype(np.uint8), out=view)
+    return window
 
 
-def paint_body(costs: np.ndarray, spec: GridSpec, person: Person, body_radius: float) -> None:
-    """Mark every cell whose centre lies within ``body_radius`` of the person LETHAL (in place)."""
+def paint_body(costs: np.ndarray, spec: GridSpec, person: Person, body_radius: float) -> Window | None:
+    """Mark every cell whose centre lies within ``body_radius`` of the person LETHAL (in place); returns the window."""
     r = body_radius
     window = spec.window((person.x - r, person.y - r), (person.x + r, person.y + r))
     if window is None:
-        return
+        return None
     xs, ys = spec.cell_axes(window)
-    view = costs[window]
+    view = costs[window.slices]
     view[(xs - person.x) ** 2 + (ys - person.y) ** 2 <= r**2] = LETHAL
+    return window
 
 
-class SocialLayer:
-    """Rebuilt from the current people and groups at every update, so it never keeps stale marks."""
+class SocialLayer(Layer):
+    """Rebuilt from the current people and groups at every update, so it never keeps stale marks.
+
+    Combined by max with its free cells left out (``max_nonzero``): they carry no opinion, as cells outside a Nav2
+    layer's bounds, so unknown space stays unknown around people. ``body_radius``: a person's body (m).
+    """
 
     name = "social"
+    combination: CombinationMethod = "max_nonzero"
 
     def __init__(self, spec: GridSpec, params: SocialParams | None = None, body_radius: float = 0.2) -> None:
         if not (np.isfinite(body_radius) and body_radius > 0):
             raise ValueError(f"body radius must be a positive number of metres, got {body_radius}")
-        self.spec = spec
+        super().__init__(spec)
         self.params = params or SocialParams()
         self.body_radius = float(body_radius)
-        self.costs = np.zeros(spec.shape, dtype=np.uint8)
+        self._painted: Window | None = None  # the cells the last update may have painted
 
-    def update(self, people: Sequence[Person], groups: Sequence[Group]) -> None:
-        """Recompute the layer for these people (world frame) and their groups."""
-        self.costs.fill(FREE_SPACE)
-        by_id = _people_by_id(people)
-        for group in groups:
-            paint_group(self.costs, self.spec, group, by_id, self.params)
-        for person in people:
-            paint_person(self.costs, self.spec, person, self.params)
-        for person in people:
-            paint_body(self.costs, self.spec, person, self.body_radius)
+    def update(self, inputs: LayerInputs, changed: Window | None) -> Window | None:
+        """Repaint the layer for the people (world frame) and groups of ``inputs``."""
+        by_id = _people_by_id(inputs.people)
+        hulls = [_zone_hull(group, by_id) for group in inputs.groups]  # raises on a bad group before any change
+        previous = self._painted
+        if previous is not None:
+            self.costs[previous.slices] = FREE_SPACE
+        painted = [paint_group(self.costs, self.spec, hull, self.params) for hull in hulls]
+        painted += [paint_person(self.costs, self.spec, person, self.params) for person in inputs.people]
+        painted += [paint_body(self.costs, self.spec, person, self.body_radius) for person in inputs.people]
+        self._painted = union(*painted)
+        return union(previous, self._painted)

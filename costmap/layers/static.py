@@ -1,10 +1,12 @@
-"""The static layer's costs: a map_server map read as Nav2's StaticLayer reads it, sampled onto a grid."""
+"""Nav2's static layer: a map_server map, read as Nav2 reads it and sampled onto the costmap's grid."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from costmap.grid import NO_INFORMATION, GridSpec
+from costmap.combine import CombinationMethod
+from costmap.grid import NO_INFORMATION, GridSpec, Window
+from costmap.layer import Layer, LayerInputs
 from costmap.occupancy import OccupancyGrid, occupancy_to_cost
 
 
@@ -21,3 +23,21 @@ def static_costs(grid: OccupancyGrid, spec: GridSpec, track_unknown_space: bool 
     out = np.full(spec.height * spec.width, NO_INFORMATION if track_unknown_space else 0, dtype=np.uint8)
     out[inside] = costs[cells[inside, 0], cells[inside, 1]]
     return out.reshape(spec.shape)
+
+
+class StaticLayer(Layer):
+    """The map, written first by true overwrite; it changes nothing after the first update."""
+
+    name = "static"
+    combination: CombinationMethod = "true_overwrite"
+
+    def __init__(self, spec: GridSpec, grid: OccupancyGrid, track_unknown_space: bool = True) -> None:
+        super().__init__(spec)
+        self.costs = static_costs(grid, spec, track_unknown_space)
+        self._new_map = True
+
+    def update(self, inputs: LayerInputs, changed: Window | None) -> Window | None:
+        """The whole grid once, for the new map; nothing afterwards."""
+        window = self.spec.whole if self._new_map else None
+        self._new_map = False
+        return window

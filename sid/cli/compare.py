@@ -4,16 +4,14 @@ prints a table (median time, success, cost ratio to the grid reference, o-space 
 from __future__ import annotations
 
 import argparse
-import json
 import sys
-from pathlib import Path
-
-import cv2
 
 from costmap.mapfile import MapFileError
 from planner.facade import PLANNERS
 from planner.problem import DEFAULT_COST_WEIGHT, PlanningError
-from sid.experiments.compare import format_summary, run_matrix, summarise, summary_chart
+from sid.experiments.compare import BY_SCENARIO, format_summary, write_comparison
+from sid.experiments.harness import prepare, run_matrix, summarise
+from sid.experiments.progress import ProgressBar
 from sid.scenario.loader import ScenarioError, load_scenario
 
 
@@ -34,29 +32,20 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.set_defaults(func=run)
 
 
-def _progress_bar(done: int, total: int, what: str) -> None:
-    filled = int(30 * done / max(total, 1))
-    line = f"\r[{'#' * filled}{'.' * (30 - filled)}] {done}/{total} {what}"
-    print(f"{line[:118]:<118}", end="\n" if done == total else "", file=sys.stderr, flush=True)
-
-
 def run(args: argparse.Namespace) -> int:
     try:
-        scenarios = [load_scenario(path) for path in args.scenarios]
-        runs = run_matrix(
-            scenarios, args.planners, args.runs, (args.time,), cost_weight=args.cost_weight, progress=_progress_bar
-        )
+        tasks = [prepare(load_scenario(path), args.cost_weight) for path in args.scenarios]
+        runs = run_matrix(tasks, args.planners, args.runs, (args.time,), progress=ProgressBar("compare"))
     except (ScenarioError, MapFileError, PlanningError, ValueError) as exc:
         print(f"\nsid compare: {exc}", file=sys.stderr)
         return 2
-    rows = summarise(runs)
-    print(format_summary(rows))
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "summary.json").write_text(json.dumps(rows, indent=2, allow_nan=False) + "\n")
-    title = f"Planner comparison: {len(scenarios)} scenario(s), {args.runs} seeds, {args.time:g} s budget (medians)"
-    if not cv2.imwrite(str(out / "planners.png"), summary_chart(summarise(runs, by_scenario=False), title)):
-        print(f"sid compare: could not write {out / 'planners.png'}", file=sys.stderr)
+    print(format_summary(summarise([run.record() for run in runs], BY_SCENARIO)))
+    title = f"Planner comparison: {len(tasks)} scenario(s), {args.runs} seeds, {args.time:g} s budget"
+    try:
+        paths = write_comparison(runs, args.out, title)
+    except OSError as exc:
+        print(f"sid compare: {exc}", file=sys.stderr)
         return 2
-    print(f"wrote {out / 'summary.json'}\nwrote {out / 'planners.png'}")
+    for path in paths.values():
+        print(f"wrote {path}")
     return 0

@@ -34,10 +34,10 @@ def run(args: argparse.Namespace) -> int:
         return 2
     kind = "without recognition" if args.no_social else "social"
     paths = export_costmap(layered, args.out, robot=scenario.robot, title=f"{scenario.name}: {kind}")
-    counts = {name: int((grid > 0).sum()) for name, grid in layered.layers.items()}
+    counts = {name: int((grid > 0).sum()) for name, grid in layered.grids.items()}
     print(
         f"{scenario.name}: {layered.spec.width}x{layered.spec.height} cells at {layered.spec.resolution} m, "
-        f"{len(layered.people)} people, {len(layered.groups)} groups ({kind})"
+        f"{len(layered.inputs.people)} people, {len(layered.inputs.groups)} groups ({kind})"
     )
     print("non-zero cells per layer: " + ", ".join(f"{k} {v}" for k, v in counts.items()))
     for path in paths.values():

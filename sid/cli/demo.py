@@ -10,7 +10,9 @@ from costmap.mapfile import MapFileError
 from planner.facade import DEFAULT_PLANNER, PLANNERS
 from planner.problem import PlanningError
 from sid.cli.plan import add_planning_options
-from sid.experiments.demo import DEMO_ITERATIONS, DEMO_SEED, format_table, goal_zone_warning, run_demo
+from sid.experiments.demo import DEMO_ITERATIONS, DEMO_SEED, run_demo
+from sid.experiments.harness import goal_zone_warning
+from sid.experiments.plan_pictures import format_table
 from sid.scenario.loader import ScenarioError, load_scenario
 
 
@@ -45,7 +47,7 @@ def run(args: argparse.Namespace) -> int:
     except (ScenarioError, MapFileError, PlanningError, ValueError) as exc:
         print(f"sid demo: {exc}", file=sys.stderr)
         return 2
-    warning = goal_zone_warning(comparison.scenario, comparison.groups)
+    warning = goal_zone_warning(comparison.task)
     if warning:
         print(f"sid demo: warning: {warning}", file=sys.stderr)
     print()
@@ -53,4 +55,4 @@ def run(args: argparse.Namespace) -> int:
     print()
     for name in ("comparison.png", "metrics.json") + (() if args.scenario else ("scenario.json",)):
         print(f"wrote {args.out}/{name}")
-    return 0 if all(r.success for r in comparison.results.values()) else 1
+    return 0 if all(run.result.success for run in comparison.runs.values()) else 1

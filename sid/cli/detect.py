@@ -12,7 +12,8 @@ import cv2
 import numpy as np
 
 from costmap.grid import Costmap2D, GridSpec
-from costmap.render import render_costmap
+from costmap.render import CameraView, render_costmap
+from sid.perception.camera import Calibration
 from sid.perception.frame import Frame
 from sid.perception.groups import GroupParams
 from sid.perception.lifting import LiftParams
@@ -22,7 +23,7 @@ from sid.perception.pipeline import FrameResult, Pipeline, PoseFn, image_pose
 from sid.perception.pose.contracts import PoseModelError
 from sid.sources import RECORDING_SUFFIXES, FrameReadError, SourceError, open_source, skip_unreadable
 
-TOP_VIEW = GridSpec.from_size(0.05, (0.0, -3.5), (7.0, 7.0))  # world frame: 7 m ahead of the camera, 3.5 m each side
+TOP_VIEW = GridSpec.from_size(0.05, (-0.5, -3.5), (7.5, 7.0))  # world frame: 7 m ahead of the camera, 3.5 m each side
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -85,7 +86,17 @@ def _skip_reason(frame: Frame) -> str | None:
     return None
 
 
-def _write_pictures(out: Path, frame: Frame, result: FrameResult) -> None:
+def camera_view(calibration: Calibration, mount: CameraMount) -> CameraView:
+    """The colour camera seen from above: at the world origin, its field of view bounded by the image's left and
+    right edges on the principal row."""
+    color = calibration.color
+    edges = np.array([[-0.5 - color.cx, 0.0, color.fx], [color.width - 0.5 - color.cx, 0.0, color.fx]])
+    world = edges @ mount.rotation.T
+    left, right = np.arctan2(world[:, 1], world[:, 0])
+    return CameraView(0.0, 0.0, float(left + right) / 2, float(left - right))
+
+
+def _write_pictures(out: Path, frame: Frame, result: FrameResult, mount: CameraMount) -> None:
     by_id = {p.id: p for p in result.people}
     people = [by_id.get(i) for i in range(len(result.detections))]
     cv2.imwrite(str(out / f"overlay_{frame.index:06d}.png"), draw_detections(frame.color, result.detections, people))
@@ -93,7 +104,10 @@ def _write_pictures(out: Path, frame: Frame, result: FrameResult) -> None:
         Costmap2D.filled(TOP_VIEW),
         result.people,
         result.groups,
-        title=f"frame {frame.index}: {len(result.people)} people, {len(result.groups)} groups",
+        title=f"frame {frame.index}: {_count(len(result.people), 'person', 'people')}, "
+        f"{_count(len(result.groups), 'group', 'groups')}",
+        camera=camera_view(frame.calibration, mount),
+        scale=6,
     )
     cv2.imwrite(str(out / f"topview_{frame.index:06d}.png"), top)
 
@@ -154,7 +168,7 @@ def run(args: argparse.Namespace) -> int:
             totals.append(result.timing_ms["total"])
             _emit(result.to_json(keypoints=not args.no_keypoints), streams)
             if args.out is not None:
-                _write_pictures(args.out, frame, result)
+                _write_pictures(args.out, frame, result, mount)
     except KeyboardInterrupt:
         interrupted = True
         print("detect: interrupted, output flushed", file=sys.stderr)

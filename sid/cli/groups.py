@@ -14,13 +14,13 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
-import math
 import os
 import re
 import sys
 from collections.abc import Iterable, Iterator
 from typing import Any, TextIO
 
+from sid.documents import is_number
 from sid.perception.groups import Group, GroupParams, detect_groups
 from sid.perception.people import Person
 
@@ -161,7 +161,7 @@ def _parse_person(data: Any, index: int) -> Person:
         value = data.get(key)
         if key == "theta" and value is None:
             continue
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        if not is_number(value):
             raise ValueError(f"{where} (id {person_id}): {key} must be a finite number, got {value!r}")
         values[key] = float(value)
     return Person(person_id, values["x"], values["y"], values.get("theta"))

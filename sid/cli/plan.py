@@ -8,7 +8,7 @@ import sys
 from costmap.mapfile import MapFileError
 from planner.facade import DEFAULT_PLANNER, PLANNERS, resolve_planner
 from planner.problem import DEFAULT_COST_WEIGHT, PlanningError
-from sid.experiments.demo import goal_zone_warning
+from sid.experiments.harness import goal_zone_warning
 from sid.experiments.scenario_plan import plan_scenario, write_plan
 from sid.scenario.loader import ScenarioError, load_scenario
 
@@ -59,7 +59,7 @@ def run(args: argparse.Namespace) -> int:
         scenario = load_scenario(args.scenario)
         budget = "deterministic" if name == "grid" else f"{args.time:g} s budget"
         print(f"planning {scenario.name} with {name} ({budget}) ...", flush=True)
-        sp = plan_scenario(
+        comparison = plan_scenario(
             scenario,
             social=not args.no_social,
             planner=name,
@@ -71,11 +71,12 @@ def run(args: argparse.Namespace) -> int:
     except (ScenarioError, MapFileError, PlanningError, ValueError) as exc:
         print(f"sid plan: {exc}", file=sys.stderr)
         return 2
-    warning = goal_zone_warning(scenario, sp.groups)
+    warning = goal_zone_warning(comparison.task)
     if warning:
         print(f"sid plan: warning: {warning}", file=sys.stderr)
-    files = write_plan(sp, args.out)
-    r, m = sp.result, sp.metrics
+    files = write_plan(comparison, args.out)
+    (run,) = comparison.runs.values()
+    r, m = run.result, run.metrics
     print(r.message)
     if r.success:
         closest = "-" if m["min_person_distance_m"] is None else f"{m['min_person_distance_m']:.2f} m"

@@ -6,18 +6,32 @@ from __future__ import annotations
 import argparse
 import shlex
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 from planner.facade import PLANNERS
 from planner.problem import DEFAULT_COST_WEIGHT
 from sid.experiments.navigation import NAV_LAYOUTS, NavSettings, navigation_tasks, run_navigation
+from sid.experiments.progress import ProgressBar
 from sid.synthetic.layouts import LAYOUTS, VARIATIONS
 from sid.synthetic.noise import DepthNoise, KeypointNoise
 
 TABLE1_DEFAULTS = {"frames": 50, "variations": len(VARIATIONS)}
 QUICK_TABLE1 = {"frames": 2, "variations": 1}
-NAVIGATION_DEFAULTS = {"layouts": tuple(NAV_LAYOUTS), "seeds": 2, "planners": PLANNERS, "time": 0.5}
-QUICK_NAVIGATION = {"layouts": ("P2", "T3"), "seeds": 1, "planners": ("grid", "rrtconnect"), "time": 0.2}
+
+
+@dataclass(frozen=True)
+class NavigationDefaults:
+    """What ``sid reproduce navigation`` runs when an option is not given: layouts, draws, planners, budget (s)."""
+
+    layouts: tuple[str, ...]
+    seeds: int
+    planners: tuple[str, ...]
+    time: float
+
+
+NAVIGATION_DEFAULTS = NavigationDefaults(tuple(NAV_LAYOUTS), 2, PLANNERS, 0.5)
+QUICK_NAVIGATION = NavigationDefaults(("P2", "T3"), 1, ("grid", "rrtconnect"), 0.2)
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -105,8 +119,8 @@ def _add_navigation(studies: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--quick", action="store_true",
-        help=f"a smoke run; defaults become: layouts {' '.join(QUICK_NAVIGATION['layouts'])}, 1 draw, planners "
-        f"{' '.join(QUICK_NAVIGATION['planners'])}, {QUICK_NAVIGATION['time']} s",
+        help=f"a smoke run; defaults become: layouts {' '.join(QUICK_NAVIGATION.layouts)}, 1 draw, planners "
+        f"{' '.join(QUICK_NAVIGATION.planners)}, {QUICK_NAVIGATION.time} s",
     )  # fmt: skip
     p.set_defaults(func=navigation_command)
 
@@ -125,7 +139,7 @@ def _output_folder(path: str) -> None:
 
 def table1_command(args: argparse.Namespace) -> int:
     # Imported here, not at the top: the pipeline and its lifting load only when a study runs.
-    from sid.experiments.reproduce import ProgressBar, table1_markdown, write_table1_report
+    from sid.experiments.reproduce import table1_markdown, write_table1_report
     from sid.experiments.table1 import Table1Settings, run_table1
 
     defaults = QUICK_TABLE1 if args.quick else TABLE1_DEFAULTS
@@ -163,13 +177,13 @@ def table1_command(args: argparse.Namespace) -> int:
 
 
 def navigation_command(args: argparse.Namespace) -> int:
-    from sid.experiments.reproduce import ProgressBar, navigation_markdown, write_navigation_report
+    from sid.experiments.reproduce import navigation_markdown, write_navigation_report
 
     defaults = QUICK_NAVIGATION if args.quick else NAVIGATION_DEFAULTS
-    layouts = [name.upper() for name in args.layouts] if args.layouts else defaults["layouts"]
-    seeds = args.seeds if args.seeds is not None else defaults["seeds"]
-    planners = args.planners or defaults["planners"]
-    time_limit = args.time if args.time is not None else defaults["time"]
+    layouts = [name.upper() for name in args.layouts] if args.layouts else defaults.layouts
+    seeds = args.seeds if args.seeds is not None else defaults.seeds
+    planners = args.planners or defaults.planners
+    time_limit = args.time if args.time is not None else defaults.time
     try:
         settings = NavSettings(tuple(planners), time_limit, args.iterations, args.cost_weight)
         tasks = navigation_tasks(seeds, layouts)

@@ -1,82 +1,128 @@
-"""Bar charts of the navigation study (OpenCV drawing, BGR uint8): one panel per metric, a pair of bars per planner
-(without and with the social layer), the value written over each bar."""
+"""Bar charts of with/without summaries (matplotlib, Agg backend, written to PNG): one panel per metric, a pair of
+bars per planner (without the social layer red, with it purple, as on the costmap pictures), the value over each
+bar, a legend above the panels."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-
-import cv2
-import numpy as np
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
 
 from planner.render import WITH_COLOUR, WITHOUT_COLOUR
 
-FONT = cv2.FONT_HERSHEY_SIMPLEX
-TEXT = (40, 40, 40)
-GRID = (225, 225, 225)
-PANEL_SIZE = (560, 300)  # width, height (px)
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
 
-# (summary key, panel title, value format)
-NAVIGATION_PANELS: tuple[tuple[str, str, str], ...] = (
-    ("success_rate", "success rate", ".2f"),
-    ("intrusion_rate", "o-space intrusion rate (share of paths entering a zone)", ".2f"),
-    ("mean_intrusion_m", "mean o-space intrusion length (m)", ".2f"),
-    ("median_min_person_distance_m", "median min distance to a person (m)", ".2f"),
-    ("median_length_ratio", "median path length / straight line", ".3f"),
-    ("median_planning_time_s", "median planning time (s)", ".2f"),
+
+@dataclass(frozen=True)
+class Panel:
+    """One panel: its title (with the unit) and how to read its value from a ``harness.summarise`` row."""
+
+    title: str
+    value: Callable[[dict], float | None]
+    fmt: str = ".2f"
+
+
+def from_key(key: str) -> Callable[[dict], float | None]:
+    """A panel value that is the row's ``key``."""
+    return lambda row: row[key]
+
+
+NAVIGATION_PANELS = (
+    Panel("success rate", from_key("success_rate")),
+    Panel("o-space intrusion rate (share of paths entering a zone)", from_key("intrusion_rate")),
+    Panel("mean o-space intrusion length (m)", from_key("mean_intrusion_m")),
+    Panel("median min distance to a person (m)", from_key("median_min_person_distance_m")),
+    Panel("median path length / straight line", from_key("median_length_ratio"), ".3f"),
+    Panel("median planning time (s)", from_key("median_planning_time_s")),
 )
+"""``sid reproduce navigation``'s chart."""
+
+PLANNER_PANELS = (
+    Panel("median planning time (s)", from_key("median_planning_time_s")),
+    Panel(
+        "median cost above the grid reference (%)",
+        lambda row: None if row["median_cost_ratio"] is None else 100 * (row["median_cost_ratio"] - 1),
+        ".1f",
+    ),
+    Panel("median path length in group zones (m)", from_key("median_intrusion_m")),
+)
+"""``sid compare``'s chart."""
+
+MODE_STYLE = {
+    False: ("without the social layer (LiDAR only)", WITHOUT_COLOUR),
+    True: ("with the social layer", WITH_COLOUR),
+}
 
 
-def bar_panel(rows: Sequence[dict], key: str, title: str, fmt: str, size: tuple[int, int] = PANEL_SIZE) -> np.ndarray:
-    """One panel: for each planner in ``rows`` (``summarise`` rows), a red bar without and a purple bar with the
-    social layer, height ``row[key]`` (missing values are left out)."""
-    width, height = size
-    img = np.full((height, width, 3), 255, np.uint8)
-    cv2.putText(img, title, (12, 22), FONT, 0.5, TEXT, 1, cv2.LINE_AA)
+def _rgb(bgr: tuple[int, int, int]) -> tuple[float, float, float]:
+    return (bgr[2] / 255, bgr[1] / 255, bgr[0] / 255)
+
+
+def _label(value: float, fmt: str) -> str:
+    text = format(value, fmt)
+    return format(0.0, fmt) if float(text) == 0 else text  # no "-0.0"
+
+
+def _draw_panel(ax: Axes, rows: Sequence[dict], panel: Panel) -> None:
     planners = list(dict.fromkeys(r["planner"] for r in rows))
-    values = [r[key] for r in rows if r.get(key) is not None]
-    top = (max(values, default=0.0) or 1.0) * 1.18  # all zero: a 0..1 axis
-    left, right, y0, y1 = 58, width - 12, 40, height - 34
-    for tick in np.linspace(0.0, top / 1.18, 4):
-        v = int(round(y1 - (y1 - y0) * tick / top))
-        cv2.line(img, (left, v), (right, v), GRID, 1)
-        cv2.putText(img, format(tick, ".2f"), (8, v + 4), FONT, 0.38, TEXT, 1, cv2.LINE_AA)
-    cv2.line(img, (left, y1), (right, y1), TEXT, 1)
-    cv2.line(img, (left, y0), (left, y1), TEXT, 1)
-    slot = (right - left) / max(1, len(planners))
-    for i, planner in enumerate(planners):
-        for j, (social, colour) in enumerate(((False, WITHOUT_COLOUR), (True, WITH_COLOUR))):
+    width = 0.4
+    values, missing = [], []
+    for j, (social, (label, colour)) in enumerate(MODE_STYLE.items()):
+        xs, heights = [], []
+        for i, planner in enumerate(planners):
             row = next((r for r in rows if r["planner"] == planner and r["social_layer"] == social), None)
-            if row is None or row.get(key) is None:
-                continue
-            x0 = int(left + i * slot + slot * (0.12 + 0.39 * j))
-            x1 = int(x0 + slot * 0.36)
-            v = int(round(y1 - (y1 - y0) * row[key] / top))
-            cv2.rectangle(img, (x0, min(v, y1 - 1)), (x1, y1), colour, -1)
-            cv2.putText(img, format(row[key], fmt), (x0, v - 4), FONT, 0.34, TEXT, 1, cv2.LINE_AA)
-        label_size = cv2.getTextSize(planner, FONT, 0.4, 1)[0][0]
-        cv2.putText(img, planner, (int(left + (i + 0.5) * slot - label_size / 2), y1 + 18), FONT, 0.4, TEXT, 1,
-                    cv2.LINE_AA)  # fmt: skip
-    return img
+            x = i + (j - 0.5) * width * 1.05
+            value = None if row is None else panel.value(row)
+            if value is None:
+                missing.append(x)
+            else:
+                xs.append(x)
+                heights.append(value)
+        values += heights
+        bars = ax.bar(xs, heights, width, color=_rgb(colour), label=label)
+        ax.bar_label(bars, labels=[_label(v, panel.fmt) for v in heights], padding=2, fontsize=8)
+    low, high = min(values, default=0.0), max(values, default=0.0)
+    if high <= 0 and low >= 0:
+        ax.set_ylim(0.0, 1.0)  # all zero: a 0..1 axis, so the ticks still read as values
+    else:
+        span = high - min(low, 0.0)
+        ax.set_ylim(min(low, 0.0) - (0.1 * span if low < 0 else 0.0), max(high, 0.0) + 0.15 * span)
+    for x in missing:
+        ax.text(x, 0.0, "n/a", ha="center", va="bottom", fontsize=8, color="0.45")
+    ax.axhline(0.0, color="0.2", linewidth=0.8)
+    ax.set_xticks(range(len(planners)), [p.replace("_", "\n") for p in planners])
+    ax.set_title(panel.title, loc="left", fontsize=10)
+    ax.grid(axis="y", color="0.9")
+    ax.set_axisbelow(True)
+    ax.spines[["top", "right"]].set_visible(False)
 
 
-def navigation_chart(rows: Sequence[dict], title: str, subtitle: str = "") -> np.ndarray:
-    """The study's summary (``navigation.summarise`` rows by planner) as a grid of ``NAVIGATION_PANELS``, with a title,
-    a subtitle and a legend."""
-    panels = [bar_panel(rows, key, name, fmt) for key, name, fmt in NAVIGATION_PANELS]
-    columns = 3
-    blank = np.full_like(panels[0], 255)
-    while len(panels) % columns:
-        panels.append(blank)
-    grid = np.vstack([np.hstack(panels[i : i + columns]) for i in range(0, len(panels), columns)])
-    header = np.full((78, grid.shape[1], 3), 255, np.uint8)
-    cv2.putText(header, title, (12, 28), FONT, 0.7, TEXT, 2, cv2.LINE_AA)
-    cv2.putText(header, subtitle, (12, 52), FONT, 0.45, TEXT, 1, cv2.LINE_AA)
-    x = 12
-    for label, colour in (
-        ("without the social layer (LiDAR only)", WITHOUT_COLOUR),
-        ("with the social layer", WITH_COLOUR),
-    ):
-        cv2.rectangle(header, (x, 60), (x + 18, 72), colour, -1)
-        cv2.putText(header, label, (x + 26, 71), FONT, 0.45, TEXT, 1, cv2.LINE_AA)
-        x += 36 + cv2.getTextSize(label, FONT, 0.45, 1)[0][0]
-    return np.vstack([header, grid])
+def bar_chart(
+    rows: Sequence[dict], panels: Sequence[Panel], path: str | Path, title: str, subtitle: str = "", columns: int = 3
+) -> Path:
+    """Write ``rows`` (``harness.summarise`` rows by planner, one costmap mode each) as a grid of ``panels`` to a
+    PNG at ``path``; returns the path. A missing value (no successful run) is marked "n/a"."""
+    # matplotlib loads here, not at import: the CLI imports this module for every command (about 1 s).
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    lines = -(-len(panels) // columns)
+    header_in, panel_in = 1.0, 3.6
+    fig = Figure(figsize=(5.2 * columns, header_in + panel_in * lines), dpi=100, layout="constrained")
+    FigureCanvasAgg(fig)
+    grid = fig.add_gridspec(2, 1, height_ratios=[header_in, panel_in * lines])
+    head, body = fig.add_subfigure(grid[0]), fig.add_subfigure(grid[1])
+    axes = body.subplots(lines, columns, squeeze=False).ravel()
+    for ax, panel in zip(axes, panels, strict=False):
+        _draw_panel(ax, rows, panel)
+    for ax in axes[len(panels) :]:
+        ax.set_visible(False)
+    head.text(0.01, 0.92, title, fontsize=14, fontweight="bold", va="top")
+    head.text(0.01, 0.52, subtitle, fontsize=10, va="top")
+    handles, labels = axes[0].get_legend_handles_labels()
+    head.legend(handles, labels, loc="lower left", bbox_to_anchor=(0.0, -0.05), ncols=2, frameon=False)
+    path = Path(path)
+    fig.savefig(path)
+    return path

@@ -1,4 +1,4 @@
-"""The navigation study: the demo's with/without comparison (``sid.experiments.demo``) over a family of tasks.
+"""The navigation study: the with/without comparison (``sid.experiments.harness``) over a family of tasks.
 
 Every task is the demo's corridor (11 x 7 m, walls at y = +-3 m, two boxes; ``sid.experiments.demo.DEMO_SCENARIO``) with
 one conversation in its middle and the robot crossing the corridor lengthwise past it. World frame (REP-103),
@@ -12,20 +12,19 @@ metres, radians. A task is drawn from ``numpy.random.default_rng([base_seed, lay
   group measures nothing). Each draw is planned in both directions ("forward": start on the left, "reverse":
   start and goal swapped), so the robot meets every layout from both sides.
 
-For each task and planner, ``sid.experiments.demo.compare_with_without`` plans on the LiDAR-only costmap ("without") and
-on the costmap with the social layer ("with"), with the same budget and OMPL seed, and measures both paths against
-the same groups, detected from the task's people (``sid.perception.groups.detect_groups`` on exact positions: this study
-is about navigation, not perception). Metrics per run are ``planner.metrics.result_metrics``; the summary gives, per
-planner and costmap: success rate, o-space intrusion rate (share of successful paths entering a group zone) and length,
-group-crossing rate, minimum distance to people, path-length ratio (length / straight line, NOTES section 4), detour
-(length with / length without, per task) and planning time.
+For each task and planner, ``sid.experiments.harness.compare_with_without`` plans on the LiDAR-only costmap
+("without") and on the costmap with the social layer ("with"), with the same budget and OMPL seed, and measures both
+paths against the same groups, detected from the task's people (``sid.perception.groups.detect_groups`` on exact
+positions: this study is about navigation, not perception). ``sid.experiments.harness.summarise`` gives, per planner
+(or layout) and costmap: success rate, o-space intrusion rate (share of successful paths entering a group zone) and
+length, group-crossing rate, minimum distance to people, path-length ratio (length / straight line, NOTES section 4),
+detour (length with / length without, per task) and planning time.
 """
 
 from __future__ import annotations
 
 import copy
 import math
-import statistics
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
@@ -33,7 +32,8 @@ import numpy as np
 
 from planner.facade import DEFAULT_PLANNER, resolve_planner
 from planner.problem import DEFAULT_COST_WEIGHT, PlanningError
-from sid.experiments.demo import DEMO_SCENARIO, Comparison, compare_with_without
+from sid.experiments.demo import DEMO_SCENARIO
+from sid.experiments.harness import Comparison, compare_with_without, prepare
 from sid.scenario.loader import Scenario, scenario_from_dict
 from sid.synthetic.layouts import LAYOUTS
 
@@ -151,8 +151,17 @@ class NavSettings:
             raise ValueError(f"navigation: iteration cap must be >= 1, got {self.max_iterations}")
 
 
-# The per-run metrics kept in the report (``planner.metrics`` keys).
+# The fields of a run kept in the report: the task's labels, then ``Run.record`` keys.
 RUN_KEYS = (
+    "task",
+    "layout",
+    "group_size",
+    "seed",
+    "direction",
+    "planner",
+    "social_layer",
+    "groups_detected",
+    "group_detected_whole",
     "success",
     "path_length_m",
     "length_ratio",
@@ -162,14 +171,15 @@ RUN_KEYS = (
     "personal_space_fraction",
     "planning_time_s",
     "message",
+    "detour",
 )
 
 
 @dataclass
 class NavigationResult:
-    """Runs (one dict per task x planner x costmap), tasks that could not be planned at all (name -> reason),
-    and, for the example picture, the comparison where the social layer avoided the most o-space intrusion with the
-    default planner (or the first one given; None when it avoided none)."""
+    """Runs (one record per task x planner x costmap, ``RUN_KEYS``), tasks that could not be planned at all
+    (name -> reason), and, for the example picture, the comparison where the social layer avoided the most o-space
+    intrusion with the default planner (or the first one given; None when it avoided none)."""
 
     settings: NavSettings
     tasks: int
@@ -186,95 +196,38 @@ def run_navigation(
 ) -> NavigationResult:
     """Plan every task with every planner, without and with the social layer; see the module docstring."""
     result = NavigationResult(settings, len(tasks))
-    jobs = [(index, task, planner) for index, task in enumerate(tasks) for planner in settings.planners]
-    best_gain = 0.0  # the example must show an intrusion the social layer avoided
     names = [resolve_planner(p) for p in settings.planners]
     example_planner = DEFAULT_PLANNER if DEFAULT_PLANNER in names else names[0]
-    for done, (index, task, planner) in enumerate(jobs):
-        if progress:
-            progress(done, len(jobs), f"{task.name}: {planner}")
-        if task.name in result.impossible:
-            continue
-        try:
-            comparison = compare_with_without(
-                task.scenario, planner, settings.time_limit, 1 + index, settings.max_iterations, settings.cost_weight
-            )
-        except PlanningError as exc:
-            result.impossible[task.name] = str(exc)
-            continue
-        members = sorted(len(g.members) for g in comparison.groups)
-        for mode, metrics in comparison.metrics.items():
-            record = {
-                "task": task.name,
-                "layout": task.layout,
-                "group_size": task.group_size,
-                "seed": task.seed,
-                "direction": task.direction,
-                "planner": resolve_planner(planner),
-                "social_layer": mode == "with",
-                "groups_detected": members,
-                "group_detected_whole": members == [task.group_size],
-            }
-            record |= {key: metrics.get(key) for key in RUN_KEYS}
-            result.runs.append(record)
-        without, with_ = comparison.metrics["without"], comparison.metrics["with"]
-        if without["success"] and with_["success"]:
-            gain = without["ospace_intrusion_m"] - with_["ospace_intrusion_m"]
-            if resolve_planner(planner) == example_planner and gain > best_gain:
-                best_gain, result.example = gain, comparison
+    best_gain = 0.0  # the example must show an intrusion the social layer avoided
+    total = len(tasks) * len(names)
+    for index, nav in enumerate(tasks):
+        task = prepare(nav.scenario, settings.cost_weight)
+        members = sorted(len(g.members) for g in task.groups)
+        task.labels |= {
+            "task": nav.name,
+            "layout": nav.layout,
+            "group_size": nav.group_size,
+            "seed": nav.seed,
+            "direction": nav.direction,
+            "groups_detected": members,
+            "group_detected_whole": members == [nav.group_size],
+        }
+        for j, planner in enumerate(names):
+            if progress:
+                progress(index * len(names) + j, total, f"{nav.name}: {planner}")
+            try:
+                comparison = compare_with_without(
+                    task, planner, settings.time_limit, 1 + index, settings.max_iterations
+                )
+            except PlanningError as exc:
+                result.impossible[nav.name] = str(exc)
+                break
+            result.runs += [{key: run.record()[key] for key in RUN_KEYS} for run in comparison.runs.values()]
+            without, with_ = comparison.metrics["without"], comparison.metrics["with"]
+            if planner == example_planner and without["success"] and with_["success"]:
+                gain = without["ospace_intrusion_m"] - with_["ospace_intrusion_m"]
+                if gain > best_gain:
+                    best_gain, result.example = gain, comparison
     if progress:
-        progress(len(jobs), len(jobs), "done")
-    _add_detours(result.runs)
+        progress(total, total, "done")
     return result
-
-
-def _add_detours(runs: list[dict]) -> None:
-    """``detour``: a path's length over the length of the same planner's other path for the same task (with /
-    without), on the run with the social layer; None when either failed."""
-    lengths = {(r["task"], r["planner"], r["social_layer"]): r["path_length_m"] for r in runs if r["success"]}
-    for run in runs:
-        run["detour"] = None
-        if run["social_layer"] and run["success"]:
-            base = lengths.get((run["task"], run["planner"], False))
-            run["detour"] = run["path_length_m"] / base if base else None
-
-
-def _median(values: Sequence[float | None]) -> float | None:
-    values = [v for v in values if v is not None]
-    return float(statistics.median(values)) if values else None
-
-
-def _mean(values: Sequence[float | None]) -> float | None:
-    values = [v for v in values if v is not None]
-    return float(statistics.fmean(values)) if values else None
-
-
-def summarise(runs: Sequence[dict], key: str = "planner") -> list[dict]:
-    """One row per (``key`` value, costmap): runs, success rate, intrusion rate and lengths, crossing rate,
-    minimum distance to people (median and worst), path-length ratio, detour and planning time (medians)."""
-    buckets: dict[tuple, list[dict]] = {}
-    for run in runs:
-        buckets.setdefault((run[key], run["social_layer"]), []).append(run)
-    rows = []
-    for (value, social), members in buckets.items():
-        ok = [r for r in members if r["success"]]
-        intruding = [r for r in ok if r["ospace_intrusion_m"] > 0]
-        distances = [r["min_person_distance_m"] for r in ok if r["min_person_distance_m"] is not None]
-        rows.append(
-            {
-                key: value,
-                "social_layer": social,
-                "runs": len(members),
-                "success_rate": len(ok) / len(members),
-                "intrusion_rate": len(intruding) / len(ok) if ok else None,
-                "mean_intrusion_m": _mean([r["ospace_intrusion_m"] for r in ok]),
-                "median_intrusion_when_intruding_m": _median([r["ospace_intrusion_m"] for r in intruding]),
-                "crossing_rate": sum(bool(r["crosses_group"]) for r in ok) / len(ok) if ok else None,
-                "median_min_person_distance_m": _median(distances),
-                "worst_min_person_distance_m": min(distances) if distances else None,
-                "median_length_ratio": _median([r["length_ratio"] for r in ok]),
-                "median_detour": _median([r["detour"] for r in ok]) if social else None,
-                "median_planning_time_s": _median([r["planning_time_s"] for r in members]),
-            }
-        )
-    return rows

@@ -1,20 +1,20 @@
-"""Small helpers the reproduction reports share: markdown tables, number cells, strict JSON, a stderr progress bar."""
+"""The reproduction reports (``sid reproduce table1|navigation``) and the helpers they share: markdown tables, number
+cells, strict JSON."""
 
 from __future__ import annotations
 
 import json
 import math
-import sys
-import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, TextIO
+from typing import Any
 
 import cv2
 
-from sid.experiments.charts import navigation_chart
+from sid.experiments.charts import NAVIGATION_PANELS, bar_chart
 from sid.experiments.demo import comparison_picture
-from sid.experiments.navigation import NAV_LAYOUTS, NavigationResult, summarise
+from sid.experiments.harness import summarise
+from sid.experiments.navigation import NAV_LAYOUTS, NavigationResult
 from sid.experiments.table1 import METRICS, PAPER_TABLE1, UNITS, Table1Result, table1_json
 from sid.synthetic.layouts import LAYOUTS, VARIATIONS
 
@@ -55,38 +55,14 @@ def write_json(path: Path, data: Any) -> None:
     path.write_text(json.dumps(json_ready(data), indent=2, allow_nan=False) + "\n")
 
 
-class ProgressBar:
-    """``progress(done, total, what)`` drawing a one-line bar with the elapsed time on ``stream`` (stderr), redrawn
-    at most every ``interval`` seconds (and always at the start and the end)."""
-
-    def __init__(self, label: str, stream: TextIO | None = None, width: int = 30, interval: float = 0.2):
-        self.label = label
-        self.stream = stream if stream is not None else sys.stderr
-        self.width = width
-        self.interval = interval
-        self.start = time.perf_counter()
-        self.last = -math.inf
-
-    def __call__(self, done: int, total: int, what: str) -> None:
-        now = time.perf_counter()
-        if 0 < done < total and now - self.last < self.interval:
-            return
-        self.last = now
-        filled = int(self.width * done / max(total, 1))
-        bar = "#" * filled + "." * (self.width - filled)
-        line = f"\r{self.label} [{bar}] {done}/{total} {now - self.start:5.0f} s {what}"
-        end = "\n" if done >= total else ""
-        print(f"{line[:118]:<118}", end=end, file=self.stream, flush=True)
-
-
 # --- navigation --------------------------------------------------------------------------------------------------
 
 
 def navigation_markdown(result: NavigationResult, seeds: int, command: str) -> str:
     """``navigation.md``: settings, the per-planner table, the per-layout table and the tasks that failed."""
     settings = result.settings
-    by_planner = summarise(result.runs, "planner")
-    by_layout = summarise(result.runs, "layout")
+    by_planner = summarise(result.runs, ("planner",))
+    by_layout = summarise(result.runs, ("layout",))
     budget = f"{settings.time_limit:g} s per plan" + (
         f", capped at {settings.max_iterations} iterations" if settings.max_iterations else ""
     )
@@ -173,7 +149,7 @@ def _layout_row(name: str, rows: list[dict]) -> list[str]:
     without = next((r for r in rows if r["layout"] == name and not r["social_layer"]), {})
     with_ = next((r for r in rows if r["layout"] == name and r["social_layer"]), {})
 
-    def pair(key: str, show) -> str:
+    def pair(key: str, show: Callable[[float | None], str]) -> str:
         return f"{show(without.get(key))} / {show(with_.get(key))}"
 
     return [
@@ -207,8 +183,8 @@ def navigation_json(result: NavigationResult, seeds: int) -> dict:
             for name, spec in NAV_LAYOUTS.items()
             if any(r["layout"] == name for r in result.runs)
         },  # fmt: skip
-        "summary": summarise(result.runs, "planner"),
-        "by_layout": summarise(result.runs, "layout"),
+        "summary": summarise(result.runs, ("planner",)),
+        "by_layout": summarise(result.runs, ("layout",)),
         "impossible": result.impossible,
         "runs": result.runs,
     }
@@ -224,21 +200,18 @@ def write_navigation_report(result: NavigationResult, out_dir: str | Path, seeds
     write_json(paths["json"], navigation_json(result, seeds))
     s = result.settings
     budget = f"{s.time_limit:g} s budget" + (f", {s.max_iterations} iterations cap" if s.max_iterations else "")
-    chart = navigation_chart(
-        summarise(result.runs, "planner"),
+    bar_chart(
+        summarise(result.runs, ("planner",)),
+        NAVIGATION_PANELS,
+        paths["png"],
         "Navigation past conversations: without vs with the social layer",
         f"{result.tasks} tasks (group sizes 2-5, both directions, {seeds} draw(s) per layout), {budget}",
     )
-    _write_image(paths["png"], chart)
     if result.example is not None:
         paths["example"] = out / "navigation_example.png"
-        _write_image(paths["example"], comparison_picture(result.example))
+        if not cv2.imwrite(str(paths["example"]), comparison_picture(result.example)):
+            raise OSError(f"could not write {paths['example']}")
     return paths
-
-
-def _write_image(path: Path, image) -> None:
-    if not cv2.imwrite(str(path), image):
-        raise OSError(f"could not write {path}")
 
 
 # --- table 1 -----------------------------------------------------------------------------------------------------

@@ -193,7 +193,7 @@ def main(argv: list[str] | None = None) -> int:
     """``python -m sid.experiments.seed_recordings [FOLDER] [--jsonl]``: agreement report, or frames as JSON lines."""
     parser = argparse.ArgumentParser(prog="python -m sid.experiments.seed_recordings", description=main.__doc__)
     parser.add_argument(
-        "folder", nargs="?", default=str(Path(__file__).resolve().parents[2] / "shared" / "data" / "seed-recordings")
+        "folder", nargs="?", default=str(Path(__file__).resolve().parents[3] / "shared" / "data" / "seed-recordings")
     )
     parser.add_argument("--jsonl", action="store_true", help="print the frames as `sid groups` input instead")
     args = parser.parse_args(argv)

@@ -31,6 +31,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
+from sid.checks import check_number
 from sid.perception.groups import Group, GroupParams
 from sid.perception.lifting import LiftParams
 from sid.perception.people import Person
@@ -82,8 +83,7 @@ class Table1Settings:
             raise ValueError(f"table1: frames must be a whole number >= 1, got {self.frames}")
         if not 1 <= self.variations <= len(VARIATIONS):
             raise ValueError(f"table1: variations must be 1..{len(VARIATIONS)}, got {self.variations}")
-        if not (math.isfinite(self.match_radius) and self.match_radius > 0):
-            raise ValueError(f"table1: match radius must be a positive number of metres, got {self.match_radius}")
+        check_number("table1", "match_radius", self.match_radius, low=0, low_open=True, unit="metres")
 
     def describe(self) -> dict:
         """The settings as plain JSON (noise records spelled out)."""

@@ -13,15 +13,15 @@ Two splat modes decide which colour pixels a depth pixel writes:
 
 - ``"point"``: the pixel centre only, exactly the paper's equations. Upsampling leaves holes: with D435i-like
   intrinsics (848x480 depth with its wider field of view into 1280x720 colour, ~2.1 colour pixels per depth pixel)
-  only 21 % of the colour pixels get a value (demos/align_depth.py).
+  only about a fifth of the colour pixels get a value (docs/parameters.md).
 - ``"rectangle"`` (default): librealsense's convention (``align_images`` in src/proc/align.cpp): project the depth
   pixel's top-left corner (u_d - 0.5, v_d - 0.5) and bottom-right corner (u_d + 0.5, v_d + 0.5), both at the pixel's
   depth, round each to the nearest colour pixel and fill the inclusive rectangle between them; cells outside the
-  image are skipped. Dense output (98 % in the same demo), the image a RealSense user gets from ``rs.align``:
-  tests/sources/test_realsense.py finds 99.96 % of the pixels identical. librealsense rounds with a cast toward zero, so
-  corners between -1 and -0.5 land on row/column 0 there (we floor), and float rounding of corners that fall within
-  ~1e-4 px of a pixel boundary moves a few rectangle edges by one pixel. Neighbouring rectangles overlap by up to
-  one pixel, so a near surface grows by up to one colour pixel into a far one.
+  image are skipped. Dense output, the image a RealSense user gets from ``rs.align`` (tests/sources/test_realsense.py
+  compares the two pixel by pixel). librealsense rounds with a cast toward zero, so corners between -1 and -0.5 land
+  on row/column 0 there (we floor), and float rounding of corners that fall within ~1e-4 px of a pixel boundary
+  moves a few rectangle edges by one pixel. Neighbouring rectangles overlap by up to one pixel, so a near surface
+  grows by up to one colour pixel into a far one.
 
 The default is the rectangle: a dense image is what pictures, overlays and any full-frame consumer need, and it can
 be checked against librealsense. Keypoint depth does not need the full frame at all (``depth_at_color_pixels``).
@@ -32,8 +32,8 @@ nothing lands on stay 0. Invalid depth is 0 or NaN.
 Stored value (``value=``): ``"z"`` (default) stores z of the point in the colour camera frame, which is what
 deprojecting a colour pixel with K_c needs (p_c = z * K_c^-1 [u_c, v_c, 1]). ``"depth"`` stores the depth pixel's
 own reading, which is what librealsense writes. They differ by (R p_d + t)_z - d, which grows with the rotation and
-the lateral offset of the point: 3.4 cm on average for the 1-degree rotation of tests/sources/test_realsense.py's 3-6 m
-scene, proportionally less for the near-identity rotation of a factory-calibrated D435i.
+the lateral offset of the point: centimetres for a 1-degree rotation at 3-6 m (docs/parameters.md), proportionally
+less for the near-identity rotation of a factory-calibrated D435i.
 """
 
 from __future__ import annotations
@@ -216,12 +216,12 @@ def _search_windows(
     rt = calib.depth_to_color.rotation.T
     shift = rt @ calib.depth_to_color.translation
     ray = [rt[i, 0] * x + rt[i, 1] * y + rt[i, 2] for i in range(3)]
-    ud, vd = [], []
+    u_parts, v_parts = [], []
     for z in (np.asarray(depth_min, dtype=float), np.asarray(depth_max, dtype=float)):
         px, py, pz = (z * ray[i] - shift[i] for i in range(3))
-        ud.append(px / pz * kd.fx + kd.cx)
-        vd.append(py / pz * kd.fy + kd.cy)
-    ud, vd = np.concatenate(ud), np.concatenate(vd)  # (8, N)
+        u_parts.append(px / pz * kd.fx + kd.cx)
+        v_parts.append(py / pz * kd.fy + kd.cy)
+    ud, vd = np.concatenate(u_parts), np.concatenate(v_parts)  # (8, N)
     lo = np.floor(np.stack([ud.min(axis=0), vd.min(axis=0)], axis=1) - 0.5)
     hi = np.ceil(np.stack([ud.max(axis=0), vd.max(axis=0)], axis=1) + 0.5)
     lo = np.clip(lo, 0, [kd.width - 1, kd.height - 1]).astype(np.int64)
@@ -236,8 +236,8 @@ class Aligner:
     the two corners) is stored as float32, so a frame costs one multiply-add per coordinate, a division, rounding
     and the z-buffer. Reuse one Aligner for a stream; ``align_depth_to_color`` builds a throw-away one.
 
-    Z-buffer: ``np.minimum.at`` on the flat colour image (numpy >= 1.25 made it fast: 1.2 ms for the 407k points
-    of a 848x480 frame here, against 3.5 ms for repeated fancy assignment and 31 ms for sorting by depth).
+    Z-buffer: ``np.minimum.at`` on the flat colour image (numpy >= 1.25 made it fast; faster than repeated fancy
+    assignment or sorting by depth, docs/parameters.md).
     Rectangles are not enumerated cell by cell (a 848x480 -> 1280x720 D435i pair gives 9-16 cells per depth pixel):
     most rectangles have the same size (3x3 cells there), and a larger one is the union of 2-4 such base rectangles.
     Base rectangles are z-buffered at their top-left cells, then one grey-level erosion (OpenCV's min filter) with the

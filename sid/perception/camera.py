@@ -17,6 +17,8 @@ from typing import Any
 
 import numpy as np
 
+from sid.checks import check_number, check_numbers
+
 
 @dataclass(frozen=True)
 class Intrinsics:
@@ -34,10 +36,7 @@ class Intrinsics:
     def __post_init__(self) -> None:
         if self.width <= 0 or self.height <= 0:
             raise ValueError(f"intrinsics: image size must be positive, got {self.width}x{self.height}")
-        for name in ("fx", "fy", "cx", "cy"):
-            value = getattr(self, name)
-            if not np.isfinite(value):
-                raise ValueError(f"intrinsics: {name} must be finite, got {value}")
+        check_numbers("intrinsics", self, ("fx", "fy", "cx", "cy"), unit="pixels")
         if self.fx <= 0 or self.fy <= 0:
             raise ValueError(f"intrinsics: focal lengths must be positive, got fx={self.fx}, fy={self.fy}")
 
@@ -199,8 +198,7 @@ class Calibration:
 
 def _depth_scale(data: dict[str, Any]) -> float:
     scale = float(data.get("depth_scale", data.get("depth_scale_m", 0.001)))
-    if not (np.isfinite(scale) and scale > 0):
-        raise ValueError(f"depth_scale must be a positive number of metres per unit, got {scale}")
+    check_number("calibration", "depth_scale", scale, low=0, low_open=True, unit="metres per unit")
     return scale
 
 

@@ -1,8 +1,9 @@
 """DBSCAN labels for the handful of people a robot sees, identical to scikit-learn's.
 
-scikit-learn's ``DBSCAN`` is the reference, but a call costs ~0.6 ms even for four points (estimator set-up,
-input validation, a neighbours index). A frame holds 2-20 people, so this module computes the same labels from
-the dense pairwise-distance matrix with a few numpy operations, and hands larger sets to scikit-learn.
+scikit-learn's ``DBSCAN`` is the reference, but a call costs far more than the clustering of a few points
+(estimator set-up, input validation, a neighbours index; timings in docs/parameters.md). A frame holds 2-20 people,
+so this module computes the same labels from the dense pairwise-distance matrix with a few numpy operations, and
+hands larger sets to scikit-learn.
 
 Labels follow scikit-learn exactly (a property test in ``tests/perception/test_cluster.py`` checks it):
 - a point is *core* when at least ``min_samples`` points (itself included) lie within ``eps`` (distance <= eps);
@@ -24,9 +25,10 @@ from __future__ import annotations
 import numpy as np
 from sklearn.cluster import DBSCAN
 
-# Above this many points scikit-learn is used: its neighbour index wins once the O(n^2) work grows. Measured on
-# the project's 2-core machine (median per call, uniform random points, eps 1.5 m): small-N / sklearn =
-# 12 / 453 us at 4 points, 25 / 739 us at 20, 99 / 763 us at 64, 318 / 847 us at 128, 1187 / 1041 us at 256.
+from sid.checks import check_number
+
+# Above this many points scikit-learn is used: its neighbour index wins once the O(n^2) work grows (the two
+# cross between 128 and 256 points, docs/parameters.md).
 SMALL_N_MAX = 128
 
 
@@ -38,8 +40,7 @@ def dbscan_labels(points: np.ndarray, eps: float, min_samples: int) -> np.ndarra
     points = np.asarray(points, dtype=float)
     if points.ndim != 2:
         raise ValueError(f"dbscan: points must be an (N, D) array, got shape {points.shape}")
-    if not (np.isfinite(eps) and eps > 0):
-        raise ValueError(f"dbscan: eps must be a positive finite distance, got {eps}")
+    check_number("dbscan", "eps", eps, low=0, low_open=True)
     if int(min_samples) != min_samples or min_samples < 1:
         raise ValueError(f"dbscan: min_samples must be an integer >= 1, got {min_samples}")
     if not np.all(np.isfinite(points)):

@@ -37,6 +37,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from sid.checks import check_number, check_numbers
 from sid.perception.cluster import dbscan_labels
 from sid.perception.people import Person
 
@@ -51,33 +52,26 @@ class GroupParams:
     """Parameters of the group detector (metres, square metres, radians).
 
     Defaults come from the geometry of conversations; the F-formation benchmarks then checked that none sits on a
-    cliff. F1 at T=2/3 (Synth / CoffeeBreak, ``sid eval fformation``) is 0.950 / 0.728 with these defaults; the
-    numbers below are the same scores with one value changed.
+    cliff (scores and one-at-a-time sensitivity: docs/parameters.md).
 
     eps: DBSCAN neighbourhood radius (m). 2.0: a member of a conversation stands within ~1.5 m of a neighbour, so
-      2 m keeps any group in one cluster; clusters only bound the work, the ray geometry splits them (1.5:
-      0.950 / 0.746, 3.0: unchanged). The authors used 3.0 on (x, y, yaw) jointly.
+      2 m keeps any group in one cluster; clusters only bound the work, the ray geometry splits them.
     min_samples: DBSCAN core size, the person included. 2: a conversation needs two people.
     area_threshold: largest area (m^2) of a group's crossing polygon. 0.5, the authors' value: with facing errors
       of 10-30 degrees the crossings of one conversation scatter over a few tenths of a square metre at most.
-      Rarely binding with short rays (0.25 or 1.0 change F1 by < 0.005).
     spread_threshold: largest D (m), the mean member distance to the interest point, i.e. the o-space radius.
       1.0: n people ~1 m apart on a circle have radius 1 / (2 sin(pi / n)), 1.0 m for six; Hall's personal
-      distance ends at 1.2 m (0.8: 0.947 / 0.697, 1.2: 0.933 / 0.637). The authors used 3.0, which also accepts
-      people side by side looking at a point 1.5 m ahead (see ``sid.experiments.seed_recordings``).
+      distance ends at 1.2 m.
     ray_length: length of each facing ray (m). 1.5: it must reach the o-space centre (D <= 1 m) with some slack;
-      longer rays mostly add crossings with strangers (1.0: 0.950 / 0.711, 2.0: 0.871 / 0.697). The authors
-      used 20 m.
+      longer rays mostly add crossings with strangers.
     facing_tolerance: two people whose rays do not cross but who face each other within this angle (rad) meet at
       their midpoint. 0.6 (~34 degrees): face-to-face rays are nearly anti-parallel and miss each other with any
-      lateral offset; the tolerance covers facing errors of tens of degrees (annotations quantised to 90 degree
-      bins, estimates of side views) plus an offset of about half the distance between the two (0.4: 0.966 /
-      0.709, 0.8: 0.950 / 0.722).
+      lateral offset; the tolerance covers facing errors of tens of degrees plus an offset of about half the
+      distance between the two.
     meeting_radius: crossings closer than this (m, single linkage) belong to one candidate group; each candidate
       is then pruned as in the paper. 0.6: the crossings of one o-space with facing errors of ~30 degrees scatter
-      by ~D tan(30 deg) = 0.6 m (0.4: 0.858 / 0.732, 0.8: 0.930 / 0.658). ``math.inf`` makes each DBSCAN cluster
-      one candidate, exactly the paper's Algorithm 1, which fails in crowded scenes (0.318 / 0.382; with all of
-      the authors' settings 0.139 / 0.038).
+      by ~D tan(30 deg) = 0.6 m. ``math.inf`` makes each DBSCAN cluster one candidate, exactly the paper's
+      Algorithm 1, which fails in crowded scenes.
     """
 
     eps: float = 2.0
@@ -89,18 +83,16 @@ class GroupParams:
     meeting_radius: float = 0.6
 
     def __post_init__(self) -> None:
-        for name in ("eps", "spread_threshold", "ray_length"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0):
-                raise ValueError(f"groups: {name} must be a positive number of metres, got {value}")
-        if not (math.isfinite(self.area_threshold) and self.area_threshold >= 0):
-            raise ValueError(f"groups: area_threshold must be >= 0 square metres, got {self.area_threshold}")
+        check_numbers("groups", self, ("eps", "spread_threshold", "ray_length"), low=0, low_open=True, unit="metres")
+        check_number("groups", "area_threshold", self.area_threshold, low=0, unit="square metres")
         if isinstance(self.min_samples, bool) or int(self.min_samples) != self.min_samples or self.min_samples < 1:
             raise ValueError(f"groups: min_samples must be an integer >= 1, got {self.min_samples}")
-        if not (self.meeting_radius > 0):  # math.inf allowed: one candidate per cluster, as in the paper
-            raise ValueError(f"groups: meeting_radius must be positive metres (or inf), got {self.meeting_radius}")
-        if not (math.isfinite(self.facing_tolerance) and 0 <= self.facing_tolerance < math.pi / 2):
-            raise ValueError(f"groups: facing_tolerance must be in [0, pi/2) radians, got {self.facing_tolerance}")
+        # math.inf: one candidate per cluster, as in the paper.
+        check_number(
+            "groups", "meeting_radius", self.meeting_radius, low=0, low_open=True, allow_inf=True, unit="metres"
+        )
+        right_angle = math.pi / 2
+        check_number("groups", "facing_tolerance", self.facing_tolerance, low=0, high=right_angle, high_open=True)
 
 
 @dataclass
@@ -281,8 +273,8 @@ def _geometry(members: np.ndarray, meetings: _Meetings, positions: np.ndarray) -
 def _convex_hull(points: list[complex]) -> list[complex]:
     """Counter-clockwise convex hull (Andrew's monotone chain), collinear points dropped.
 
-    Hand-written rather than shapely's: the pruning loop builds several hulls of a handful of points per call, and
-    this costs a few microseconds where a shapely round trip costs ~40 (measured on the project's machine).
+    Hand-written rather than shapely's: the pruning loop builds several hulls of a handful of points per call, where
+    a shapely round trip costs several times more (docs/parameters.md).
     """
     ordered = sorted(set(points), key=lambda p: (p.real, p.imag))
     if len(ordered) < 3:

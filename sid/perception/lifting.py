@@ -17,9 +17,9 @@ A depth camera sees the body's surface, not its joints. Two corrections, both al
    (joint centres, the head's mid-plane), which is what the position (their mean) and the body plane need.
 2. **Far-side completion** (``LiftParams.complete_far_side``): in a side view the far shoulder, hip, ear, ... are
    hidden behind the person's own body; a pose model still places them (it knows the body's shape) with a lower
-   score, but their pixels show the near side of the body, whose depth is 0.15-0.3 m too near. The body plane then
-   turns towards the camera and the front/back order of left and right collapses. A left/right pair is taken as
-   *collapsed* when its two keypoints lie closer in 3D than ``min_pair_fraction`` of their anthropometric
+   score, but their pixels show the near side of the body, whose depth is tens of centimetres too near. The body
+   plane then turns towards the camera and the front/back order of left and right collapses. A left/right pair is
+   taken as *collapsed* when its two keypoints lie closer in 3D than ``min_pair_fraction`` of their anthropometric
    separation W (the joints of a pair cannot come closer than that: the depth of one is wrong), and its lower-score
    keypoint is then taken as the hidden one when its score is at least ``far_side_score_gap`` below its partner's.
    That keypoint keeps its ray and is placed behind its partner, at the depth where the pair is W apart in 3D:
@@ -42,6 +42,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sid.checks import check_number, check_numbers
 from sid.perception.align import depth_at_color_pixels
 from sid.perception.camera import Calibration
 from sid.perception.keypoints import COCO_KEYPOINTS, KP, NUM_KEYPOINTS, PoseDetection
@@ -63,11 +64,11 @@ for _side in ("left", "right"):
 
 @dataclass(frozen=True)
 class LiftParams:
-    """How keypoints become 3D points.
+    """How keypoints become 3D points (metres). Measurements behind the defaults: docs/parameters.md.
 
     min_score: a keypoint is used when its score is at least this. 0.3 is a common visibility cut for MoveNet and
-      YOLO-pose keypoints, but scores are model-specific (our float ONNX conversions differ from the int8 TFLite
-      originals by up to 0.35): set it per model.
+      YOLO-pose keypoints, but scores are model-specific (float ONNX conversions score differently from the int8
+      TFLite originals): set it per model.
     min_keypoints: a detection with fewer lifted keypoints gives no Person. 3: fewer cannot be placed reliably
       (one occluded limb at a wrong depth would decide the position) and cannot give a facing direction.
     patch: side (pixels, odd) of the depth window read around each keypoint. 5, as the paper's authors did.
@@ -80,29 +81,22 @@ class LiftParams:
       nearer, with a depth closer to that person's median than to its own person's, read the person in front (an
       arm or leg hidden behind them, a silhouette edge) and is dropped. 0.2: about a body's depth (chest depth
       0.20-0.25 m); people whose medians differ less stand side by side, where the closer median would be a coin
-      toss. On ../shared/data/rgbd/five_people it drops one elbow each of the two partly hidden people (their
-      median depths differ by 0.31 and 0.22 m from the person in front). ``math.inf`` turns it off.
+      toss. ``math.inf`` turns it off.
     surface_offset: how far (m) a keypoint's point inside the body lies behind the surface the camera sees, added
-      along every keypoint's viewing ray. 0.07: about half the front-back thickness of an adult around the joints:
-      chest depth 0.20-0.25 m puts the hip and shoulder joints ~0.1 m behind the front of the torso, upper arm and
-      thigh diameters (0.09-0.15 m) put elbows and knees 0.05-0.07 m inside, clothes add 1-2 cm; head length
-      (0.18-0.20 m) puts the head's centre ~0.1 m behind the nose and eyes. Measured on the synthetic bodies of
-      ``sid.synthetic`` (joint range minus read range, people within 30 deg of facing the camera): 0.045-0.06 m at
-      shoulders, elbows, wrists, ankles and ears, 0.076 m at knees, 0.09 m at hips, 0.005-0.02 m at nose and eyes
-      (skin landmarks: there the offset moves the point into the head). 0 turns it off.
+      along every keypoint's viewing ray. 0.07: about half the front-back thickness of an adult around the joints
+      (chest depth 0.20-0.25 m, upper arm and thigh diameters 0.09-0.15 m, clothes 1-2 cm; the head's centre lies
+      ~0.1 m behind the face). 0 turns it off.
     complete_far_side: place the hidden far side of a collapsed left/right pair behind its partner (module
       docstring). shoulder_separation, hip_separation, ear_separation: the pairs' 3D separation W (m), adult
       values from ``sid.perception.orientation`` (sources there); lower them for children.
     min_pair_fraction: a pair closer in 3D than this fraction of W is collapsed. 0.7 (0.24 m for shoulders): the
       narrowest adults (biacromial breadth 0.325 m, 5th percentile of women) put their shoulder keypoints ~0.26 m
-      apart (at the keypoint-to-bone ratio measured on five_people, where the five show 0.29-0.31 m), and depth
-      noise adds a few centimetres either way. In the Table 1 scenes a self-occluded far shoulder that read the
-      near side's surface leaves the pair 0.07-0.30 m apart (median 0.20 m); pairs seen on both sides, 0.29-0.39 m.
+      apart, and depth noise adds a few centimetres either way, while a far side that read the near side's surface
+      leaves the pair much closer.
     far_side_score_gap: the lower-score keypoint of a collapsed pair is the hidden one when its score is at least
-      this much below its partner's. 0.1: real models score both visible shoulders or hips within a few hundredths
-      of each other (YOLO11-pose on five_people: <= 0.03) and a hidden far side tenths lower (its hidden ear there:
-      0.36 against 0.97). A model that scores its guesses as high as what it sees gets no completion: side views
-      then fail as without it (docs/reproduction.md, sensitivity).
+      this much below its partner's. 0.1: pose models score both visible shoulders or hips within a few hundredths
+      of each other and a hidden far side tenths lower. A model that scores its guesses as high as what it sees
+      gets no completion: side views then fail as without it.
     """
 
     min_score: float = 0.3
@@ -120,26 +114,17 @@ class LiftParams:
     far_side_score_gap: float = 0.1
 
     def __post_init__(self) -> None:
-        if not (math.isfinite(self.min_score) and 0 <= self.min_score <= 1):
-            raise ValueError(f"lift: min_score must be in [0, 1], got {self.min_score}")
+        check_number("lift", "min_score", self.min_score, low=0, high=1)
         if int(self.min_keypoints) != self.min_keypoints or not 1 <= self.min_keypoints <= NUM_KEYPOINTS:
             raise ValueError(f"lift: min_keypoints must be an integer in 1..{NUM_KEYPOINTS}, got {self.min_keypoints}")
         if int(self.patch) != self.patch or self.patch < 1 or self.patch % 2 == 0:
             raise ValueError(f"lift: patch must be a positive odd number of pixels, got {self.patch}")
-        if not (self.occluder_gap >= 0):  # math.inf allowed: off
-            raise ValueError(
-                f"lift: occluder_gap must be a non-negative number of metres (or inf), got {self.occluder_gap}"
-            )
-        for name in ("max_range", "depth_gate", "shoulder_separation", "hip_separation", "ear_separation"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0):
-                raise ValueError(f"lift: {name} must be a positive number of metres, got {value}")
-        if not (math.isfinite(self.surface_offset) and 0 <= self.surface_offset < 0.5):
-            raise ValueError(f"lift: surface_offset must be in [0, 0.5) metres, got {self.surface_offset}")
-        if not (math.isfinite(self.min_pair_fraction) and 0 < self.min_pair_fraction <= 1):
-            raise ValueError(f"lift: min_pair_fraction must be in (0, 1], got {self.min_pair_fraction}")
-        if not (math.isfinite(self.far_side_score_gap) and 0 <= self.far_side_score_gap <= 1):
-            raise ValueError(f"lift: far_side_score_gap must be in [0, 1], got {self.far_side_score_gap}")
+        check_number("lift", "occluder_gap", self.occluder_gap, low=0, allow_inf=True, unit="metres")  # inf: off
+        metres = ("max_range", "depth_gate", "shoulder_separation", "hip_separation", "ear_separation")
+        check_numbers("lift", self, metres, low=0, low_open=True, unit="metres")
+        check_number("lift", "surface_offset", self.surface_offset, low=0, high=0.5, high_open=True, unit="metres")
+        check_number("lift", "min_pair_fraction", self.min_pair_fraction, low=0, high=1, low_open=True)
+        check_number("lift", "far_side_score_gap", self.far_side_score_gap, low=0, high=1)
 
 
 def lift_people(
@@ -223,7 +208,7 @@ def _reads_someone_in_front(
     # Closer to j's median than to i's, j in front: nearer than the midpoint of the two medians (-inf: j not in front).
     in_front = median[None, :] < median[:, None] - gap  # (P, P)
     limit = np.where(in_front, 0.5 * (median[:, None] + median[None, :]), -np.inf)
-    return (inside & (depth[:, None, :] < limit[:, :, None])).any(axis=1)
+    return np.asarray((inside & (depth[:, None, :] < limit[:, :, None])).any(axis=1))
 
 
 def _complete_far_side(

@@ -11,6 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sid.checks import check_number
+
 
 @dataclass(frozen=True)
 class CameraMount:
@@ -23,10 +25,9 @@ class CameraMount:
     tilt: float = 0.0
 
     def __post_init__(self) -> None:
-        if not (np.isfinite(self.height) and np.isfinite(self.tilt)):
-            raise ValueError(f"camera mount must be finite, got height={self.height}, tilt={self.tilt}")
-        if abs(self.tilt) >= np.pi / 2:
-            raise ValueError(f"camera tilt must be within (-pi/2, pi/2), got {self.tilt}")
+        check_number("camera mount", "height", self.height, unit="metres")
+        half_turn = np.pi / 2
+        check_number("camera mount", "tilt", self.tilt, low=-half_turn, high=half_turn, low_open=True, high_open=True)
 
     @property
     def rotation(self) -> np.ndarray:

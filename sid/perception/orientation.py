@@ -12,17 +12,14 @@ gets a facing. Elbows and wrists are left out: folded or crossed arms put them o
 World frame: REP-103 (x forward, y left, z up, metres); yaw counter-clockwise from +x, radians in (-pi, pi].
 
 Typical adult left-right separations (m), used to judge the left-right evidence here and to complete a person's
-hidden far side in ``sid.perception.lifting``:
+hidden far side in ``sid.perception.lifting`` (keypoint separations measured on real people: docs/parameters.md):
 
-- shoulders ``SHOULDER_SEPARATION`` = 0.34: the biacromial breadth, the anthropometric "lateral separation of the
-  centres of rotation of the upper limb", is 0.355 m (women) and 0.400 m (men) at the 50th percentile of British
-  adults (Pheasant & Haslegrave, "Bodyspace", 3rd ed., table of adult dimensions; US adults alike). Pose models
-  trained on COCO put the shoulder keypoint inside the bony acromion: YOLO11-pose places the shoulders of the five
-  people of ../shared/data/rgbd/five_people 0.29-0.31 m apart (3D, measured). 0.34 m lies between the two, within
-  15 % of both. (The synthetic skeleton, ``sid.perception.skeleton``, uses 0.22 h = 0.374 m for a 1.70 m person.)
+- shoulders ``SHOULDER_SEPARATION`` = 0.34: between the biacromial breadth, 0.355 m (women) and 0.400 m (men) at the
+  50th percentile of British adults (Pheasant & Haslegrave, "Bodyspace", 3rd ed.; US adults alike), and the
+  narrower spacing of COCO shoulder keypoints, which pose models put inside the bony acromion. (The synthetic
+  skeleton, ``sid.perception.skeleton``, uses 0.22 h = 0.374 m for a 1.70 m person.)
 - hips ``HIP_SEPARATION`` = 0.18: hip-joint centres sit ~36 % of the inter-ASIS breadth (~0.23-0.26 m) either side
   of the midline (Bell, Pedersen & Brand, J. Biomech. 1990; Harrington et al., J. Biomech. 2007): 0.17-0.19 m.
-  Measured on five_people: 0.17-0.21 m.
 - ears ``EAR_SEPARATION`` = 0.15: head breadth, 0.145 m (women) and 0.155 m (men) at the 50th percentile (Pheasant).
 - eyes ``EYE_SEPARATION`` = 0.063: the adult interpupillary distance (Dodgson, Proc. SPIE 5291, 2004: mean 63 mm).
 - knees and ankles: a standing person's legs hang below the hip joints, so the hip separation.
@@ -59,8 +56,8 @@ _COLLINEAR_RATIO = 1e-3
 # The front/back sign is trusted fully when the pairs present show at least this fraction of their typical frontal
 # separation across the facing axis: cos 60 deg, what a correctly measured body turned 60 deg still shows in its
 # image. The 3D separation does not depend on the view when every keypoint's depth is right; it collapses when the
-# far side of a person in profile reads the near side's surface, where keypoint noise flips the sign (measured in
-# tests/perception/test_orientation.py), and quality falls in proportion.
+# far side of a person in profile reads the near side's surface, where keypoint noise flips the sign (as
+# tests/perception/test_orientation.py shows), and quality falls in proportion.
 _FULL_FRACTION = 0.5
 # A pair with a keypoint put in place by the far-side completion of ``sid.perception.lifting`` (``inferred``) counts a
 # quarter: its separation comes from the anthropometric table and from which side the pose model scored lower, not from

@@ -38,21 +38,50 @@ def _pt(uv: np.ndarray) -> tuple[int, int]:
     return int(round(float(uv[0]))), int(round(float(uv[1])))
 
 
-def _labels(image: np.ndarray, lines: Sequence[str], left: int, bottom: int, scale: float) -> None:
-    """Lines of text on dark bands, stacked upwards from baseline ``bottom`` (first line lowest), inside the image.
-
-    The block is moved as a whole (never line by line, which would stack lines on top of each other at the edge).
-    """
-    h, w = image.shape[:2]
+def _block_size(lines: Sequence[str], scale: float) -> tuple[int, int]:
+    """Width and height (px) of ``_draw_block``'s lines of text, each on a dark band."""
     sizes = [cv2.getTextSize(text, FONT, scale, 1) for text in lines]
-    # Baseline of the first line such that the last line's band starts at row 0 or below it.
-    lowest = sum(th + base + 3 for (_, th), base in sizes[:-1]) + sizes[-1][0][1] + 2
-    bottom = int(np.clip(bottom, lowest, h - sizes[0][1] - 1))
-    for text, ((tw, th), base) in zip(lines, sizes, strict=True):
-        x = int(np.clip(left, 0, max(0, w - tw - 2)))
-        cv2.rectangle(image, (x, bottom - th - 2), (x + tw + 2, bottom + base), (0, 0, 0), cv2.FILLED)
-        cv2.putText(image, text, (x + 1, bottom - 1), FONT, scale, (255, 255, 255), 1, cv2.LINE_AA)
+    return max(tw for (tw, _), _ in sizes) + 3, sum(th + base + 3 for (_, th), base in sizes)
+
+
+def _draw_block(image: np.ndarray, lines: Sequence[str], left: int, top: int, scale: float) -> None:
+    """Lines of text on dark bands, the first line lowest, in the block whose top-left corner is (left, top)."""
+    bottom = top + _block_size(lines, scale)[1]  # one past the lowest row
+    for text in lines:
+        (tw, th), base = cv2.getTextSize(text, FONT, scale, 1)
+        cv2.rectangle(image, (left, bottom - th - base - 3), (left + tw + 2, bottom - 1), (0, 0, 0), cv2.FILLED)
+        cv2.putText(image, text, (left + 1, bottom - base - 2), FONT, scale, (255, 255, 255), 1, cv2.LINE_AA)
         bottom -= th + base + 3
+
+
+def place_labels(
+    sizes: Sequence[tuple[int, int]], boxes: Sequence[Sequence[float]], shape: tuple[int, int], gap: int = 1
+) -> list[tuple[int, int]]:
+    """Top-left corners (u, v) of label blocks of ``sizes`` (w, h) px, one per box (u0, v0, u1, v1), in an image of
+    ``shape`` (h, w).
+
+    Each block goes, in the order given, to the free spot nearest (in u + v distance) to its preferred place, just
+    above its box's top-left corner: inside the image, centred over its box's columns, at least ``gap`` px from the
+    blocks already placed. When no spot is free, it goes where it overlaps the placed blocks least.
+    """
+    height, width = shape
+    placed: list[tuple[int, int, int, int]] = []
+    corners = []
+    for (w, h), box in zip(sizes, boxes, strict=True):
+        u0, v0, u1 = (int(round(float(c))) for c in box[:3])
+        hi_u, hi_v = max(0, width - w), max(0, height - h)
+        want_u, want_v = int(np.clip(u0, 0, hi_u)), int(np.clip(v0 - 2 - h, 0, hi_v))
+        us = np.union1d(np.arange(np.clip(u0 - w // 2, 0, hi_u), np.clip(u1 - w // 2, 0, hi_u) + 1), [want_u])
+        u, v = (grid.ravel() for grid in np.meshgrid(us, np.arange(hi_v + 1)))
+        overlap = np.zeros(u.shape)
+        for a0, b0, a1, b1 in placed:
+            du = np.minimum(u + w, a1 + gap) - np.maximum(u, a0 - gap)
+            dv = np.minimum(v + h, b1 + gap) - np.maximum(v, b0 - gap)
+            overlap += np.clip(du, 0, None) * np.clip(dv, 0, None)
+        best = int(np.lexsort((np.abs(u - want_u) + np.abs(v - want_v), overlap))[0])
+        corners.append((int(u[best]), int(v[best])))
+        placed.append((corners[-1][0], corners[-1][1], corners[-1][0] + w, corners[-1][1] + h))
+    return corners
 
 
 def person_label(person: Person) -> tuple[str, str]:
@@ -81,6 +110,7 @@ def draw_detections(
     thick = max(1, round(min(h, w) / 240))
     font_scale = 0.3 * thick
     people = [None] * len(detections) if people is None else people
+    labels = []
     for det, person in zip(detections, people, strict=True):
         box = det.box
         cv2.rectangle(image, _pt(box[:2]), _pt(box[2:]), BOX_COLOUR, thick, cv2.LINE_AA)
@@ -95,7 +125,11 @@ def draw_detections(
         if person is not None:
             name, where = person_label(person)
             lines = [f"{name}  ({lines[0]})", where]
-        _labels(image, lines, _pt(box[:2])[0], _pt(box[:2])[1] - 2, font_scale)
+        labels.append(lines)
+    sizes = [_block_size(lines, font_scale) for lines in labels]
+    corners = place_labels(sizes, [det.box for det in detections], (h, w))
+    for lines, (left, top) in zip(labels, corners, strict=True):
+        _draw_block(image, lines, left, top, font_scale)
     for det, person in zip(detections, people, strict=True):  # arrows last, over every label
         if person is not None and person.theta is not None:
             _draw_arrow(image, det, person.theta, _confident(det, keypoint_threshold), thick)

@@ -10,6 +10,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -66,7 +67,7 @@ def group_json(group: Group) -> dict:
 
 
 def _person_json(person: Person, keypoints: bool) -> dict:
-    record = {
+    record: dict[str, Any] = {
         "id": int(person.id),
         "x": round(float(person.x), 4),
         "y": round(float(person.y), 4),

@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 from costmap.grid import Costmap2D
-from costmap.layered import CostmapParams, LayeredCostmap
+from costmap.layer import LayerInputs
+from costmap.layered import LayeredCostmap
 from costmap.layers.static import static_costs
 from costmap.mapfile import read_map
+from costmap.plugins import CostmapParams, layered_costmap
 from planner.problem import DEFAULT_COST_WEIGHT, PlanningProblem
-from sid.perception.groups import Group
+from sid.perception.groups import Group, detect_groups
 from sid.scenario.lidar import simulate_scan
 from sid.scenario.loader import Scenario
 
@@ -20,23 +22,24 @@ def build_costmap(
 ) -> LayeredCostmap:
     """The costmap of a scenario: a simulated scan from the robot's start pose, people, groups and layers.
 
-    ``groups`` None: detect them with ``sid.perception.groups.detect_groups`` (only when ``social``). ``params`` None:
-    the
-    scenario's "layers" block.
+    ``social`` False leaves the social layer out (a robot without recognition). ``groups`` None: detect them with
+    ``sid.perception.groups.detect_groups`` (only when ``social``). ``params`` None: the scenario's "layers" block.
     """
     params = params or scenario.layers
-    static = None
-    if scenario.static_map is not None:
-        static = static_costs(read_map(scenario.static_map), scenario.grid, params.obstacle.track_unknown_space)
-    layered = LayeredCostmap(
+    if not social:
+        params = params.without("social")
+    static_map = None if scenario.static_map is None else read_map(scenario.static_map)
+    layered = layered_costmap(
         scenario.grid,
         params,
         robot_radius=scenario.robot.radius,
         body_radius=scenario.lidar.body_radius,
-        social=social,
-        static=static,
+        static_map=static_map,
     )
     lidar = scenario.lidar
+    walls = None  # the static map's walls, which the simulated LiDAR sees whatever the costmap's layers
+    if static_map is not None:
+        walls = Costmap2D(scenario.grid, static_costs(static_map, scenario.grid, params.obstacle.track_unknown_space))
     scan = simulate_scan(
         scenario.robot.start,
         scenario.obstacles,
@@ -44,16 +47,11 @@ def build_costmap(
         beams=lidar.beams,
         range_max=lidar.range_max,
         body_radius=lidar.body_radius,
-        static=None if static is None else Costmap2D(scenario.grid, static),
+        static=walls,
     )
     if groups is None:
-        if social:
-            from sid.perception.groups import detect_groups  # the group detector is only needed with recognition
-
-            groups = detect_groups(scenario.people, scenario.group_params)
-        else:
-            groups = []
-    layered.update(scenario.people, groups, scan)
+        groups = detect_groups(scenario.people, scenario.group_params) if social else []
+    layered.update(LayerInputs(scenario.people, groups, scan))
     return layered
 
 

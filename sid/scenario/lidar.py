@@ -12,6 +12,7 @@ import numpy as np
 
 from costmap.grid import LETHAL, Costmap2D
 from costmap.scan import LaserScan
+from sid.checks import check_number
 from sid.perception.people import Person
 from sid.scenario.obstacles import BoxObstacle, CircleObstacle, Obstacle, SegmentObstacle
 
@@ -99,8 +100,7 @@ def simulate_scan(
     """
     if beams < 1:
         raise ValueError(f"lidar.beams must be >= 1, got {beams}")
-    if not (np.isfinite(range_max) and range_max > 0):
-        raise ValueError(f"lidar.range_max must be a positive number, got {range_max}")
+    check_number("lidar", "range_max", range_max, low=0, low_open=True, unit="metres")
     pose_t = tuple(float(v) for v in pose)
     if len(pose_t) != 3 or not np.isfinite(pose_t).all():
         raise ValueError(f"scan pose must be a finite (x, y, yaw), got {pose}")

@@ -7,19 +7,21 @@ docs/scenario.md ("Scenario file"). A malformed file raises ``ScenarioError`` na
 from __future__ import annotations
 
 import dataclasses
-import math
 from collections.abc import Callable
+from collections.abc import Set as AbstractSet
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from costmap.grid import GridSpec
-from costmap.layered import CostmapParams
 from costmap.layers.inflation import InflationParams
 from costmap.layers.obstacle import ObstacleParams
 from costmap.layers.social import SocialParams
 from costmap.mapfile import MapFileError, read_map
-from sid.documents import load_document
+from costmap.plugins import PLUGINS, CostmapParams
+from sid.documents import is_number, load_document
 from sid.perception.groups import GroupParams
 from sid.perception.people import Person
 from sid.scenario.obstacles import BoxObstacle, CircleObstacle, Obstacle, SegmentObstacle
@@ -87,7 +89,7 @@ def _fail(name: str, expected: str, value: Any) -> ScenarioError:
 
 
 def _number(value: Any, name: str, *, positive: bool = False, minimum: float | None = None) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+    if not is_number(value):
         raise _fail(name, "a finite number", value)
     if positive and value <= 0:
         raise _fail(name, "a positive number", value)
@@ -108,7 +110,12 @@ def _point(value: Any, name: str, sizes: tuple[int, ...] = (2,)) -> tuple[float,
     return tuple(_number(v, f"{name}[{i}]") for i, v in enumerate(value))
 
 
-def _mapping(value: Any, name: str, known: set[str], required: set[str] = frozenset()) -> dict:
+def _xy(value: Any, name: str) -> tuple[float, float]:
+    x, y = _point(value, name)
+    return (x, y)
+
+
+def _mapping(value: Any, name: str, known: AbstractSet[str], required: AbstractSet[str] = frozenset()) -> dict:
     if not isinstance(value, dict):
         raise _fail(name, "a mapping", value)
     unknown = sorted(set(value) - known)
@@ -130,7 +137,7 @@ def _params(value: Any, name: str, cls: type) -> Any:
     """A parameter dataclass from a mapping of its fields, typed by the defaults (bool, int or float)."""
     defaults = {f.name: getattr(cls(), f.name) for f in dataclasses.fields(cls)}
     data = _mapping(value, name, set(defaults))
-    kwargs = {}
+    kwargs: dict[str, Any] = {}
     for key, raw in data.items():
         default, key_name = defaults[key], f"{name}.{key}"
         if isinstance(default, bool):
@@ -147,6 +154,16 @@ def _params(value: Any, name: str, cls: type) -> Any:
         raise ScenarioError(f"{name}: {exc}") from exc
 
 
+def _plugins(value: Any, name: str) -> tuple[str, ...]:
+    """Layer names in combination order, each a key of ``costmap.plugins.PLUGINS``."""
+    if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+        raise _fail(name, "a list of layer names", value)
+    for i, layer in enumerate(value):
+        if layer not in PLUGINS:
+            raise ScenarioError(f"{name}[{i}]: unknown layer {layer!r}; known layers: {', '.join(PLUGINS)}")
+    return tuple(value)
+
+
 # --- sections -----------------------------------------------------------------------------------------------
 
 
@@ -160,10 +177,11 @@ def _grid(value: Any, static: GridSpec | None) -> GridSpec:
     origin = _point(data.get("origin", [0.0, 0.0]), "map.origin", (2, 3))
     if len(origin) == 3 and origin[2] != 0:
         raise ScenarioError(f"map.origin: a rotated map is not supported (yaw {origin[2]}); use yaw 0")
-    size = tuple(_number(v, f"map.size[{i}]", positive=True) for i, v in enumerate(_point(data["size"], "map.size")))
+    width, height = (_number(v, f"map.size[{i}]", positive=True) for i, v in enumerate(_xy(data["size"], "map.size")))
+    size = (width, height)
     if min(size) < resolution:
         raise ScenarioError(f"map.size: {size} m is smaller than one {resolution} m cell")
-    return GridSpec.from_size(resolution, origin[:2], size)
+    return GridSpec.from_size(resolution, (origin[0], origin[1]), size)
 
 
 def _obstacle(value: Any, name: str) -> Obstacle:
@@ -175,14 +193,14 @@ def _obstacle(value: Any, name: str) -> Obstacle:
         points = _list(data["points"], f"{name}.points")
         if len(points) < 2:
             raise _fail(f"{name}.points", "at least 2 points", points)
-        return SegmentObstacle(tuple(_point(p, f"{name}.points[{i}]") for i, p in enumerate(points)))
+        return SegmentObstacle(tuple(_xy(p, f"{name}.points[{i}]") for i, p in enumerate(points)))
     if kind == "circle":
         data = _mapping(value, name, {"type", "center", "radius"}, {"center", "radius"})
         radius = _number(data["radius"], f"{name}.radius", positive=True)
-        return CircleObstacle(_point(data["center"], f"{name}.center"), radius)
+        return CircleObstacle(_xy(data["center"], f"{name}.center"), radius)
     if kind == "box":
         data = _mapping(value, name, {"type", "min", "max"}, {"min", "max"})
-        lo, hi = _point(data["min"], f"{name}.min"), _point(data["max"], f"{name}.max")
+        lo, hi = _xy(data["min"], f"{name}.min"), _xy(data["max"], f"{name}.max")
         if not (lo[0] < hi[0] and lo[1] < hi[1]):
             raise ScenarioError(f"{name}: min {lo} must be below max {hi} in x and y")
         return BoxObstacle(lo, hi)
@@ -195,7 +213,7 @@ def _person(value: Any, name: str, index: int) -> Person:
     x, y = _number(data["x"], f"{name}.x"), _number(data["y"], f"{name}.y")
     theta = data.get("theta")
     if theta is not None:
-        if isinstance(theta, bool) or not isinstance(theta, int | float) or not math.isfinite(theta):
+        if not is_number(theta):
             raise _fail(f"{name}.theta", "a finite number of radians, or null when unknown", theta)
         theta = float(theta)
     quality = _number(data.get("orientation_quality", 0.0 if theta is None else 1.0), f"{name}.orientation_quality")
@@ -210,7 +228,7 @@ def _pose(value: Any, name: str) -> tuple[float, float, float]:
 
 
 def _inside(grid: GridSpec, xy: tuple[float, ...], name: str) -> None:
-    if not grid.contains([xy[:2]])[0]:
+    if not grid.contains(np.array([xy[:2]]))[0]:
         x0, y0, x1, y1 = grid.bounds
         raise ScenarioError(f"{name}: ({xy[0]}, {xy[1]}) is outside the map (x {x0:g}..{x1:g}, y {y0:g}..{y1:g})")
 
@@ -265,12 +283,17 @@ def scenario_from_dict(data: Any, base_dir: Path | None = None, default_name: st
     )
 
     layer_sections: dict[str, Callable[[Any, str], Any]] = {
+        "plugins": _plugins,
         "obstacle": lambda v, n: _params(v, n, ObstacleParams),
         "inflation": lambda v, n: _params(v, n, InflationParams),
         "social": lambda v, n: _params(v, n, SocialParams),
     }
     layers_data = _mapping(data.get("layers", {}), "layers", set(layer_sections))
-    layers = CostmapParams(**{k: layer_sections[k](v, f"layers.{k}") for k, v in layers_data.items()})
+    sections = {k: layer_sections[k](v, f"layers.{k}") for k, v in layers_data.items()}
+    try:
+        layers = CostmapParams(**sections)
+    except ValueError as exc:
+        raise ScenarioError(f"layers.{exc}") from exc
 
     return Scenario(
         name=name,

@@ -3,7 +3,7 @@
 Two layouts (the calibration is ``intrinsics.json`` or ``calibration.json`` in the folder, any form
 ``sid.perception.camera.Calibration.from_json`` reads; a flat intrinsics dict means depth registered to colour):
 
-- one frame: ``DIR/color.png`` (or ``.jpg``/``.jpeg``) + ``DIR/depth.png``, as in ../shared/data/rgbd/five_people;
+- one frame: ``DIR/color.png`` (or ``.jpg``/``.jpeg``) + ``DIR/depth.png``;
 - a sequence: ``DIR/color/NAME.png|jpg|jpeg`` + ``DIR/depth/NAME.png``, paired by NAME and played in natural order
   (``frame2`` before ``frame10``).
 

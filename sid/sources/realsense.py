@@ -15,13 +15,13 @@ recording. Depth alignment (``align=``):
 
 Recordings play as fast as they are read (real-time playback off, so no frame is dropped for a slow reader) and
 stop at the end of the file. They are read from the playback device (``rs.context().load_device``) through a syncer,
-not through ``rs.pipeline`` + ``rs.config.enable_device_from_file``: the pipeline lost 1 to 3 of the first frames of
-a 4-frame recording in 5 of 5 runs here, and 12-21 of 60 frames in 2 of 5 runs, even with real-time playback off
-(realsense-ros moved to the playback API for the same reason, its PR #2669). librealsense starts playing when the
-first sensor starts, so the first colour or depth image can still be missed (about half of the runs here): that
-first frame then comes with one stream only and is reported as a ``FrameReadError`` and skipped. Rewinding or
-pausing the playback around the start made it stall for 10 s or jump to the end of the file in some runs, so it is
-not done. The syncer delivers the first frames one stream at a time; they are paired by timestamp here.
+not through ``rs.pipeline`` + ``rs.config.enable_device_from_file``, which drops frames at the start of a recording
+even with real-time playback off (realsense-ros moved to the playback API for the same reason, its PR #2669; what
+was observed: docs/parameters.md). librealsense starts playing when the first sensor starts, so the first colour or
+depth image can still be missed: that first frame then comes with one stream only and is reported as a
+``FrameReadError`` and skipped. Rewinding or pausing the playback around the start is not done: it can stall the
+playback or jump to the end of the file. The syncer delivers the first frames one stream at a time; they are paired
+by timestamp here.
 """
 
 from __future__ import annotations

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from sid.checks import check_number
 from sid.perception.keypoints import KP, NUM_KEYPOINTS
 from sid.synthetic.render import Capsule
 
@@ -36,6 +37,10 @@ _TORSO_ABOVE_SHOULDERS = 0.04
 _HEAD_SEMI = (0.085, 0.10, 0.115)  # lateral (ears included), front-back, vertical (m)
 
 
+def _scaled(semi_axes: tuple[float, float, float], s: float) -> tuple[float, float, float]:
+    return (semi_axes[0] * s, semi_axes[1] * s, semi_axes[2] * s)
+
+
 def body_frame(keypoints: np.ndarray) -> np.ndarray:
     """(3, 3) rotation whose columns are the body's left, forward and up directions (world frame), from the
     shoulders and hips of (17, 3) world keypoints."""
@@ -52,8 +57,7 @@ def body_capsules(keypoints: np.ndarray, height: float = REFERENCE_HEIGHT) -> li
     keypoints = np.asarray(keypoints, dtype=float)
     if keypoints.shape != (NUM_KEYPOINTS, 3) or not np.all(np.isfinite(keypoints)):
         raise ValueError(f"body: expected finite (17, 3) world keypoints, got shape {keypoints.shape}")
-    if not (np.isfinite(height) and height > 0):
-        raise ValueError(f"body: height must be positive metres, got {height}")
+    check_number("body", "height", height, low=0, low_open=True, unit="metres")
     s = height / REFERENCE_HEIGHT
     frame = body_frame(keypoints)
     left, forward, up = frame.T
@@ -64,11 +68,11 @@ def body_capsules(keypoints: np.ndarray, height: float = REFERENCE_HEIGHT) -> li
 
     bottom = mid_hip - _TORSO_BELOW_HIPS * s * up
     top = mid_shoulder + _TORSO_ABOVE_SHOULDERS * s * up
-    torso_semi = tuple(v * s for v in _TORSO_SEMI)
+    torso_semi = _scaled(_TORSO_SEMI, s)
     torso_length = max(float(np.linalg.norm(top - bottom)) - 2 * torso_semi[2], 0.0)
     shapes = [
         Capsule.oriented((top + bottom) / 2, frame, torso_semi, torso_length),
-        Capsule.oriented(head_centre, frame, tuple(v * s for v in _HEAD_SEMI)),
+        Capsule.oriented(head_centre, frame, _scaled(_HEAD_SEMI, s)),
         Capsule.segment(mid_shoulder, head_centre, _NECK_RADIUS * s),
     ]
     shapes += [Capsule.segment(kp[a], kp[b], r * s) for a, b, r in _LIMBS]

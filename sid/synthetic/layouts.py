@@ -35,6 +35,7 @@ from typing import Any
 
 import numpy as np
 
+from sid.checks import check_numbers
 from sid.perception.mount import CameraMount
 from sid.synthetic.scene import Scene, ScenePerson
 
@@ -66,9 +67,8 @@ class Formation:
     from above), Gaussian jitter of positions (m) and facing directions (rad), heights (m), random seed.
 
     focus_offset (m): everyone faces a point this much nearer to the camera than the centre instead of the centre
-    itself, so the group opens towards the camera (the paper authors' own two-person recording,
-    ../shared/data/seed-recordings/people_groups_data.csv, shows such a V: two people ~1 m apart side by side,
-    each turned ~60 deg from the other towards the camera). 0: face the centre.
+    itself, so the group opens towards the camera (the paper authors' own two-person recording shows such a V,
+    docs/parameters.md). 0: face the centre.
     """
 
     centre_distance: float | None = None
@@ -83,16 +83,10 @@ class Formation:
     seed: int = 0
 
     def __post_init__(self) -> None:
-        for name in ("lateral", "rotation", "jitter_xy", "jitter_theta", "focus_offset", "height", "height_jitter"):
-            if not np.isfinite(getattr(self, name)):
-                raise ValueError(f"layout: {name} must be finite, got {getattr(self, name)}")
-        for name in ("jitter_xy", "jitter_theta", "height_jitter"):
-            if getattr(self, name) < 0:
-                raise ValueError(f"layout: {name} must be >= 0, got {getattr(self, name)}")
-        for name in ("centre_distance", "radius"):
-            value = getattr(self, name)
-            if value is not None and not (np.isfinite(value) and value > 0):
-                raise ValueError(f"layout: {name} must be positive metres, got {value}")
+        check_numbers("layout", self, ("lateral", "rotation", "focus_offset", "height"))
+        check_numbers("layout", self, ("jitter_xy", "jitter_theta", "height_jitter"), low=0)
+        given = [name for name in ("centre_distance", "radius") if getattr(self, name) is not None]  # None: layout's
+        check_numbers("layout", self, given, low=0, low_open=True, unit="metres")
 
 
 # The documented variations of every layout: as described; turned by -turn and +turn about its centre (15 deg;
@@ -107,10 +101,6 @@ VARIATIONS: tuple[dict[str, Any], ...] = (
     {"jitter_xy": 0.05, "jitter_theta": np.radians(5.0), "seed": 1},
     {"jitter_xy": 0.05, "jitter_theta": np.radians(5.0), "seed": 2},
 )
-
-
-def layout_names() -> tuple[str, ...]:
-    return tuple(LAYOUTS)
 
 
 def layout(

@@ -21,6 +21,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from sid.checks import check_number, check_numbers
+
 
 @dataclass(frozen=True)
 class DepthNoise:
@@ -49,15 +51,12 @@ class DepthNoise:
     depth_unit_m: float = 0.001
 
     def __post_init__(self) -> None:
-        for name in ("subpixel", "correlation_px", "min_range_m", "depth_unit_m"):
-            _check(name, getattr(self, name), minimum=0.0)
-        for name in ("baseline_m", "edge_jump_m"):
-            _check(name, getattr(self, name), minimum=0.0, strict=True)
-        _check("max_range_m", self.max_range_m, minimum=0.0, strict=True, allow_inf=True)
-        for name in ("hole_fraction", "edge_holes"):
-            _check(name, getattr(self, name), minimum=0.0, maximum=1.0)
+        check_numbers("depth noise", self, ("subpixel", "correlation_px", "min_range_m", "depth_unit_m"), low=0)
+        check_numbers("depth noise", self, ("baseline_m", "edge_jump_m"), low=0, low_open=True)
+        check_number("depth noise", "max_range_m", self.max_range_m, low=0, low_open=True, allow_inf=True)
+        check_numbers("depth noise", self, ("hole_fraction", "edge_holes"), low=0, high=1)
         if self.focal_px is not None:
-            _check("focal_px", self.focal_px, minimum=0.0, strict=True)
+            check_number("depth noise", "focal_px", self.focal_px, low=0, low_open=True)
         if self.edge_width_px < 0:
             raise ValueError(f"depth noise: edge_width_px must be >= 0, got {self.edge_width_px}")
         if self.max_range_m <= self.min_range_m:
@@ -164,8 +163,8 @@ class KeypointNoise:
     drop: float = 0.02
 
     def __post_init__(self) -> None:
-        _check("sigma_px", self.sigma_px, minimum=0.0)
-        _check("drop", self.drop, minimum=0.0, maximum=1.0)
+        check_number("keypoint noise", "sigma_px", self.sigma_px, low=0)
+        check_number("keypoint noise", "drop", self.drop, low=0, high=1)
 
     def apply(self, pixels: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
         """(N, 2) exact pixels -> (noisy (N, 2) pixels, kept (N,) bool)."""
@@ -173,14 +172,3 @@ class KeypointNoise:
         noisy = pixels + rng.normal(0.0, self.sigma_px, pixels.shape) if self.sigma_px > 0 else pixels.copy()
         kept = rng.random(len(pixels)) >= self.drop
         return noisy, kept
-
-
-def _check(
-    name: str, value: float, minimum: float, maximum: float | None = None, strict: bool = False, allow_inf: bool = False
-) -> None:
-    ok = bool(np.isfinite(value)) or (allow_inf and value == np.inf)
-    ok = ok and (value > minimum if strict else value >= minimum) and (maximum is None or value <= maximum)
-    if not ok:
-        bound = f"> {minimum}" if strict else f">= {minimum}"
-        bound += f" and <= {maximum}" if maximum is not None else ""
-        raise ValueError(f"noise: {name} must be {bound}, got {value}")

@@ -4,11 +4,10 @@ A vectorised numpy ray caster: every shape is intersected analytically with the 
 projected bounding box, and a z-buffer keeps the nearest hit. Rays are built as ``K^-1 [u, v, 1]``, so the ray
 parameter of a hit *is* its depth z in the camera's optical frame (x right, y down, z forward, metres), which is
 what a RealSense depth image stores. Pixel centres follow ``sid.perception.camera``: (0, 0) is the centre of the
-top-left
-pixel.
+top-left pixel.
 
 Why not a library renderer: OpenGL/pyrender/Open3D would add heavy dependencies (and a display or EGL context)
-to draw a few dozen quadrics; the analytic intersection is exact, short and fast enough (see the package README).
+to draw a few dozen quadrics; the analytic intersection is exact, short and fast enough (docs/parameters.md).
 """
 
 from __future__ import annotations
@@ -18,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sid.checks import check_number
 from sid.perception.camera import Extrinsics, Intrinsics
 
 # Label image values that are not a body index.
@@ -103,8 +103,8 @@ class Background:
     wall_distance: float | None = 5.0
 
     def __post_init__(self) -> None:
-        if self.wall_distance is not None and not (np.isfinite(self.wall_distance) and self.wall_distance > 0):
-            raise ValueError(f"background: wall_distance must be positive metres or None, got {self.wall_distance}")
+        if self.wall_distance is not None:
+            check_number("background", "wall_distance", self.wall_distance, low=0, low_open=True, unit="metres")
 
 
 @dataclass
@@ -187,6 +187,7 @@ class RayCaster:
         shade = None
         if shading:
             shade = self._bg_shade.copy()
+            assert nearest is not None  # made when shading
             for number, ((_, shape), window) in enumerate(zip(shapes, windows, strict=True)):
                 if window is not None:
                     self._shade(shape, window, depth, nearest, number, shade)

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from sid.checks import check_numbers
 from sid.documents import load_document
 from sid.perception.mount import CameraMount
 from sid.perception.people import Person
@@ -35,9 +36,7 @@ class ScenePerson:
     height: float = 1.70
 
     def __post_init__(self) -> None:
-        values = (self.x, self.y, self.theta, self.height)
-        if not all(np.isfinite(v) for v in values):
-            raise ValueError(f"scene person {self.id}: x, y, theta, height must be finite, got {values}")
+        check_numbers(f"scene person {self.id}", self, ("x", "y", "theta", "height"))
         if not 0.5 <= self.height <= 2.5:
             raise ValueError(f"scene person {self.id}: height {self.height} m is not a standing person (0.5-2.5 m)")
 
@@ -127,7 +126,8 @@ class Scene:
         unknown = [p.id for p in people if p.theta is None]
         if unknown:
             raise ValueError(f"scene {name}: people {unknown} have no facing direction (theta is None)")
-        return cls(name, tuple(ScenePerson(p.id, p.x, p.y, float(p.theta)) for p in people), groups, **options)
+        known = tuple(ScenePerson(p.id, p.x, p.y, float(p.theta)) for p in people if p.theta is not None)
+        return cls(name, known, groups, **options)
 
     @classmethod
     def from_scenario(cls, scenario: Scenario, mount: CameraMount | None = None) -> Scene:

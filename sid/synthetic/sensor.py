@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from sid.checks import check_number, check_numbers
 from sid.perception.camera import Calibration, Extrinsics, Intrinsics, project
 from sid.perception.frame import Frame
 from sid.perception.groups import GroupParams
@@ -150,12 +151,10 @@ class SyntheticCamera:
             self.sensor_focal_px = self.calibration.depth.fx
         self.occlusion_margin = float(occlusion_margin)
         self.self_occlusion_margin = None if self_occlusion_margin is None else float(self_occlusion_margin)
-        margins = [self.occlusion_margin] + ([] if self.self_occlusion_margin is None else [self.self_occlusion_margin])
-        if not all(np.isfinite(m) and m >= 0 for m in margins):
-            raise ValueError(f"synthetic camera: occlusion margins must be >= 0 metres, got {margins}")
+        margins = ["occlusion_margin"] + ([] if self.self_occlusion_margin is None else ["self_occlusion_margin"])
+        check_numbers("synthetic camera", self, margins, low=0, unit="metres")
         self.shaded_color = shaded_color
-        if not (np.isfinite(fps) and fps > 0):
-            raise ValueError(f"synthetic camera: fps must be positive, got {fps}")
+        check_number("synthetic camera", "fps", fps, low=0, low_open=True)
         self.fps = float(fps)
         self.group_params = group_params or GroupParams()
         self._cached: tuple[Scene, _SceneRender] | None = None
@@ -220,6 +219,7 @@ class SyntheticCamera:
         depth = views.depth.render(bodies)
         color_intr = self.calibration.color
         if views.color is not None:
+            assert views.backdrop is not None  # made together with the colour caster
             color = _paint(views.color.render(bodies, shading=True), views.backdrop)
         else:
             color = np.full((color_intr.height, color_intr.width, 3), 128, dtype=np.uint8)
@@ -315,6 +315,7 @@ def _backdrop(rendering: Rendering, background_world: np.ndarray) -> np.ndarray:
 def _paint(rendering: Rendering, backdrop: np.ndarray) -> np.ndarray:
     """RGB uint8 image: people in flat colours shaded by the viewing angle, in front of the backdrop."""
     label, shade = rendering.label, rendering.shade
+    assert shade is not None, "_paint needs a rendering made with shading=True"
     image = backdrop.copy()
     people = label >= 0
     colors = PERSON_COLORS[label[people] % len(PERSON_COLORS)]

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 
+import cv2
 import numpy as np
 import pytest
 
@@ -61,6 +62,28 @@ def test_detect_streams_json_lines_and_writes_pictures(tmp_path, capsys):
     assert len((out / "detections.jsonl").read_text().splitlines()) == 3
     assert len(list(out.glob("overlay_*.png"))) == 3 and len(list(out.glob("topview_*.png"))) == 3
     assert "3 frames with people" in captured.err
+
+
+def test_detect_top_view_shows_the_camera_and_only_what_it_draws(tmp_path):
+    from costmap.render import CAMERA, GOAL, INSCRIBED_COLOUR, PERSON, SCAN, START, world_to_image
+    from sid.cli.detect import TOP_VIEW
+
+    out = tmp_path / "out"
+    assert main(["detect", "--source", "synthetic:S5", "--frames", "1", "--out", str(out)]) == 0
+    (path,) = out.glob("topview_*.png")
+    top = cv2.imread(str(path))
+
+    def at(x: float, y: float) -> tuple[int, ...]:
+        u, v = world_to_image([[x, y]], TOP_VIEW, 6)[0].astype(int)
+        return tuple(top[v, u])
+
+    assert at(0.05, 0.0) == CAMERA  # the camera at the world origin, looking along +x
+    assert at(6.0, 0.0) not in ((255, 255, 255), CAMERA)  # inside the field of view: shaded
+    assert at(0.5, 3.0) == (255, 255, 255)  # behind the edge of the field of view: not shaded
+    colours = {tuple(c) for c in np.unique(top.reshape(-1, 3), axis=0)}
+    assert PERSON in colours and CAMERA in colours
+    for absent in (GOAL, START, SCAN, INSCRIBED_COLOUR):  # no robot, scan or costs drawn: none in the legend either
+        assert absent not in colours, f"colour {absent} is drawn, yet nothing it stands for is on the map"
 
 
 def test_detect_needs_a_model_for_real_sources(tmp_path, capsys):

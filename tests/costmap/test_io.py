@@ -167,7 +167,7 @@ def test_npz_round_trip_is_exact(tmp_path):
     assert saved.spec == layered.spec
     np.testing.assert_array_equal(saved.master.costs, layered.master.costs)
     assert list(saved.layers) == ["lidar", "social", "inflation"]
-    for name, grid in layered.layers.items():
+    for name, grid in layered.grids.items():
         np.testing.assert_array_equal(saved.layers[name], grid)
 
 
@@ -234,7 +234,7 @@ def test_export_writes_every_file_and_they_read_back(tmp_path):
     }
     np.testing.assert_array_equal(read_map(paths["yaml"]).data, cost_to_occupancy(layered.master.costs))
     bag = read_occupancy_grids(paths["mcap"])
-    np.testing.assert_array_equal(bag["/social_costmap"][0].data, cost_to_occupancy(layered.social.costs))
+    np.testing.assert_array_equal(bag["/social_costmap"][0].data, cost_to_occupancy(layered.grids["social"]))
     assert cv2.imread(str(paths["png"])).shape[0] > 400
 
 
@@ -258,5 +258,5 @@ def test_sid_costmap_reports_a_bad_scenario(tmp_path, capsys):
 
 def test_people_without_recognition_are_only_lidar_obstacles():
     layered = example_layered(social=False)
-    assert set(layered.layers) == {"lidar", "inflation"} and layered.groups == []
-    assert isinstance(layered.people[0], Person)
+    assert set(layered.grids) == {"lidar", "inflation"} and layered.inputs.groups == ()
+    assert isinstance(layered.inputs.people[0], Person)

@@ -6,12 +6,14 @@ import numpy as np
 import pytest
 import shapely
 
-from costmap.combine import combine, update_with_max
+from costmap.combine import combine
 from costmap.grid import FREE_SPACE, INSCRIBED, LETHAL, NO_INFORMATION, Costmap2D, GridSpec
-from costmap.layered import CostmapParams, LayeredCostmap
+from costmap.layer import LayerInputs
+from costmap.layered import LayeredCostmap
 from costmap.layers.inflation import InflationLayer, InflationParams, distance_to_lethal_cells
 from costmap.layers.obstacle import ObstacleLayer, ObstacleParams
 from costmap.layers.social import SocialLayer, SocialParams, group_zone_polygon
+from costmap.plugins import CostmapParams, layered_costmap
 from costmap.scan import LaserScan
 from sid.perception.groups import Group
 from sid.perception.people import Person
@@ -47,7 +49,7 @@ def test_inflation_around_one_lethal_cell_is_nav2_formula_everywhere_within_radi
     master = np.zeros(spec.shape, dtype=np.uint8)
     master[40, 40] = LETHAL
     layer = InflationLayer(spec, InflationParams(radius, k), inscribed_radius=0.25)
-    layer.apply(master)
+    layer.write(master, spec.whole)
     rows, cols = np.indices(spec.shape)
     d = np.hypot(rows - 40, cols - 40) * resolution
     within = d <= radius
@@ -65,7 +67,7 @@ def test_inflation_reach_rounds_up_like_nav2_cell_distance():
     master = np.zeros(spec.shape, dtype=np.uint8)
     master[20, 20] = LETHAL
     layer = InflationLayer(spec, InflationParams(inflation_radius=0.53), inscribed_radius=0.25)
-    layer.apply(master)
+    layer.write(master, spec.whole)
     assert layer.cell_radius == 11  # ceil(0.53 / 0.05): the reach is 0.55 m, beyond the 0.53 m asked for
     assert master[20, 31] == nav2_cost(0.55, 0.25, 10.0) > 0
     assert master[20, 32] == 0
@@ -88,20 +90,20 @@ def test_inflation_keeps_the_larger_cost_and_nav2_unknown_rule():
     master[20, 30] = 250  # already more than inflation gives 10 cells away
     master[20, 22] = NO_INFORMATION  # 0.10 m away: inscribed, replaces unknown
     master[20, 28] = NO_INFORMATION  # 0.40 m away: graded, unknown stays unknown
-    InflationLayer(spec, InflationParams(0.55), inscribed_radius=0.25).apply(master)
+    InflationLayer(spec, InflationParams(0.55), inscribed_radius=0.25).write(master, spec.whole)
     assert master[20, 30] == 250
     assert master[20, 22] == INSCRIBED
     assert master[20, 28] == NO_INFORMATION
     master2 = np.zeros(spec.shape, dtype=np.uint8)
     master2[20, 20], master2[20, 28] = LETHAL, NO_INFORMATION
-    InflationLayer(spec, InflationParams(0.55, inflate_unknown=True), 0.25).apply(master2)
+    InflationLayer(spec, InflationParams(0.55, inflate_unknown=True), 0.25).write(master2, spec.whole)
     assert master2[20, 28] == nav2_cost(0.40, 0.25, 10.0)
 
 
 def test_inflation_without_lethal_cells_is_zero():
     layer = InflationLayer(SPEC, InflationParams(), inscribed_radius=0.25)
     master = np.full(SPEC.shape, 100, dtype=np.uint8)
-    layer.apply(master)
+    layer.write(master, SPEC.whole)
     assert (master == 100).all() and not layer.costs.any()
 
 
@@ -123,13 +125,18 @@ def test_combination_methods_follow_nav2():
     out = master.copy()
     combine(out, layer, "addition")
     assert out.tolist() == [50, 100, 30, 252, 252]
+    master = np.array([0, 255, 255, 255, 10, 10], dtype=np.uint8)
+    layer = np.array([5, 100, 253, 254, 0, 40], dtype=np.uint8)
+    out = master.copy()
+    combine(out, layer, "max_keep_unknown")  # Nav2's inflation rule: only >= 253 replaces unknown
+    assert out.tolist() == [5, 255, 253, 254, 10, 40]
     with pytest.raises(ValueError, match="combination method"):
         combine(out, layer, "min")
 
 
 def test_max_can_skip_a_layer_value_that_carries_no_opinion():
     master = np.array([255, 255, 10, 10], dtype=np.uint8)
-    update_with_max(master, np.array([0, 40, 0, 40], dtype=np.uint8), no_opinion=FREE_SPACE)
+    combine(master, np.array([0, 40, 0, 40], dtype=np.uint8), "max_nonzero")
     assert master.tolist() == [255, 40, 10, 40]  # a zero social cell does not turn unknown into free
 
 
@@ -227,7 +234,7 @@ def test_every_cell_inside_the_group_zone_costs_at_least_group_cost():
     people, group = triad()
     params = SocialParams()
     layer = SocialLayer(SPEC, params)
-    layer.update(people, [group])
+    layer.update(LayerInputs(people, [group]), None)
     xs, ys = SPEC.cell_centres()
     inside = shapely.contains_xy(group_zone_polygon(group, people, params.group_margin), xs, ys)
     assert inside.sum() > 300
@@ -239,7 +246,7 @@ def test_every_cell_inside_the_group_zone_costs_at_least_group_cost():
 
 def test_personal_space_is_larger_in_front_and_circular_without_orientation():
     layer = SocialLayer(SPEC, SocialParams())
-    layer.update([Person(1, 2.0, 0.0, 0.0), Person(2, 6.0, 0.0, None)], [])
+    layer.update(LayerInputs([Person(1, 2.0, 0.0, 0.0), Person(2, 6.0, 0.0, None)]), None)
     costmap = Costmap2D(SPEC, layer.costs)
     front, back = costmap.cost_at([[2.8, 0.0], [1.2, 0.0]])
     assert front > back > 0
@@ -251,12 +258,17 @@ def test_personal_space_is_larger_in_front_and_circular_without_orientation():
 
 def test_social_layer_clips_people_outside_the_map():
     layer = SocialLayer(SPEC, SocialParams())
-    layer.update([Person(1, 9.3, 0.0, np.pi)], [])  # 0.3 m beyond the right edge, facing into the map
+    layer.update(LayerInputs([Person(1, 9.3, 0.0, np.pi)]), None)  # 0.3 m beyond the right edge, facing into the map
     assert layer.costs[:, -1].max() > 0
     assert not (layer.costs == LETHAL).any()  # the body itself is outside
 
 
 # --- the layered costmap and people updates -------------------------------------------------------------------
+
+
+def social_costmap(social: bool = True) -> LayeredCostmap:
+    """The default layers on SPEC (no static map), with or without the social layer."""
+    return layered_costmap(SPEC, CostmapParams() if social else CostmapParams().without("social"))
 
 
 def scan_of(people, pose=(0.0, 0.0, 0.0)):
@@ -270,19 +282,19 @@ def lethal_near(costs: np.ndarray, xy, radius: float) -> int:
 
 def test_without_social_layer_only_lidar_marks_and_their_inflation_remain():
     people, group = triad()
-    layered = LayeredCostmap(SPEC, social=False)
-    layered.update(people, [group], scan_of(people))
-    assert set(layered.layers) == {"lidar", "inflation"}
-    expected = layered.lidar.costs.copy()
-    layered.inflation.apply(expected)
+    layered = social_costmap(social=False)
+    layered.update(LayerInputs(people, [group], scan_of(people)))
+    assert set(layered.grids) == {"lidar", "inflation"}
+    expected = layered.grids["lidar"].copy()
+    InflationLayer(SPEC, InflationParams(), inscribed_radius=0.25).write(expected, SPEC.whole)
     np.testing.assert_array_equal(layered.master.costs, expected)
     assert layered.master.cost_at([group.interest_point])[0] < 240  # the o-space is not protected
 
 
 def test_with_social_layer_the_group_zone_is_high_cost_in_the_master():
     people, group = triad()
-    layered = LayeredCostmap(SPEC)
-    layered.update(people, [group], scan_of(people))
+    layered = social_costmap()
+    layered.update(LayerInputs(people, [group], scan_of(people)))
     xs, ys = SPEC.cell_centres()
     inside = shapely.contains_xy(group_zone_polygon(group, people), xs, ys)
     assert (layered.master.costs[inside] >= 240).all()
@@ -295,50 +307,57 @@ def test_a_moved_person_leaves_no_stale_marks_with_or_without_a_new_scan():
     old = [Person(1, 4.0, 0.0, np.pi)]
     new = [Person(1, 4.0, 1.5, np.pi)]
     for new_scan in (None, scan_of(new)):
-        layered = LayeredCostmap(SPEC)
-        layered.update(old, [], scan_of(old))
+        layered = social_costmap()
+        layered.update(LayerInputs(old, [], scan_of(old)))
         assert lethal_near(layered.master.costs, (4.0, 0.0), 0.3) > 0
-        layered.update(new, [], new_scan)
+        layered.update(LayerInputs(new, [], new_scan))
         assert lethal_near(layered.master.costs, (4.0, 0.0), 0.3) == 0
-        assert lethal_near(layered.lidar.costs, (4.0, 1.5), 0.3) == 0  # the person is the social layer's, once
+        assert lethal_near(layered.grids["lidar"], (4.0, 1.5), 0.3) == 0  # the person is the social layer's, once
         assert lethal_near(layered.master.costs, (4.0, 1.5), 0.2) > 0
         assert layered.master.cost_at([[4.0, 0.0]])[0] < 50  # only the new position's fading personal space
 
 
 def test_baseline_keeps_people_marks_where_no_new_beam_passes():
     old = [Person(1, 4.0, 0.0, np.pi)]
-    layered = LayeredCostmap(SPEC, social=False)
-    layered.update(old, [], scan_of(old))
-    layered.update([Person(1, 4.0, 1.5, np.pi)], [], None)
+    layered = social_costmap(social=False)
+    layered.update(LayerInputs(old, [], scan_of(old)))
+    layered.update(LayerInputs([Person(1, 4.0, 1.5, np.pi)]))
     assert lethal_near(layered.master.costs, (4.0, 0.0), 0.3) > 0  # Nav2 behaviour without recognition
 
 
 def test_something_left_at_a_person_old_position_is_kept_when_the_scan_sees_it():
     old = [Person(1, 4.0, 0.0, np.pi)]
-    layered = LayeredCostmap(SPEC)
-    layered.update(old, [], scan_of(old))
+    layered = social_costmap()
+    layered.update(LayerInputs(old, [], scan_of(old)))
     pillar = simulate_scan((0.0, 0.0, 0.0), [CircleObstacle((4.0, 0.0), 0.2)], [], beams=720)
-    layered.update([Person(1, 4.0, 1.5, np.pi)], [], pillar)
+    layered.update(LayerInputs([Person(1, 4.0, 1.5, np.pi)], [], pillar))
     assert lethal_near(layered.master.costs, (4.0, 0.0), 0.3) > 0
 
 
 def test_update_rejects_nan_people_duplicate_ids_and_a_sensor_off_the_map_before_changing_anything():
-    layered = LayeredCostmap(SPEC)
-    layered.update([Person(1, 4.0, 0.0)], [], scan_of([Person(1, 4.0, 0.0)]))
-    before = layered.master.costs.copy()
+    layered = social_costmap()
+    layered.update(LayerInputs([Person(1, 4.0, 0.0)], [], scan_of([Person(1, 4.0, 0.0)])))
+    before = {"master": layered.master.costs.copy()} | {k: v.copy() for k, v in layered.grids.items()}
     with pytest.raises(ValueError, match="outside the costmap"):
-        layered.update([Person(1, 5.0, 0.0)], [], scan_of([], pose=(20.0, 0.0, 0.0)))
-    np.testing.assert_array_equal(layered.master.costs, before)
+        layered.update(LayerInputs([Person(1, 5.0, 0.0)], [], scan_of([], pose=(20.0, 0.0, 0.0))))
+    after = {"master": layered.master.costs} | layered.grids
+    for name, grid in before.items():
+        np.testing.assert_array_equal(after[name], grid, err_msg=name)
+    with pytest.raises(ValueError, match=r"members \[7\]"):  # the social layer refuses; the master waits
+        layered.update(LayerInputs([Person(1, 5.0, 0.0)], [Group((1, 7), (5.0, 0.5), 0.0, np.zeros((0, 2)), 0.5)]))
+    np.testing.assert_array_equal(layered.master.costs, before["master"])
+    np.testing.assert_array_equal(layered.grids["social"], before["social"])
+    assert layered.inputs.people == (Person(1, 4.0, 0.0),)
     with pytest.raises(ValueError, match="person 3"):
-        layered.update([Person(3, np.nan, 0.0)], [])
+        layered.update(LayerInputs([Person(3, np.nan, 0.0)]))
     with pytest.raises(ValueError, match="twice"):
-        layered.update([Person(1, 0.0, 0.0), Person(1, 1.0, 0.0)], [])
+        layered.update(LayerInputs([Person(1, 0.0, 0.0), Person(1, 1.0, 0.0)]))
 
 
 def test_unknown_space_stays_unknown_around_people_when_tracked():
     spec = GridSpec(0.05, 0.0, 0.0, 100, 100)
-    layered = LayeredCostmap(spec, CostmapParams(obstacle=ObstacleParams(track_unknown_space=True)))
-    layered.update([Person(1, 2.5, 2.5, 0.0)], [])  # no scan: everything unknown except the social costs
+    layered = layered_costmap(spec, CostmapParams(obstacle=ObstacleParams(track_unknown_space=True)))
+    layered.update(LayerInputs([Person(1, 2.5, 2.5, 0.0)]))  # no scan: everything unknown except the social costs
     costs = layered.master.costs
     assert costs[0, 0] == NO_INFORMATION
     assert costs[50, 50] == LETHAL and costs[50, 62] not in (0, NO_INFORMATION)
@@ -365,9 +384,10 @@ def test_static_map_walls_survive_and_lidar_adds_to_them(tmp_path):
         base_dir=tmp_path,
     )
     layered = build_costmap(scenario, social=False)
-    assert list(layered.layers) == ["static", "lidar", "inflation"]
+    assert list(layered.grids) == ["static", "lidar", "inflation"]
     master = layered.master.costs
     assert (master[50, :] == LETHAL).all()  # static wall, also where the LiDAR saw nothing
-    assert (layered.lidar.costs[10:40, 80] == LETHAL).any()  # the LiDAR-only wall at x = 4.0
+    assert (layered.grids["lidar"][10:40, 80] == LETHAL).any()  # the LiDAR-only wall at x = 4.0
     assert (master[56:, :5] == NO_INFORMATION).all()  # unknown in the static map, never seen
-    assert layered.scan.ranges[np.argmin(np.abs(layered.scan.angles - np.pi / 2))] == pytest.approx(1.5, abs=0.05)
+    scan = layered.inputs.scan
+    assert scan is not None and scan.ranges[np.argmin(np.abs(scan.angles - np.pi / 2))] == pytest.approx(1.5, abs=0.05)

@@ -1,42 +1,40 @@
-"""Planner comparison and benchmark plumbing on the demo scenario (tiny budgets: structure, not speed)."""
+"""``sid compare``: the per-scenario table, summary.json and the chart, end to end."""
 
 from __future__ import annotations
 
 import json
 
+import cv2
+import numpy as np
+
 from sid.cli import main
-from sid.experiments.compare import format_summary, run_matrix, summarise, summary_chart
+from sid.experiments.compare import BY_SCENARIO, format_summary, write_comparison
 from sid.experiments.demo import DEMO_SCENARIO, demo_scenario
-from sid.experiments.planner_bench import bench_planners, meets_target
+from sid.experiments.harness import prepare, run_matrix, summarise
 
 
-def test_run_matrix_summary_table_and_chart():
-    runs = run_matrix([demo_scenario()], ["grid", "rrtconnect"], runs=2, time_limits=(0.2,))
-    assert len(runs) == 2 * (1 + 2)  # per social mode: grid once, rrtconnect with seeds 1 and 2
-    grid = [r for r in runs if r.planner == "grid"]
-    assert all(r.cost_ratio == 1.0 for r in grid)  # the reference is the grid planner's own path
-    rows = summarise(runs)
-    assert {(r["planner"], r["social"]) for r in rows} == {(p, s) for p in ("grid", "rrtconnect") for s in (0, 1)}
-    without_grid = next(r for r in rows if r["planner"] == "grid" and not r["social"])
+def test_summary_table_and_chart(tmp_path):
+    runs = run_matrix([prepare(demo_scenario())], ["grid", "rrtconnect"], runs=2, time_limits=(5.0,))
+    rows = summarise([r.record() for r in runs], BY_SCENARIO)
+    assert [(r["planner"], r["social_layer"]) for r in rows] == [
+        ("grid", False), ("grid", True), ("rrtconnect", False), ("rrtconnect", True)
+    ]  # fmt: skip
+    without_grid = rows[0]
     assert without_grid["crossing_rate"] == 1.0 and without_grid["median_intrusion_m"] > 1.0
-    table = format_summary(rows)
-    assert "rrtconnect" in table and "cost/grid" in table
-    chart = summary_chart(summarise(runs, by_scenario=False))
-    assert chart.ndim == 3 and chart.shape[1] >= 1200
-
-
-def test_bench_reports_per_budget_and_target():
-    rows = bench_planners(budgets=(0.1,), runs=1, planners=["grid", "rrtconnect"])
-    assert [(r["planner"], r["time_limit_s"]) for r in rows] == [("grid", 0.1), ("rrtconnect", 0.1)]
-    assert meets_target(rows) is None  # the default planner was not run
-    assert meets_target(rows, "grid") is None  # no row at the 0.5 s target budget
+    table = format_summary(rows).splitlines()
+    assert len(table) == 2 + 4 and "cost/grid" in table[0] and "rrtconnect" in table[-1]
+    paths = write_comparison(runs, tmp_path, "test chart")
+    assert json.loads(paths["summary"].read_text()) == rows
+    chart = cv2.imread(str(paths["chart"]))
+    assert chart is not None and chart.shape[1] >= 1200 and chart.shape[0] >= 400
+    assert len(np.unique(chart.reshape(-1, 3), axis=0)) > 50  # drawn, not blank
 
 
 def test_compare_command_writes_summary_and_chart(tmp_path, capsys):
     scenario = tmp_path / "demo.json"
     scenario.write_text(json.dumps(DEMO_SCENARIO))
     out = tmp_path / "cmp"
-    args = ["compare", str(scenario), "--planners", "grid", "rrtconnect", "--runs", "1", "--time", "0.2"]
+    args = ["compare", str(scenario), "--planners", "grid", "rrtconnect", "--runs", "1", "--time", "5"]
     assert main([*args, "--out", str(out)]) == 0
     captured = capsys.readouterr()
     assert "rrtconnect" in captured.out and "4/4" in captured.err  # the progress bar reaches the end

@@ -9,11 +9,13 @@ import pytest
 from shapely.geometry import Point
 
 from costmap.layers.social import group_zone_polygon
-from sid.experiments.demo import DEMO_SCENARIO, _circle, compare_with_without, demo_scenario, goal_zone_warning
+from planner.facade import DEFAULT_PLANNER
+from sid.experiments.demo import DEMO_ITERATIONS, DEMO_SCENARIO, _circle, run_demo
+from sid.experiments.harness import compare_with_without, prepare
 from sid.scenario.loader import scenario_from_dict
 from sid.synthetic.layouts import LAYOUTS
 
-BUDGET = dict(time_limit=30.0, seed=1, max_iterations=5000)  # the cap, not the time, ends these runs
+BUDGET = dict(planner=DEFAULT_PLANNER, time_limit=30.0, seed=1, max_iterations=5000)  # the cap ends these runs
 
 # The paper's layouts S1-S5 (sid.synthetic.layouts) and wider conversations (o-space radius within the detector's
 # spread threshold); the robot could squeeze between the members of the pair and of the triangle.
@@ -32,24 +34,26 @@ def scenario_with(angles: tuple[float, ...], radius: float, turn: float = 0.0):
     return scenario_from_dict(data)
 
 
-def test_builtin_demo_goes_through_without_and_around_with_recognition():
-    comparison = compare_with_without(demo_scenario(), **BUDGET)
+def test_the_demo_claim_at_its_defaults(tmp_path):
+    """``sid demo`` as the README reports it: its seed and iteration cap; only the time guard is raised, so that a
+    loaded machine cannot end the runs before the cap."""
+    comparison = run_demo(tmp_path, time_limit=120.0)
+    assert [g.members for g in comparison.task.groups] == [(1, 2, 3)]  # the lone person 4 is not in the group
+    assert all(run.result.iterations == DEMO_ITERATIONS for run in comparison.runs.values())  # the cap ended both
     without, with_ = comparison.metrics["without"], comparison.metrics["with"]
-    assert [g.members for g in comparison.groups] == [(1, 2, 3)]  # the lone person 4 is not in the group
-    assert without["success"] and with_["success"]
-    assert without["ospace_intrusion_m"] > 1.0 and without["crosses_group"] is True
-    assert with_["ospace_intrusion_m"] == 0.0 and with_["crosses_group"] is False
-    assert with_["min_person_distance_m"] > without["min_person_distance_m"]
-    assert with_["path_length_m"] < 1.2 * without["path_length_m"]  # a modest detour
-    assert with_["lethal_samples"] == 0 and without["lethal_samples"] == 0
+    assert round(without["path_length_m"], 2) == 9.05 and round(with_["path_length_m"], 2) == 9.90
+    assert round(without["ospace_intrusion_m"], 2) == 1.46 and with_["ospace_intrusion_m"] == 0.0
+    assert without["crosses_group"] is True and with_["crosses_group"] is False
+    assert round(without["min_person_distance_m"], 2) == 0.70 and round(with_["min_person_distance_m"], 2) == 1.28
+    assert without["lethal_samples"] == 0 and with_["lethal_samples"] == 0
 
 
 @pytest.mark.parametrize("turn", [0.0, 90.0])
 @pytest.mark.parametrize("name", list(LAYOUT_CASES))
 def test_with_recognition_never_enters_a_group_zone(name, turn):
     angles, radius = LAYOUT_CASES[name]
-    comparison = compare_with_without(scenario_with(angles, radius, turn), **BUDGET)
-    found = [g.members for g in comparison.groups]
+    comparison = compare_with_without(prepare(scenario_with(angles, radius, turn)), **BUDGET)
+    found = [g.members for g in comparison.task.groups]
     assert len(found) == 1 and len(found[0]) == len(angles), (
         f"sid.perception.groups.detect_groups found {found}: no test"
     )
@@ -61,7 +65,7 @@ def test_with_recognition_never_enters_a_group_zone(name, turn):
 @pytest.mark.parametrize("name", ["pair 1.6 m apart", "triangle 1.56 m sides"])
 def test_without_recognition_wide_conversations_are_crossed(name):
     angles, radius = LAYOUT_CASES[name]
-    comparison = compare_with_without(scenario_with(angles, radius), **BUDGET)
+    comparison = compare_with_without(prepare(scenario_with(angles, radius)), **BUDGET)
     assert comparison.metrics["without"]["ospace_intrusion_m"] > 0.0
     assert comparison.metrics["without"]["crosses_group"] is True
 
@@ -69,13 +73,9 @@ def test_without_recognition_wide_conversations_are_crossed(name):
 def test_goal_inside_a_group_zone_is_planned_and_reported():
     data = copy.deepcopy(DEMO_SCENARIO)
     data["robot"]["goal"] = [4.5, 0.0, 0.0]  # the conversation's o-space centre
-    scenario = scenario_from_dict(data)
-    comparison = compare_with_without(scenario, **BUDGET)
-    warning = goal_zone_warning(scenario, comparison.groups)
-    assert warning is not None and "inside the interaction zone of group (1, 2, 3)" in warning
-    with_ = comparison.metrics["with"]
+    task = prepare(scenario_from_dict(data))
+    with_ = compare_with_without(task, **BUDGET).metrics["with"]
     assert with_["success"] and with_["goal_in_group_zone"] is True
-    zone = group_zone_polygon(comparison.groups[0], scenario.people)
+    zone = group_zone_polygon(task.groups[0], task.scenario.people)
     depth = zone.exterior.distance(Point(4.5, 0.0))  # the shortest way in from the zone's edge
     assert 0.0 < with_["ospace_intrusion_m"] < depth + 0.5
-    assert goal_zone_warning(demo_scenario(), comparison.groups) is None

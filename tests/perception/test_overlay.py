@@ -14,6 +14,7 @@ from sid.perception.overlay import (
     RIGHT_COLOUR,
     draw_detections,
     person_label,
+    place_labels,
 )
 from sid.perception.people import Person
 
@@ -88,3 +89,38 @@ def test_people_must_match_detections():
         draw_detections(np.zeros((10, 10, 3), np.uint8), [], [Person(0, 1.0, 0.0)])
     picture = draw_detections(np.zeros((500, 600, 3), np.uint8), [_standing(300)], [None])
     assert not np.any(np.all(picture == ARROW_COLOUR, axis=-1))
+
+
+def _disjoint(a: tuple[int, int, int, int], b: tuple[int, int, int, int]) -> bool:
+    return a[2] <= b[0] or b[2] <= a[0] or a[3] <= b[1] or b[3] <= a[1]
+
+
+def test_labels_of_neighbours_do_not_overlap_and_stay_over_their_boxes():
+    """Five people side by side with labels wider than their boxes, two cut by the image's top and left edges."""
+    boxes = [(-20, 5, 90, 400), (60, 40, 170, 420), (150, 10, 260, 400), (240, 40, 350, 420), (330, 30, 440, 420)]
+    sizes = [(150, 40)] * len(boxes)
+    corners = place_labels(sizes, boxes, (480, 460))
+    blocks = [(u, v, u + w, v + h) for (u, v), (w, h) in zip(corners, sizes, strict=True)]
+    for i, a in enumerate(blocks):
+        assert min(a[:2]) >= 0 and a[2] <= 460 and a[3] <= 480  # inside the image
+        assert boxes[i][0] <= (a[0] + a[2]) / 2 <= boxes[i][2]  # centred over its own box's columns
+        assert all(_disjoint(a, b) for b in blocks[i + 1 :]), f"labels {i} and another overlap: {blocks}"
+    assert corners[0] == (0, 0)  # a label with room keeps its place above its box, clamped inside the image
+
+
+def test_overlay_places_neighbouring_labels_apart(monkeypatch):
+    import sid.perception.overlay as overlay
+
+    drawn = []
+    draw_block = overlay._draw_block
+
+    def record(image, lines, left, top, scale):
+        w, h = overlay._block_size(lines, scale)
+        drawn.append((left, top, left + w, top + h))
+        draw_block(image, lines, left, top, scale)
+
+    monkeypatch.setattr(overlay, "_draw_block", record)
+    people = [Person(i, 2.0 + i, 0.5 * i, 0.1) for i in range(3)]
+    draw_detections(np.zeros((500, 600, 3), np.uint8), [_standing(u) for u in (200, 260, 320)], people)
+    assert len(drawn) == 3
+    assert all(_disjoint(a, b) for i, a in enumerate(drawn) for b in drawn[i + 1 :]), drawn

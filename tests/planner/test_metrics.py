@@ -58,6 +58,24 @@ def test_path_around_the_group_stays_out():
     assert m["goal_in_group_zone"] is False
 
 
+def test_every_group_counts_not_only_the_first():
+    """Two groups; the paths stay far from the trio (the first) and cross, or end in, the pair's zone (the second)."""
+    pair_people = [Person(4, 4.0, 5.6, -math.pi / 2), Person(5, 4.0, 4.4, math.pi / 2)]
+    pair = Group((4, 5), (4.0, 5.0), 0.0, np.array([[4.0, 5.0]]), 0.6)
+    people, groups = TRIO + pair_people, [trio_group(), pair]
+    zone = group_zone_polygon(pair, people)
+    for path, crosses, ends_inside in (
+        (np.array([[0.0, 5.0], [8.0, 5.0]]), True, False),  # between the two members
+        (np.array([[0.0, 5.0], [3.9, 5.0]]), False, True),  # stops short of them, inside the zone
+    ):
+        assert group_zone_polygon(groups[0], people).distance(LineString(path)) > 2.0
+        m = path_metrics(path, people, groups)
+        chord = zone.intersection(LineString(path)).length
+        assert m["ospace_intrusion_m"] == pytest.approx(chord) and chord > 0.15
+        assert m["crosses_group"] is crosses
+        assert m["goal_in_group_zone"] is ends_inside
+
+
 def test_bands_of_a_path_at_constant_distance():
     person = Person(7, 0.0, 0.0, 0.0)
     for radius, band in ((0.3, "intimate"), (1.0, "personal"), (2.0, "social")):

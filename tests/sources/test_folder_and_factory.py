@@ -15,6 +15,7 @@ from sid.sources import FrameReadError, SourceError, open_source, skip_unreadabl
 from sid.sources.folder import FolderSource
 from sid.sources.librealsense import record_synthetic
 from sid.sources.realsense import RealSenseSource
+from sid.sources.synthetic import SyntheticSource
 
 INTR = {"width": 64, "height": 48, "fx": 50.0, "fy": 50.0, "cx": 31.5, "cy": 23.5, "depth_scale_m": 0.001}
 
@@ -138,9 +139,8 @@ def test_open_source_dispatch_and_errors(tmp_path: Path) -> None:
 
 
 def test_synthetic_spec_is_delegated() -> None:
-    synthetic = pytest.importorskip("sid.sources.synthetic", reason="the synthetic source is another module's job")
     source = open_source("synthetic:S1", frames=1)
-    assert isinstance(source, synthetic.SyntheticSource)
+    assert isinstance(source, SyntheticSource)
     assert len(list(source)) == 1
 
 

@@ -182,7 +182,7 @@ def test_specs_scenarios_and_errors(tmp_path: Path) -> None:
         SyntheticSource("S1", frames=-1)
     with pytest.raises(TypeError, match="Scene"):
         SyntheticSource(42)
-    with pytest.raises(ValueError, match="margins"):
+    with pytest.raises(ValueError, match="occlusion_margin"):
         SyntheticSource("S1", occlusion_margin=-0.1)
     with pytest.raises(ValueError, match="fps"):
         SyntheticSource("S1", fps=0.0)

@@ -15,27 +15,24 @@ from typing import Any
 
 import numpy as np
 
+from sid.experiments.bench.runner import RunSettings, measure_parts
 from sid.perception.pose import MoveNetSinglePose, load_pose_estimator
 from sid.perception.pose.base import check_boxes, check_color_image
 
 WARMUP = 3
 
 
-def _median_ms(samples: list[int]) -> float:
-    return float(np.median(samples)) / 1e6
-
-
 def _time_stages(stages: Callable[[], tuple[int, int, int]], runs: int) -> dict[str, float]:
-    for _ in range(WARMUP):
-        stages()
-    pre, infer, post = zip(*(stages() for _ in range(runs)), strict=True)
-    total = [a + b + c for a, b, c in zip(pre, infer, post, strict=True)]
-    return {
-        "preprocess_ms": _median_ms(list(pre)),
-        "inference_ms": _median_ms(list(infer)),
-        "postprocess_ms": _median_ms(list(post)),
-        "total_ms": _median_ms(total),
-    }
+    """Median milliseconds of each part of ``stages()`` ((preprocess, inference, postprocess) in ns) and of their
+    sum, over ``runs`` timed calls after ``WARMUP`` untimed ones (``sid.experiments.bench.runner``)."""
+
+    def parts() -> dict[str, float]:
+        pre, infer, post = stages()
+        return {"preprocess_ms": pre / 1e6, "inference_ms": infer / 1e6, "postprocess_ms": post / 1e6,
+                "total_ms": (pre + infer + post) / 1e6}  # fmt: skip
+
+    settings = RunSettings(warmup=WARMUP, min_runs=runs, max_runs=runs, budget_s=1.0)  # exactly ``runs`` calls
+    return {name: stats.median_ms for name, stats in measure_parts(parts, settings).items()}
 
 
 def _strips(image_hw: Sequence[int], count: int) -> np.ndarray:
@@ -44,10 +41,11 @@ def _strips(image_hw: Sequence[int], count: int) -> np.ndarray:
     return np.stack([edges[:-1], np.full(count, -0.5), edges[1:], np.full(count, h - 0.5)], axis=1)
 
 
-def timed_call(estimator: Any, image: np.ndarray) -> tuple[tuple[int, int, int], int]:
-    """One whole-image call split into stages: ((preprocess, inference, postprocess) in ns, people found)."""
+def timed_call(estimator: Any, image: np.ndarray, box: np.ndarray | None = None) -> tuple[tuple[int, int, int], int]:
+    """One call split into stages: ((preprocess, inference, postprocess) in ns, people found). ``box``: the crop
+    (u_min, v_min, u_max, v_max) of a SinglePose call; None: the whole image."""
     t0 = time.perf_counter_ns()
-    tensor, letterbox = estimator.preprocess(image)
+    tensor, letterbox = estimator.preprocess(image) if box is None else estimator.preprocess(image, box)
     t1 = time.perf_counter_ns()
     output = estimator.infer(tensor)
     t2 = time.perf_counter_ns()
@@ -111,17 +109,8 @@ def _bench_crops(
         chosen = check_boxes(boxes)[np.arange(count) % len(boxes)]
 
     def crop_loop() -> tuple[int, int, int]:
-        pre = infer = post = 0
-        for box in chosen:
-            t0 = time.perf_counter_ns()
-            tensor, letterbox = estimator.preprocess(image, box)
-            t1 = time.perf_counter_ns()
-            output = estimator.infer(tensor)
-            t2 = time.perf_counter_ns()
-            estimator.decode(output, letterbox, image.shape[:2])
-            t3 = time.perf_counter_ns()
-            pre, infer, post = pre + t1 - t0, infer + t2 - t1, post + t3 - t2
-        return pre, infer, post
+        pre, infer, post = zip(*(timed_call(estimator, image, box)[0] for box in chosen), strict=True)
+        return sum(pre), sum(infer), sum(post)
 
     times = _time_stages(crop_loop, runs)
     return times | {"per_crop_total_ms": times["total_ms"] / count}

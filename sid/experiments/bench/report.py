@@ -20,10 +20,12 @@ import json
 import os
 import platform
 import subprocess
-from datetime import UTC, datetime
+from datetime import datetime, timezone
 from importlib import metadata
 from pathlib import Path
 from typing import Any
+
+from sid.cpu import physical_cores, usable_cpus
 
 FORMAT = "sid-bench/1"
 LIBRARIES = ("numpy", "scipy", "scikit-learn", "shapely", "opencv-python-headless", "onnxruntime", "ompl",
@@ -44,21 +46,6 @@ def _cpu_model() -> str:
     return platform.processor() or platform.machine()
 
 
-def _physical_cores() -> int | None:
-    """Distinct (physical id, core id) pairs of /proc/cpuinfo; None where it is not available."""
-    try:
-        cores, package = set(), "0"
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            key, _, value = line.partition(":")
-            if key.strip() == "physical id":
-                package = value.strip()
-            elif key.strip() == "core id":
-                cores.add((package, value.strip()))
-        return len(cores) or None
-    except OSError:
-        return None
-
-
 def _commit(repo: Path) -> str | None:
     try:
         head = subprocess.run(["git", "-C", str(repo), "rev-parse", "--short", "HEAD"], capture_output=True,
@@ -75,8 +62,8 @@ def machine_info(repo: Path) -> dict[str, Any]:
     info: dict[str, Any] = {
         "cpu": _cpu_model(),
         "logical_cores": os.cpu_count(),
-        "physical_cores": _physical_cores(),
-        "usable_cores": len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count(),
+        "physical_cores": physical_cores(range(os.cpu_count() or 1)),
+        "usable_cores": len(usable_cpus()),
         "load_average": [round(v, 2) for v in os.getloadavg()] if hasattr(os, "getloadavg") else None,
         "platform": platform.platform(),
         "python": platform.python_version(),
@@ -93,7 +80,7 @@ def machine_info(repo: Path) -> dict[str, Any]:
     except ImportError:
         info["onnxruntime_providers"] = None
     info["commit"] = _commit(repo)
-    info["date"] = datetime.now(UTC).isoformat(timespec="seconds")
+    info["date"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
     return info
 
 

@@ -15,7 +15,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -24,10 +24,12 @@ from sid.experiments.bench.pose import timed_call
 from sid.experiments.bench.runner import RunSettings, Stats, measure, measure_parts
 from sid.perception.people import Person
 
+if TYPE_CHECKING:
+    from sid.experiments.harness import Task
+
 GROUP_SIZES = (2, 3, 4, 6, 20)
 DBSCAN_SIZES = (4, 20)
 FRAME_SIZES = (2, 3, 4, 6)
-PLAN_BUDGET_S = 0.5
 
 # The paper's Table 2 (ms per frame on a Jetson Orin NX, NOTES section 6) for 2 / 3 / 4 people.
 PAPER_POSE_MS = {2: 3.15, 3: 2.86, 4: 3.32}
@@ -438,12 +440,14 @@ def _costmap_setup(ctx: Context) -> dict[str, Any]:
 
 def _bench_costmap_update(social: bool) -> Callable[[Context], Records]:
     def run(ctx: Context) -> Records:
-        from costmap.layered import LayeredCostmap
+        from costmap.layer import LayerInputs
+        from costmap.plugins import CostmapParams, layered_costmap
 
         setup = _costmap_setup(ctx)
-        layered = LayeredCostmap(setup["spec"], social=social)
+        params = CostmapParams() if social else CostmapParams().without("social")
+        layered = layered_costmap(setup["spec"], params)
         frames, counter = setup["frames"], iter(range(10**9))
-        stats = measure(lambda: layered.update(*frames[next(counter) % 2]), ctx.settings)
+        stats = measure(lambda: layered.update(LayerInputs(*frames[next(counter) % 2])), ctx.settings)
         name = "costmap/update" if social else "costmap/update_no_social"
         people, groups, _ = frames[0]
         return {name: record(stats, cells=setup["spec"].width * setup["spec"].height, beams=720,
@@ -453,62 +457,51 @@ def _bench_costmap_update(social: bool) -> Callable[[Context], Records]:
 
 
 def _bench_inflation(ctx: Context) -> Records:
-    from costmap.layered import LayeredCostmap
+    from costmap.layer import LayerInputs
+    from costmap.layers.inflation import InflationLayer, InflationParams
+    from costmap.plugins import layered_costmap
 
     setup = _costmap_setup(ctx)
-    layered = LayeredCostmap(setup["spec"])
-    layered.update(*setup["frames"][0])
+    spec = setup["spec"]
+    layered = layered_costmap(spec)
+    layered.update(LayerInputs(*setup["frames"][0]))
     master = layered.master.costs.copy()  # walls and bodies (and their inflation, which does not change the result)
     work = master.copy()
+    inflation = InflationLayer(spec, InflationParams(), inscribed_radius=0.25)
 
     def inflate() -> None:
-        np.copyto(work, master)  # apply() writes in place; the 160 kB copy is part of the timing (~10 us)
-        layered.inflation.apply(work)
+        np.copyto(work, master)  # write() works in place; the 160 kB copy is part of the timing (~10 us)
+        inflation.write(work, spec.whole)
 
     stats = measure(inflate, ctx.settings)
     return {"costmap/inflation": record(stats, cells=master.size, method="opencv")}
 
 
-def _planning_setup(ctx: Context) -> dict[str, Any]:
-    """The demo scenario (``sid.experiments.demo``) with the social layer, as ``sid demo`` plans it, and the grid
-    planner's any-angle path as the cost reference."""
+def _planning_task(ctx: Context) -> Task:
+    """``sid.experiments.planner_bench.planner_task``, built once per run."""
+    from sid.experiments.planner_bench import planner_task
 
-    def build() -> dict[str, Any]:
-        from planner.facade import plan
-        from planner.problem import DEFAULT_COST_WEIGHT
-        from sid.experiments.demo import demo_scenario
-        from sid.perception.groups import detect_groups
-        from sid.scenario.build import build_costmap, planning_problem
-
-        scenario = demo_scenario()
-        groups = detect_groups(scenario.people, scenario.group_params)
-        layered = build_costmap(scenario, social=True, groups=groups)
-        problem = planning_problem(scenario, layered.master, DEFAULT_COST_WEIGHT)
-        return {"problem": problem, "reference_cost": plan(problem, "grid").cost}
-
-    return ctx.cached("planning", build)
+    return ctx.cached("planning", planner_task)
 
 
 def _bench_plan(planner: str) -> Callable[[Context], Records]:
     def run(ctx: Context) -> Records:
         from planner.facade import plan
+        from sid.experiments.planner_bench import TARGET_BUDGET_S, bench_planner, meets_target
 
-        setup = _planning_setup(ctx)
-        problem, reference = setup["problem"], setup["reference_cost"]
+        task = _planning_task(ctx)
         if planner == "grid":  # deterministic: timed like any other stage
-            stats = measure(lambda: plan(problem, "grid"), ctx.settings)
+            stats = measure(lambda: plan(task.problems["with"], "grid"), ctx.settings)
             return {"plan/grid": record(stats, cost_ratio=1.0, success_rate=1.0)}
-        results = [plan(problem, planner, time_limit=PLAN_BUDGET_S, seed=seed) for seed in range(1, ctx.plan_runs + 1)]
-        ok = [r for r in results if r.success]
-        ratios = [r.cost / reference for r in ok]
-        stats = Stats.of([r.planning_time_s * 1e3 for r in results])
+        runs, row = bench_planner(task, planner, ctx.plan_runs)
         return {
             f"plan/{planner}": record(
-                stats,
-                budget_s=PLAN_BUDGET_S,
-                success_rate=len(ok) / len(results),
-                cost_ratio=float(np.median(ratios)) if ratios else None,
-                worst_cost_ratio=max(ratios) if ratios else None,
+                Stats.of([run.result.planning_time_s * 1e3 for run in runs]),
+                budget_s=TARGET_BUDGET_S,
+                success_rate=row["success_rate"],
+                cost_ratio=row["median_cost_ratio"],
+                worst_cost_ratio=row["worst_cost_ratio"],
+                meets_target=meets_target(row),
             )
         }
 

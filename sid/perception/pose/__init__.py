@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 from sid.perception.pose.base import Letterbox, PoseEstimator
 from sid.perception.pose.contracts import (
@@ -67,7 +68,7 @@ def load_pose_estimator(
     name = detect_contract(model.signature, contract, source=str(model.path))
     if iou_threshold is not None and name != YOLO_POSE:
         raise ValueError(f"pose: iou_threshold applies to yolo_pose models only, this one is {name}")
-    options = {} if score_threshold is None else {"score_threshold": score_threshold}
+    options: dict[str, Any] = {} if score_threshold is None else {"score_threshold": score_threshold}
     if name == MOVENET_MULTIPOSE:
         return MoveNetMultiPose(model, size=input_size, **options)
     if name == MOVENET_SINGLEPOSE:

@@ -15,6 +15,7 @@ from typing import Protocol, runtime_checkable
 import cv2
 import numpy as np
 
+from sid.checks import check_number, check_numbers
 from sid.perception.keypoints import PoseDetection
 
 
@@ -48,10 +49,8 @@ class Letterbox:
     input_size: tuple[int, int]
 
     def __post_init__(self) -> None:
-        if not (np.isfinite(self.scale) and self.scale > 0):
-            raise ValueError(f"letterbox: scale must be positive and finite, got {self.scale}")
-        if not (np.isfinite(self.pad_x) and np.isfinite(self.pad_y)):
-            raise ValueError(f"letterbox: padding must be finite, got ({self.pad_x}, {self.pad_y})")
+        check_number("letterbox", "scale", self.scale, low=0, low_open=True)
+        check_numbers("letterbox", self, ("pad_x", "pad_y"), unit="pixels")
         if min(self.input_size) <= 0:
             raise ValueError(f"letterbox: input size must be positive, got {self.input_size}")
 

@@ -8,8 +8,9 @@ one fits a model; naming a contract explicitly only adds a check.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -17,7 +18,7 @@ MOVENET_MULTIPOSE = "movenet_multipose"
 MOVENET_SINGLEPOSE = "movenet_singlepose"
 YOLO_POSE = "yolo_pose"
 
-_ORT_DTYPES = {
+_ORT_DTYPES: dict[str, np.dtype] = {
     "tensor(float)": np.dtype(np.float32),
     "tensor(float16)": np.dtype(np.float16),
     "tensor(double)": np.dtype(np.float64),
@@ -53,7 +54,7 @@ class ModelSignature:
     outputs: tuple[TensorSpec, ...]
 
     @classmethod
-    def from_session(cls, session) -> ModelSignature:  # noqa: ANN001 - onnxruntime.InferenceSession
+    def from_session(cls, session: Any) -> ModelSignature:  # an onnxruntime.InferenceSession
         return cls(tuple(_spec(a) for a in session.get_inputs()), tuple(_spec(a) for a in session.get_outputs()))
 
     def __str__(self) -> str:
@@ -73,9 +74,15 @@ class Contract:
     """Returns None when the signature fits this contract, else the reason it does not."""
 
 
-def _spec(arg) -> TensorSpec:  # noqa: ANN001 - onnxruntime.NodeArg
+def _spec(arg: Any) -> TensorSpec:  # an onnxruntime.NodeArg
     shape = tuple(d if isinstance(d, int) and d > 0 else None for d in (arg.shape or ()))
     return TensorSpec(arg.name, _ORT_DTYPES.get(arg.type), shape)
+
+
+def fixed_hw(dims: Sequence[int | None]) -> tuple[int, int] | None:
+    """An input's two spatial dimensions (height, width) in pixels, or None when either is dynamic."""
+    height, width = dims[0], dims[1]
+    return None if height is None or width is None else (height, width)
 
 
 def _dim_is(dim: int | None, *allowed: int) -> bool:

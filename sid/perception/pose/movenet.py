@@ -13,7 +13,7 @@ import numpy as np
 
 from sid.perception.keypoints import NUM_KEYPOINTS, PoseDetection
 from sid.perception.pose.base import Letterbox, check_boxes, check_color_image, clip_boxes
-from sid.perception.pose.contracts import MOVENET_MULTIPOSE, MOVENET_SINGLEPOSE
+from sid.perception.pose.contracts import MOVENET_MULTIPOSE, MOVENET_SINGLEPOSE, fixed_hw
 from sid.perception.pose.session import OnnxModel
 
 PAD_VALUE = 0  # tf.image.resize_with_pad pads with zeros
@@ -22,9 +22,8 @@ PAPER_WIDTH = 128  # the paper authors' choice: 128 px wide, keeping the aspect 
 MULTIPOSE_DEFAULT_THRESHOLD = 0.2
 SINGLEPOSE_DEFAULT_THRESHOLD = 0.2
 # Crops for SinglePose: a square 1.2 x the box's longer side, blacked out beyond 10 % of the box's size around it.
-# Without the mask a tall person's square crop shows the neighbours and MoveNet may take their shoulders; on
-# ../shared/data/rgbd/five_people (YOLO boxes) masking raised the mean shoulder/hip score from 0.42 to 0.67 and
-# kept every shoulder and hip inside its own person's box (expand 1.0-1.3 and margins 0-0.2 all tried).
+# Without the mask a tall person's square crop shows the neighbours and MoveNet may take their shoulders (measured
+# choice: docs/parameters.md).
 CROP_EXPAND = 1.2
 CROP_MARGIN = 0.1
 
@@ -90,8 +89,7 @@ class MoveNetMultiPose:
     ):
         self.model = model
         self.score_threshold = float(score_threshold)
-        fixed = model.signature.inputs[0].shape[1:3]
-        self._fixed = (fixed[0], fixed[1]) if None not in fixed else None
+        self._fixed = fixed_hw(model.signature.inputs[0].shape[1:3])
         requested = tuple(size) if isinstance(size, (list, tuple)) else size
         if self._fixed is not None and requested is not None and requested != self._fixed:
             raise ValueError(f"movenet: this MultiPose model has a fixed input {self._fixed}, cannot use size {size!r}")
@@ -159,11 +157,11 @@ class MoveNetSinglePose:
         if self.crop_margin < 0:
             raise ValueError(f"movenet: crop_margin must be >= 0, got {crop_margin}")
         spec = model.signature.inputs[0]
-        fixed = spec.shape[1:3]
-        if None not in fixed:
-            if size is not None and (size, size) != tuple(fixed):
-                raise ValueError(f"movenet: this SinglePose model has a fixed input {tuple(fixed)}, cannot use {size}")
-            self._size = (int(fixed[0]), int(fixed[1]))
+        fixed = fixed_hw(spec.shape[1:3])
+        if fixed is not None:
+            if size is not None and (size, size) != fixed:
+                raise ValueError(f"movenet: this SinglePose model has a fixed input {fixed}, cannot use {size}")
+            self._size = fixed
         else:
             side = 192 if size is None else int(size)
             if side < 32:

@@ -1,7 +1,7 @@
 """Opening an ONNX model with onnxruntime, with session options chosen for a real-time perception loop.
 
 Choices (see docs/models.md):
-- ``intra_op_num_threads`` = physical cores this process may use (2 on the reference machine): one inference uses
+- ``intra_op_num_threads`` = physical cores this process may use (``sid.cpu.physical_cores``): one inference uses
   every core; hyper-threads add little to convolution throughput and contend with the rest of the pipeline.
 - ``inter_op_num_threads`` = 1 with sequential execution: pose graphs are a single chain of layers, there is no
   parallel branch worth a second thread pool.
@@ -14,41 +14,16 @@ Choices (see docs/models.md):
 
 from __future__ import annotations
 
-import os
 from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 import onnxruntime as ort
 
+from sid.cpu import physical_cores
 from sid.perception.pose.contracts import ModelSignature, PoseModelError, supported_contracts_text
 
 PREFERRED_PROVIDERS: tuple[str, ...] = ("TensorrtExecutionProvider", "CUDAExecutionProvider", "CPUExecutionProvider")
-
-
-def physical_cores() -> int:
-    """Physical CPU cores this process may run on (SMT siblings counted once); at least 1.
-
-    Reads the (physical id, core id) pairs of the allowed CPUs from /proc/cpuinfo (Linux); elsewhere falls back to
-    the number of usable logical CPUs.
-    """
-    try:
-        allowed = os.sched_getaffinity(0)
-    except AttributeError:  # not Linux
-        return max(1, os.cpu_count() or 1)
-    try:
-        cores, processor, package = set(), None, "0"
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            key, _, value = (part.strip() for part in line.partition(":"))
-            if key == "processor":
-                processor, package = int(value), "0"
-            elif key == "physical id":
-                package = value
-            elif key == "core id" and processor in allowed:
-                cores.add((package, value))
-        return max(1, len(cores) or len(allowed))
-    except (OSError, ValueError):
-        return max(1, len(allowed))
 
 
 def default_providers() -> list[str]:

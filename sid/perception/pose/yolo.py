@@ -5,9 +5,8 @@ Pre-processing follows Ultralytics' ``LetterBox``: keep the aspect ratio, centre
 exports such as the reference 256 px model); which one is found once, on a blank image, when the model is loaded.
 
 NMS is OpenCV's ``cv2.dnn.NMSBoxes`` (greedy, by score, IoU on (x, y, w, h) boxes), the same algorithm as the
-torchvision NMS Ultralytics uses. On the five-people frame 49 candidates pass the score threshold; NMSBoxes keeps
-the same 5 as a vectorised numpy greedy NMS in 9 us instead of 63 us (medians of 2000 calls), so the library
-call is both simpler and faster than writing our own.
+torchvision NMS Ultralytics uses; it keeps the same boxes as a numpy greedy NMS, faster (docs/parameters.md), so
+the library call is both simpler and faster than writing our own.
 """
 
 from __future__ import annotations
@@ -19,7 +18,7 @@ import numpy as np
 
 from sid.perception.keypoints import NUM_KEYPOINTS, PoseDetection
 from sid.perception.pose.base import Letterbox, check_color_image, clip_boxes
-from sid.perception.pose.contracts import YOLO_POSE, yolo_layout
+from sid.perception.pose.contracts import YOLO_POSE, fixed_hw, yolo_layout
 from sid.perception.pose.session import OnnxModel
 
 PAD_VALUE = 114  # Ultralytics LetterBox fill
@@ -49,11 +48,11 @@ class YoloPose:
             raise ValueError(f"yolo: iou_threshold must be in (0, 1], got {iou_threshold}")
         spec = model.signature.inputs[0]
         self.layout = yolo_layout(spec)
-        fixed = spec.shape[2:4] if self.layout == "nchw" else spec.shape[1:3]
-        if None not in fixed:
-            if size is not None and tuple(np.broadcast_to(size, 2)) != tuple(fixed):
-                raise ValueError(f"yolo: this model has a fixed input {tuple(fixed)}, cannot use size {size!r}")
-            self._size = (int(fixed[0]), int(fixed[1]))
+        fixed = fixed_hw(spec.shape[2:4] if self.layout == "nchw" else spec.shape[1:3])
+        if fixed is not None:
+            if size is not None and tuple(np.broadcast_to(size, 2)) != fixed:
+                raise ValueError(f"yolo: this model has a fixed input {fixed}, cannot use size {size!r}")
+            self._size = fixed
         else:
             h, w = (int(x) for x in np.broadcast_to(DEFAULT_SIZE if size is None else size, 2))
             if min(h, w) < 32 or h % 32 or w % 32:
@@ -104,8 +103,8 @@ class YoloPose:
             self.score_threshold,
             self.iou_threshold,
         )
-        keep = np.asarray(keep, dtype=int).reshape(-1)
-        candidates, corners = candidates[keep], corners[keep]
+        kept = np.asarray(keep, dtype=int).reshape(-1)
+        candidates, corners = candidates[kept], corners[kept]
         kpts = candidates[:, 5:].reshape(-1, NUM_KEYPOINTS, 3)
         unit = 1.0 if self.normalised else 1.0 / np.array(self._size[::-1], dtype=float)  # input px -> [0, 1]
         keypoints = letterbox.normalised_to_image(kpts[..., :2] * unit)

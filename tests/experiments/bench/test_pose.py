@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from sid.experiments.bench.pose import bench_pose
-from sid.testing import build_multipose_model, build_singlepose_model
+from tests.pose_models import build_multipose_model, build_singlepose_model
 
 IMAGE = np.zeros((120, 160, 3), np.uint8)
 STAGES = {"preprocess_ms", "inference_ms", "postprocess_ms", "total_ms"}

@@ -7,6 +7,7 @@ import onnxruntime as ort
 import pytest
 from onnx import TensorProto, helper
 
+from sid.cpu import physical_cores
 from sid.perception.pose import PoseEstimator, load_pose_estimator
 from sid.perception.pose.contracts import (
     CONTRACTS,
@@ -15,8 +16,8 @@ from sid.perception.pose.contracts import (
     TensorSpec,
     detect_contract,
 )
-from sid.perception.pose.session import physical_cores, session_options
-from sid.testing import build_multipose_model, build_singlepose_model, build_yolo_pose_model
+from sid.perception.pose.session import session_options
+from tests.pose_models import build_multipose_model, build_singlepose_model, build_yolo_pose_model
 
 
 def _signature(in_dtype, in_shape, out_shape, out_dtype=np.float32) -> ModelSignature:

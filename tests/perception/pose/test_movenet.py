@@ -7,7 +7,7 @@ import pytest
 
 from sid.perception.keypoints import NUM_KEYPOINTS
 from sid.perception.pose import MoveNetMultiPose, MoveNetSinglePose, load_pose_estimator
-from sid.testing import build_multipose_model, build_singlepose_model
+from tests.pose_models import build_multipose_model, build_singlepose_model
 
 
 def _person(y: float, x: float, score: float, box=(0.1, 0.2, 0.6, 0.4), box_score: float = 0.9) -> np.ndarray:

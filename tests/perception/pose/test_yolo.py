@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from sid.perception.pose import YoloPose, load_pose_estimator
-from sid.testing import build_yolo_pose_model, yolo_candidate
+from tests.pose_models import build_yolo_pose_model, yolo_candidate
 
 IMAGE = np.zeros((480, 640, 3), np.uint8)  # in 256x256: scale 0.4, 32 px bands above and below
 

@@ -1,11 +1,11 @@
-"""Tiny ONNX models with the signatures of the supported contracts, for tests and demos without real weights.
+"""Tiny ONNX models with the signatures of the supported contracts, for tests without real weights.
 
 Each model answers a crafted output. A "marker" model also looks at its input: it finds the brightest pixel of the
 red channel and adds that pixel centre's normalised (y, x) to the crafted keypoints (and boxes), so a test can put
 a red dot in an image and check that the keypoint comes back on the dot in image pixels (this checks RGB order,
 dtype, letterboxing and the inverse map together).
 
-Needs the ``onnx`` package (a test dependency of sid, not a runtime one).
+Needs the ``onnx`` package (in sid's ``test`` extra, not a runtime dependency).
 """
 
 from __future__ import annotations
@@ -14,25 +14,17 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
+import onnx
+from onnx import TensorProto, helper, numpy_helper
 
 OPSET = 17
 IR_VERSION = 8  # loadable by every onnxruntime sid supports (>= 1.17)
 
 
-def _onnx():
-    try:
-        import onnx
-        from onnx import TensorProto, helper, numpy_helper
-    except ImportError as exc:  # pragma: no cover - depends on the environment
-        raise ImportError("sid.testing builds ONNX models and needs the 'onnx' package: pip install onnx") from exc
-    return onnx, TensorProto, helper, numpy_helper
-
-
 def _build(path: str | Path, nodes: list, x_info, y_info, initializers: dict[str, np.ndarray]) -> Path:
-    onnx, _, helper, numpy_helper = _onnx()
     inits = [numpy_helper.from_array(np.asarray(v), name=k) for k, v in initializers.items()]
     graph = helper.make_graph(nodes, "sid_test_pose_model", [x_info], [y_info], initializer=inits)
-    model = helper.make_model(graph, opset_imports=[helper.make_opsetid("", OPSET)], producer_name="sid.testing")
+    model = helper.make_model(graph, opset_imports=[helper.make_opsetid("", OPSET)], producer_name="sid tests")
     model.ir_version = IR_VERSION
     onnx.checker.check_model(model)
     path = Path(path)
@@ -42,7 +34,6 @@ def _build(path: str | Path, nodes: list, x_info, y_info, initializers: dict[str
 
 def _marker_nodes(channels_last: bool = True) -> tuple[list, dict[str, np.ndarray]]:
     """Nodes computing ``marker_y``, ``marker_x`` ([1] float): normalised centre of the brightest red pixel of X."""
-    _, _, helper, _ = _onnx()
     h_axis, w_axis, c_axis = (1, 2, 3) if channels_last else (2, 3, 1)
     return [
         helper.make_node("Slice", ["X", "c0", "c1", "c_axis"], ["red"]),
@@ -72,7 +63,6 @@ def _marker_nodes(channels_last: bool = True) -> tuple[list, dict[str, np.ndarra
 
 def _crafted_output(base: np.ndarray, y_mask: np.ndarray, x_mask: np.ndarray, marker: bool, channels_last=True):
     """Nodes and constants for Y = base + marker_y * y_mask + marker_x * x_mask (masks zero without a marker)."""
-    _, _, helper, _ = _onnx()
     nodes, consts = _marker_nodes(channels_last)
     scale = np.float32(1.0 if marker else 0.0)
     consts |= {"base": base.astype(np.float32), "y_mask": scale * y_mask, "x_mask": scale * x_mask}
@@ -96,14 +86,15 @@ def build_multipose_model(
     With ``marker`` the marker's normalised (y, x) is added to person 0's keypoint and box (y, x) entries.
     ``input_hw`` None entries are dynamic dimensions.
     """
-    _, tp, helper, _ = _onnx()
     base = np.zeros((1, 6, 56), np.float32) if people is None else np.asarray(people, np.float32).reshape(1, 6, 56)
     y_mask, x_mask = np.zeros((1, 6, 56), np.float32), np.zeros((1, 6, 56), np.float32)
     y_mask[0, 0, [*range(0, 51, 3), 51, 53]] = 1.0
     x_mask[0, 0, [*range(1, 51, 3), 52, 54]] = 1.0
     nodes, consts = _crafted_output(base, y_mask, x_mask, marker)
-    x_info = helper.make_tensor_value_info("X", tp.INT32, [1, input_hw[0] or "height", input_hw[1] or "width", 3])
-    y_info = helper.make_tensor_value_info("Y", tp.FLOAT, [1, 6, 56])
+    x_info = helper.make_tensor_value_info(
+        "X", TensorProto.INT32, [1, input_hw[0] or "height", input_hw[1] or "width", 3]
+    )
+    y_info = helper.make_tensor_value_info("Y", TensorProto.FLOAT, [1, 6, 56])
     return _build(path, nodes, x_info, y_info, consts)
 
 
@@ -116,14 +107,13 @@ def build_singlepose_model(
 ) -> Path:
     """MoveNet SinglePose signature: uint8/int32 [1, size, size, 3] -> float32 [1, 1, 17, 3] equal to
     ``keypoints`` (17, 3) as (y, x, score); with ``marker`` the marker's (y, x) is added to every keypoint."""
-    _, tp, helper, _ = _onnx()
     base = np.zeros((1, 1, 17, 3), np.float32) if keypoints is None else np.asarray(keypoints).reshape(1, 1, 17, 3)
     y_mask, x_mask = np.zeros((1, 1, 17, 3), np.float32), np.zeros((1, 1, 17, 3), np.float32)
     y_mask[..., 0], x_mask[..., 1] = 1.0, 1.0
     nodes, consts = _crafted_output(base, y_mask, x_mask, marker)
-    elem = {np.dtype(np.uint8): tp.UINT8, np.dtype(np.int32): tp.INT32}[np.dtype(dtype)]
+    elem = {np.dtype(np.uint8): TensorProto.UINT8, np.dtype(np.int32): TensorProto.INT32}[np.dtype(dtype)]
     x_info = helper.make_tensor_value_info("X", elem, [1, size, size, 3])
-    y_info = helper.make_tensor_value_info("Y", tp.FLOAT, [1, 1, 17, 3])
+    y_info = helper.make_tensor_value_info("Y", TensorProto.FLOAT, [1, 1, 17, 3])
     return _build(path, nodes, x_info, y_info, consts)
 
 
@@ -135,14 +125,13 @@ def build_yolo_pose_model(
 ) -> Path:
     """YOLO-pose signature: float32 [1, H, W, 3] (``layout="nhwc"``) or [1, 3, H, W] -> float32 [1, 56, N]
     equal to ``candidates`` (56, N): cx, cy, w, h, score, 17 x (x, y, visibility), in whatever units you give."""
-    _, tp, helper, _ = _onnx()
     base = np.asarray(candidates, np.float32).reshape(1, 56, -1)
     zeros = np.zeros_like(base)
     nodes, consts = _crafted_output(base, zeros, zeros, marker=False, channels_last=layout == "nhwc")
     h, w = input_hw
     shape = [1, h, w, 3] if layout == "nhwc" else [1, 3, h, w]
-    x_info = helper.make_tensor_value_info("X", tp.FLOAT, shape)
-    y_info = helper.make_tensor_value_info("Y", tp.FLOAT, list(base.shape))
+    x_info = helper.make_tensor_value_info("X", TensorProto.FLOAT, shape)
+    y_info = helper.make_tensor_value_info("Y", TensorProto.FLOAT, list(base.shape))
     return _build(path, nodes, x_info, y_info, consts)
 
 

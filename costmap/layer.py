@@ -1,0 +1,72 @@
+"""The costmap layer interface, in the spirit of Nav2's costmap_2d plugins.
+
+Every frame, ``LayeredCostmap.update`` hands each layer, in order, the same ``LayerInputs``; the layer updates its own
+uint8 grid and reports the window of cells it changed (Nav2's ``updateBounds``). The master grid is then reset over
+the union of those windows and every layer, in order, writes its grid there with its combination method (Nav2's
+``updateCosts``; methods in ``costmap.combine``). A layer may read the master in ``write`` (inflation does).
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from costmap.combine import CombinationMethod, check_method, combine
+from costmap.grid import FREE_SPACE, GridSpec, Window
+from costmap.scan import LaserScan
+from sid.perception.groups import Group
+from sid.perception.people import Person
+
+
+@dataclass(frozen=True)
+class LayerInputs:
+    """What the layers see in one frame: people and their groups (world frame) and, when there is one, a 2D scan.
+
+    People need finite poses and distinct ids. New kinds of input (tracked people, a robot pose, ...) are new fields
+    with a default, so existing layers and callers are unaffected.
+    """
+
+    people: Sequence[Person] = ()
+    groups: Sequence[Group] = ()
+    scan: LaserScan | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "people", tuple(self.people))
+        object.__setattr__(self, "groups", tuple(self.groups))
+        seen = set()
+        for p in self.people:
+            if not (np.isfinite(p.x) and np.isfinite(p.y)) or (p.theta is not None and not np.isfinite(p.theta)):
+                raise ValueError(f"person {p.id}: pose must be finite, got x={p.x}, y={p.y}, theta={p.theta}")
+            if p.id in seen:
+                raise ValueError(f"person id {p.id} appears twice")
+            seen.add(p.id)
+
+
+class Layer(ABC):
+    """One layer: its own uint8 grid ``costs`` over ``spec`` (Nav2 cost values), written into the master grid with
+    ``combination``. Subclasses set ``name`` (unique within a costmap) and ``combination``, and implement ``update``.
+    """
+
+    name: str
+    combination: CombinationMethod
+
+    def __init__(self, spec: GridSpec, fill: int = FREE_SPACE) -> None:
+        check_method(self.combination)
+        self.spec = spec
+        self.costs = np.full(spec.shape, fill, dtype=np.uint8)
+
+    @abstractmethod
+    def update(self, inputs: LayerInputs, changed: Window | None) -> Window | None:
+        """Bring the layer to this frame's ``inputs``; return the window of cells it changed (None: none).
+
+        ``changed``: the union of the windows the layers before this one changed (and any not yet written).
+        Raise ValueError before changing anything when the inputs cannot be used.
+        """
+
+    def write(self, master: np.ndarray, window: Window) -> None:
+        """Combine this layer's costs into ``master`` (the combined grid) over ``window``."""
+        rows, cols = window.slices
+        combine(master[rows, cols], self.costs[rows, cols], self.combination)

@@ -1,0 +1,263 @@
+"""The with/without comparison harness: plan a scenario's robot task on the LiDAR-only costmap ("without") and on
+the costmap with the social layer ("with"), measure every path alike, and summarise runs.
+
+One ``Task`` per scenario holds its groups (detected from its people with ``sid.perception.groups.detect_groups``),
+the costmap and planning problem of each mode, and the grid planner's cost as the reference for cost ratios. Every
+path is measured against those groups and on the social costmap (``planner.metrics.result_metrics``), also when the
+robot planned without the social layer: "the path went through the conversation" is measured whether or not the
+robot knew about it, and the two modes' numbers compare directly. ``sid demo``, ``sid plan``, ``sid compare``,
+``sid reproduce navigation`` and ``sid bench``'s planner stages all plan through here.
+
+World frame (REP-103), metres, seconds. A run's ``cost_ratio`` is its path cost J over the grid planner's J on the
+same costmap (``raw_cost_ratio``: the planner's own path before smoothing); ``detour`` is, on a "with" run, its
+length over the same planner's "without" length for the same task and seed.
+"""
+
+from __future__ import annotations
+
+import statistics
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field
+from functools import partial
+from typing import Any
+
+from shapely.geometry import Point
+
+from costmap.layered import LayeredCostmap
+from costmap.layers.social import group_zone_polygon
+from planner.facade import PlanResult, plan, resolve_planner
+from planner.metrics import result_metrics
+from planner.problem import DEFAULT_COST_WEIGHT, PlanningError, PlanningProblem
+from sid.perception.groups import Group, detect_groups
+from sid.scenario.build import build_costmap, planning_problem
+from sid.scenario.loader import Scenario
+
+MODES: dict[str, bool] = {"without": False, "with": True}
+"""The two costmap modes by name: whether the costmap has the social layer."""
+LABELS = {"without": "without recognition (LiDAR only)", "with": "with recognition (social layer)"}
+
+
+@dataclass
+class Task:
+    """A scenario ready to plan in both modes; ``labels`` (free JSON-ready fields) go into every run record."""
+
+    scenario: Scenario
+    groups: list[Group]
+    costmaps: dict[str, LayeredCostmap]
+    problems: dict[str, PlanningProblem]
+    labels: dict[str, Any] = field(default_factory=dict)
+    _references: dict[str, PlanResult] = field(default_factory=dict, repr=False)
+
+    def reference_cost(self, mode: str) -> float:
+        """J of the grid planner's path on the mode's costmap (planned once). Raises ``PlanningError`` naming the
+        scenario when its task is impossible."""
+        if mode not in self._references:
+            try:
+                self._references[mode] = plan(self.problems[mode], "grid")
+            except PlanningError as exc:
+                raise PlanningError(f"{self.scenario.name}: {exc}") from exc
+        return self._references[mode].cost
+
+
+def prepare(scenario: Scenario, cost_weight: float = DEFAULT_COST_WEIGHT, labels: dict | None = None) -> Task:
+    """Detect the scenario's groups and build the costmap and planning problem of each mode."""
+    groups = detect_groups(scenario.people, scenario.group_params)
+    costmaps = {mode: build_costmap(scenario, social=s, groups=groups if s else []) for mode, s in MODES.items()}
+    problems = {mode: planning_problem(scenario, c.master, cost_weight) for mode, c in costmaps.items()}
+    return Task(scenario, groups, costmaps, problems, dict(labels or {}))
+
+
+def goal_zone_warning(task: Task) -> str | None:
+    """A message when the robot's goal lies inside a group's interaction zone, else None. The plan is still made:
+    the robot may have to go there (to join or serve the group), and the metrics report the intrusion."""
+    goal = Point(task.scenario.robot.goal[:2])
+    for group in task.groups:
+        if group_zone_polygon(group, task.scenario.people).covers(goal):
+            return (
+                f"the goal lies inside the interaction zone of group {group.members}: the path has to enter it "
+                "(by the shortest way the costs allow); see ospace_intrusion_m"
+            )
+    return None
+
+
+@dataclass(frozen=True)
+class Run:
+    """One plan of a task in one mode: the result, its metrics and its ratios (None where not measured)."""
+
+    scenario: str
+    planner: str
+    mode: str
+    time_limit_s: float
+    max_iterations: int | None
+    result: PlanResult = field(repr=False)
+    metrics: dict
+    labels: dict
+    cost_ratio: float | None = None
+    raw_cost_ratio: float | None = None
+    detour: float | None = None
+
+    @property
+    def social_layer(self) -> bool:
+        return MODES[self.mode]
+
+    def record(self) -> dict:
+        """The run as one flat JSON-ready dict: every metric, then the run's fields, then the task's labels (a
+        label wins over a metric of the same name, e.g. a task's draw ``seed`` over the planner's seed)."""
+        fields = {
+            "scenario": self.scenario,
+            "planner": self.planner,
+            "social_layer": self.social_layer,
+            "time_limit_s": self.time_limit_s,
+            "max_iterations": self.max_iterations,
+            "cost_ratio": self.cost_ratio,
+            "raw_cost_ratio": self.raw_cost_ratio,
+            "detour": self.detour,
+        }
+        return self.metrics | fields | self.labels
+
+
+@dataclass
+class Comparison:
+    """The runs of one task with one planner and budget, keyed by mode ("without", "with")."""
+
+    task: Task
+    runs: dict[str, Run]
+
+    @property
+    def metrics(self) -> dict[str, dict]:
+        return {mode: run.metrics for mode, run in self.runs.items()}
+
+
+Progress = Callable[[str, Run | None], None]
+"""progress(mode, run): called with None before a mode is planned and with its run after."""
+
+
+def compare_with_without(
+    task: Task,
+    planner: str,
+    time_limit: float,
+    seed: int | None = None,
+    max_iterations: int | None = None,
+    modes: Sequence[str] = tuple(MODES),
+    reference: bool = False,
+    progress: Progress | None = None,
+) -> Comparison:
+    """Plan the task in each of ``modes`` with the same planner, budget and OMPL seed, and measure each path.
+
+    reference: also compute cost ratios to the grid planner. Raises ``planner.problem.PlanningError`` when the task
+    is impossible (naming the scenario when ``reference``) and ValueError for an unknown planner or a bad budget.
+    """
+    name = resolve_planner(planner)
+    measure_on = task.costmaps["with"].master
+    runs: dict[str, Run] = {}
+    for mode in modes:
+        reference_cost = task.reference_cost(mode) if reference else None  # an impossible task fails here, named
+        if progress:
+            progress(mode, None)
+        result = plan(task.problems[mode], name, time_limit=time_limit, seed=seed, max_iterations=max_iterations)
+        metrics = result_metrics(result, task.scenario.people, task.groups, measure_on)
+        ratio = raw_ratio = detour = None
+        if reference_cost is not None and result.success:
+            ratio, raw_ratio = result.cost / reference_cost, result.raw_cost / reference_cost
+        without = runs.get("without")
+        if mode == "with" and result.success and without is not None and without.result.success:
+            detour = metrics["path_length_m"] / without.metrics["path_length_m"]
+        runs[mode] = Run(
+            task.scenario.name, name, mode, time_limit, max_iterations, result, metrics, task.labels,
+            ratio, raw_ratio, detour,
+        )  # fmt: skip
+        if progress:
+            progress(mode, runs[mode])
+    return Comparison(task, runs)
+
+
+MatrixProgress = Callable[[int, int, str], None]
+"""progress(done, total, what): called before each plan and once at the end."""
+
+
+def run_matrix(
+    tasks: Sequence[Task],
+    planners: Sequence[str],
+    runs: int = 3,
+    time_limits: Sequence[float] = (0.5,),
+    modes: Sequence[str] = tuple(MODES),
+    max_iterations: int | None = None,
+    progress: MatrixProgress | None = None,
+) -> list[Run]:
+    """Every planner (grid: once, it is deterministic; the others with OMPL seeds 1..``runs``) for every time limit
+    and task, in each mode, with cost ratios to the grid reference."""
+    names = [resolve_planner(p) for p in planners]
+    if runs < 1:
+        raise ValueError(f"runs must be at least 1, got {runs}")
+    jobs = [
+        (task, limit, name, seed)
+        for task in tasks
+        for limit in time_limits
+        for name in names
+        for seed in ([None] if name == "grid" else range(1, runs + 1))
+    ]
+    total = len(jobs) * len(modes)
+    out: list[Run] = []
+
+    def step(what: str, mode: str, run: Run | None) -> None:
+        if run is None and progress:
+            progress(len(out) + list(modes).index(mode), total, f"{what}, {mode} the social layer")
+
+    for task, limit, name, seed in jobs:
+        what = f"{task.scenario.name}: {name}" + ("" if seed is None else f" seed {seed}")
+        comparison = compare_with_without(task, name, limit, seed, max_iterations, modes, True, partial(step, what))
+        out.extend(comparison.runs.values())
+    if progress:
+        progress(total, total, "done")
+    return out
+
+
+def _stat(fn: Callable[[list], float], values: Iterable[float | None]) -> float | None:
+    """``fn`` (median, mean, min, max) of the values that are not None; None when there are none."""
+    present = [v for v in values if v is not None]
+    return float(fn(present)) if present else None
+
+
+def summarise(records: Sequence[dict], by: Sequence[str] = ("planner",)) -> list[dict]:
+    """One row per value of the ``by`` fields and costmap mode, in order of first appearance, "without" first.
+
+    ``records``: ``Run.record()`` dicts (``cost_ratio``, ``raw_cost_ratio`` and ``detour`` may be left out). Rates
+    and path statistics are over successful runs, planning time over all runs. Row fields: the ``by`` fields,
+    social_layer, runs, success_rate, median_planning_time_s, median_cost_ratio, worst_cost_ratio,
+    median_raw_cost_ratio, intrusion_rate (share of paths entering a group zone), mean_intrusion_m,
+    median_intrusion_m, median_intrusion_when_intruding_m, crossing_rate, median_min_person_distance_m,
+    worst_min_person_distance_m, median_length_ratio, median_detour (None where not measured).
+    """
+    buckets: dict[tuple, dict[bool, list[dict]]] = {}
+    for record in records:
+        buckets.setdefault(tuple(record[k] for k in by), {}).setdefault(record["social_layer"], []).append(record)
+    rows = []
+    for values, modes in buckets.items():
+        for social in sorted(modes):
+            members = modes[social]
+            ok = [r for r in members if r["success"]]
+            intrusion = [r["ospace_intrusion_m"] for r in ok]
+            intruding = [v for v in intrusion if v > 0]
+            distances = [r["min_person_distance_m"] for r in ok]
+            rows.append(
+                dict(zip(by, values, strict=True))
+                | {
+                    "social_layer": social,
+                    "runs": len(members),
+                    "success_rate": len(ok) / len(members),
+                    "median_planning_time_s": _stat(statistics.median, (r["planning_time_s"] for r in members)),
+                    "median_cost_ratio": _stat(statistics.median, (r.get("cost_ratio") for r in ok)),
+                    "worst_cost_ratio": _stat(max, (r.get("cost_ratio") for r in ok)),
+                    "median_raw_cost_ratio": _stat(statistics.median, (r.get("raw_cost_ratio") for r in ok)),
+                    "intrusion_rate": len(intruding) / len(ok) if ok else None,
+                    "mean_intrusion_m": _stat(statistics.fmean, intrusion),
+                    "median_intrusion_m": _stat(statistics.median, intrusion),
+                    "median_intrusion_when_intruding_m": _stat(statistics.median, intruding),
+                    "crossing_rate": sum(bool(r["crosses_group"]) for r in ok) / len(ok) if ok else None,
+                    "median_min_person_distance_m": _stat(statistics.median, distances),
+                    "worst_min_person_distance_m": _stat(min, distances),
+                    "median_length_ratio": _stat(statistics.median, (r["length_ratio"] for r in ok)),
+                    "median_detour": _stat(statistics.median, (r.get("detour") for r in ok)) if social else None,
+                }
+            )
+    return rows

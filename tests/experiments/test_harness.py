@@ -1,0 +1,101 @@
+"""The with/without harness: what a run measures, the run matrix, run records and the one summary."""
+
+from __future__ import annotations
+
+import copy
+
+import pytest
+
+from planner.problem import PlanningError
+from sid.experiments.demo import DEMO_SCENARIO, demo_scenario
+from sid.experiments.harness import compare_with_without, goal_zone_warning, prepare, run_matrix, summarise
+from sid.scenario.loader import scenario_from_dict
+
+
+@pytest.fixture(scope="module")
+def task():
+    return prepare(demo_scenario())
+
+
+def test_both_modes_are_measured_on_the_social_costmap_against_the_detected_groups(task):
+    assert [g.members for g in task.groups] == [(1, 2, 3)]  # the lone person 4 is not in the group
+    comparison = compare_with_without(task, "grid", 1.0, reference=True)
+    without, with_ = comparison.runs["without"], comparison.runs["with"]
+    # Without the social layer the robot does not know the group, but its path is still measured against it.
+    assert without.metrics["crosses_group"] is True and without.metrics["ospace_intrusion_m"] > 1.0
+    assert without.metrics["cost_integral"] > with_.metrics["cost_integral"]  # both on the social costs
+    assert without.cost_ratio == with_.cost_ratio == 1.0  # the grid planner is its own reference
+    assert without.detour is None and with_.detour == pytest.approx(
+        with_.metrics["path_length_m"] / without.metrics["path_length_m"]
+    )
+    record = with_.record()
+    assert record["social_layer"] is True and record["planner"] == "grid" and record["scenario"] == task.scenario.name
+    assert record["detour"] == with_.detour and record["path_length_m"] == with_.metrics["path_length_m"]
+
+
+def test_labels_go_into_records_and_win_over_metrics(task):
+    labelled = prepare(task.scenario, labels={"layout": "T3", "seed": 7})
+    run = compare_with_without(labelled, "rrtconnect", 5.0, seed=2, modes=("with",)).runs["with"]
+    assert run.metrics["seed"] == 2  # the planner's seed
+    assert run.record()["seed"] == 7 and run.record()["layout"] == "T3"  # the task's
+
+
+def test_run_matrix_plans_grid_once_and_counts_progress(task):
+    calls: list[tuple[int, int]] = []
+    runs = run_matrix(
+        [task], ["grid", "rrtconnect"], runs=2, time_limits=(5.0,), progress=lambda d, t, _: calls.append((d, t))
+    )
+    assert [(r.planner, r.mode) for r in runs] == [
+        ("grid", "without"), ("grid", "with"),
+        ("rrtconnect", "without"), ("rrtconnect", "with"), ("rrtconnect", "without"), ("rrtconnect", "with"),
+    ]  # fmt: skip
+    assert calls[0] == (0, 6) and calls[-1] == (6, 6) and len(calls) == 7
+    assert all(r.cost_ratio >= 0.99 for r in runs)  # against the grid path on the same costmap
+    with pytest.raises(ValueError, match="runs must be at least 1"):
+        run_matrix([task], ["grid"], runs=0)
+
+
+def test_an_impossible_task_is_named():
+    data = copy.deepcopy(DEMO_SCENARIO)
+    data["name"], data["robot"]["goal"] = "walled in", [5.0, -2.9, 0.0]  # the goal is in the wall
+    task = prepare(scenario_from_dict(data))
+    with pytest.raises(PlanningError, match="walled in: goal"):
+        run_matrix([task], ["grid"])
+
+
+def test_goal_zone_warning_names_the_group():
+    data = copy.deepcopy(DEMO_SCENARIO)
+    data["robot"]["goal"] = [4.5, 0.0, 0.0]  # the conversation's o-space centre
+    assert "inside the interaction zone of group (1, 2, 3)" in goal_zone_warning(prepare(scenario_from_dict(data)))
+    assert goal_zone_warning(prepare(demo_scenario())) is None
+
+
+def _record(social: bool, success: bool, **values) -> dict:
+    base = {"planner": "p", "layout": "L", "social_layer": social, "success": success, "planning_time_s": 0.1}
+    return base | {"ospace_intrusion_m": None, "crosses_group": None, "min_person_distance_m": None} | values
+
+
+def test_summary_counts_failures_and_orders_without_first():
+    records = [
+        _record(True, True, ospace_intrusion_m=0.0, crosses_group=False, min_person_distance_m=1.3,
+                length_ratio=1.1, detour=1.08, cost_ratio=1.01),
+        _record(False, True, ospace_intrusion_m=1.0, crosses_group=True, min_person_distance_m=0.5,
+                length_ratio=1.0, cost_ratio=1.0),
+        _record(False, False, planning_time_s=0.3, length_ratio=None),
+        _record(False, True, ospace_intrusion_m=0.0, crosses_group=False, min_person_distance_m=0.9,
+                length_ratio=1.02, cost_ratio=1.04),
+    ]  # fmt: skip
+    without, with_ = summarise(records, ("planner",))
+    assert (without["social_layer"], with_["social_layer"]) == (False, True)
+    assert without["runs"] == 3 and without["success_rate"] == pytest.approx(2 / 3)
+    assert without["intrusion_rate"] == 0.5 and without["crossing_rate"] == 0.5
+    assert without["mean_intrusion_m"] == 0.5 and without["median_intrusion_when_intruding_m"] == 1.0
+    assert without["median_min_person_distance_m"] == pytest.approx(0.7)
+    assert without["worst_min_person_distance_m"] == 0.5
+    assert without["median_cost_ratio"] == pytest.approx(1.02) and without["worst_cost_ratio"] == 1.04
+    assert without["median_planning_time_s"] == pytest.approx(0.1) and without["median_detour"] is None
+    assert with_["median_detour"] == 1.08 and with_["intrusion_rate"] == 0.0
+    (by_layout,) = summarise([r for r in records if not r["social_layer"]], ("layout",))
+    assert by_layout["layout"] == "L" and "planner" not in by_layout
+    failed = summarise([_record(False, False)], ("planner",))[0]
+    assert failed["success_rate"] == 0.0 and failed["intrusion_rate"] is None and failed["median_cost_ratio"] is None

@@ -1,0 +1,58 @@
+"""One error format for bad numbers in parameter records: ``owner: name must be <rule>, got <value>``."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import pytest
+
+from sid.checks import check_number, check_numbers
+
+
+@pytest.mark.parametrize(
+    ("value", "bounds", "rule"),
+    [
+        (math.nan, {}, "a finite number"),
+        (math.inf, {"unit": "metres"}, "a finite number of metres"),
+        (0.0, {"low": 0, "low_open": True, "unit": "metres"}, "a positive number of metres"),
+        (-1.0, {"low": 0}, "a finite number >= 0"),
+        (2.0, {"high": 1, "high_open": True}, "a finite number < 1"),
+        (1.5, {"low": 0, "high": 1}, "a finite number in [0, 1]"),
+        (0.5, {"low": 0, "high": 0.5, "low_open": True, "high_open": True}, "a finite number in (0, 0.5)"),
+        (-math.inf, {"low": 0, "allow_inf": True}, "a number >= 0 (or inf)"),
+        ("north", {}, "a finite number"),
+    ],
+)
+def test_out_of_range_values_are_named_with_the_rule(value, bounds, rule):
+    with pytest.raises(ValueError) as error:
+        check_number("groups", "eps", value, **bounds)
+    assert str(error.value) == f"groups: eps must be {rule}, got {value}"
+
+
+@pytest.mark.parametrize(
+    ("value", "bounds"),
+    [(0.0, {"low": 0}), (1.0, {"low": 0, "high": 1}), (math.inf, {"low": 0, "allow_inf": True}), (-3, {})],
+)
+def test_values_within_the_bounds_pass(value, bounds):
+    check_number("groups", "eps", value, **bounds)
+
+
+def test_the_error_type_can_be_chosen():
+    class PlanningError(ValueError):
+        pass
+
+    with pytest.raises(PlanningError, match="robot_radius"):
+        check_number("problem", "robot_radius", -1.0, low=0, error=PlanningError)
+
+
+def test_check_numbers_reports_the_first_bad_field():
+    @dataclass
+    class Params:
+        a: float = 1.0
+        b: float = -2.0
+        c: float = -3.0
+
+    check_numbers("params", Params(), ("a",), low=0)
+    with pytest.raises(ValueError, match="params: b must be"):
+        check_numbers("params", Params(), ("a", "b", "c"), low=0)
