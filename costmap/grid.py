@@ -9,6 +9,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
+
+from sid.checks import check_number, check_numbers
 
 FREE_SPACE = 0
 MAX_NON_OBSTACLE = 252
@@ -78,18 +81,15 @@ class GridSpec:
     height: int
 
     def __post_init__(self) -> None:
-        if not (np.isfinite(self.resolution) and self.resolution > 0):
-            raise ValueError(f"map.resolution must be a positive number of metres, got {self.resolution}")
-        if not (np.isfinite(self.origin_x) and np.isfinite(self.origin_y)):
-            raise ValueError(f"map.origin must be finite, got ({self.origin_x}, {self.origin_y})")
+        check_number("map", "resolution", self.resolution, low=0, low_open=True, unit="metres")
+        check_numbers("map", self, ("origin_x", "origin_y"), unit="metres")
         if self.width <= 0 or self.height <= 0:
             raise ValueError(f"map.size must give at least one cell, got {self.width}x{self.height} cells")
 
     @classmethod
     def from_size(cls, resolution: float, origin: tuple[float, float], size_m: tuple[float, float]) -> GridSpec:
         """A grid covering ``size_m`` (width, height in metres) from ``origin``."""
-        if not (np.isfinite(resolution) and resolution > 0):
-            raise ValueError(f"map.resolution must be a positive number of metres, got {resolution}")
+        check_number("map", "resolution", resolution, low=0, low_open=True, unit="metres")
         width, height = (int(round(s / resolution)) for s in size_m)
         return cls(float(resolution), float(origin[0]), float(origin[1]), width, height)
 
@@ -131,7 +131,7 @@ class GridSpec:
         w, h = self.size_m
         return (self.origin_x, self.origin_y, self.origin_x + w, self.origin_y + h)
 
-    def world_to_map(self, xy: np.ndarray) -> np.ndarray:
+    def world_to_map(self, xy: ArrayLike) -> np.ndarray:
         """World points (N, 2) -> continuous map coordinates (N, 2) as (col, row) in cells; cell centres at k + 0.5."""
         xy = np.asarray(xy, dtype=float).reshape(-1, 2)
         return np.stack([(xy[:, 0] - self.origin_x) / self.resolution, (xy[:, 1] - self.origin_y) / self.resolution], 1)

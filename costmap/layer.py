@@ -17,6 +17,7 @@ import numpy as np
 from costmap.combine import CombinationMethod, check_method, combine
 from costmap.grid import FREE_SPACE, GridSpec, Window
 from costmap.scan import LaserScan
+from sid.checks import check_numbers
 from sid.perception.groups import Group
 from sid.perception.people import Person
 
@@ -38,8 +39,7 @@ class LayerInputs:
         object.__setattr__(self, "groups", tuple(self.groups))
         seen = set()
         for p in self.people:
-            if not (np.isfinite(p.x) and np.isfinite(p.y)) or (p.theta is not None and not np.isfinite(p.theta)):
-                raise ValueError(f"person {p.id}: pose must be finite, got x={p.x}, y={p.y}, theta={p.theta}")
+            check_numbers(f"person {p.id}", p, ("x", "y") if p.theta is None else ("x", "y", "theta"))
             if p.id in seen:
                 raise ValueError(f"person id {p.id} appears twice")
             seen.add(p.id)

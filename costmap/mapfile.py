@@ -14,7 +14,6 @@ map_server loads exactly the values written. (map_saver's trinary output would k
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import cv2
@@ -23,6 +22,7 @@ import yaml
 
 from costmap.grid import GridSpec
 from costmap.occupancy import OCC_OCCUPIED, OCC_UNKNOWN, OccupancyGrid
+from sid.documents import is_number, load_document
 
 MODES = ("trinary", "scale", "raw")
 
@@ -35,18 +35,16 @@ def _number(doc: dict, key: str, path: Path) -> float:
     if key not in doc:
         raise MapFileError(f"{path}: missing key '{key}'")
     value = doc[key]
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+    if not is_number(value):
         raise MapFileError(f"{path}: '{key}' must be a finite number, got {value!r}")
     return float(value)
 
 
 def _read_metadata(path: Path) -> dict:
     try:
-        doc = yaml.safe_load(path.read_text())
-    except OSError as exc:
-        raise MapFileError(f"{path}: cannot read map YAML ({exc.strerror or exc})") from exc
-    except yaml.YAMLError as exc:
-        raise MapFileError(f"{path}: not valid YAML ({exc})") from exc
+        doc = load_document(path, "map YAML")
+    except ValueError as exc:  # names the file: unreadable, or not valid YAML
+        raise MapFileError(str(exc)) from exc
     if not isinstance(doc, dict):
         raise MapFileError(f"{path}: expected a mapping of map_server keys, got {type(doc).__name__}")
     image = doc.get("image")

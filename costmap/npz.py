@@ -36,6 +36,7 @@ def save_npz(path: str | Path, layered: LayeredCostmap) -> Path:
         layer_names=np.array(list(layers)),
         resolution=np.float64(spec.resolution),
         origin=np.array([spec.origin_x, spec.origin_y]),
+        allow_pickle=True,  # numpy's default, spelled out so type checkers do not bind the layer grids below to it
         **{f"layer_{name}": grid for name, grid in layers.items()},
     )
     return path

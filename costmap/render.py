@@ -14,6 +14,7 @@ from typing import Protocol
 
 import cv2
 import numpy as np
+from numpy.typing import ArrayLike
 
 from costmap.grid import INSCRIBED, LETHAL, MAX_NON_OBSTACLE, NO_INFORMATION, Costmap2D, GridSpec
 from costmap.layered import LayeredCostmap
@@ -79,18 +80,25 @@ def default_scale(spec: GridSpec, target_width: int = 800) -> int:
     return max(1, round(target_width / spec.width))
 
 
-def world_to_image(xy: np.ndarray, spec: GridSpec, scale: int) -> np.ndarray:
+def world_to_image(xy: ArrayLike, spec: GridSpec, scale: int) -> np.ndarray:
     """World points (N, 2) -> pixel coordinates (N, 2) as (u right, v down), float, in ``render_costmap``'s layout."""
     m = spec.world_to_map(xy)
     return np.stack([MARGIN_LEFT + m[:, 0] * scale, MARGIN_TOP + (spec.height - m[:, 1]) * scale], axis=1)
 
 
-def _px(points: np.ndarray, spec: GridSpec, scale: int) -> np.ndarray:
+def _px(points: ArrayLike, spec: GridSpec, scale: int) -> np.ndarray:
     """Integer pixel coordinates with 4 fractional bits, for OpenCV's ``shift=4`` drawing."""
     return np.rint(world_to_image(points, spec, scale) * 16).astype(np.int32)
 
 
-def _text(img: np.ndarray, text: str, org: tuple[int, int], size: float = 0.45, colour=TEXT, thick: int = 1) -> None:
+def _text(
+    img: np.ndarray,
+    text: str,
+    org: tuple[int, int],
+    size: float = 0.45,
+    colour: tuple[int, int, int] = TEXT,
+    thick: int = 1,
+) -> None:
     cv2.putText(img, text, org, FONT, size, colour, thick, cv2.LINE_AA)
 
 
@@ -173,9 +181,9 @@ def _draw_camera(img: np.ndarray, spec: GridSpec, scale: int, camera: CameraView
     """The field of view, shaded and edged up to the map's border, and the camera on top of it."""
     x0, y0, x1, y1 = spec.bounds
     reach = float(np.hypot(x1 - x0, y1 - y0))
-    edges = [camera.yaw + camera.fov / 2, camera.yaw - camera.fov / 2]
+    angles = np.linspace(camera.yaw + camera.fov / 2, camera.yaw - camera.fov / 2, 16)
     origin = np.array([camera.x, camera.y])
-    wedge = [origin] + [origin + reach * np.array([np.cos(a), np.sin(a)]) for a in np.linspace(*edges, 16)]
+    wedge = [origin] + [origin + reach * np.array([np.cos(a), np.sin(a)]) for a in angles]
     rows, cols = (
         slice(MARGIN_TOP, MARGIN_TOP + spec.height * scale),
         slice(MARGIN_LEFT, MARGIN_LEFT + spec.width * scale),
@@ -207,7 +215,9 @@ def _draw_people(img: np.ndarray, spec: GridSpec, scale: int, people: Sequence[P
         _text(img, label, (u + radius + 2, v - radius - 2), 0.4, PERSON, 1)
 
 
-def _draw_groups(img, spec, scale, groups: Sequence[Group], people: Sequence[Person], margin: float) -> None:
+def _draw_groups(
+    img: np.ndarray, spec: GridSpec, scale: int, groups: Sequence[Group], people: Sequence[Person], margin: float
+) -> None:
     by_id = {p.id: p for p in people}
     for group in groups:
         polygon = group_zone_polygon(group, by_id, margin)

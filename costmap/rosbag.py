@@ -18,6 +18,8 @@ import numpy as np
 from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, QosReliability, QosTime
 from rosbags.rosbag2 import Reader, StoragePlugin, Writer
 from rosbags.typesys import Stores, get_typestore
+from rosbags.typesys.store import Typestore
+from rosbags.typesys.stores.ros2_humble import nav_msgs__msg__OccupancyGrid as OccupancyGridMsg
 
 from costmap.grid import GridSpec
 from costmap.occupancy import OccupancyGrid
@@ -37,7 +39,7 @@ _LATCHED = Qos(
 )
 
 
-def _message(typestore, grid: OccupancyGrid, stamp_ns: int):
+def _message(typestore: Typestore, grid: OccupancyGrid, stamp_ns: int) -> object:
     t = typestore.types
     sec, nanosec = divmod(int(stamp_ns), 1_000_000_000)
     stamp = t["builtin_interfaces/msg/Time"](sec=sec, nanosec=nanosec)
@@ -104,6 +106,8 @@ def read_occupancy_grids(path: str | Path) -> dict[str, list[OccupancyGrid]]:
         connections = [c for c in reader.connections if c.msgtype == MSGTYPE]
         for connection, _, raw in reader.messages(connections=connections):
             msg = typestore.deserialize_cdr(raw, MSGTYPE)
+            if not isinstance(msg, OccupancyGridMsg):  # the Humble store builds this class for MSGTYPE
+                raise TypeError(f"{path}: {MSGTYPE} deserialized as {type(msg).__name__}")
             q = msg.info.origin.orientation
             yaw = float(2 * np.arctan2(q.z, q.w))
             spec = GridSpec(

@@ -10,6 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sid.checks import check_number, check_numbers
+
 
 @dataclass(frozen=True)
 class LaserScan:
@@ -35,12 +37,11 @@ class LaserScan:
         if len(pose) != 3 or not np.isfinite(pose).all():
             raise ValueError(f"scan.pose must be a finite (x, y, yaw), got {self.pose}")
         object.__setattr__(self, "pose", pose)
-        if not (np.isfinite(self.angle_min) and np.isfinite(self.angle_increment) and self.angle_increment != 0):
-            raise ValueError(
-                f"scan angles must be finite with a non-zero increment, got {self.angle_min}, {self.angle_increment}"
-            )
-        if not (np.isfinite(self.range_max) and 0 <= self.range_min < self.range_max):
-            raise ValueError(f"scan needs 0 <= range_min < range_max (finite), got {self.range_min}, {self.range_max}")
+        check_numbers("scan", self, ("angle_min", "angle_increment"), unit="radians")
+        if self.angle_increment == 0:
+            raise ValueError("scan: angle_increment must not be 0")
+        check_number("scan", "range_min", self.range_min, low=0, unit="metres")
+        check_number("scan", "range_max", self.range_max, low=self.range_min, low_open=True, unit="metres")
 
     @property
     def angles(self) -> np.ndarray:

@@ -7,9 +7,10 @@ Only cells within ``ceil(inflation_radius / resolution)`` cells of a lethal cell
 ``cellDistance`` rounds up, so the reach can exceed ``inflation_radius`` by up to one cell).
 
 Distances come from an exact Euclidean distance transform (OpenCV's Felzenszwalb-Huttenlocher
-``DIST_MASK_PRECISE``, as newer Nav2 does; ``scipy.ndimage.distance_transform_edt`` gives the same values and
-is kept as a measured alternative). Both return d in cells; squaring and rounding recovers the exact integer
-squared distance, which indexes a cost table built with Nav2's formula, so every cell gets exactly Nav2's value.
+``DIST_MASK_PRECISE``, as newer Nav2 does, and faster than ``scipy.ndimage.distance_transform_edt``, which gives
+the same values and is kept as an alternative; timings in docs/parameters.md). Both return d in cells; squaring and
+rounding recovers the exact integer squared distance, which indexes a cost table built with Nav2's formula, so every
+cell gets exactly Nav2's value.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ from scipy import ndimage
 
 from costmap.grid import FREE_SPACE, INSCRIBED, LETHAL, MAX_NON_OBSTACLE, GridSpec, Window
 from costmap.layer import Layer, LayerInputs
+from sid.checks import check_number
 
 DistanceMethod = Literal["opencv", "scipy"]
 
@@ -40,10 +42,8 @@ class InflationParams:
     inflate_unknown: bool = False
 
     def __post_init__(self) -> None:
-        if not (np.isfinite(self.inflation_radius) and self.inflation_radius >= 0):
-            raise ValueError(f"inflation_radius must be a finite number >= 0, got {self.inflation_radius}")
-        if not (np.isfinite(self.cost_scaling_factor) and self.cost_scaling_factor >= 0):
-            raise ValueError(f"cost_scaling_factor must be a finite number >= 0, got {self.cost_scaling_factor}")
+        check_number("inflation", "inflation_radius", self.inflation_radius, low=0, unit="metres")
+        check_number("inflation", "cost_scaling_factor", self.cost_scaling_factor, low=0)
 
 
 def inflation_cost(distance_m: np.ndarray, inscribed_radius: float, cost_scaling_factor: float) -> np.ndarray:
@@ -77,8 +77,7 @@ class InflationLayer(Layer):
     name = "inflation"
 
     def __init__(self, spec: GridSpec, params: InflationParams, inscribed_radius: float) -> None:
-        if not (np.isfinite(inscribed_radius) and inscribed_radius >= 0):
-            raise ValueError(f"robot.radius (inscribed radius) must be a finite number >= 0, got {inscribed_radius}")
+        check_number("inflation layer", "robot.radius (inscribed radius)", inscribed_radius, low=0, unit="metres")
         self.combination = "max_nonzero" if params.inflate_unknown else "max_keep_unknown"
         super().__init__(spec)
         self.params = params
@@ -110,6 +109,6 @@ class InflationLayer(Layer):
         far = len(self._cost_by_d2) - 1  # index of the "beyond reach" entry
         np.minimum(distance, np.float32(np.sqrt(far)), out=distance)  # clip first: the squares stay small
         d2 = np.rint(np.square(distance, out=distance))
-        if far < 256:  # the usual case (reach <= 15 cells): OpenCV's table lookup is ~4x faster (measured)
+        if far < 256:  # the usual case (reach <= 15 cells): OpenCV's table lookup is faster (docs/parameters.md)
             return cv2.LUT(d2.astype(np.uint8), np.pad(self._cost_by_d2, (0, 255 - far)))
         return self._cost_by_d2[d2.astype(np.int32)]

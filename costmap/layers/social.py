@@ -27,11 +27,13 @@ import numpy as np
 import shapely
 import shapely.affinity
 from shapely.geometry import MultiPoint, Polygon
+from shapely.geometry.base import BaseGeometry
 from shapely.geometry.polygon import orient
 
 from costmap.combine import CombinationMethod
 from costmap.grid import FREE_SPACE, LETHAL, MAX_NON_OBSTACLE, GridSpec, Window, union
 from costmap.layer import Layer, LayerInputs
+from sid.checks import check_number, check_numbers
 from sid.perception.groups import Group
 from sid.perception.people import Person
 
@@ -51,18 +53,10 @@ class SocialParams:
     people_clear_margin: float = 0.1
 
     def __post_init__(self) -> None:
-        for name in ("amplitude", "group_cost"):
-            value = getattr(self, name)
-            if not (np.isfinite(value) and 0 <= value <= MAX_NON_OBSTACLE):
-                raise ValueError(f"social.{name} must be a cost in 0..{MAX_NON_OBSTACLE}, got {value}")
-        for name in ("sigma_front", "sigma_rear", "sigma_side", "sigma_unknown", "group_sigma"):
-            value = getattr(self, name)
-            if not (np.isfinite(value) and value > 0):
-                raise ValueError(f"social.{name} must be a positive number of metres, got {value}")
-        for name in ("group_margin", "people_clear_margin"):
-            value = getattr(self, name)
-            if not (np.isfinite(value) and value >= 0):
-                raise ValueError(f"social.{name} must be a number of metres >= 0, got {value}")
+        check_numbers("social", self, ("amplitude", "group_cost"), low=0, high=MAX_NON_OBSTACLE)
+        sigmas = ("sigma_front", "sigma_rear", "sigma_side", "sigma_unknown", "group_sigma")
+        check_numbers("social", self, sigmas, low=0, low_open=True, unit="metres")
+        check_numbers("social", self, ("group_margin", "people_clear_margin"), low=0, unit="metres")
 
 
 def _reach(amplitude: float, sigma: float) -> float:
@@ -74,7 +68,7 @@ def _people_by_id(people: Sequence[Person] | Mapping[int, Person]) -> Mapping[in
     return people if isinstance(people, Mapping) else {p.id: p for p in people}
 
 
-def _zone_hull(group: Group, people: Sequence[Person] | Mapping[int, Person]) -> shapely.Geometry:
+def _zone_hull(group: Group, people: Sequence[Person] | Mapping[int, Person]) -> BaseGeometry:
     """Convex hull (Polygon, LineString or Point) of the group's o-space vertices and its members' positions."""
     by_id = _people_by_id(people)
     missing = [m for m in group.members if m not in by_id]
@@ -97,25 +91,24 @@ def group_zone_polygon(
     ``margin`` metres: it covers the o-space, the members and the space between them (the p-space). ``people``
     may be a list of persons or a mapping id -> person; every member must be there.
     """
-    if not (np.isfinite(margin) and margin >= 0):
-        raise ValueError(f"group zone margin must be a number of metres >= 0, got {margin}")
+    check_number("group zone", "margin", margin, low=0, unit="metres")
     grown = _zone_hull(group, people).buffer(margin, quad_segs=16) if margin > 0 else _zone_hull(group, people)
     if not isinstance(grown, Polygon) or grown.is_empty or grown.area == 0:
         raise ValueError(f"group {group.members}: the zone is degenerate (collinear points); use a margin > 0")
     return grown
 
 
-def _distance_to_hull(xs: np.ndarray, ys: np.ndarray, hull: shapely.Geometry) -> np.ndarray:
+def _distance_to_hull(xs: np.ndarray, ys: np.ndarray, hull: BaseGeometry) -> np.ndarray:
     """Exact distance (m) from points (xs, ys broadcast together) to a convex hull (0 inside).
 
     hull is a Point, LineString or convex Polygon.
 
-    Written out in numpy rather than ``shapely.distance``, which needs a point object per cell and took ~25x longer
-    on an 86 x 86 window (measured); one pass per edge, keeping the running minimum, was ~6x faster than
-    broadcasting all edges at once.
+    Written out in numpy rather than ``shapely.distance``, which needs a point object per cell, and one pass per
+    edge (keeping the running minimum) rather than all edges at once: both are faster (docs/parameters.md).
     """
     polygon = isinstance(hull, Polygon)
-    ring = np.asarray(orient(hull, sign=1.0).exterior.coords if polygon else hull.coords)  # closed, CCW
+    coords = orient(hull, sign=1.0).exterior.coords if isinstance(hull, Polygon) else hull.coords
+    ring = np.asarray(coords)  # closed, CCW
     if len(ring) == 1:
         return np.hypot(xs - ring[0, 0], ys - ring[0, 1])
     shape = np.broadcast_shapes(np.shape(xs), np.shape(ys))
@@ -150,8 +143,8 @@ def _person_box(person: Person, params: SocialParams) -> tuple[tuple[float, floa
 
 
 def _local_axes(spec: GridSpec, window: Window, x: float, y: float) -> tuple[np.ndarray, np.ndarray]:
-    """Cell-centre offsets from (x, y) in a window as float32 (1, cols) and (rows, 1): float32 halves the time of
-    the per-cell arithmetic (measured) and is exact to ~1e-6 m over a few metres."""
+    """Cell-centre offsets from (x, y) in a window as float32 (1, cols) and (rows, 1): float32 for the speed of the
+    per-cell arithmetic (docs/parameters.md), exact to ~1e-6 m over a few metres."""
     xs, ys = spec.cell_axes(window)
     return (xs - x).astype(np.float32), (ys - y).astype(np.float32)
 
@@ -175,7 +168,7 @@ def paint_person(costs: np.ndarray, spec: GridSpec, person: Person, params: Soci
     return window
 
 
-def paint_group(costs: np.ndarray, spec: GridSpec, hull: shapely.Geometry, params: SocialParams) -> Window | None:
+def paint_group(costs: np.ndarray, spec: GridSpec, hull: BaseGeometry, params: SocialParams) -> Window | None:
     """Max a group's zone cost and its fall-off into ``costs`` (in place); returns the window it reaches.
 
     ``hull``: the group's ``_zone_hull``.
@@ -221,8 +214,7 @@ class SocialLayer(Layer):
     combination: CombinationMethod = "max_nonzero"
 
     def __init__(self, spec: GridSpec, params: SocialParams | None = None, body_radius: float = 0.2) -> None:
-        if not (np.isfinite(body_radius) and body_radius > 0):
-            raise ValueError(f"body radius must be a positive number of metres, got {body_radius}")
+        check_number("social layer", "body_radius", body_radius, low=0, low_open=True, unit="metres")
         super().__init__(spec)
         self.params = params or SocialParams()
         self.body_radius = float(body_radius)

@@ -1,4 +1,7 @@
-"""The ``sid`` command line: one subcommand per module in this package."""
+"""The ``sid`` command line: one subcommand per module in this package.
+
+``common`` is the exception: the options and messages several subcommands share.
+"""
 
 from __future__ import annotations
 

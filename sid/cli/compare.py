@@ -6,13 +6,13 @@ from __future__ import annotations
 import argparse
 import sys
 
-from costmap.mapfile import MapFileError
 from planner.facade import PLANNERS
-from planner.problem import DEFAULT_COST_WEIGHT, PlanningError
+from planner.problem import DEFAULT_COST_WEIGHT
+from sid.cli.common import INPUT_ERRORS, fail, print_written
 from sid.experiments.compare import BY_SCENARIO, format_summary, write_comparison
 from sid.experiments.harness import prepare, run_matrix, summarise
 from sid.experiments.progress import ProgressBar
-from sid.scenario.loader import ScenarioError, load_scenario
+from sid.scenario.loader import load_scenario
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -36,16 +36,14 @@ def run(args: argparse.Namespace) -> int:
     try:
         tasks = [prepare(load_scenario(path), args.cost_weight) for path in args.scenarios]
         runs = run_matrix(tasks, args.planners, args.runs, (args.time,), progress=ProgressBar("compare"))
-    except (ScenarioError, MapFileError, PlanningError, ValueError) as exc:
-        print(f"\nsid compare: {exc}", file=sys.stderr)
-        return 2
+    except INPUT_ERRORS as exc:
+        print(file=sys.stderr)  # end the progress bar's line
+        return fail("sid compare", exc)
     print(format_summary(summarise([run.record() for run in runs], BY_SCENARIO)))
     title = f"Planner comparison: {len(tasks)} scenario(s), {args.runs} seeds, {args.time:g} s budget"
     try:
         paths = write_comparison(runs, args.out, title)
     except OSError as exc:
-        print(f"sid compare: {exc}", file=sys.stderr)
-        return 2
-    for path in paths.values():
-        print(f"wrote {path}")
+        return fail("sid compare", exc)
+    print_written(paths.values())
     return 0

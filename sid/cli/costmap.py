@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import sys
 
 from costmap.export import export_costmap
 from costmap.mapfile import MapFileError
+from sid.cli.common import add_scenario_arguments, fail, print_written
 from sid.scenario.build import build_costmap
 from sid.scenario.loader import ScenarioError, load_scenario
 
@@ -17,11 +17,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="build a scenario's costmap and write map_server YAML/PGM, .npz, .mcap and a picture",
         description=__doc__.replace("``", ""),
     )
-    parser.add_argument("scenario", help="scenario file (.json or .yaml); see docs/scenario.md")
-    parser.add_argument("--out", required=True, help="output folder (created if missing)")
-    parser.add_argument(
-        "--no-social", action="store_true", help="leave out the social layer (the 'without recognition' baseline)"
-    )
+    add_scenario_arguments(parser, "leave out the social layer (the 'without recognition' baseline)")
     parser.set_defaults(func=run)
 
 
@@ -30,8 +26,7 @@ def run(args: argparse.Namespace) -> int:
         scenario = load_scenario(args.scenario)
         layered = build_costmap(scenario, social=not args.no_social)
     except (ScenarioError, MapFileError) as exc:
-        print(f"sid costmap: {exc}", file=sys.stderr)
-        return 2
+        return fail("sid costmap", exc)
     kind = "without recognition" if args.no_social else "social"
     paths = export_costmap(layered, args.out, robot=scenario.robot, title=f"{scenario.name}: {kind}")
     counts = {name: int((grid > 0).sum()) for name, grid in layered.grids.items()}
@@ -40,6 +35,5 @@ def run(args: argparse.Namespace) -> int:
         f"{len(layered.inputs.people)} people, {len(layered.inputs.groups)} groups ({kind})"
     )
     print("non-zero cells per layer: " + ", ".join(f"{k} {v}" for k, v in counts.items()))
-    for path in paths.values():
-        print(f"wrote {path}")
+    print_written(paths.values())
     return 0

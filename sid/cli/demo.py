@@ -4,16 +4,11 @@ group recognition; write comparison.png, metrics.json and the scenario file."""
 from __future__ import annotations
 
 import argparse
-import sys
 
-from costmap.mapfile import MapFileError
-from planner.facade import DEFAULT_PLANNER, PLANNERS
-from planner.problem import PlanningError
-from sid.cli.plan import add_planning_options
+from sid.cli.common import INPUT_ERRORS, add_planner_option, add_planning_options, fail, print_written, warn_goal_zone
 from sid.experiments.demo import DEMO_ITERATIONS, DEMO_SEED, run_demo
-from sid.experiments.harness import goal_zone_warning
 from sid.experiments.plan_pictures import format_table
-from sid.scenario.loader import ScenarioError, load_scenario
+from sid.scenario.loader import load_scenario
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -24,9 +19,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--out", default="sid-demo", help="output folder (default ./sid-demo)")
     parser.add_argument("--scenario", default=None, help="a scenario file to use instead of the built-in one")
-    parser.add_argument(
-        "--planner", default=DEFAULT_PLANNER, help=f"one of {', '.join(PLANNERS)} (default {DEFAULT_PLANNER})"
-    )
+    add_planner_option(parser)
     add_planning_options(parser, time_default=5.0)
     parser.set_defaults(func=run, seed=DEMO_SEED, iterations=DEMO_ITERATIONS)
 
@@ -44,15 +37,12 @@ def run(args: argparse.Namespace) -> int:
             cost_weight=args.cost_weight,
             progress=lambda line: print(line, flush=True),
         )
-    except (ScenarioError, MapFileError, PlanningError, ValueError) as exc:
-        print(f"sid demo: {exc}", file=sys.stderr)
-        return 2
-    warning = goal_zone_warning(comparison.task)
-    if warning:
-        print(f"sid demo: warning: {warning}", file=sys.stderr)
+    except INPUT_ERRORS as exc:
+        return fail("sid demo", exc)
+    warn_goal_zone("sid demo", comparison)
     print()
     print(format_table(comparison))
     print()
-    for name in ("comparison.png", "metrics.json") + (() if args.scenario else ("scenario.json",)):
-        print(f"wrote {args.out}/{name}")
+    names = ("comparison.png", "metrics.json") + (() if args.scenario else ("scenario.json",))
+    print_written(f"{args.out}/{name}" for name in names)
     return 0 if all(run.result.success for run in comparison.runs.values()) else 1

@@ -160,7 +160,7 @@ def run(args: argparse.Namespace) -> int:
             result = None if reason else pipeline(frame)
             if result is not None and not result.people:
                 reason = "no people"
-            if reason:
+            if reason or result is None:  # result is None only when there is a reason
                 skipped += 1
                 print(f"detect: frame {frame.index}: skipped, {reason}", file=sys.stderr)
                 continue

@@ -10,7 +10,7 @@ import sys
 from pathlib import Path
 
 from sid.cli.groups import add_group_params, group_params_from
-from sid.experiments.fformation import DEFAULT_THRESHOLDS, load_dataset, parse_threshold
+from sid.experiments.fformation import DEFAULT_THRESHOLDS, LabelledFrame, load_dataset, parse_threshold
 from sid.experiments.fformation import evaluate as evaluate_fformation
 
 
@@ -55,7 +55,7 @@ def _threshold(text: str) -> float:
 def run(args: argparse.Namespace) -> int:
     try:
         params = group_params_from(args)
-        datasets = {}
+        datasets: dict[str, list[LabelledFrame]] = {}
         for folder in args.dirs:
             name = _dataset_name(folder, datasets)
             datasets[name] = load_dataset(folder, args.scale)

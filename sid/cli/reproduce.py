@@ -11,6 +11,7 @@ from pathlib import Path
 
 from planner.facade import PLANNERS
 from planner.problem import DEFAULT_COST_WEIGHT
+from sid.cli.common import fail, print_written
 from sid.experiments.navigation import NAV_LAYOUTS, NavSettings, navigation_tasks, run_navigation
 from sid.experiments.progress import ProgressBar
 from sid.synthetic.layouts import LAYOUTS, VARIATIONS
@@ -45,15 +46,22 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     _add_navigation(studies)
 
 
+def _add_study(studies: argparse._SubParsersAction, name: str, help: str, description: str) -> argparse.ArgumentParser:
+    """A study's parser, with the option every study has (``--out``)."""
+    parser = studies.add_parser(name, help=help, description=description)
+    parser.add_argument("--out", default="sid-reproduce", help="output folder (default ./sid-reproduce)")
+    return parser
+
+
 def _add_table1(studies: argparse._SubParsersAction) -> None:
     depth, kp = DepthNoise(), KeypointNoise()
-    p = studies.add_parser(
+    p = _add_study(
+        studies,
         "table1",
-        help="RMSE of zone area, interest point, positions and facing on S1-S5 vs the paper (table1.md/.json)",
-        description="Render S1-S5 (and their documented variations) with D435-like depth noise, keypoint noise and "
-        "occlusion, run the full pipeline, and compare the errors with the paper's Table 1.",
+        "RMSE of zone area, interest point, positions and facing on S1-S5 vs the paper (table1.md/.json)",
+        "Render S1-S5 (and their documented variations) with D435-like depth noise, keypoint noise and occlusion, run "
+        "the full pipeline, and compare the errors with the paper's Table 1.",
     )
-    p.add_argument("--out", default="sid-reproduce", help="output folder (default ./sid-reproduce)")
     p.add_argument("--frames", type=int, default=None, metavar="N", help="frames per layout variation (50)")
     p.add_argument(
         "--variations", type=int, default=None, metavar="K",
@@ -62,31 +70,17 @@ def _add_table1(studies: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=int, default=0, metavar="S", help="noise seed (0)")
     p.add_argument("--scenarios", nargs="+", default=list(LAYOUTS), metavar="SN", help="layouts (S1 .. S5)")
     noise = p.add_argument_group("noise (defaults: a D435i on textured clothes, a good pose model)")
-    noise.add_argument(
-        "--subpixel", type=float, default=depth.subpixel, metavar="PX",
-        help=f"disparity RMS error in px ({depth.subpixel:g}: Intel's figure for textured surfaces, 0.76 %% of "
-        "the distance at 2 m; 0.21 reaches the datasheet's 2 %% bound)",
+    noise_options = (  # flag, default, metavar, help with {:g} for the default
+        ("--subpixel", depth.subpixel, "PX", "disparity RMS error in px ({:g}: Intel's figure for textured surfaces, "
+         "0.76 %% of the distance at 2 m; 0.21 reaches the datasheet's 2 %% bound)"),
+        ("--correlation", depth.correlation_px, "PX", "spatial correlation length of the depth noise in px ({:g})"),
+        ("--holes", depth.hole_fraction, "P", "fraction of depth pixels missing at random ({:g})"),
+        ("--edge-holes", depth.edge_holes, "P", "probability that a pixel next to a depth jump is missing ({:g})"),
+        ("--keypoint-sigma", kp.sigma_px, "PX", "keypoint pixel noise per axis, colour pixels ({:g})"),
+        ("--keypoint-drop", kp.drop, "P", "probability that a visible keypoint is missed ({:g})"),
     )  # fmt: skip
-    noise.add_argument(
-        "--correlation", type=float, default=depth.correlation_px, metavar="PX",
-        help=f"spatial correlation length of the depth noise in px ({depth.correlation_px:g})",
-    )  # fmt: skip
-    noise.add_argument(
-        "--holes", type=float, default=depth.hole_fraction, metavar="P",
-        help=f"fraction of depth pixels missing at random ({depth.hole_fraction:g})",
-    )  # fmt: skip
-    noise.add_argument(
-        "--edge-holes", type=float, default=depth.edge_holes, metavar="P",
-        help=f"probability that a pixel next to a depth jump is missing ({depth.edge_holes:g})",
-    )  # fmt: skip
-    noise.add_argument(
-        "--keypoint-sigma", type=float, default=kp.sigma_px, metavar="PX",
-        help=f"keypoint pixel noise per axis, colour pixels ({kp.sigma_px:g})",
-    )  # fmt: skip
-    noise.add_argument(
-        "--keypoint-drop", type=float, default=kp.drop, metavar="P",
-        help=f"probability that a visible keypoint is missed ({kp.drop:g})",
-    )  # fmt: skip
+    for flag, default, metavar, text in noise_options:
+        noise.add_argument(flag, type=float, default=default, metavar=metavar, help=text.format(default))
     noise.add_argument(
         "--exact", action="store_true",
         help="no depth or keypoint noise at all (occlusion stays): isolates the pipeline's systematic errors",
@@ -99,13 +93,13 @@ def _add_table1(studies: argparse._SubParsersAction) -> None:
 
 
 def _add_navigation(studies: argparse._SubParsersAction) -> None:
-    p = studies.add_parser(
+    p = _add_study(
+        studies,
         "navigation",
-        help="plan past conversations with and without the social layer, per planner (navigation.md/.json/.png)",
-        description="The demo's with/without comparison over a family of tasks: group sizes 2-5 (S1-S5, a wide "
-        "pair, a triangle, a circle and a semicircle of five), random turns and offsets, both directions.",
+        "plan past conversations with and without the social layer, per planner (navigation.md/.json/.png)",
+        "The demo's with/without comparison over a family of tasks: group sizes 2-5 (S1-S5, a wide pair, a triangle, "
+        "a circle and a semicircle of five), random turns and offsets, both directions.",
     )
-    p.add_argument("--out", default="sid-reproduce", help="output folder (default ./sid-reproduce)")
     p.add_argument("--planners", nargs="+", default=None, metavar="P", help=f"default: {' '.join(PLANNERS)}")
     p.add_argument("--seeds", type=int, default=None, metavar="K", help="draws per layout (2); each in both directions")
     p.add_argument("--layouts", nargs="+", default=None, metavar="L", help=f"default: {' '.join(NAV_LAYOUTS)}")
@@ -168,11 +162,9 @@ def table1_command(args: argparse.Namespace) -> int:
         result = run_table1(settings, progress=ProgressBar("table1"))
         paths = write_table1_report(result, args.out, _command())
     except (ValueError, OSError) as exc:
-        print(f"sid reproduce: {exc}", file=sys.stderr)
-        return 2
+        return fail("sid reproduce", exc)
     print(table1_markdown(result, _command()))
-    for path in paths.values():
-        print(f"wrote {path}")
+    print_written(paths.values())
     return 0
 
 
@@ -191,9 +183,7 @@ def navigation_command(args: argparse.Namespace) -> int:
         result = run_navigation(tasks, settings, progress=ProgressBar("navigation"))
         paths = write_navigation_report(result, args.out, seeds, _command())
     except (ValueError, OSError) as exc:
-        print(f"sid reproduce: {exc}", file=sys.stderr)
-        return 2
+        return fail("sid reproduce", exc)
     print(navigation_markdown(result, seeds, _command()))
-    for path in paths.values():
-        print(f"wrote {path}")
+    print_written(paths.values())
     return 0 if not result.impossible else 1

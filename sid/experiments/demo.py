@@ -55,7 +55,7 @@ DEMO_SCENARIO: dict = {
 DEMO_SEED = 1
 DEMO_ITERATIONS = 20000
 """The demo's planner budget: a fixed seed and iteration cap make every run draw the same paths; the time limit
-only guards against a machine far slower than the one this was measured on."""
+(``sid demo --time``) only guards against a machine too slow to reach the cap (docs/parameters.md)."""
 
 
 def demo_scenario() -> Scenario:

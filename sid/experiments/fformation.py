@@ -6,7 +6,7 @@ array ``[id, x, y, theta]`` per frame with ``timestamp(t)``; ``GTgroups{t}`` lis
 is the facing yaw in radians in the same frame. A dataset is a folder holding ``features.mat`` (one sequence) or
 sub-folders that do (sequences pooled frame by frame).
 
-Scoring (the protocol of this literature, see ../shared/data/README.md): only frames with ground truth are scored,
+Scoring (the protocol of this literature; its source: docs/parameters.md): only frames with ground truth are scored,
 groups of one are dropped on both sides; a truth group is found when some detected group G has
 |G & GT| / max(|G|, |GT|) >= T; per frame TP = found truth groups, FP = detections - TP, FN = truth - TP,
 precision = TP / (TP + FP), recall = TP / (TP + FN) (nothing detected and no truth: P = R = 1; truth but nothing
@@ -17,13 +17,14 @@ over its frames, and F1 = 2PR / (P + R).
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import scipy.io
 
+from sid.checks import check_number
 from sid.perception.groups import GroupParams, detect_groups
 from sid.perception.people import Person
 
@@ -60,8 +61,7 @@ def load_sequence(folder: str | Path, scale: float = 1.0) -> list[LabelledFrame]
     an unknown facing (theta None). Raises ValueError naming the file for anything malformed.
     """
     folder = Path(folder)
-    if not (math.isfinite(scale) and scale > 0):
-        raise ValueError(f"fformation: scale must be positive, got {scale}")
+    check_number("fformation", "scale", scale, low=0, low_open=True)
     features_path, truth_path = folder / "features.mat", folder / "groundtruth.mat"
     features = _load_mat(features_path, ("features", "timestamp"))
     truth = _load_mat(truth_path, ("GTgroups", "GTtimestamp"))
@@ -128,7 +128,7 @@ def score(frames: Sequence[LabelledFrame], detections: Sequence[Sequence[Iterabl
 
 
 def evaluate(
-    datasets: dict[str, Sequence[LabelledFrame]],
+    datasets: Mapping[str, Sequence[LabelledFrame]],
     params: GroupParams | None = None,
     thresholds: Sequence[float] = DEFAULT_THRESHOLDS,
 ) -> dict[str, dict[str, dict[str, float | int]]]:

@@ -17,8 +17,8 @@ For each task and planner, ``sid.experiments.harness.compare_with_without`` plan
 paths against the same groups, detected from the task's people (``sid.perception.groups.detect_groups`` on exact
 positions: this study is about navigation, not perception). ``sid.experiments.harness.summarise`` gives, per planner
 (or layout) and costmap: success rate, o-space intrusion rate (share of successful paths entering a group zone) and
-length, group-crossing rate, minimum distance to people, path-length ratio (length / straight line, NOTES section 4),
-detour (length with / length without, per task) and planning time.
+length, group-crossing rate, minimum distance to people, path-length ratio (length / straight line), detour (length
+with / length without, per task) and planning time; docs/reproduction.md says where these metrics come from.
 """
 
 from __future__ import annotations
@@ -32,6 +32,7 @@ import numpy as np
 
 from planner.facade import DEFAULT_PLANNER, resolve_planner
 from planner.problem import DEFAULT_COST_WEIGHT, PlanningError
+from sid.checks import check_number
 from sid.experiments.demo import DEMO_SCENARIO
 from sid.experiments.harness import Comparison, compare_with_without, prepare
 from sid.scenario.loader import Scenario, scenario_from_dict
@@ -145,8 +146,7 @@ class NavSettings:
             raise ValueError("navigation: give at least one planner")
         for name in self.planners:
             resolve_planner(name)  # raises ValueError naming the unknown planner
-        if not (math.isfinite(self.time_limit) and self.time_limit > 0):
-            raise ValueError(f"navigation: time limit must be a positive number of seconds, got {self.time_limit}")
+        check_number("navigation", "time limit", self.time_limit, low=0, low_open=True, unit="seconds")
         if self.max_iterations is not None and self.max_iterations < 1:
             raise ValueError(f"navigation: iteration cap must be >= 1, got {self.max_iterations}")
 

@@ -1,8 +1,8 @@
 """Replay the paper authors' logged group detections through our detector and measure the agreement.
 
-The CSVs (``../shared/data/seed-recordings``) hold one row per person per detected group per message, written by
-the authors' ROS 2 node: Timestamp (whole seconds, shared by several messages), Group Index, Interaction Area,
-Centroid X/Y (interest point, m), Group Radius, Person Index (order in the message), Person X/Y (m, world frame:
+The CSVs (by default in ``../shared/data/seed-recordings``) hold one row per person per detected group per message,
+written by the authors' ROS 2 node: Timestamp (whole seconds, shared by several messages), Group Index, Interaction
+Area, Centroid X/Y (interest point, m), Group Radius, Person Index (order in the message), Person X/Y (m, world frame:
 X forward, Y left), Person Orientation (yaw, degrees), Runtime (s). Only people in a logged group appear, and
 messages without a group were not logged.
 

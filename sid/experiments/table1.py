@@ -52,7 +52,7 @@ PAPER_TABLE1: dict[str, dict[str, float]] = {
     "S4": {"IZA": 0.038, "IPX": 0.089, "IPY": 0.186, "HPX": 0.123, "HPY": 0.129, "HFD": 6.897},
     "S5": {"IZA": 0.067, "IPX": 0.124, "IPY": 0.087, "HPX": 0.154, "HPY": 0.086, "HFD": 6.942},
 }
-"""The paper's Table 1 (RMSE per scenario; ../shared/NOTES.md section 6)."""
+"""The paper's Table 1 (RMSE per scenario; its source: docs/reproduction.md)."""
 
 
 @dataclass(frozen=True)

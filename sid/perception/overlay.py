@@ -55,7 +55,10 @@ def _draw_block(image: np.ndarray, lines: Sequence[str], left: int, top: int, sc
 
 
 def place_labels(
-    sizes: Sequence[tuple[int, int]], boxes: Sequence[Sequence[float]], shape: tuple[int, int], gap: int = 1
+    sizes: Sequence[tuple[int, int]],
+    boxes: Sequence[np.ndarray | Sequence[float]],
+    shape: tuple[int, int],
+    gap: int = 1,
 ) -> list[tuple[int, int]]:
     """Top-left corners (u, v) of label blocks of ``sizes`` (w, h) px, one per box (u0, v0, u1, v1), in an image of
     ``shape`` (h, w).
@@ -119,7 +122,7 @@ def draw_detections(
             if ok[a] and ok[b]:
                 cv2.line(image, _pt(det.keypoints[a]), _pt(det.keypoints[b]), _bone_colour(a, b), thick, cv2.LINE_AA)
         for k in np.flatnonzero(ok):
-            cv2.circle(image, _pt(det.keypoints[k]), thick + 2, _side_colour(k), cv2.FILLED, cv2.LINE_AA)
+            cv2.circle(image, _pt(det.keypoints[k]), thick + 2, _side_colour(int(k)), cv2.FILLED, cv2.LINE_AA)
             cv2.circle(image, _pt(det.keypoints[k]), thick + 2, (0, 0, 0), 1, cv2.LINE_AA)
         lines = [f"{det.box_score:.2f}"]
         if person is not None:

@@ -248,7 +248,7 @@ def test_the_lidar_layer_clears_people_marks_by_its_own_parameter():
         assert layer.update(LayerInputs(people), None) == (
             None if radius == 0 else SPEC.window((3.7, -0.3), (4.3, 0.3))
         )
-    with pytest.raises(ValueError, match="clear radius"):
+    with pytest.raises(ValueError, match="people_clear_radius"):
         ObstacleLayer(SPEC, people_clear_radius=-1.0)
 
 

@@ -154,7 +154,7 @@ def test_malformed_files_give_clear_errors(tmp_path, tiny):
     scipy.io.savemat(broken / "features.mat", {"features": cells([np.zeros((0, 0))]), "timestamp": np.array([[9]])})
     with pytest.raises(ValueError, match="GTtimestamp 1.0 has no frame"):
         load_sequence(broken)
-    with pytest.raises(ValueError, match="scale must be positive"):
+    with pytest.raises(ValueError, match="scale must be a positive number"):
         load_sequence(tiny, scale=0.0)
 
 

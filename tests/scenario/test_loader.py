@@ -94,8 +94,8 @@ def test_yaml_files_load_too(tmp_path):
         ("obstacles", [{"type": "segment", "points": [[0, 0]]}], r"obstacles\[0\]\.points: expected at least 2"),
         ("lidar", {"beams": 0}, r"lidar\.beams: expected an integer >= 1"),
         ("groups", {"epsilon": 1}, r"groups\.epsilon: unknown field"),
-        ("layers", {"inflation": {"inflation_radius": -1}}, r"layers\.inflation: inflation_radius"),
-        ("layers", {"social": {"group_cost": 300}}, r"layers\.social: social\.group_cost"),
+        ("layers", {"inflation": {"inflation_radius": -1}}, r"layers\.inflation: inflation: inflation_radius"),
+        ("layers", {"social": {"group_cost": 300}}, r"layers\.social: social: group_cost"),
         ("peple", [], r"scenario\.peple: unknown field"),
     ],
 )

@@ -2,7 +2,7 @@
 
 Not used by the pipeline. ``sid bench`` times it side by side with ``sid.perception.groups.detect_groups`` and checks
 that both find the same groups where their logic agrees. Written from the description of the authors' public ROS 2 node
-(../shared/NOTES.md section 6) and the paper's Algorithm 1, with the same building blocks they use:
+(its source: docs/benchmarks.md) and the paper's Algorithm 1, with the same building blocks they use:
 
 - scikit-learn ``DBSCAN(eps=3.0, min_samples=2)`` fitted on every call, on the features (x, y, yaw) of each person
   (metres and radians in one space, as their node does);
@@ -77,7 +77,7 @@ def baseline_groups(people: Sequence[Person], params: BaselineParams = BaselineP
     """
     known = [p for p in people if p.theta is not None]
     for person in known:
-        if not all(math.isfinite(v) for v in (person.x, person.y, person.theta)):
+        if not all(math.isfinite(v) for v in (person.x, person.y, _facing(person))):
             raise ValueError(
                 f"baseline: person {person.id} has a non-finite pose ({person.x}, {person.y}, {person.theta})"
             )
@@ -92,6 +92,21 @@ def baseline_groups(people: Sequence[Person], params: BaselineParams = BaselineP
         if found is not None:
             groups.append(found)
     return groups
+
+
+def _facing(person: Person) -> float:
+    """The facing (rad) of a person the baseline kept: people with theta None are left out before DBSCAN."""
+    if person.theta is None:
+        raise ValueError(f"baseline: person {person.id} has no facing (theta None) to cast a ray along")
+    return person.theta
+
+
+def _ray(person: Person, length: float) -> LineString:
+    """``length`` metres from the person's position along their facing."""
+    theta = _facing(person)
+    return LineString(
+        [(person.x, person.y), (person.x + length * math.cos(theta), person.y + length * math.sin(theta))]
+    )
 
 
 def _detect(cluster: list[Person], params: BaselineParams) -> BaselineGroup | None:
@@ -111,15 +126,7 @@ def _detect(cluster: list[Person], params: BaselineParams) -> BaselineGroup | No
 
 def _evaluate(members: list[Person], params: BaselineParams) -> _Evaluation:
     """Area, interest point and D of ``members`` from their rays' crossings, and whether they pass."""
-    lines = [
-        LineString(
-            [
-                (p.x, p.y),
-                (p.x + params.ray_length * math.cos(p.theta), p.y + params.ray_length * math.sin(p.theta)),
-            ]
-        )
-        for p in members
-    ]
+    lines = [_ray(p, params.ray_length) for p in members]
     crossings = []
     for i, first in enumerate(lines):
         for second in lines[i + 1 :]:

@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import Any
 
 from sid.cpu import physical_cores, usable_cpus
+from sid.documents import load_document
 
 FORMAT = "sid-bench/1"
 LIBRARIES = ("numpy", "scipy", "scikit-learn", "shapely", "opencv-python-headless", "onnxruntime", "ompl",
@@ -99,11 +100,9 @@ def load_report(path: str | Path) -> dict[str, Any]:
     """Read a ``bench.json``; ValueError naming the file and the problem when it is not one."""
     path = Path(path)
     try:
-        data = json.loads(path.read_text())
-    except OSError as exc:
-        raise ValueError(f"bench: cannot read {path} ({exc.strerror})") from None
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"bench: {path} is not JSON ({exc})") from None
+        data = load_document(path, "bench report")
+    except ValueError as exc:  # names the file: unreadable, or not valid JSON
+        raise ValueError(f"bench: {exc}") from None
     stages = data.get("stages") if isinstance(data, dict) else None
     if not isinstance(stages, dict):
         raise ValueError(f'bench: {path} is not a sid bench report (no "stages" object)')

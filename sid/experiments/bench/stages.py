@@ -1,9 +1,10 @@
 """The stages ``sid bench`` times, each on a fixed, seeded input, and what each corresponds to in the paper.
 
 Every benchmark returns one or more stage records ``{"median_ms", "min_ms", "max_ms", "runs", ...extra}``
-keyed by stage name. Extra fields: ``paper_ms`` (the paper's Jetson Orin NX figure for the same step, NOTES
-section 6, another machine), ``ratio_to`` (the stage this one is compared with: ``sid.experiments.bench.suite`` adds
-``ratio`` = this median / that median), and counts or checks that show the stage did its work.
+keyed by stage name. Extra fields: ``paper_ms`` (the paper's Table 2 figure for the same step, from a Jetson Orin
+NX, another machine; docs/benchmarks.md), ``ratio_to`` (the stage this one is compared with:
+``sid.experiments.bench.suite`` adds ``ratio`` = this median / that median), and counts or checks that show the
+stage did its work.
 
 Each benchmark imports what it times inside its own function, so that a module that fails to import (or an
 optional piece missing on a machine) costs only the benchmarks that need it, reported as such, not the run.
@@ -12,26 +13,33 @@ optional piece missing on a machine) costs only the benchmarks that need it, rep
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from sid.experiments.bench.baseline import baseline_groups
+from sid.experiments.bench.baseline import BaselineGroup, baseline_groups
 from sid.experiments.bench.pose import timed_call
 from sid.experiments.bench.runner import RunSettings, Stats, measure, measure_parts
 from sid.perception.people import Person
 
 if TYPE_CHECKING:
     from sid.experiments.harness import Task
+    from sid.perception.align import SplatMode
+    from sid.perception.frame import Frame
+    from sid.perception.groups import Group
+    from sid.perception.keypoints import PoseDetection
+    from sid.perception.pose import MoveNetMultiPose, MoveNetSinglePose, YoloPose
+    from sid.synthetic import Scene
 
 GROUP_SIZES = (2, 3, 4, 6, 20)
 DBSCAN_SIZES = (4, 20)
 FRAME_SIZES = (2, 3, 4, 6)
+ALIGN_MODES: tuple[SplatMode, ...] = ("rectangle", "point")
 
-# The paper's Table 2 (ms per frame on a Jetson Orin NX, NOTES section 6) for 2 / 3 / 4 people.
+# The paper's Table 2 (ms per frame on a Jetson Orin NX; docs/benchmarks.md) for 2 / 3 / 4 people.
 PAPER_POSE_MS = {2: 3.15, 3: 2.86, 4: 3.32}
 PAPER_LIFT_MS = {2: 0.55, 3: 0.52, 4: 0.55}  # "depth alignment + 3D"
 PAPER_GROUP_MS = {2: 0.25, 3: 0.14, 4: 0.15}  # "DBSCAN + groups"
@@ -113,7 +121,7 @@ def grouping_scene(n: int, seed: int = 0) -> list[Person]:
     return people
 
 
-def _frame_scene(n: int):
+def _frame_scene(n: int) -> Scene:
     """The synthetic scene of the per-frame pipeline: the paper's S1 (2 people), S3 (3), S5 (4), or 6 people on a
     1 m circle 3 m in front of the camera, facing its centre."""
     from sid.synthetic import Scene, ScenePerson, layout
@@ -128,10 +136,10 @@ def _frame_scene(n: int):
     return Scene(f"circle{n}", people, (tuple(range(n)),))
 
 
-def _frames(ctx: Context, n: int, count: int = 4) -> list:
+def _frames(ctx: Context, n: int, count: int = 4) -> list[Frame]:
     """``count`` synthetic RGB-D frames (D435i depth 848x480 with noise, colour grid 1280x720) of ``n`` people."""
 
-    def build() -> list:
+    def build() -> list[Frame]:
         from sid.synthetic import SyntheticCamera
 
         camera = SyntheticCamera(shaded_color=False)  # the colour image is not used: faster rendering
@@ -141,7 +149,7 @@ def _frames(ctx: Context, n: int, count: int = 4) -> list:
     return ctx.cached(f"frames/{n}", build)
 
 
-def _truth_detections(frame) -> list:
+def _truth_detections(frame: Frame) -> list[PoseDetection]:
     from sid.synthetic.pose import TruthPose
 
     return TruthPose()(frame)
@@ -149,11 +157,10 @@ def _truth_detections(frame) -> list:
 
 # --- grouping -----------------------------------------------------------------------------------------------------
 
-# The grouping stages run with native thread pools (OpenMP, BLAS) limited to one thread. The work is tiny, and
-# scikit-learn's OpenMP pool (used by DBSCAN's brute-force neighbour search below ~20 points) turned 0.46 ms into
-# 64 ms per call on this 2-core machine while other processes kept both cores busy (measured, median of 30 calls);
-# one thread is how such a step runs next to a camera driver and a planner. threadpoolctl is a dependency of
-# scikit-learn, not an extra one.
+# The grouping stages run with native thread pools (OpenMP, BLAS) limited to one thread: the work is tiny, and
+# scikit-learn's OpenMP pool (DBSCAN's brute-force neighbour search on small inputs) is many times slower while
+# other processes keep the cores busy (docs/benchmarks.md, "Grouping threads"); one thread is how such a step runs
+# next to a camera driver and a planner. threadpoolctl is a dependency of scikit-learn, not an extra one.
 GROUPING_THREADS = 1
 
 
@@ -164,7 +171,7 @@ def _measure_one_thread(fn: Callable[[], object], settings: RunSettings) -> Stat
         return measure(fn, settings)
 
 
-def _member_sets(groups) -> set[tuple[int, ...]]:
+def _member_sets(groups: Iterable[Group | BaselineGroup]) -> set[tuple[int, ...]]:
     return {tuple(sorted(g.members)) for g in groups}
 
 
@@ -247,7 +254,7 @@ def _bench_dbscan_sklearn(n: int) -> Callable[[Context], Records]:
 # --- alignment, lifting, orientation ------------------------------------------------------------------------------
 
 
-def _bench_align(mode: str) -> Callable[[Context], Records]:
+def _bench_align(mode: SplatMode) -> Callable[[Context], Records]:
     def run(ctx: Context) -> Records:
         from sid.perception.align import Aligner
 
@@ -255,6 +262,8 @@ def _bench_align(mode: str) -> Callable[[Context], Records]:
         aligner = Aligner(frame.calibration, mode)  # built once per stream, as a user does
         stats = measure(lambda: aligner(frame.depth), ctx.settings)
         kd, kc = frame.calibration.depth, frame.calibration.color
+        if kd is None:  # unreachable: Aligner refuses a calibration without depth intrinsics
+            raise ValueError("bench: align needs depth intrinsics; the frame's depth is registered to colour")
         filled = float(np.count_nonzero(aligner(frame.depth)) / (kc.width * kc.height))
         size = f"{kd.width}x{kd.height} -> {kc.width}x{kc.height}"
         return {f"align/{mode}": record(stats, size=size, filled_fraction=round(filled, 3))}
@@ -321,7 +330,7 @@ def _pose_image(ctx: Context) -> tuple[np.ndarray, str]:
     return ctx.cached("pose_image", build)
 
 
-def _estimator(ctx: Context, path: Path):
+def _estimator(ctx: Context, path: Path) -> MoveNetMultiPose | MoveNetSinglePose | YoloPose:
     from sid.perception.pose import load_pose_estimator
 
     return ctx.cached(f"estimator/{path}", lambda: load_pose_estimator(path))
@@ -329,6 +338,8 @@ def _estimator(ctx: Context, path: Path):
 
 def _bench_pose(path: Path) -> Callable[[Context], Records]:
     def run(ctx: Context) -> Records:
+        from sid.perception.pose import MoveNetMultiPose
+
         estimator = _estimator(ctx, path)
         image, image_name = _pose_image(ctx)
         image_hw = image.shape[:2]
@@ -342,7 +353,9 @@ def _bench_pose(path: Path) -> Callable[[Context], Records]:
 
         parts = measure_parts(call, ctx.settings)
         name = f"pose/{path.stem}"
-        input_size = estimator.input_size or estimator.input_size_for(image_hw)
+        input_size = estimator.input_size
+        if input_size is None and isinstance(estimator, MoveNetMultiPose):  # dynamic MultiPose: sized per image
+            input_size = estimator.input_size_for(image_hw)
         out = {
             name: record(
                 parts["total"],
@@ -369,12 +382,12 @@ def _pipeline_pose(ctx: Context) -> tuple[Callable, str]:
     truth = TruthPose()
     models = [p for p in pose_models(ctx.shared) if p.stem.startswith("yolo")]
     image, image_name = _pose_image(ctx) if models else (None, "")
-    if not models or not image_name.startswith("five_people"):
+    if not models or image is None or not image_name.startswith("five_people"):
         ctx.note("per-frame pipeline: no YOLO-pose model or real image in ../shared, pose = TruthPose (no network)")
         return truth, "TruthPose"
     estimator = _estimator(ctx, models[0])
 
-    def pose(frame) -> list:
+    def pose(frame: Frame) -> list[PoseDetection]:
         estimator(image)
         return truth(frame)
 
@@ -470,7 +483,7 @@ def _bench_inflation(ctx: Context) -> Records:
     inflation = InflationLayer(spec, InflationParams(), inscribed_radius=0.25)
 
     def inflate() -> None:
-        np.copyto(work, master)  # write() works in place; the 160 kB copy is part of the timing (~10 us)
+        np.copyto(work, master)  # write() works in place; the 160 kB copy is part of the timing (docs/benchmarks.md)
         inflation.write(work, spec.whole)
 
     stats = measure(inflate, ctx.settings)
@@ -543,8 +556,7 @@ def benchmarks(ctx: Context) -> list[Benchmark]:
             )  # fmt: skip
         )
     items += [
-        Benchmark(f"align/{mode}", f"Aligner ({mode} splat), full frame", _bench_align(mode))
-        for mode in ("rectangle", "point")
+        Benchmark(f"align/{mode}", f"Aligner ({mode} splat), full frame", _bench_align(mode)) for mode in ALIGN_MODES
     ]
     items += [
         Benchmark("align/sparse_4x17", "depth_at_color_pixels, 4 x 17 keypoints", _bench_sparse_depth),
