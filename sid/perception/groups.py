@@ -292,16 +292,22 @@ def _convex_hull(points: list[complex]) -> list[complex]:
 
 
 def _shoelace(polygon: list[complex]) -> tuple[float, complex]:
-    """Area and centroid of a counter-clockwise polygon (shoelace formula); the centroid is 0 for zero area."""
+    """Area and centroid of a counter-clockwise polygon (shoelace formula); the centroid is 0 for zero area.
+
+    Computed relative to the first vertex, so a thin polygon far from the origin keeps its precision (the products
+    of absolute coordinates would cancel).
+    """
+    origin = polygon[0]
+    local = [p - origin for p in polygon]
     twice_area = 0.0
     moment = 0j
-    for a, b in zip(polygon, polygon[1:] + polygon[:1], strict=True):
+    for a, b in zip(local, local[1:] + local[:1], strict=True):
         cross = (a.conjugate() * b).imag
         twice_area += cross
         moment += cross * (a + b)
     if twice_area <= 0:
         return 0.0, 0j
-    return 0.5 * twice_area, moment / (3.0 * twice_area)
+    return 0.5 * twice_area, origin + moment / (3.0 * twice_area)
 
 
 def _segment_ends(crossings: np.ndarray, centre: complex) -> np.ndarray:

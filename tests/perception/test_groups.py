@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 import shapely
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from sid.perception.groups import Group, GroupParams, _convex_hull, _shoelace, detect_groups
@@ -179,6 +179,7 @@ def random_scene(seed: int) -> list[Person]:
 
 @settings(max_examples=200, deadline=None)
 @given(st.integers(0, 2**32 - 1), st.floats(-math.pi, math.pi), st.floats(-20, 20), st.floats(-20, 20))
+@example(9322, 0.0, -13.0, 10.0)  # a near-degenerate zone (7e-8 m^2) whose centroid lost 1e-6 m to cancellation
 def test_rotating_and_translating_the_scene_moves_the_groups_with_it(seed, angle, tx, ty):
     people = random_scene(seed)
     c, s = math.cos(angle), math.sin(angle)
