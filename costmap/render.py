@@ -1,4 +1,5 @@
-"""Pictures of costmaps (OpenCV, BGR uint8): costs, walls, people with facing arrows, group zones, a colour scale.
+"""Pictures of costmaps (OpenCV, BGR uint8): costs, known obstacles' outlines, people with facing arrows, group zones,
+a colour scale.
 
 Image layout: world x to the right, world y up; the map sits at (MARGIN_LEFT, MARGIN_TOP) with ``scale`` pixels
 per cell, axes in metres below and left of it, the colour scale and a legend of what is drawn to its right.
@@ -37,6 +38,10 @@ class RobotTask(Protocol):
     def radius(self) -> float: ...
 
 
+Outline = tuple[ArrayLike, bool]
+"""A shape drawn over the map: its world points (N, 2) (metres) and whether the polyline closes into a polygon."""
+
+
 @dataclass(frozen=True)
 class CameraView:
     """A camera seen from above (world frame): position (m), yaw of its optical axis and horizontal field of view
@@ -56,6 +61,7 @@ START = (60, 140, 0)
 GOAL = (30, 30, 220)  # red
 SCAN = (60, 60, 230)
 CAMERA = (90, 60, 60)  # dark slate
+OBSTACLE = (150, 150, 0)  # teal: the outlines of known obstacles, clear on black lethal cells and on steel blue
 INSCRIBED_COLOUR = (200, 140, 110)  # RGB (110, 140, 200), steel blue
 UNKNOWN_COLOUR = (205, 205, 205)  # map_saver's unknown grey
 # Graded costs 1..252: ColorBrewer YlOrBr anchors (RGB), light to dark, clear of black walls and grey unknown.
@@ -133,6 +139,7 @@ LEGEND = {  # name -> swatch drawn centred at (u, v)
     "person, facing": _legend_person,
     "group zone": lambda img, u, v: cv2.rectangle(img, (u - 9, v - 6), (u + 9, v + 6), ZONE, 2),
     "interest point": lambda img, u, v: cv2.drawMarker(img, (u, v), ZONE, cv2.MARKER_CROSS, 10, 2, cv2.LINE_AA),
+    "known obstacle": lambda img, u, v: cv2.rectangle(img, (u - 9, v - 6), (u + 9, v + 6), OBSTACLE, 2),
     "LiDAR hits": lambda img, u, v: cv2.circle(img, (u, v), 2, SCAN, -1),
     "robot start": lambda img, u, v: cv2.circle(img, (u, v), 6, START, 2, cv2.LINE_AA),
     "goal": lambda img, u, v: cv2.drawMarker(img, (u, v), GOAL, cv2.MARKER_TILTED_CROSS, 12, 2, cv2.LINE_AA),
@@ -200,6 +207,12 @@ def _draw_camera(img: np.ndarray, spec: GridSpec, scale: int, camera: CameraView
     _camera_glyph(img, world_to_image(origin[None], spec, scale)[0], camera.yaw)
 
 
+def _draw_outlines(img: np.ndarray, spec: GridSpec, scale: int, outlines: Sequence[Outline]) -> None:
+    for points, closed in outlines:
+        ring = _px(np.asarray(points, dtype=float).reshape(-1, 2), spec, scale)
+        cv2.polylines(img, [ring], bool(closed), OBSTACLE, 2, cv2.LINE_AA, shift=4)
+
+
 def _draw_people(img: np.ndarray, spec: GridSpec, scale: int, people: Sequence[Person], body_radius: float) -> None:
     px_per_m = scale / spec.resolution
     radius = max(3, int(round(body_radius * px_per_m)))
@@ -253,8 +266,12 @@ def render_costmap(
     body_radius: float | None = None,
     zone_margin: float | None = None,
     camera: CameraView | None = None,
+    outlines: Sequence[Outline] = (),
 ) -> np.ndarray:
     """A readable BGR picture of a costmap (world y up) with people, group zones, robot task, camera and colour scale.
+
+    ``outlines``: shapes of the known map (e.g. a scenario's declared obstacles), each (world points (N, 2), closed),
+    drawn as lines over the costs, so a shape shows whole whatever the scan saw of it.
 
     With a LayeredCostmap, its combined grid is drawn; people, groups and scan default to the inputs it last applied,
     body radius and zone margin to its social layer's. ``scale``: pixels per cell (default: a map about 800 px wide).
@@ -288,6 +305,7 @@ def render_costmap(
     cv2.rectangle(img, (MARGIN_LEFT - 1, MARGIN_TOP - 1), (MARGIN_LEFT + w_px, MARGIN_TOP + h_px), TEXT, 1)
     if camera is not None:
         _draw_camera(img, spec, scale, camera)
+    _draw_outlines(img, spec, scale, outlines)
     if scan is not None:
         for u, v in (world_to_image(scan.hit_points(), spec, scale)).astype(int):
             cv2.circle(img, (int(u), int(v)), 1, SCAN, -1)
@@ -300,6 +318,7 @@ def render_costmap(
         "person, facing": bool(people),
         "group zone": bool(groups),
         "interest point": bool(groups),
+        "known obstacle": bool(outlines),
         "LiDAR hits": scan is not None,
         "robot start": robot is not None,
         "goal": robot is not None,

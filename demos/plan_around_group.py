@@ -21,19 +21,19 @@ print(f"{len(scenario.people)} people, groups found: {[g.members for g in groups
 
 paths = []
 for social, colour in ((False, WITHOUT_COLOUR), (True, WITH_COLOUR)):
-    # The costmap the robot sees: LiDAR only, or LiDAR plus the social layer from the recognised groups.
+    # The costmap the robot sees: the known map and LiDAR, plus the social layer from the recognised groups.
     costmap = build_costmap(scenario, social=social, groups=groups if social else [])
     problem = planning_problem(scenario, costmap.master)
     # BIT* with a fixed seed and iteration cap: the same path on every run.
     result = plan(problem, "bitstar", time_limit=5.0, seed=1, max_iterations=5000)
     m = path_metrics(result.path, scenario.people, groups)
-    label = "with social layer" if social else "LiDAR only"
+    label = "with social layer" if social else "map + LiDAR"
     print(
         f"{label:18s}: {m['path_length_m']:.2f} m, {m['ospace_intrusion_m']:.2f} m inside the group zone, "
         f"closest person {m['min_person_distance_m']:.2f} m"
     )
     paths.append((result.path, PathStyle(label, colour, dashed=not social)))
 
-picture, _ = render_paths(costmap, paths, robot=scenario.robot, groups=groups, title="dashed: LiDAR only")
+picture, _ = render_paths(costmap, paths, robot=scenario.robot, groups=groups, title="dashed: map + LiDAR only")
 cv2.imwrite("plan_around_group.png", picture)
 print("wrote plan_around_group.png")

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import ndimage
 
+from costmap.grid import INSCRIBED, LETHAL, NO_INFORMATION
 from planner.grid_planner import grid_search
 from planner.ompl_planners import OMPL_PLANNERS, seed_ompl, solve_ompl
 from planner.problem import CostField, PlanningError, PlanningProblem
@@ -26,6 +27,8 @@ from planner.validity import check_path
 PLANNERS: tuple[str, ...] = (*OMPL_PLANNERS, "grid")
 """Every planner ``plan`` offers: OMPL's (``planner.ompl_planners``) and the grid planner."""
 DEFAULT_PLANNER = "bitstar"
+MAX_SEED = 2**32 - 1
+"""The largest seed ``plan`` takes: OMPL's seed is a ``std::uint_fast32_t``, 32 bits wide on some platforms."""
 UNAVAILABLE: dict[str, str] = {
     "prmstar": (
         "PRM* is not available: it grows its roadmap in a worker thread that calls the Python cost objective, "
@@ -67,8 +70,21 @@ def resolve_planner(name: str) -> str:
     return key
 
 
+def _collision(cost: int, problem: PlanningProblem) -> str:
+    """Why a robot centre in a cell of ``cost`` is not free, in words."""
+    radius = f"{problem.robot_radius:.2f} m"
+    if cost == LETHAL:
+        return f"it lies inside an obstacle (cell cost {LETHAL}, lethal)"
+    if cost == INSCRIBED:
+        return f"an obstacle is within the robot radius {radius} (cell cost {INSCRIBED}, inscribed)"
+    if cost == NO_INFORMATION:
+        return f"it lies in unknown space (cell cost {NO_INFORMATION})"
+    return f"an obstacle is within the robot radius {radius} (cell cost {cost})"
+
+
 def check_endpoints(field: CostField) -> None:
-    """Raise PlanningError naming the reason when the start or goal cannot be used, or cannot be connected."""
+    """Raise PlanningError, its message starting "no path: " and naming the reason, when the start or goal lies in
+    collision or the two cannot be connected (or "... is outside the map")."""
     problem, spec = field.problem, field.spec
     x0, y0 = spec.origin_x, spec.origin_y
     x1, y1 = x0 + spec.size_m[0], y0 + spec.size_m[1]
@@ -82,10 +98,7 @@ def check_endpoints(field: CostField) -> None:
         cell = spec.world_to_cell(np.array([x, y]))[0]
         if not field.free[cell[0], cell[1]]:
             cost = int(problem.costmap.costs[cell[0], cell[1]])
-            raise PlanningError(
-                f"{name} ({x:.2f}, {y:.2f}) is in collision: cell cost {cost} (253 inscribed, 254 lethal, 255 "
-                f"unknown) or an obstacle within the robot radius {problem.robot_radius:.2f} m"
-            )
+            raise PlanningError(f"no path: {name} ({x:.2f}, {y:.2f}) is in collision: {_collision(cost, problem)}")
         cells.append(cell)
     # 4-connected regions: a diagonal step between plannable cells needs the two cells beside it plannable too (no
     # corner cutting, as in the grid planner), so cells that touch only at a corner are not connected.
@@ -93,8 +106,8 @@ def check_endpoints(field: CostField) -> None:
     (sr, sc), (gr, gc) = cells
     if labels[sr, sc] != labels[gr, gc]:
         raise PlanningError(
-            "no collision-free path: the start and the goal lie in separate free regions of the costmap "
-            f"(for a robot of radius {problem.robot_radius:.2f} m)"
+            "no path: the start and the goal lie in separate free regions of the costmap (walled off from each "
+            f"other for a robot of radius {problem.robot_radius:.2f} m)"
         )
 
 
@@ -121,8 +134,8 @@ def plan(
     t0 = time.perf_counter()
     if name != "grid":
         seed = secrets.randbelow(2**31 - 1) + 1 if seed is None else int(seed)
-        if seed <= 0:
-            raise ValueError(f"seed must be a positive integer (OMPL ignores 0), got {seed}")
+        if not 1 <= seed <= MAX_SEED:
+            raise ValueError(f"seed must be a whole number from 1 to {MAX_SEED} (OMPL ignores 0), got {seed}")
         seed_ompl(seed)
     else:
         seed = None

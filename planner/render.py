@@ -14,7 +14,7 @@ import numpy as np
 
 from costmap.grid import Costmap2D, GridSpec
 from costmap.layered import LayeredCostmap
-from costmap.render import RobotTask, default_scale, render_costmap, world_to_image
+from costmap.render import Outline, RobotTask, default_scale, render_costmap, world_to_image
 from planner.validity import interpolate
 from sid.perception.groups import Group
 
@@ -103,11 +103,14 @@ def render_paths(
     groups: Sequence[Group] | None = None,
     title: str | None = None,
     scale: int | None = None,
+    outlines: Sequence[Outline] = (),
 ) -> tuple[np.ndarray, int]:
-    """The costmap picture of ``layered`` (a ``LayeredCostmap`` or ``Costmap2D``) with paths on top; (image, scale)."""
+    """The costmap picture of ``layered`` (a ``LayeredCostmap`` or ``Costmap2D``) with paths on top; (image, scale).
+
+    ``outlines``: shapes of the known map to draw whole (``costmap.render.render_costmap``)."""
     spec = layered.spec
     scale = default_scale(spec) if scale is None else scale
-    img = render_costmap(layered, groups=groups, robot=robot, title=title, scale=scale)
+    img = render_costmap(layered, groups=groups, robot=robot, title=title, scale=scale, outlines=outlines)
     for path, style in paths:
         draw_path(img, path, spec, scale, style)
     return img, scale

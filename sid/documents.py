@@ -13,18 +13,37 @@ import yaml
 def load_document(path: str | Path, kind: str = "file") -> Any:
     """Parsed content of a ``.json`` file (JSON) or any other file (YAML, which also reads JSON).
 
-    Raises ValueError naming the file and ``kind`` (what the file should be): unreadable, or not valid JSON / YAML.
+    Raises ValueError naming the file and ``kind`` (what the file should be): unreadable, not UTF-8 text (a
+    byte-order mark is allowed), not valid JSON / YAML, or nested too deeply to parse.
     """
     path = Path(path)
     try:
-        text = path.read_text()
+        raw = path.read_bytes()
     except OSError as exc:
         raise ValueError(f"{path}: cannot read {kind} ({exc.strerror or exc})") from None
+    text = decode_text(raw, f"{path}: cannot read {kind}")
     is_json = path.suffix.lower() == ".json"
     try:
         return json.loads(text) if is_json else yaml.safe_load(text)
-    except (json.JSONDecodeError, yaml.YAMLError) as exc:
-        raise ValueError(f"{path}: not valid {'JSON' if is_json else 'YAML'} ({exc})") from None
+    except RecursionError:
+        raise ValueError(f"{path}: cannot read {kind}: nested too deeply") from None
+    except (json.JSONDecodeError, yaml.YAMLError, ValueError, TypeError, OverflowError) as exc:
+        # Besides syntax errors, YAML's constructors raise ValueError for values such as `2001-02-30` or `!!int 0xZZ`.
+        # PyYAML's messages span lines and name "<unicode string>": made one line here.
+        reason = " ".join(str(exc).split()).replace(' in "<unicode string>",', " at")
+        raise ValueError(f"{path}: not valid {'JSON' if is_json else 'YAML'} ({reason})") from None
+
+
+def decode_text(raw: bytes, what: str) -> str:
+    """``raw`` decoded as UTF-8 (a leading byte-order mark dropped); ValueError ``"what: ..."`` naming the first
+    byte that is not UTF-8 and where it is (line and byte offset), e.g. for a binary file."""
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        raise ValueError(
+            f"{what}: byte 0x{raw[exc.start]:02x} at offset {exc.start} (line {line}) is not UTF-8 text"
+        ) from None
 
 
 def is_number(value: Any) -> TypeGuard[int | float]:

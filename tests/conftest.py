@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from types import ModuleType
 
 import pytest
 from hypothesis import settings
@@ -25,6 +26,16 @@ def shared_path(*parts: str) -> Path:
     if not path.exists():
         pytest.skip(f"real data {path} is absent (../shared is not checked out next to the repo)")
     return path
+
+
+def realsense() -> ModuleType:
+    """pyrealsense2, or skip the calling test (or, called at import time, the whole module) saying why it cannot
+    load: it is not installed, or the system library libusb-1.0-0 is missing (`sudo apt-get install libusb-1.0-0`)."""
+    try:
+        import pyrealsense2
+    except ImportError as exc:
+        pytest.skip(f"pyrealsense2 cannot be loaded ({exc}); it needs libusb-1.0-0", allow_module_level=True)
+    return pyrealsense2
 
 
 @pytest.fixture

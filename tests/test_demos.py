@@ -61,7 +61,7 @@ def end_to_end(out: str, cwd: Path) -> None:
 def plan_around_group(out: str, cwd: Path) -> None:
     assert re.search(r"groups found: \[\(1, 2, 3\)\]", out)
     row = r": ([\d.]+) m, ([\d.]+) m inside the group zone, closest person ([\d.]+) m"
-    lidar = _numbers("^LiDAR only *" + row, out)
+    lidar = _numbers("^map \\+ LiDAR *" + row, out)
     social = _numbers("^with social layer *" + row, out)
     assert lidar[1] > 0.5 and social[1] == 0.0  # through the conversation without the layer, around it with it
     assert social[2] > lidar[2] and social[0] > lidar[0]  # farther from people, for a longer path

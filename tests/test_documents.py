@@ -27,3 +27,59 @@ def test_bad_content_names_file_and_format(tmp_path, name, text, message):
 def test_missing_file_names_what_was_expected(tmp_path):
     with pytest.raises(ValueError, match="missing.json: cannot read scenario file"):
         load_document(tmp_path / "missing.json", "scenario file")
+
+
+# Regression fixtures (issue 15): bytes that are not a text document at all, and nesting deeper than Python parses.
+NOT_TEXT = {
+    "binary": b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR\xff\xfe",
+    "latin1": b'{"name": "caf\xe9"}',
+    "utf16": "x: 1".encode("utf-16"),
+}
+
+
+@pytest.mark.parametrize("suffix", [".json", ".yaml"])
+@pytest.mark.parametrize("kind", NOT_TEXT)
+def test_bytes_that_are_not_utf8_name_the_file_and_the_byte(tmp_path, kind, suffix):
+    path = tmp_path / f"{kind}{suffix}"
+    path.write_bytes(NOT_TEXT[kind])
+    with pytest.raises(
+        ValueError,
+        match=rf"{kind}{suffix}: cannot read map YAML: byte 0x[0-9a-f]{{2}} at offset \d+ "
+        r"\(line \d\) is not UTF-8 text",
+    ) as error:
+        load_document(path, "map YAML")
+    assert type(error.value) is ValueError  # not UnicodeDecodeError, whose message names no file
+
+
+@pytest.mark.parametrize(("name", "text"), [("deep.json", "[" * 100_000 + "]" * 100_000),
+                                            ("deep.yaml", "[" * 100_000 + "]" * 100_000),
+                                            ("deep_maps.yaml", "{a: " * 100_000 + "1" + "}" * 100_000)])  # fmt: skip
+def test_nesting_too_deep_to_parse_is_a_named_error(tmp_path, name, text):
+    path = tmp_path / name
+    path.write_text(text)
+    with pytest.raises(ValueError, match=rf"{name}: cannot read scenario file: nested too deeply"):
+        load_document(path, "scenario file")
+
+
+@pytest.mark.parametrize("text", ["when: 2001-02-30", "n: !!int 0xZZ", "x: !!float abc"])
+def test_yaml_values_python_cannot_build_name_the_file(tmp_path, text):
+    path = tmp_path / "odd.yaml"
+    path.write_text(text)
+    with pytest.raises(ValueError, match="odd.yaml: not valid YAML"):
+        load_document(path)
+
+
+@pytest.mark.parametrize("name", ["bom.json", "bom.yaml"])
+def test_a_utf8_byte_order_mark_is_allowed(tmp_path, name):
+    path = tmp_path / name
+    path.write_bytes(b"\xef\xbb\xbf" + b'{"x": 1}')
+    assert load_document(path) == {"x": 1}
+
+
+@pytest.mark.parametrize("raw", [b"\x00\x00", b"a: [1\nb: 2\n", b"a: b: c"])
+def test_yaml_errors_are_one_line(tmp_path, raw):
+    path = tmp_path / "map.yaml"
+    path.write_bytes(raw)
+    with pytest.raises(ValueError, match="map.yaml: not valid YAML") as error:
+        load_document(path)
+    assert "\n" not in str(error.value) and "<unicode string>" not in str(error.value)

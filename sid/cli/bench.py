@@ -4,10 +4,13 @@ run and write DIR/bench.json and DIR/bench.md (see docs/benchmarks.md)."""
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from dataclasses import asdict
 from pathlib import Path
 
+from sid.cli.common import check_output_folder, fail
+from sid.cli.detect import positive_int
 from sid.experiments.bench import (
     FULL,
     QUICK,
@@ -22,9 +25,34 @@ from sid.experiments.bench import (
     write_report,
 )
 from sid.experiments.bench.report import build_report
+from sid.perception.pose.session import PROVIDER_CHOICES
 
-REPO_ROOT = Path(__file__).resolve().parents[2]
 PLAN_RUNS_FULL, PLAN_RUNS_QUICK = 5, 1
+SHARED_ENV = "SID_SHARED"
+"""The environment variable naming the folder with models/ and data/ (``--shared``'s default when set)."""
+
+
+def find_repository(start: Path) -> Path | None:
+    """The sid source checkout holding ``start``: it or its nearest parent with pyproject.toml and sid/, or None."""
+    for folder in (start, *start.parents):
+        if (folder / "pyproject.toml").is_file() and (folder / "sid" / "__init__.py").is_file():
+            return folder
+    return None
+
+
+def repository() -> Path | None:
+    """The sid checkout this module runs from (a source or editable install), else the one holding the current
+    directory (after ``pip install .`` the module lives in site-packages), else None."""
+    return find_repository(Path(__file__).resolve().parent) or find_repository(Path.cwd().resolve())
+
+
+def default_shared() -> Path:
+    """``--shared``'s default: $SID_SHARED; else ../shared next to ``repository()``; else ../shared from the
+    current directory."""
+    if os.environ.get(SHARED_ENV):
+        return Path(os.environ[SHARED_ENV])
+    repo = repository()
+    return (repo.parent if repo is not None else Path.cwd().resolve().parent) / "shared"
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -48,10 +76,24 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--list", action="store_true", help="list the benchmarks and exit")
     parser.add_argument(
+        "--threads",
+        type=positive_int,
+        default=None,
+        metavar="N",
+        help="pose model threads, as sid detect --threads (default: the physical cores this process may use)",
+    )
+    parser.add_argument(
+        "--provider",
+        choices=PROVIDER_CHOICES,
+        default="auto",
+        help="pose models' execution provider, as sid detect --provider (default: %(default)s)",
+    )
+    parser.add_argument(
         "--shared",
         type=Path,
-        default=REPO_ROOT.parent / "shared",
-        help="folder with models/ and data/ (default: ../shared next to the repository)",
+        default=default_shared(),
+        help=f"folder with models/ (pose models) and data/ (default: ${SHARED_ENV} when set, else ../shared next to "
+        "the sid repository, the one sid runs from or the one holding the current directory; here %(default)s)",
     )
     parser.set_defaults(func=run)
 
@@ -70,23 +112,37 @@ def run(args: argparse.Namespace) -> int:
         print(f"sid bench: {exc}", file=sys.stderr)
         return 2
     settings = QUICK if args.quick else FULL
-    ctx = Context(settings, args.shared, PLAN_RUNS_QUICK if args.quick else PLAN_RUNS_FULL)
+    ctx = Context(
+        settings,
+        args.shared,
+        PLAN_RUNS_QUICK if args.quick else PLAN_RUNS_FULL,
+        pose_threads=args.threads,
+        pose_provider=args.provider,
+    )
     items = benchmarks(ctx)
+    for note in ctx.notes:  # e.g. no pose models under --shared: said now, not only at the end of the report
+        print(f"sid bench: note: {note} (--shared {args.shared}; ${SHARED_ENV} sets the default)", file=sys.stderr)
     if args.list:
         for item in items:
             print(f"{item.name:<28} {item.what}")
         return 0
     try:
         chosen = select(items, args.only)
+        check_output_folder(args.out)  # before the run, not after it
     except ValueError as exc:
         print(f"sid bench: {exc}", file=sys.stderr)
         return 2
-    machine = machine_info(REPO_ROOT)  # before the run: the load average is the one the run started under
+    repo = repository() or Path(__file__).resolve().parent  # no checkout: git finds no commit to record
+    machine = machine_info(repo)  # before the run: the load average is the one the run started under
     result = run_suite(chosen, ctx, _progress)
-    run_settings = {"quick": args.quick, "only": args.only, "plan_runs": ctx.plan_runs} | asdict(settings)
+    run_settings = {"quick": args.quick, "only": args.only, "plan_runs": ctx.plan_runs, "pose_threads": args.threads,
+                    "pose_provider": args.provider} | asdict(settings)  # fmt: skip
     report = build_report(machine, run_settings, result.stages, ctx.notes, result.failures)
     comparison = format_comparison(old, report) if old is not None else None
-    json_path, md_path = write_report(report, args.out, comparison)
+    try:
+        json_path, md_path = write_report(report, args.out, comparison)
+    except OSError as exc:
+        return fail("sid bench", exc)
     print(markdown(report, comparison), end="")
     print(f"wrote {json_path} and {md_path}", file=sys.stderr)
     if result.failures:

@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import argparse
 import sys
+import tempfile
 from collections.abc import Iterable
+from pathlib import Path
 
 from costmap.mapfile import MapFileError
-from planner.facade import DEFAULT_PLANNER, PLANNERS
+from planner.facade import DEFAULT_PLANNER, MAX_SEED, PLANNERS
 from planner.problem import DEFAULT_COST_WEIGHT, PlanningError
 from sid.experiments.harness import Comparison, goal_zone_warning
 from sid.scenario.loader import ScenarioError
@@ -30,12 +32,25 @@ def add_planner_option(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def seed_number(text: str) -> int:
+    """argparse type of ``--seed``: a whole number from 1 to ``MAX_SEED`` (what OMPL takes)."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if not 1 <= value <= MAX_SEED:
+        raise argparse.ArgumentTypeError(f"expected a whole number from 1 to {MAX_SEED}, got {text!r}")
+    return value
+
+
 def add_planning_options(parser: argparse.ArgumentParser, time_default: float) -> None:
     """The planner budget options ``sid plan`` and ``sid demo`` share."""
     parser.add_argument(
         "--time", type=float, default=time_default, metavar="S", help=f"planner time budget in seconds ({time_default})"
     )
-    parser.add_argument("--seed", type=int, default=None, metavar="N", help="random seed (positive) for OMPL")
+    parser.add_argument(
+        "--seed", type=seed_number, default=None, metavar="N", help=f"random seed for OMPL, 1 to {MAX_SEED}"
+    )
     parser.add_argument(
         "--iterations",
         type=int,
@@ -50,6 +65,40 @@ def add_planning_options(parser: argparse.ArgumentParser, time_default: float) -
         metavar="W",
         help=f"w in cost = integral of (1 + w c/252) ds ({DEFAULT_COST_WEIGHT:g}; 0 = shortest path)",
     )
+
+
+class OutputFolderError(ValueError):
+    """``--out`` names something that cannot be (or become) a writable folder."""
+
+
+def check_output_folder(path: str | Path, option: str = "--out") -> Path:
+    """``path`` as a Path when it is a folder sid can write in, or can be created as one; creates nothing.
+
+    Commands call this before any work, so a run is not spent and then lost on the write. Raises
+    OutputFolderError ``"--out PATH: reason"``: the path is a file, a parent of it is a file, or the nearest
+    existing folder cannot be written (permissions, a read-only file system).
+    """
+    folder = existing = Path(path)
+    try:
+        if "\0" in str(path):
+            raise ValueError("embedded null byte")
+        while not existing.exists() and existing != existing.parent:
+            existing = existing.parent  # the nearest existing ancestor: the folder is created in it
+    except (OSError, ValueError) as exc:  # a name too long, a parent that cannot be searched
+        reason = getattr(exc, "strerror", None) or exc
+        raise OutputFolderError(f"{option} {path!r}: not a usable path ({reason})") from None
+    writable = existing.is_dir()
+    if writable:
+        try:
+            with tempfile.TemporaryFile(dir=existing):
+                pass
+        except OSError as exc:  # permissions, a read-only file system
+            where = "in the folder" if existing == folder else f"in {existing} to create the folder"
+            raise OutputFolderError(f"{option} {path}: cannot write {where} ({exc.strerror or exc})") from None
+    if not writable:
+        reason = "is a file, not a folder" if existing == folder else f"cannot create the folder, {existing} is a file"
+        raise OutputFolderError(f"{option} {path}: {reason}")
+    return folder
 
 
 def fail(command: str, error: Exception) -> int:

@@ -8,7 +8,7 @@ import sys
 
 from planner.facade import PLANNERS
 from planner.problem import DEFAULT_COST_WEIGHT
-from sid.cli.common import INPUT_ERRORS, fail, print_written
+from sid.cli.common import INPUT_ERRORS, check_output_folder, fail, print_written
 from sid.experiments.compare import BY_SCENARIO, format_summary, write_comparison
 from sid.experiments.harness import prepare, run_matrix, summarise
 from sid.experiments.progress import ProgressBar
@@ -33,6 +33,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    try:
+        check_output_folder(args.out)  # before the runs, not after them
+    except ValueError as exc:
+        return fail("sid compare", exc)
     try:
         tasks = [prepare(load_scenario(path), args.cost_weight) for path in args.scenarios]
         runs = run_matrix(tasks, args.planners, args.runs, (args.time,), progress=ProgressBar("compare"))

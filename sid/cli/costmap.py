@@ -6,9 +6,10 @@ import argparse
 
 from costmap.export import export_costmap
 from costmap.mapfile import MapFileError
-from sid.cli.common import add_scenario_arguments, fail, print_written
+from sid.cli.common import OutputFolderError, add_scenario_arguments, check_output_folder, fail, print_written
 from sid.scenario.build import build_costmap
 from sid.scenario.loader import ScenarioError, load_scenario
+from sid.scenario.obstacles import outline
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -23,12 +24,14 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     try:
+        check_output_folder(args.out)
         scenario = load_scenario(args.scenario)
         layered = build_costmap(scenario, social=not args.no_social)
-    except (ScenarioError, MapFileError) as exc:
+    except (OutputFolderError, ScenarioError, MapFileError) as exc:
         return fail("sid costmap", exc)
     kind = "without recognition" if args.no_social else "social"
-    paths = export_costmap(layered, args.out, robot=scenario.robot, title=f"{scenario.name}: {kind}")
+    outlines = [outline(ob) for ob in scenario.obstacles]
+    paths = export_costmap(layered, args.out, robot=scenario.robot, title=f"{scenario.name}: {kind}", outlines=outlines)
     counts = {name: int((grid > 0).sum()) for name, grid in layered.grids.items()}
     print(
         f"{scenario.name}: {layered.spec.width}x{layered.spec.height} cells at {layered.spec.resolution} m, "

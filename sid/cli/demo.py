@@ -5,7 +5,15 @@ from __future__ import annotations
 
 import argparse
 
-from sid.cli.common import INPUT_ERRORS, add_planner_option, add_planning_options, fail, print_written, warn_goal_zone
+from sid.cli.common import (
+    INPUT_ERRORS,
+    add_planner_option,
+    add_planning_options,
+    check_output_folder,
+    fail,
+    print_written,
+    warn_goal_zone,
+)
 from sid.experiments.demo import DEMO_ITERATIONS, DEMO_SEED, run_demo
 from sid.experiments.plan_pictures import format_table
 from sid.scenario.loader import load_scenario
@@ -26,6 +34,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     try:
+        check_output_folder(args.out)
         scenario = load_scenario(args.scenario) if args.scenario else None
         comparison = run_demo(
             args.out,
@@ -37,7 +46,7 @@ def run(args: argparse.Namespace) -> int:
             cost_weight=args.cost_weight,
             progress=lambda line: print(line, flush=True),
         )
-    except INPUT_ERRORS as exc:
+    except (*INPUT_ERRORS, OSError) as exc:
         return fail("sid demo", exc)
     warn_goal_zone("sid demo", comparison)
     print()

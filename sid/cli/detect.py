@@ -13,6 +13,7 @@ import numpy as np
 
 from costmap.grid import Costmap2D, GridSpec
 from costmap.render import CameraView, render_costmap
+from sid.cli.common import OutputFolderError, check_output_folder, fail
 from sid.perception.camera import Calibration
 from sid.perception.frame import Frame
 from sid.perception.groups import GroupParams
@@ -21,6 +22,7 @@ from sid.perception.mount import CameraMount
 from sid.perception.overlay import draw_detections
 from sid.perception.pipeline import FrameResult, Pipeline, PoseFn, image_pose
 from sid.perception.pose.contracts import PoseModelError
+from sid.perception.pose.session import PROVIDER_CHOICES
 from sid.sources import RECORDING_SUFFIXES, FrameReadError, SourceError, open_source, skip_unreadable
 
 TOP_VIEW = GridSpec.from_size(0.05, (-0.5, -3.5), (7.5, 7.0))  # world frame: 7 m ahead of the camera, 3.5 m each side
@@ -37,6 +39,20 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--source", required=True, help="realsense | FILE.db3 | FILE.bag | DIR | synthetic:SCENE")
     parser.add_argument("--model", type=Path, help="pose model (.onnx); optional for synthetic sources")
     parser.add_argument("--contract", help="pose model contract, if it cannot be read from the model")
+    parser.add_argument(
+        "--threads",
+        type=positive_int,
+        default=None,
+        metavar="N",
+        help="pose model threads (default: the physical cores this process may use)",
+    )
+    parser.add_argument(
+        "--provider",
+        choices=PROVIDER_CHOICES,
+        default="auto",
+        help="onnxruntime execution provider for the pose model: 'auto' (default) uses OpenVINO when "
+        "onnxruntime-openvino is installed (pip install 'sid[openvino]'), else CPU",
+    )
     parser.add_argument("--frames", type=int, help="stop after this many frames (default: all; synthetic: 30)")
     parser.add_argument("--out", type=Path, help="also write detections.jsonl, overlay and top-view PNGs here")
     parser.add_argument(
@@ -59,11 +75,24 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.set_defaults(func=run)
 
 
+def positive_int(text: str) -> int:
+    """argparse type: a whole number >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}")
+    return value
+
+
 def _pose(args: argparse.Namespace) -> PoseFn:
     if args.model is not None:
         from sid.perception.pose import load_pose_estimator
 
-        return image_pose(load_pose_estimator(args.model, contract=args.contract))
+        return image_pose(
+            load_pose_estimator(args.model, contract=args.contract, threads=args.threads, providers=args.provider)
+        )
     if args.source.startswith("synthetic:"):
         from sid.synthetic.pose import TruthPose
 
@@ -131,6 +160,11 @@ def run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 2
+    if args.out is not None:
+        try:
+            check_output_folder(args.out)  # before the model loads and the camera opens
+        except OutputFolderError as exc:
+            return fail("sid detect", exc)
     try:
         lift = LiftParams() if args.keypoint_threshold is None else LiftParams(min_score=args.keypoint_threshold)
         mount = CameraMount(args.camera_height, args.camera_tilt)

@@ -5,8 +5,8 @@ Input, one frame per line (world frame, metres, radians; theta may be null or ab
 Output, one line per good input line, flushed as it is written:
     {"frame": 0, "groups": [{"members": [1, 2], "interest_point": [x, y], "area": a, "spread": d,
                              "zone": [[x, y], ...]}]}
-A malformed line is reported on stderr with its line number and skipped, or ends the run with --strict (exit 1);
-everything written before it stays written.
+A malformed line (including one that is not UTF-8 text) is reported on stderr with its line number and skipped,
+or ends the run with --strict (exit 1); everything written before it stays written.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import os
 import re
 import sys
 from collections.abc import Iterable, Iterator
-from typing import Any, TextIO
+from typing import IO, Any, TextIO
 
 from sid.documents import is_number
 from sid.perception.groups import Group, GroupParams, detect_groups
@@ -72,7 +72,11 @@ def run(args: argparse.Namespace) -> int:
         print(f"sid groups: {exc}", file=sys.stderr)
         return 2
     try:
-        stream = sys.stdin if args.file == "-" else open(args.file, encoding="utf-8")  # noqa: SIM115
+        # Bytes, decoded line by line: a line that is not UTF-8 is reported and skipped like any malformed line.
+        if args.file == "-":
+            stream: IO[Any] = getattr(sys.stdin, "buffer", sys.stdin)
+        else:
+            stream = open(args.file, "rb")  # noqa: SIM115
     except OSError as exc:
         print(f"sid groups: cannot read {args.file}: {exc.strerror}", file=sys.stderr)
         return 2
@@ -82,10 +86,16 @@ def run(args: argparse.Namespace) -> int:
         except BrokenPipeError:  # the reader went away (e.g. `| head`): stop quietly, as Unix tools do
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
             return 0
+        except OSError as exc:  # e.g. FILE is a directory, or the disk fails mid-read
+            print(f"sid groups: cannot read {args.file}: {exc.strerror or exc}", file=sys.stderr)
+            return 2
 
 
-def process(lines: Iterable[str], out: TextIO, err: TextIO, params: GroupParams, strict: bool = False) -> int:
-    """Detect groups frame by frame; returns the exit code (1 when --strict stopped at a bad line)."""
+def process(lines: Iterable[str | bytes], out: TextIO, err: TextIO, params: GroupParams, strict: bool = False) -> int:
+    """Detect groups frame by frame; returns the exit code (1 when --strict stopped at a bad line).
+
+    ``lines`` are text, or bytes decoded here line by line as UTF-8 (a byte-order mark before the first is dropped).
+    """
     skipped = 0
     for number, frame, problem in _frames(lines):
         if problem is None:
@@ -116,9 +126,26 @@ def group_to_json(group: Group) -> dict[str, Any]:
     }
 
 
-def _frames(lines: Iterable[str]) -> Iterator[tuple[int, dict[str, Any], str | None]]:
+def _frames(lines: Iterable[str | bytes]) -> Iterator[tuple[int, dict[str, Any], str | None]]:
     """(line number, {"frame", "people": [Person]}, problem or None) for each non-blank line."""
-    for number, line in enumerate(lines, start=1):
+    for number, raw in enumerate(lines, start=1):
+        if isinstance(raw, bytes):
+            try:
+                line = raw.decode("utf-8")
+            except UnicodeDecodeError as exc:
+                if number == 1 and raw[:2] in (b"\xff\xfe", b"\xfe\xff"):
+                    yield number, {}, "not UTF-8 text (it starts with a UTF-16 byte-order mark; save it as UTF-8)"
+                else:
+                    yield (
+                        number,
+                        {},
+                        f"not UTF-8 text (byte 0x{raw[exc.start]:02x} at byte {exc.start + 1} of the line)",
+                    )
+                continue
+        else:
+            line = raw
+        if number == 1:
+            line = line.removeprefix("\ufeff")  # a byte-order mark (some Windows editors write one)
         if not line.strip():
             continue
         try:

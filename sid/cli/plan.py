@@ -10,6 +10,7 @@ from sid.cli.common import (
     add_planner_option,
     add_planning_options,
     add_scenario_arguments,
+    check_output_folder,
     fail,
     print_written,
     warn_goal_zone,
@@ -32,6 +33,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     try:
+        check_output_folder(args.out)  # before the plan, not after it
         name = resolve_planner(args.planner)
         scenario = load_scenario(args.scenario)
         budget = "deterministic" if name == "grid" else f"{args.time:g} s budget"
@@ -48,7 +50,10 @@ def run(args: argparse.Namespace) -> int:
     except INPUT_ERRORS as exc:
         return fail("sid plan", exc)
     warn_goal_zone("sid plan", comparison)
-    files = write_plan(comparison, args.out)
+    try:
+        files = write_plan(comparison, args.out)
+    except OSError as exc:
+        return fail("sid plan", exc)
     (run,) = comparison.runs.values()
     r, m = run.result, run.metrics
     print(r.message)

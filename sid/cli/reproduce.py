@@ -7,11 +7,10 @@ import argparse
 import shlex
 import sys
 from dataclasses import dataclass
-from pathlib import Path
 
 from planner.facade import PLANNERS
 from planner.problem import DEFAULT_COST_WEIGHT
-from sid.cli.common import fail, print_written
+from sid.cli.common import check_output_folder, fail, print_written
 from sid.experiments.navigation import NAV_LAYOUTS, NavSettings, navigation_tasks, run_navigation
 from sid.experiments.progress import ProgressBar
 from sid.synthetic.layouts import LAYOUTS, VARIATIONS
@@ -123,14 +122,6 @@ def _command() -> str:
     return "sid " + " ".join(shlex.quote(a) for a in sys.argv[1:]) if sys.argv[1:] else "sid reproduce"
 
 
-def _output_folder(path: str) -> None:
-    """Create the output folder (OSError naming it when that is impossible)."""
-    try:
-        Path(path).mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise OSError(f"cannot create the output folder {path}: {exc.strerror or exc}") from exc
-
-
 def table1_command(args: argparse.Namespace) -> int:
     # Imported here, not at the top: the pipeline and its lifting load only when a study runs.
     from sid.experiments.reproduce import table1_markdown, write_table1_report
@@ -158,7 +149,7 @@ def table1_command(args: argparse.Namespace) -> int:
             depth_noise=depth,
             keypoint_noise=keypoints,
         )
-        _output_folder(args.out)  # fail before the run, not after it
+        check_output_folder(args.out)  # fail before the run, not after it
         result = run_table1(settings, progress=ProgressBar("table1"))
         paths = write_table1_report(result, args.out, _command())
     except (ValueError, OSError) as exc:
@@ -179,7 +170,7 @@ def navigation_command(args: argparse.Namespace) -> int:
     try:
         settings = NavSettings(tuple(planners), time_limit, args.iterations, args.cost_weight)
         tasks = navigation_tasks(seeds, layouts)
-        _output_folder(args.out)
+        check_output_folder(args.out)
         result = run_navigation(tasks, settings, progress=ProgressBar("navigation"))
         paths = write_navigation_report(result, args.out, seeds, _command())
     except (ValueError, OSError) as exc:

@@ -51,7 +51,7 @@ PLANNER_PANELS = (
 """``sid compare``'s chart."""
 
 MODE_STYLE = {
-    False: ("without the social layer (LiDAR only)", WITHOUT_COLOUR),
+    False: ("without the social layer (map + LiDAR)", WITHOUT_COLOUR),
     True: ("with the social layer", WITH_COLOUR),
 }
 

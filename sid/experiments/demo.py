@@ -69,7 +69,7 @@ def comparison_picture(comparison: Comparison) -> np.ndarray:
         comparison,
         "Without group recognition the robot cuts through the conversation; with it, it goes around",
         f"{comparison.task.scenario.name}. Colours: the costmap with the social layer. Planner {planner}, "
-        f"seed {seed}. The dashed path was planned on the LiDAR-only costmap.",
+        f"seed {seed}. The dashed path was planned on the costmap without the social layer.",
     )
 
 

@@ -1,5 +1,5 @@
-"""The with/without comparison harness: plan a scenario's robot task on the LiDAR-only costmap ("without") and on
-the costmap with the social layer ("with"), measure every path alike, and summarise runs.
+"""The with/without comparison harness: plan a scenario's robot task on the costmap without the social layer (the
+known map and LiDAR: "without") and on the costmap with it ("with"), measure every path alike, and summarise runs.
 
 One ``Task`` per scenario holds its groups (detected from its people with ``sid.perception.groups.detect_groups``),
 the costmap and planning problem of each mode, and the grid planner's cost as the reference for cost ratios. Every
@@ -34,7 +34,7 @@ from sid.scenario.loader import Scenario
 
 MODES: dict[str, bool] = {"without": False, "with": True}
 """The two costmap modes by name: whether the costmap has the social layer."""
-LABELS = {"without": "without recognition (LiDAR only)", "with": "with recognition (social layer)"}
+LABELS = {"without": "without recognition (map + LiDAR)", "with": "with recognition (social layer)"}
 
 
 @dataclass

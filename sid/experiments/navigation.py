@@ -12,8 +12,8 @@ metres, radians. A task is drawn from ``numpy.random.default_rng([base_seed, lay
   group measures nothing). Each draw is planned in both directions ("forward": start on the left, "reverse":
   start and goal swapped), so the robot meets every layout from both sides.
 
-For each task and planner, ``sid.experiments.harness.compare_with_without`` plans on the LiDAR-only costmap
-("without") and on the costmap with the social layer ("with"), with the same budget and OMPL seed, and measures both
+For each task and planner, ``sid.experiments.harness.compare_with_without`` plans on the costmap without the social
+layer ("without") and on the costmap with it ("with"), with the same budget and OMPL seed, and measures both
 paths against the same groups, detected from the task's people (``sid.perception.groups.detect_groups`` on exact
 positions: this study is about navigation, not perception). ``sid.experiments.harness.summarise`` gives, per planner
 (or layout) and costmap: success rate, o-space intrusion rate (share of successful paths entering a group zone) and
@@ -222,7 +222,8 @@ def run_navigation(
             except PlanningError as exc:
                 result.impossible[nav.name] = str(exc)
                 break
-            result.runs += [{key: run.record()[key] for key in RUN_KEYS} for run in comparison.runs.values()]
+            # A failed run has no path metrics (length_ratio, ...): they are recorded as None.
+            result.runs += [{key: run.record().get(key) for key in RUN_KEYS} for run in comparison.runs.values()]
             without, with_ = comparison.metrics["without"], comparison.metrics["with"]
             if planner == example_planner and without["success"] and with_["success"]:
                 gain = without["ospace_intrusion_m"] - with_["ospace_intrusion_m"]

@@ -7,6 +7,7 @@ import numpy as np
 
 from planner.render import WITH_COLOUR, WITHOUT_COLOUR, PathStyle, add_header, add_table, render_paths
 from sid.experiments.harness import LABELS, Comparison
+from sid.scenario.obstacles import outline
 
 STYLES = {
     "without": PathStyle(LABELS["without"], WITHOUT_COLOUR, dashed=True),
@@ -48,10 +49,12 @@ def format_table(comparison: Comparison) -> str:
 
 def plan_picture(comparison: Comparison, title: str, subtitle: str = "") -> np.ndarray:
     """BGR image: the costmap with the social layer when the comparison has a "with" run (else the one planned on),
-    every found path, people, group zones, robot and goal, a title, and the metrics table."""
+    the scenario's declared obstacles outlined, every found path, people, group zones, robot and goal, a title, and
+    the metrics table."""
     task = comparison.task
     background = task.costmaps["with" if "with" in comparison.runs else next(iter(comparison.runs))]
     paths = [(run.result.path, STYLES[mode]) for mode, run in comparison.runs.items() if run.result.success]
-    img, _ = render_paths(background, paths, robot=task.scenario.robot, groups=task.groups)
+    outlines = [outline(ob) for ob in task.scenario.obstacles]
+    img, _ = render_paths(background, paths, robot=task.scenario.robot, groups=task.groups, outlines=outlines)
     rows = [(STYLES[mode], row) for mode, row in zip(comparison.runs, _rows(comparison), strict=True)]
     return add_table(add_header(img, title, subtitle), HEADER, rows)

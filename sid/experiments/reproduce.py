@@ -74,7 +74,8 @@ def navigation_markdown(result: NavigationResult, seeds: int, command: str) -> s
         f"{result.tasks} tasks ({len({r['layout'] for r in result.runs})} layouts x {seeds} draw(s) x 2 directions; "
         "see `sid.experiments.navigation` and docs/reproduction.md), planners: "
         f"{', '.join(settings.planners)}; budget {budget}; cost weight {settings.cost_weight:g}. "
-        "Each task is planned on the LiDAR-only costmap (without) and on the costmap with the social layer (with), "
+        "Each task is planned on the costmap without the social layer (known map + LiDAR) and on the costmap with "
+        "it (with), "
         "same planner, budget and seed; both paths are measured against the groups detected from the task's people.",
         "",
         "## Per planner",

@@ -55,7 +55,7 @@ def write_plan(comparison: Comparison, out_dir: str | Path) -> dict[str, Path]:
     out.mkdir(parents=True, exist_ok=True)
     paths = {"path": out / "path.json", "picture": out / "plan.png"}
     paths["path"].write_text(json.dumps(path_record(comparison), indent=2, allow_nan=False) + "\n")
-    costmap = "the costmap with the social layer" if run.social_layer else "the LiDAR-only costmap"
+    costmap = "the costmap with the social layer" if run.social_layer else "the costmap without the social layer"
     title = f"{run.scenario}: {run.planner} on {costmap}"
     seed = "" if run.result.seed is None else f", seed {run.result.seed}"
     if not cv2.imwrite(str(paths["picture"]), plan_picture(comparison, title, run.result.message + seed)):

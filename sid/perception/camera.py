@@ -18,6 +18,10 @@ from typing import Any
 import numpy as np
 
 from sid.checks import check_number, check_numbers
+from sid.documents import is_number, load_document
+
+MAX_IMAGE_SIDE = 100_000
+"""The largest image width or height a calibration file may give (pixels)."""
 
 
 @dataclass(frozen=True)
@@ -74,23 +78,24 @@ class Intrinsics:
         )
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> Intrinsics:
-        """From ``{"width", "height", "fx", "fy", "cx", "cy"}`` (``ppx``/``ppy`` accepted for cx/cy)."""
-        try:
-            cx = data["cx"] if "cx" in data else data["ppx"]
-            cy = data["cy"] if "cy" in data else data["ppy"]
-            return cls(
-                int(data["width"]),
-                int(data["height"]),
-                float(data["fx"]),
-                float(data["fy"]),
-                float(cx),
-                float(cy),
-                str(data.get("model", "none")),
-                tuple(float(c) for c in data.get("coeffs", (0.0,) * 5)),
-            )
-        except KeyError as exc:
-            raise ValueError(f"intrinsics: missing field {exc.args[0]!r}") from None
+    def from_dict(cls, data: Any, where: str = "intrinsics") -> Intrinsics:
+        """From ``{"width", "height", "fx", "fy", "cx", "cy"}`` (``ppx``/``ppy`` accepted for cx/cy).
+
+        A missing or mistyped field is a ValueError naming ``where`` (e.g. ``color``), the field and its value.
+        """
+        if not isinstance(data, dict):
+            raise ValueError(f"{where}: expected an object with width, height, fx, fy, cx, cy, got {_shown(data)}")
+        width, height = (_pixel_count(data, key, where) for key in ("width", "height"))
+        fx, fy = (_number(data, key, where, low=0, low_open=True, unit="pixels") for key in ("fx", "fy"))
+        cx = _number(data, "cx" if "cx" in data or "ppx" not in data else "ppx", where, unit="pixels")
+        cy = _number(data, "cy" if "cy" in data or "ppy" not in data else "ppy", where, unit="pixels")
+        model = data.get("model", "none")
+        if not isinstance(model, str):
+            raise ValueError(f"{where}: model must be a distortion model name, got {_shown(model)}")
+        coeffs = data.get("coeffs", [0.0] * 5)
+        if not (isinstance(coeffs, list) and all(is_number(c) for c in coeffs)):
+            raise ValueError(f"{where}: coeffs must be a list of numbers, got {_shown(coeffs)}")
+        return cls(width, height, fx, fy, cx, cy, model, tuple(float(c) for c in coeffs))
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -132,12 +137,19 @@ class Extrinsics:
         return cls(np.asarray(extr.rotation, dtype=float).reshape(3, 3).T, np.asarray(extr.translation))
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> Extrinsics:
-        """From ``{"rotation": 3x3 row-major nested list, "translation": [x, y, z]}``."""
+    def from_dict(cls, data: Any, where: str = "extrinsics") -> Extrinsics:
+        """From ``{"rotation": 3x3 row-major nested list, "translation": [x, y, z]}``.
+
+        A missing or mistyped field is a ValueError naming ``where`` (e.g. ``depth_to_color``), the field and its value.
+        """
+        if not isinstance(data, dict):
+            raise ValueError(f"{where}: expected an object with rotation and translation, got {_shown(data)}")
+        rotation = _numbers(data, "rotation", where, 9, "a 3x3 row-major matrix of numbers")
+        translation = _numbers(data, "translation", where, 3, "[x, y, z] in metres")
         try:
-            return cls(np.asarray(data["rotation"], dtype=float), np.asarray(data["translation"], dtype=float))
-        except KeyError as exc:
-            raise ValueError(f"extrinsics: missing field {exc.args[0]!r}") from None
+            return cls(rotation, translation)
+        except ValueError as exc:  # e.g. a rotation that is not one
+            raise ValueError(f"{where}: {str(exc).removeprefix('extrinsics: ')}") from None
 
     def to_dict(self) -> dict[str, Any]:
         return {"rotation": self.rotation.tolist(), "translation": self.translation.tolist()}
@@ -164,26 +176,26 @@ class Calibration:
         Accepted forms: ``{"color": {...}, "depth": {...}, "depth_to_color": {...}, "depth_scale": s}`` or a
         flat intrinsics dict (``fx, fy, cx, cy, width, height[, depth_scale]``) for a registered RGB-D pair.
         ``depth_scale_m`` is accepted for ``depth_scale``; a flat dict with ``"depth_aligned_to_color": false`` is
-        refused (unregistered depth needs the depth intrinsics and extrinsics).
+        refused (unregistered depth needs the depth intrinsics and extrinsics). Every error is a ValueError naming
+        the file, and the field and its value when one is at fault.
         """
         path = Path(path)
-        try:
-            data = json.loads(path.read_text())
-        except (OSError, json.JSONDecodeError) as exc:
-            raise ValueError(f"calibration {path}: cannot read JSON ({exc})") from None
+        data = load_document(path, "calibration JSON")  # names the file itself
         if not isinstance(data, dict):
-            raise ValueError(f"calibration {path}: expected a JSON object")
+            raise ValueError(f"calibration {path}: expected a JSON object, got {_shown(data)}")
+        depth_scale = _depth_scale(data, f"calibration {path}")
         try:
             if "color" in data:
+                extrinsics = data.get("depth_to_color")
                 return cls(
-                    Intrinsics.from_dict(data["color"]),
-                    Intrinsics.from_dict(data["depth"]) if data.get("depth") else None,
-                    Extrinsics.from_dict(data["depth_to_color"]) if data.get("depth_to_color") else Extrinsics(),
-                    _depth_scale(data),
+                    Intrinsics.from_dict(data["color"], "color"),
+                    Intrinsics.from_dict(data["depth"], "depth") if data.get("depth") is not None else None,
+                    Extrinsics.from_dict(extrinsics, "depth_to_color") if extrinsics is not None else Extrinsics(),
+                    depth_scale,
                 )
             if data.get("depth_aligned_to_color") is False:
                 raise ValueError("depth is not aligned to colour; give color, depth and depth_to_color sections")
-            return cls(Intrinsics.from_dict(data), depth_scale=_depth_scale(data))
+            return cls(Intrinsics.from_dict(data), depth_scale=depth_scale)
         except ValueError as exc:
             raise ValueError(f"calibration {path}: {exc}") from None
 
@@ -196,10 +208,50 @@ class Calibration:
         }
 
 
-def _depth_scale(data: dict[str, Any]) -> float:
-    scale = float(data.get("depth_scale", data.get("depth_scale_m", 0.001)))
-    check_number("calibration", "depth_scale", scale, low=0, low_open=True, unit="metres per unit")
-    return scale
+def _depth_scale(data: dict[str, Any], where: str) -> float:
+    """``depth_scale`` (or ``depth_scale_m``), metres per depth unit; 0.001 when absent."""
+    key = "depth_scale" if "depth_scale" in data or "depth_scale_m" not in data else "depth_scale_m"
+    return _number({key: 0.001} | data, key, where, low=0, low_open=True, unit="metres per unit")
+
+
+def _shown(value: Any, limit: int = 80) -> str:
+    """A parsed JSON value as JSON (``null``, ``[525]``, ``"abc"``), shortened to ``limit`` characters."""
+    try:
+        text = json.dumps(value)
+    except (TypeError, ValueError):
+        text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def _number(data: dict[str, Any], key: str, where: str, **bounds: Any) -> float:
+    """``data[key]`` as a float: ValueError ``"where: key ..."`` when it is missing, not a number or out of bounds
+    (``bounds`` as in ``sid.checks.check_number``)."""
+    if key not in data:
+        raise ValueError(f"{where}: missing field {key!r}")
+    value = data[key]
+    if not is_number(value):
+        raise ValueError(f"{where}: {key} must be a number, got {_shown(value)}")
+    check_number(where, key, value, **bounds)
+    return float(value)
+
+
+def _pixel_count(data: dict[str, Any], key: str, where: str) -> int:
+    """``data[key]`` as a whole number of pixels in [1, MAX_IMAGE_SIDE] (image width or height)."""
+    value = _number(data, key, where, low=1, high=MAX_IMAGE_SIDE, unit="pixels")
+    if not value.is_integer():
+        raise ValueError(f"{where}: {key} must be a whole number of pixels, got {_shown(data[key])}")
+    return int(value)
+
+
+def _numbers(data: dict[str, Any], key: str, where: str, count: int, rule: str) -> np.ndarray:
+    """``data[key]``, a list of ``count`` numbers or of lists of numbers (rows), flattened."""
+    if key not in data:
+        raise ValueError(f"{where}: missing field {key!r}")
+    value = data[key]
+    flat = [x for row in value for x in (row if isinstance(row, list) else [row])] if isinstance(value, list) else None
+    if flat is None or len(flat) != count or not all(is_number(x) for x in flat):
+        raise ValueError(f"{where}: {key} must be {rule}, got {_shown(value)}")
+    return np.array(flat, dtype=float)
 
 
 def deproject(pixels: np.ndarray, depth_m: np.ndarray, intrinsics: Intrinsics) -> np.ndarray:

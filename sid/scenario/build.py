@@ -1,4 +1,5 @@
-"""What a scenario builds: its layered costmap (a simulated scan from the robot's start) and its planning problem."""
+"""What a scenario builds: its layered costmap (its known map and a simulated scan from the robot's start) and its
+planning problem."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ from costmap.mapfile import read_map
 from costmap.plugins import CostmapParams, layered_costmap
 from planner.problem import DEFAULT_COST_WEIGHT, PlanningProblem
 from sid.perception.groups import Group, detect_groups
+from sid.scenario.known_map import known_map
 from sid.scenario.lidar import simulate_scan
 from sid.scenario.loader import Scenario
 
@@ -20,7 +22,11 @@ def build_costmap(
     groups: list[Group] | None = None,
     params: CostmapParams | None = None,
 ) -> LayeredCostmap:
-    """The costmap of a scenario: a simulated scan from the robot's start pose, people, groups and layers.
+    """The costmap of a scenario: its known map, a simulated scan from the robot's start, people, groups and layers.
+
+    The static layer holds the known map: every declared obstacle whole (rasterised by ``sid.scenario.known_map``)
+    drawn into the ``static_map`` file, if any; without either there is no static layer. The LiDAR layer marks what
+    the scan from the start sees (obstacles' near faces, the map file's walls, people).
 
     ``social`` False leaves the social layer out (a robot without recognition). ``groups`` None: detect them with
     ``sid.perception.groups.detect_groups`` (only when ``social``). ``params`` None: the scenario's "layers" block.
@@ -29,12 +35,15 @@ def build_costmap(
     if not social:
         params = params.without("social")
     static_map = None if scenario.static_map is None else read_map(scenario.static_map)
+    known = None  # the static layer's map: the declared obstacles drawn into the map file (sid.scenario.known_map)
+    if scenario.obstacles or static_map is not None:
+        known = known_map(scenario.obstacles, scenario.grid, static_map)
     layered = layered_costmap(
         scenario.grid,
         params,
         robot_radius=scenario.robot.radius,
         body_radius=scenario.lidar.body_radius,
-        static_map=static_map,
+        static_map=known,
     )
     lidar = scenario.lidar
     walls = None  # the static map's walls, which the simulated LiDAR sees whatever the costmap's layers

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 
 @dataclass(frozen=True)
 class SegmentObstacle:
@@ -27,3 +29,16 @@ class BoxObstacle:
 
 
 Obstacle = SegmentObstacle | CircleObstacle | BoxObstacle
+
+
+def outline(obstacle: Obstacle, sides: int = 48) -> tuple[np.ndarray, bool]:
+    """The shape of ``obstacle`` for drawing: world points (N, 2) and whether they close into a polygon (a box, a
+    circle as a regular polygon of ``sides`` corners) or stay an open polyline (a wall)."""
+    if isinstance(obstacle, BoxObstacle):
+        (x0, y0), (x1, y1) = obstacle.min, obstacle.max
+        return np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], dtype=float), True
+    if isinstance(obstacle, CircleObstacle):
+        angles = np.linspace(0.0, 2 * np.pi, sides, endpoint=False)
+        centre = np.asarray(obstacle.center, dtype=float)
+        return centre + obstacle.radius * np.stack([np.cos(angles), np.sin(angles)], axis=1), True
+    return np.asarray(obstacle.points, dtype=float), False

@@ -48,14 +48,12 @@ def open_source(spec: str, **options: Any) -> Iterable[Frame]:
 
         return synthetic_source(spec, **options)
     if spec == "realsense":
-        from sid.sources.realsense import RealSenseSource
-
-        return RealSenseSource(None, **options)
+        return _realsense()(None, **options)
     path = Path(spec)
     if path.suffix.lower() in RECORDING_SUFFIXES:
-        from sid.sources.realsense import RealSenseSource
-
-        return RealSenseSource(path, **options)
+        if not path.exists():
+            raise SourceError(f"recording {path} does not exist")
+        return _realsense()(path, **options)
     if path.is_dir():
         from sid.sources.folder import FolderSource
 
@@ -63,6 +61,19 @@ def open_source(spec: str, **options: Any) -> Iterable[Frame]:
     if not path.exists():
         raise SourceError(f"source {spec!r}: no such file or directory (use realsense, FILE.db3, DIR, synthetic:...)")
     raise SourceError(f"source {spec!r}: not a recording (.db3/.bag) or a folder of frames")
+
+
+def _realsense() -> Any:
+    """``sid.sources.realsense.RealSenseSource``, imported only now: pyrealsense2 loads only when a RealSense source
+    is opened, and a SourceError says why when it cannot load (not installed, or no libusb-1.0 on the system)."""
+    try:
+        from sid.sources.realsense import RealSenseSource
+    except (ImportError, OSError) as exc:
+        raise SourceError(
+            f"RealSense sources need pyrealsense2, which cannot be loaded ({exc}); install it with "
+            "`pip install pyrealsense2` and the system library libusb-1.0-0 (`sudo apt-get install libusb-1.0-0`)"
+        ) from None
+    return RealSenseSource
 
 
 def skip_unreadable(source: Iterable[Frame], on_error: Callable[[FrameReadError], None]) -> Iterator[Frame]:

@@ -13,7 +13,7 @@ from sid.perception.frame import Frame
 from sid.perception.pipeline import Pipeline
 from sid.sources.synthetic import SyntheticSource
 from sid.synthetic.pose import TruthPose
-from tests.conftest import shared_path
+from tests.conftest import realsense, shared_path
 
 
 def test_pipeline_finds_the_s1_pair_where_the_truth_puts_it():
@@ -129,6 +129,7 @@ def test_bad_keypoint_threshold_is_reported(threshold, capsys):
 
 def test_pipeline_on_a_realsense_recording_matches_the_scene(tmp_path):
     """Synthetic frames recorded through librealsense (.db3), played back unaligned, lifted sparsely."""
+    realsense()
     from sid.sources import open_source, skip_unreadable
     from sid.sources.librealsense import record_synthetic
 
@@ -169,3 +170,53 @@ def test_ctrl_c_stops_cleanly_and_keeps_what_was_written(tmp_path, capsys, monke
     assert [r["frame"] for r in _lines(captured.out)] == [0, 1]
     assert len((out / "detections.jsonl").read_text().splitlines()) == 2
     assert "interrupted" in captured.err
+
+
+def test_threads_and_provider_reach_the_pose_session(monkeypatch, capsys):
+    import sid.perception.pose as pose
+
+    loaded = []
+
+    def load(*args, **kwargs):
+        loaded.append(pose_load(*args, **kwargs))
+        return loaded[-1]
+
+    pose_load = pose.load_pose_estimator
+    monkeypatch.setattr(pose, "load_pose_estimator", load)
+    folder = shared_path("data", "rgbd", "five_people")
+    model = shared_path("models", "yolo11n-pose-256.onnx")
+    args = ["detect", "--source", str(folder), "--model", str(model), "--no-keypoints"]
+    assert main([*args, "--threads", "1", "--provider", "cpu"]) == 0
+    (session,) = [estimator.model.session for estimator in loaded]
+    assert session.get_session_options().intra_op_num_threads == 1
+    assert session.get_session_options().get_session_config_entry("session.intra_op.allow_spinning") == "0"
+    assert session.get_providers() == ["CPUExecutionProvider"]
+    assert len(_lines(capsys.readouterr().out)) == 1
+
+
+@pytest.mark.parametrize("threads", ["0", "-1", "two", "1.5"])
+def test_bad_thread_count_is_refused(threads, capsys):
+    with pytest.raises(SystemExit) as info:
+        main(["detect", "--source", "synthetic:S1", "--model", "m.onnx", "--threads", threads])
+    assert info.value.code == 2
+    assert f"--threads: expected a whole number >= 1, got {threads!r}" in capsys.readouterr().err
+
+
+def test_unknown_provider_is_refused(capsys):
+    with pytest.raises(SystemExit) as info:
+        main(["detect", "--source", "synthetic:S1", "--provider", "gpu"])
+    assert info.value.code == 2
+    assert "invalid choice: 'gpu'" in capsys.readouterr().err
+
+
+def test_missing_openvino_provider_is_explained(tmp_path, capsys):
+    import onnxruntime as ort
+
+    if "OpenVINOExecutionProvider" in ort.get_available_providers():
+        pytest.skip("the openvino provider is installed here")
+    from tests.pose_models import build_yolo_pose_model
+
+    model = build_yolo_pose_model(tmp_path / "yolo.onnx", np.zeros((56, 10)))
+    assert main(["detect", "--source", "synthetic:S1", "--model", str(model), "--provider", "openvino"]) == 2
+    err = capsys.readouterr().err
+    assert "openvino provider is not available" in err and "pip install 'sid[openvino]'" in err

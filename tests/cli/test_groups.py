@@ -83,6 +83,59 @@ def test_group_params_come_from_the_options(tmp_path, capsys, monkeypatch):
     assert code == 2 and "cannot read" in err
 
 
+# Regression fixture (issue 15): a UTF-8 byte-order mark, Latin-1 bytes, raw binary, then good lines again.
+NOT_UTF8 = b"\n".join(
+    [
+        b"\xef\xbb\xbf" + json.dumps(PAIR).encode(),
+        b'{"frame": 1, "people": [], "note": "caf\xe9"}',
+        b"\x00\xff\xfe\x89PNG",
+        json.dumps(APART).encode(),
+        b"",
+    ]
+)
+
+
+def test_lines_that_are_not_utf8_are_reported_and_skipped(tmp_path, capsys):
+    source = tmp_path / "frames.jsonl"
+    source.write_bytes(NOT_UTF8)
+    code, out, err = run_sid(["groups", str(source)], capsys)
+    assert code == 0
+    assert [json.loads(line)["frame"] for line in out] == [0, 2]  # the BOM line and the line after the bad bytes
+    assert err.splitlines() == [
+        "sid groups: line 2: not UTF-8 text (byte 0xe9 at byte 40 of the line)",
+        "sid groups: line 3: not UTF-8 text (byte 0xff at byte 2 of the line)",
+        "sid groups: skipped 2 malformed line(s)",
+    ]
+    code, out, err = run_sid(["groups", "--strict", str(source)], capsys)
+    assert (
+        code == 1
+        and len(out) == 1
+        and err.splitlines() == ["sid groups: line 2: not UTF-8 text (byte 0xe9 at byte 40 of the line)"]
+    )
+
+
+def test_a_utf16_file_is_named_as_such(tmp_path, capsys):
+    source = tmp_path / "frames.jsonl"
+    source.write_text(json.dumps(PAIR) + "\n", encoding="utf-16")
+    code, out, err = run_sid(["groups", "--strict", str(source)], capsys)
+    assert code == 1 and out == []
+    assert err == "sid groups: line 1: not UTF-8 text (it starts with a UTF-16 byte-order mark; save it as UTF-8)\n"
+
+
+def test_stdin_bytes_are_decoded_line_by_line():
+    done = subprocess.run(
+        [sys.executable, "-m", "sid", "groups", "-"], input=NOT_UTF8, capture_output=True, cwd=REPO_ROOT, timeout=60
+    )
+    assert done.returncode == 0
+    assert [json.loads(line)["frame"] for line in done.stdout.splitlines()] == [0, 2]
+    assert b"Traceback" not in done.stderr and b"line 3: not UTF-8 text" in done.stderr
+
+
+def test_a_folder_as_input_is_one_line(tmp_path, capsys):
+    code, out, err = run_sid(["groups", str(tmp_path)], capsys)
+    assert code == 2 and out == [] and err.count("\n") == 1 and "cannot read" in err
+
+
 def test_output_is_flushed_line_by_line_through_a_pipe():
     # A consumer reading the first output line must get it before the input ends.
     process = subprocess.Popen(

@@ -5,11 +5,14 @@ from __future__ import annotations
 import copy
 import json
 
+import cv2
 import pytest
 
+from costmap.render import OBSTACLE, default_scale, world_to_image
 from planner.metrics import FIXED_KEYS
 from sid.cli import main
 from sid.experiments.demo import DEMO_SCENARIO
+from sid.scenario.loader import load_scenario
 
 
 def write_scenario(tmp_path, **robot) -> str:
@@ -29,6 +32,12 @@ def test_plan_writes_path_and_picture(tmp_path, capsys):
     assert record["waypoints"][0] == [0.0, 0.0] and record["waypoints"][-1] == [9.0, 0.0]
     assert record["social_layer"] is True and record["ospace_intrusion_m"] == 0.0
     assert (out / "plan.png").stat().st_size > 10_000
+    # The picture outlines the declared box (6.8..7.6, -3.0..-1.6) whole: its face x = 7.6, which the scan from the
+    # start never hits, is a vertical line 1.4 m (112 px) long.
+    img = cv2.imread(str(out / "plan.png"))
+    spec = load_scenario(write_scenario(tmp_path)).grid
+    u = int(round(world_to_image([[7.6, 0.0]], spec, default_scale(spec))[0, 0]))
+    assert 105 <= sum(tuple(pixel) == OBSTACLE for pixel in img[:, u]) <= 130
     printed = capsys.readouterr().out
     assert "repeat exactly: --seed 3 --iterations" in printed and "wrote" in printed
 
@@ -53,6 +62,31 @@ def test_plan_refuses_impossible_or_bad_requests(tmp_path, capsys, robot, args, 
     code = main(["plan", write_scenario(tmp_path, **robot), "--out", str(tmp_path / "out"), *args])
     assert code == 2
     assert message in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("obstacle", "message"),
+    [
+        (
+            {"type": "box", "min": [8.0, -1.0], "max": [9.6, 1.0]},
+            "sid plan: no path: goal (9.00, 0.00) is in collision: it lies inside an obstacle (cell cost 254, lethal)",
+        ),
+        (
+            {"type": "segment", "points": [[8.0, -1.0], [9.6, -1.0], [9.6, 1.0], [8.0, 1.0], [8.0, -1.0]]},
+            "sid plan: no path: the start and the goal lie in separate free regions of the costmap",
+        ),
+    ],
+)
+def test_plan_says_no_path_for_a_goal_inside_a_box_or_walled_in(tmp_path, capsys, obstacle, message):
+    """The declared obstacles are the known map, whole: also the faces the scan from the start cannot see."""
+    data = copy.deepcopy(DEMO_SCENARIO)
+    data["obstacles"].append(obstacle)
+    path = tmp_path / "scenario.json"
+    path.write_text(json.dumps(data))
+    assert main(["plan", str(path), "--out", str(tmp_path / "out"), "--planner", "grid"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith(message)
+    assert not (tmp_path / "out" / "path.json").exists()
 
 
 def test_plan_that_finds_nothing_exits_1_and_says_so(tmp_path, capsys):

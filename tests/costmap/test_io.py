@@ -14,7 +14,7 @@ from costmap.layers.static import static_costs
 from costmap.mapfile import MapFileError, read_map, write_map
 from costmap.npz import load_npz, save_npz
 from costmap.occupancy import OccupancyGrid, cost_to_occupancy, costmap_to_occupancy, occupancy_to_cost
-from costmap.render import render_costmap, world_to_image
+from costmap.render import OBSTACLE, default_scale, render_costmap, world_to_image
 from costmap.rosbag import read_occupancy_grids, write_occupancy_mcap
 from sid.cli import main
 from sid.perception.groups import Group
@@ -166,7 +166,7 @@ def test_npz_round_trip_is_exact(tmp_path):
     saved = load_npz(save_npz(tmp_path / "c.npz", layered))
     assert saved.spec == layered.spec
     np.testing.assert_array_equal(saved.master.costs, layered.master.costs)
-    assert list(saved.layers) == ["lidar", "social", "inflation"]
+    assert list(saved.layers) == ["static", "lidar", "social", "inflation"]  # static: the declared obstacles
     for name, grid in layered.grids.items():
         np.testing.assert_array_equal(saved.layers[name], grid)
 
@@ -222,6 +222,26 @@ def test_render_draws_costs_people_and_zones_where_the_world_says():
         render_costmap(layered, scale=0)
 
 
+def test_render_draws_outlines_closed_or_open_over_the_costs():
+    spec = GridSpec(0.05, 0.0, 0.0, 80, 60)
+    costmap = Costmap2D.filled(spec, 0)
+    costmap.costs[20:41, 20:41] = 254  # the box's cells: the outline is drawn over them too
+    box = np.array([[1.0, 1.0], [2.0, 1.0], [2.0, 2.0], [1.0, 2.0]])
+    wall = np.array([[0.5, 0.5], [3.5, 0.5], [3.5, 2.5]])
+    img = render_costmap(costmap, scale=3, outlines=[(box, True), (wall, False)])
+
+    def drawn(points) -> np.ndarray:
+        uv = np.rint(world_to_image(np.asarray(points, dtype=float), spec, 3)).astype(int)
+        return np.array([tuple(img[v, u]) == OBSTACLE for u, v in uv])
+
+    t = np.linspace(0.05, 0.95, 19)[:, None]
+    for a, b in zip(box, np.roll(box, -1, axis=0), strict=True):  # every side, the closing one included
+        assert drawn(a + t * (b - a)).all()
+    assert drawn(wall[0] + t * (wall[1] - wall[0])).all() and drawn(wall[1] + t * (wall[2] - wall[1])).all()
+    assert not drawn(wall[2] + t[:6] * (wall[0] - wall[2])).any()  # an open polyline stays open
+    assert not drawn([[1.5, 1.5], [0.2, 2.8]]).any()
+
+
 def test_export_writes_every_file_and_they_read_back(tmp_path):
     layered = example_layered()
     paths = export_costmap(layered, tmp_path / "out", stamp_ns=0)
@@ -246,6 +266,14 @@ def test_sid_costmap_command(tmp_path, capsys):
     assert set(read_occupancy_grids(tmp_path / "costmap.mcap")) == {"/costmap"}
     saved = load_npz(tmp_path / "costmap.npz")
     assert "social" not in saved.layers
+    # The picture draws the declared box (7..8, 1.6..2.4) whole, also the far faces the scan from (0, 0) never hits.
+    img = cv2.imread(str(tmp_path / "costmap.png"))
+    spec = load_scenario(EXAMPLE).grid
+    scale = default_scale(spec)
+    t = np.linspace(0.05, 0.95, 19)[:, None]
+    for a, b in (((8.0, 1.6), (8.0, 2.4)), ((7.0, 2.4), (8.0, 2.4))):
+        uv = np.rint(world_to_image(np.array(a) + t * (np.array(b) - np.array(a)), spec, scale)).astype(int)
+        assert all(tuple(img[v, u]) == OBSTACLE for u, v in uv)
 
 
 def test_sid_costmap_reports_a_bad_scenario(tmp_path, capsys):
@@ -258,5 +286,5 @@ def test_sid_costmap_reports_a_bad_scenario(tmp_path, capsys):
 
 def test_people_without_recognition_are_only_lidar_obstacles():
     layered = example_layered(social=False)
-    assert set(layered.grids) == {"lidar", "inflation"} and layered.inputs.groups == ()
+    assert set(layered.grids) == {"static", "lidar", "inflation"} and layered.inputs.groups == ()
     assert isinstance(layered.inputs.people[0], Person)

@@ -39,7 +39,7 @@ def test_scaled_intrinsics_keep_pixel_centres():
 
 @pytest.mark.parametrize(
     ("field", "value", "message"),
-    [("fx", -1.0, "focal"), ("cx", float("nan"), "cx"), ("width", 0, "size")],
+    [("fx", -1.0, "fx must be a positive number of pixels"), ("cx", float("nan"), "cx"), ("width", 0, "width")],
 )
 def test_bad_intrinsics_are_named(field, value, message):
     data = D435_COLOR.to_dict() | {field: value}
@@ -100,3 +100,70 @@ def test_mount_round_trip_and_ground_plane(tilt, height):
 def test_mount_rejects_vertical_tilt():
     with pytest.raises(ValueError, match="tilt"):
         CameraMount(tilt=np.pi / 2)
+
+
+FLAT = {"width": 640, "height": 480, "fx": 525, "fy": 525, "cx": 319.5, "cy": 239.5}
+FULL = {"color": FLAT, "depth": FLAT, "depth_to_color": {"rotation": np.eye(3).tolist(), "translation": [0.01, 0, 0]}}
+
+
+# Regression fixtures (issue 15): each was a TypeError naming neither the file nor the field.
+@pytest.mark.parametrize(
+    ("data", "message"),
+    [
+        (FLAT | {"fx": None}, "intrinsics: fx must be a number, got null"),
+        (FLAT | {"fx": [525]}, "intrinsics: fx must be a number, got [525]"),
+        (FLAT | {"fx": "525"}, 'intrinsics: fx must be a number, got "525"'),
+        (FLAT | {"fx": True}, "intrinsics: fx must be a number, got true"),
+        (FLAT | {"width": None}, "intrinsics: width must be a number, got null"),
+        (FLAT | {"width": 640.5}, "intrinsics: width must be a whole number of pixels, got 640.5"),
+        (FLAT | {"width": 1e300}, "intrinsics: width must be a finite number of pixels in [1, 100000], got 1e+300"),
+        (FLAT | {"depth_scale_m": None}, "depth_scale_m must be a number, got null"),
+        (FLAT | {"depth_scale_m": [0.001]}, "depth_scale_m must be a number, got [0.001]"),
+        (FLAT | {"depth_scale": 0}, "depth_scale must be a positive number of metres per unit, got 0"),
+        (FLAT | {"coeffs": 5}, "intrinsics: coeffs must be a list of numbers, got 5"),
+        (FLAT | {"model": 5}, "intrinsics: model must be a distortion model name, got 5"),
+        ({"color": "abc"}, 'color: expected an object with width, height, fx, fy, cx, cy, got "abc"'),
+        (FULL | {"color": FLAT | {"fy": None}}, "color: fy must be a number, got null"),
+        (FULL | {"depth": [1, 2]}, "depth: expected an object with width, height, fx, fy, cx, cy, got [1, 2]"),
+        (FULL | {"depth": {}}, "depth: missing field 'width'"),
+        (
+            FULL | {"depth_to_color": "abc"},
+            'depth_to_color: expected an object with rotation and translation, got "abc"',
+        ),
+        (
+            FULL | {"depth_to_color": {"rotation": "abc", "translation": [0, 0, 0]}},
+            'depth_to_color: rotation must be a 3x3 row-major matrix of numbers, got "abc"',
+        ),
+        (
+            FULL | {"depth_to_color": {"rotation": np.eye(3).tolist(), "translation": None}},
+            "depth_to_color: translation must be [x, y, z] in metres, got null",
+        ),
+        (
+            FULL | {"depth_to_color": {"rotation": np.diag([1, 2, 1]).tolist(), "translation": [0, 0, 0]}},
+            "depth_to_color: rotation is not orthonormal",
+        ),
+        ([FLAT], "expected a JSON object, got [{"),
+    ],
+)
+def test_mistyped_calibration_fields_name_the_file_field_and_value(tmp_path, data, message):
+    path = tmp_path / "calibration.json"
+    path.write_text(json.dumps(data))
+    with pytest.raises(ValueError) as error:
+        Calibration.from_json(path)
+    assert type(error.value) is ValueError
+    assert str(error.value).startswith(f"calibration {path}: ") and message in str(error.value)
+
+
+@pytest.mark.parametrize("raw", [b"\xff\xfe\x00{", b"\x89PNG\r\n\x1a\n", b"[" * 100_000])
+def test_calibration_that_is_not_json_text_names_the_file(tmp_path, raw):
+    path = tmp_path / "intrinsics.json"
+    path.write_bytes(raw)
+    with pytest.raises(ValueError, match="intrinsics.json: (cannot read calibration JSON|not valid JSON)"):
+        Calibration.from_json(path)
+
+
+def test_calibration_values_that_are_right_still_load(tmp_path):
+    path = tmp_path / "calibration.json"
+    path.write_text(json.dumps(FULL | {"depth_scale_m": 0.0001, "color": FLAT | {"ppx": 1.0} | {"coeffs": [0.1] * 5}}))
+    calib = Calibration.from_json(path)
+    assert calib.depth_scale == 0.0001 and calib.color.coeffs == (0.1,) * 5 and calib.depth is not None

@@ -3,19 +3,18 @@
 from __future__ import annotations
 
 import json
+import sys
 from pathlib import Path
 
 import cv2
 import numpy as np
-import pyrealsense2 as rs
 import pytest
 
 from sid.perception.camera import Calibration, Extrinsics, Intrinsics
 from sid.sources import FrameReadError, SourceError, open_source, skip_unreadable
 from sid.sources.folder import FolderSource
-from sid.sources.librealsense import record_synthetic
-from sid.sources.realsense import RealSenseSource
 from sid.sources.synthetic import SyntheticSource
+from tests.conftest import realsense
 
 INTR = {"width": 64, "height": 48, "fx": 50.0, "fy": 50.0, "cx": 31.5, "cy": 23.5, "depth_scale_m": 0.001}
 
@@ -74,7 +73,10 @@ def test_folder_errors_name_the_problem(tmp_path: Path) -> None:
     with pytest.raises(SourceError, match="intrinsics.json"):
         FolderSource(tmp_path)
     (tmp_path / "intrinsics.json").write_text("{not json")
-    with pytest.raises(SourceError, match="cannot read JSON"):
+    with pytest.raises(SourceError, match="intrinsics.json: not valid JSON"):
+        FolderSource(tmp_path)
+    (tmp_path / "intrinsics.json").write_text(json.dumps({**INTR, "fx": None}))
+    with pytest.raises(SourceError, match="intrinsics.json: intrinsics: fx must be a number, got null"):
         FolderSource(tmp_path)
     (tmp_path / "intrinsics.json").write_text(json.dumps({**INTR, "width": 32}))
     with pytest.raises(FrameReadError, match="color.png is 64x48, the calibration says 32x48"):
@@ -102,6 +104,10 @@ def test_five_people_folder(shared) -> None:  # noqa: ANN001 - fixture from conf
 
 
 def test_recording_through_open_source(tmp_path: Path) -> None:
+    realsense()
+    from sid.sources.librealsense import record_synthetic
+    from sid.sources.realsense import RealSenseSource
+
     depth_intr = Intrinsics(64, 48, 40.0, 40.0, 31.5, 23.5)
     color_intr = Intrinsics(96, 72, 70.0, 70.0, 47.5, 35.5)
     calib = Calibration(color_intr, depth_intr, Extrinsics(np.eye(3), [0.015, 0.0, 0.0]), 0.001)
@@ -138,6 +144,21 @@ def test_open_source_dispatch_and_errors(tmp_path: Path) -> None:
         open_source("")
 
 
+def test_realsense_sources_without_pyrealsense2_say_why(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """As on a machine without libusb-1.0: pyrealsense2 loads only when a RealSense source is opened."""
+    monkeypatch.setitem(sys.modules, "pyrealsense2", None)  # `import pyrealsense2` now raises ImportError
+    for name in ("sid.sources.realsense", "sid.sources.librealsense"):
+        monkeypatch.delitem(sys.modules, name, raising=False)
+    recording = tmp_path / "walk.db3"
+    recording.write_bytes(b"")
+    for spec in ("realsense", str(recording)):
+        with pytest.raises(SourceError, match=r"need pyrealsense2, which cannot be loaded .*libusb-1\.0-0"):
+            open_source(spec)
+    with pytest.raises(SourceError, match="does not exist"):  # checked before pyrealsense2 is needed
+        open_source(str(tmp_path / "missing.bag"))
+    assert len(list(open_source("synthetic:S1", frames=1))) == 1  # other sources never need it
+
+
 def test_synthetic_spec_is_delegated() -> None:
     source = open_source("synthetic:S1", frames=1)
     assert isinstance(source, SyntheticSource)
@@ -145,6 +166,7 @@ def test_synthetic_spec_is_delegated() -> None:
 
 
 def test_live_camera_absent_gives_a_clear_error() -> None:
+    rs = realsense()
     if len(rs.context().query_devices()) > 0:
         pytest.skip("a RealSense camera is connected")
     with pytest.raises(SourceError, match="no RealSense camera is connected"):

@@ -10,15 +10,18 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-import pyrealsense2 as rs
 import pytest
 from scipy.spatial.transform import Rotation
 
 from sid.perception.align import Aligner
 from sid.perception.camera import Calibration, Extrinsics, Intrinsics
 from sid.sources import FrameReadError, skip_unreadable
-from sid.sources.librealsense import RealSenseFrames, record_synthetic, rs_extrinsics, rs_intrinsics
-from sid.sources.realsense import RealSenseSource
+from tests.conftest import realsense
+
+rs = realsense()  # skips this module, with the reason, when pyrealsense2 cannot load
+
+from sid.sources.librealsense import RealSenseFrames, record_synthetic, rs_extrinsics, rs_intrinsics  # noqa: E402
+from sid.sources.realsense import RealSenseSource  # noqa: E402
 
 DEPTH = Intrinsics(848, 480, 426.2, 425.9, 423.5, 239.8)
 COLOR = Intrinsics(1280, 720, 910.3, 909.8, 641.2, 358.9)

@@ -6,7 +6,8 @@
      "machine": {"cpu", "logical_cores", "physical_cores", "usable_cores", "load_average", "platform", "python",
                  "numpy", "scipy", "scikit-learn", "shapely", "opencv-python-headless", "onnxruntime", "ompl",
                  "pyrealsense2", "onnxruntime_providers", "commit", "date"},
-     "settings": {"quick", "only", "warmup", "min_runs", "max_runs", "budget_s", "plan_runs"},
+     "settings": {"quick", "only", "warmup", "min_runs", "max_runs", "budget_s", "plan_runs", "pose_threads",
+                  "pose_provider"},
      "stages": {NAME: {"median_ms", "min_ms", "max_ms", "runs", ...optional extras}},
      "notes": [...], "failures": {NAME: message}}
 

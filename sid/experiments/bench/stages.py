@@ -52,12 +52,15 @@ Records = dict[str, dict[str, Any]]
 class Context:
     """What every benchmark may use: timing settings, where ../shared is, shared set-ups and notes for the report.
 
-    plan_runs: seeds per sampling planner (each run takes the whole 0.5 s budget).
+    plan_runs: seeds per sampling planner (each run takes the whole 0.5 s budget). pose_threads, pose_provider:
+    the pose sessions' thread count (None: physical cores) and execution provider (``load_pose_estimator``'s).
     """
 
     settings: RunSettings
     shared: Path
     plan_runs: int
+    pose_threads: int | None = None
+    pose_provider: str = "auto"
     notes: list[str] = field(default_factory=list)
     _cache: dict[str, Any] = field(default_factory=dict, repr=False)
 
@@ -333,7 +336,10 @@ def _pose_image(ctx: Context) -> tuple[np.ndarray, str]:
 def _estimator(ctx: Context, path: Path) -> MoveNetMultiPose | MoveNetSinglePose | YoloPose:
     from sid.perception.pose import load_pose_estimator
 
-    return ctx.cached(f"estimator/{path}", lambda: load_pose_estimator(path))
+    return ctx.cached(
+        f"estimator/{path}",
+        lambda: load_pose_estimator(path, threads=ctx.pose_threads, providers=ctx.pose_provider),
+    )
 
 
 def _bench_pose(path: Path) -> Callable[[Context], Records]:
@@ -362,6 +368,7 @@ def _bench_pose(path: Path) -> Callable[[Context], Records]:
                 contract=estimator.contract,
                 input_size=list(input_size) if isinstance(input_size, tuple) else input_size,
                 threads=estimator.model.threads,
+                provider=estimator.model.provider,
                 image=image_name,
                 people=found[-1],
             )

@@ -24,7 +24,7 @@ from sid.perception.pose.contracts import (
     supported_contracts_text,
 )
 from sid.perception.pose.movenet import MoveNetMultiPose, MoveNetSinglePose, multipose_input_size
-from sid.perception.pose.session import OnnxModel
+from sid.perception.pose.session import PROVIDER_CHOICES, OnnxModel
 from sid.perception.pose.yolo import YoloPose
 
 __all__ = [
@@ -33,6 +33,7 @@ __all__ = [
     "MoveNetMultiPose",
     "MoveNetSinglePose",
     "OnnxModel",
+    "PROVIDER_CHOICES",
     "PoseEstimator",
     "PoseModelError",
     "YoloPose",
@@ -49,22 +50,26 @@ def load_pose_estimator(
     score_threshold: float | None = None,
     input_size: int | tuple[int, int] | str | None = None,
     iou_threshold: float | None = None,
-    providers: Sequence[str] | None = None,
+    providers: str | Sequence[str] | None = None,
+    spinning: bool = False,
 ) -> MoveNetMultiPose | MoveNetSinglePose | YoloPose:
     """Open a pose model and wrap it in the estimator its contract needs.
 
     path: an .onnx file. contract: ``movenet_multipose``, ``movenet_singlepose`` or ``yolo_pose``; None reads it
-    from the model's signature. threads: onnxruntime intra-op threads (default: physical cores).
+    from the model's signature. threads: onnxruntime intra-op threads, an int >= 1 (default: physical cores); the
+    thread pools do not spin-wait unless ``spinning`` (see ``sid.perception.pose.session``).
     score_threshold: minimum person score (default per model: 0.2 MoveNet, 0.25 YOLO; scores of converted models
     differ from the originals, so tune it per model file). input_size: only for models with dynamic height and
     width (MultiPose: long side in px, (h, w) or "paper"; SinglePose: side; YOLO: side or (h, w)).
-    iou_threshold: YOLO NMS overlap (default 0.7). providers: onnxruntime execution providers (default: TensorRT,
-    CUDA when available, then CPU).
+    iou_threshold: YOLO NMS overlap (default 0.7). providers: ``"auto"`` (default: TensorRT, CUDA, OpenVINO when
+    this onnxruntime offers them, then CPU), ``"cpu"``, ``"openvino"`` (needs ``pip install 'sid[openvino]'``) or
+    a list of onnxruntime provider names; ``estimator.model.providers`` says what the session uses.
 
     Raises PoseModelError (missing file, not ONNX, unsupported signature; the message lists the contracts and
-    where such models come from) and ValueError for options the model cannot take.
+    where such models come from) and ValueError for options the model cannot take, a bad thread count, an unknown
+    provider, or ``"openvino"`` when it is not installed.
     """
-    model = OnnxModel(path, threads=threads, providers=providers)
+    model = OnnxModel(path, threads=threads, providers=providers, spinning=spinning)
     name = detect_contract(model.signature, contract, source=str(model.path))
     if iou_threshold is not None and name != YOLO_POSE:
         raise ValueError(f"pose: iou_threshold applies to yolo_pose models only, this one is {name}")
