@@ -10,7 +10,14 @@ import sys
 from pathlib import Path
 
 from sid.cli.groups import add_group_params, group_params_from
-from sid.experiments.fformation import DEFAULT_THRESHOLDS, LabelledFrame, load_dataset, parse_threshold
+from sid.experiments.fformation import (
+    DEFAULT_THRESHOLDS,
+    LIKELY_METRES_M,
+    LabelledFrame,
+    load_dataset,
+    median_neighbour_distance,
+    parse_threshold,
+)
 from sid.experiments.fformation import evaluate as evaluate_fformation
 
 
@@ -29,7 +36,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     ff.add_argument("dirs", nargs="+", metavar="DIR", help="dataset folder (e.g. ../shared/data/fformation/Synth)")
     ff.add_argument(
-        "--scale", type=float, default=1.0, help="multiply positions by this to get metres (0.01 for centimetres)"
+        "--scale",
+        type=float,
+        default=None,
+        help="multiply positions by this to get metres (0.01 for centimetres; default 1, with a warning when the "
+        "positions look like centimetres)",
     )
     ff.add_argument(
         "--T",
@@ -58,7 +69,9 @@ def run(args: argparse.Namespace) -> int:
         datasets: dict[str, list[LabelledFrame]] = {}
         for folder in args.dirs:
             name = _dataset_name(folder, datasets)
-            datasets[name] = load_dataset(folder, args.scale)
+            datasets[name] = load_dataset(folder, 1.0 if args.scale is None else args.scale)
+            if args.scale is None:
+                _warn_if_not_metres(name, datasets[name])
         scores = evaluate_fformation(datasets, params, args.thresholds)
     except ValueError as exc:
         print(f"sid eval fformation: {exc}", file=sys.stderr)
@@ -69,6 +82,17 @@ def run(args: argparse.Namespace) -> int:
         settings = {k: v if math.isfinite(v) else str(v) for k, v in dataclasses.asdict(params).items()}
         print(json.dumps({"params": settings, "scores": scores}, indent=2))
     return 0
+
+
+def _warn_if_not_metres(name: str, frames: list[LabelledFrame]) -> None:
+    """Say so on stderr when a dataset's people stand implausibly far apart for metres (no --scale given)."""
+    gap = median_neighbour_distance(frames)
+    if gap is not None and gap > LIKELY_METRES_M:
+        print(
+            f"sid eval fformation: warning: {name}: the median distance from a person to their nearest neighbour is "
+            f"{gap:.3g} units, implausible for metres; if the positions are centimetres, pass --scale 0.01",
+            file=sys.stderr,
+        )
 
 
 def _dataset_name(folder: str, taken: dict) -> str:

@@ -98,6 +98,25 @@ def load_dataset(folder: str | Path, scale: float = 1.0) -> list[LabelledFrame]:
     return [frame for sequence in sequences for frame in load_sequence(sequence, scale)]
 
 
+LIKELY_METRES_M = 5.0
+"""People in a conversation stand well within this of their nearest neighbour (m); a median nearest-neighbour distance
+above it means the positions are not in metres (the Verona sets store centimetres: pass ``scale=0.01``)."""
+
+
+def median_neighbour_distance(frames: Sequence[LabelledFrame]) -> float | None:
+    """Median over people of the distance to their nearest neighbour in the same frame (input units); None when no
+    frame holds two people."""
+    distances: list[float] = []
+    for frame in frames:
+        xy = np.array([(p.x, p.y) for p in frame.people], dtype=float).reshape(-1, 2)
+        if len(xy) < 2:
+            continue
+        gaps = np.hypot(*(xy[:, None, :] - xy[None, :, :]).transpose(2, 0, 1))
+        np.fill_diagonal(gaps, np.inf)
+        distances.extend(gaps.min(axis=1).tolist())
+    return float(np.median(distances)) if distances else None
+
+
 def frame_precision_recall(
     detected: Sequence[Iterable[int]], truth: Sequence[Iterable[int]], threshold: float
 ) -> tuple[float, float]:

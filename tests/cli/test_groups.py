@@ -184,3 +184,12 @@ def test_eval_fformation_on_the_real_datasets(capsys):
     rows = {(line.split()[0], line.split()[1]): float(line.split()[-1]) for line in out[1:]}
     assert set(rows) == {(d, t) for d in ("Synth", "CoffeeBreak", "pooled") for t in ("2/3", "1")}
     assert rows[("Synth", "2/3")] > 0.9
+
+
+def test_eval_fformation_warns_when_positions_look_like_centimetres(tmp_path, capsys):
+    tiny = write_sequence(tmp_path / "Tiny", tiny_frames(), {1: [[1, 2]], 2: [[1, 2, 3]], 3: []})
+    code, _, err = run_sid(["eval", "fformation", str(tiny)], capsys)
+    assert code == 0 and "Tiny: the median distance" in err and "pass --scale 0.01" in err
+    for scale in ("0.01", "1"):  # an explicit scale is the user's word: no warning
+        code, _, err = run_sid(["eval", "fformation", str(tiny), "--scale", scale], capsys)
+        assert code == 0 and "warning" not in err

@@ -10,11 +10,13 @@ import pytest
 import scipy.io
 
 from sid.experiments.fformation import (
+    LIKELY_METRES_M,
     evaluate,
     format_threshold,
     frame_precision_recall,
     load_dataset,
     load_sequence,
+    median_neighbour_distance,
     parse_threshold,
     score,
 )
@@ -190,3 +192,12 @@ def test_one_candidate_per_cluster_is_the_papers_algorithm_and_fails_in_crowds()
     default_found = sum(len(detect_groups(f.people)) for f in synth)
     paper_found = sum(len(detect_groups(f.people, paper)) for f in synth)
     assert paper_found < default_found
+
+
+def test_median_neighbour_distance_is_in_the_input_units(tiny):
+    centimetres = median_neighbour_distance(load_dataset(tiny, 1.0))
+    metres = median_neighbour_distance(load_dataset(tiny, 0.01))
+    assert centimetres is not None and metres is not None
+    assert centimetres == pytest.approx(100 * metres)
+    assert centimetres > LIKELY_METRES_M > metres
+    assert median_neighbour_distance([]) is None
