@@ -180,10 +180,13 @@ def run(args: argparse.Namespace) -> int:
         args.out.mkdir(parents=True, exist_ok=True)
         streams.append((args.out / "detections.jsonl").open("w"))
 
+    done = skipped = 0
+
     def report(error: FrameReadError) -> None:
+        nonlocal skipped
+        skipped += 1
         print(f"detect: frame {error.index}: skipped, {error}", file=sys.stderr)
 
-    done = skipped = 0
     interrupted = False
     totals: list[float] = []
     try:

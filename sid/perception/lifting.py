@@ -72,6 +72,9 @@ class LiftParams:
     min_keypoints: a detection with fewer lifted keypoints gives no Person. 3: fewer cannot be placed reliably
       (one occluded limb at a wrong depth would decide the position) and cannot give a facing direction.
     patch: side (pixels, odd) of the depth window read around each keypoint. 5, as the paper's authors did.
+    min_range: keypoints nearer than this to the camera (m, optical z) are dropped. 0.2: a D435's minimum depth at
+      848x480 is about 0.2 m, so a nearer reading is an artefact or a corrupt depth image (1 mm everywhere would
+      otherwise place people 7 cm from the lens).
     max_range: keypoints farther than this from the camera (m, optical z) are dropped. 6.0: D435-class depth
       noise grows with range squared (~2 % at 2 m, ~20 cm at 6 m), beyond which body orientation is noise.
     depth_gate: keypoints whose depth differs from the person's median keypoint depth by more than this (m) are
@@ -102,6 +105,7 @@ class LiftParams:
     min_score: float = 0.3
     min_keypoints: int = 3
     patch: int = 5
+    min_range: float = 0.2
     max_range: float = 6.0
     depth_gate: float = 0.6
     occluder_gap: float = 0.2
@@ -120,6 +124,9 @@ class LiftParams:
         if int(self.patch) != self.patch or self.patch < 1 or self.patch % 2 == 0:
             raise ValueError(f"lift: patch must be a positive odd number of pixels, got {self.patch}")
         check_number("lift", "occluder_gap", self.occluder_gap, low=0, allow_inf=True, unit="metres")  # inf: off
+        check_number("lift", "min_range", self.min_range, low=0, unit="metres")
+        if self.min_range >= self.max_range:
+            raise ValueError(f"lift: min_range ({self.min_range} m) must be below max_range ({self.max_range} m)")
         metres = ("max_range", "depth_gate", "shoulder_separation", "hip_separation", "ear_separation")
         check_numbers("lift", self, metres, low=0, low_open=True, unit="metres")
         check_number("lift", "surface_offset", self.surface_offset, low=0, high=0.5, high_open=True, unit="metres")
@@ -152,7 +159,7 @@ def lift_people(
     confident = (scores >= params.min_score) & np.isfinite(keypoints).all(axis=2)  # (comparisons with NaN: False)
     depth = np.full(scores.shape, np.nan)
     depth[confident] = depth_at_color_pixels(depth_m, keypoints[confident], calib, patch=params.patch)
-    usable = confident & (depth > 0) & (depth <= params.max_range)
+    usable = confident & (depth >= params.min_range) & (depth <= params.max_range)
     # Median depth per person over its usable keypoints (unusable ones sort last as +inf; np.nanmedian is ~30x
     # slower on arrays this small).
     ordered = np.sort(np.where(usable, depth, np.inf), axis=1)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import shutil
 
 import cv2
 import numpy as np
@@ -220,3 +221,22 @@ def test_missing_openvino_provider_is_explained(tmp_path, capsys):
     assert main(["detect", "--source", "synthetic:S1", "--model", str(model), "--provider", "openvino"]) == 2
     err = capsys.readouterr().err
     assert "openvino provider is not available" in err and "pip install 'sid[openvino]'" in err
+
+
+def test_summary_counts_every_skipped_frame(tmp_path, capsys):
+    """Unreadable frames, frames without people and corrupt (1 mm) depth each count as skipped in the summary."""
+    real = shared_path("data", "rgbd", "five_people")
+    model = shared_path("models", "yolo11n-pose-256.onnx")
+    (tmp_path / "color").mkdir()
+    (tmp_path / "depth").mkdir()
+    shutil.copy(real / "intrinsics.json", tmp_path / "intrinsics.json")
+    for name in ("a", "b", "c", "d"):
+        shutil.copy(real / "color.png", tmp_path / "color" / f"{name}.png")
+    shutil.copy(real / "depth.png", tmp_path / "depth" / "a.png")  # a: five people
+    corrupt = np.ones_like(cv2.imread(str(real / "depth.png"), cv2.IMREAD_UNCHANGED))  # b: 1 mm everywhere
+    cv2.imwrite(str(tmp_path / "depth" / "b.png"), corrupt)
+    cv2.imwrite(str(tmp_path / "depth" / "c.png"), np.zeros_like(corrupt))  # c: no depth at all; d: no depth file
+    assert main(["detect", "--source", str(tmp_path), "--model", str(model), "--no-keypoints"]) == 0
+    captured = capsys.readouterr()
+    assert len(_lines(captured.out)) == 1
+    assert "1 frames with people, 3 skipped" in captured.err

@@ -278,6 +278,8 @@ def test_bad_input_is_rejected():
         ("min_keypoints", 0),
         ("patch", 4),
         ("max_range", 0.0),
+        ("min_range", -0.1),
+        ("min_range", 7.0),  # not below max_range
         ("depth_gate", -1),
         ("surface_offset", -0.01),
         ("occluder_gap", -0.1),
@@ -289,6 +291,17 @@ def test_bad_input_is_rejected():
     ]:
         with pytest.raises(ValueError, match=field):
             LiftParams(**{field: value})
+
+
+def test_depth_nearer_than_the_minimum_range_places_nobody():
+    """A corrupt depth image (1 mm everywhere) must not place people a few centimetres from the lens."""
+    detections, depth, _ = scene([(2.0, 0.0, math.pi), (2.5, 1.0, 0.0)])
+    assert len(lift_people(detections, depth, REGISTERED, MOUNT)) == 2
+    corrupt = np.full_like(depth, 0.001)
+    assert lift_people(detections, corrupt, REGISTERED, MOUNT) == []
+    near = np.where(depth > 0, 0.15, 0.0).astype(depth.dtype)  # below the default 0.2 m minimum
+    assert lift_people(detections, near, REGISTERED, MOUNT) == []
+    assert len(lift_people(detections, near, REGISTERED, MOUNT, LiftParams(min_range=0.1, depth_gate=1.0))) == 2
 
 
 def test_bench_lifting_four_people(benchmark):
