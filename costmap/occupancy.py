@@ -51,6 +51,17 @@ class OccupancyGrid:
                 f"occupancy grid: data must be int8 of shape {self.spec.shape}, got {self.data.dtype} {self.data.shape}"
             )
 
+    def resampled(self, spec: GridSpec) -> OccupancyGrid:
+        """This map on another grid ``spec`` (nearest cell: each cell of ``spec`` takes the value under its centre;
+        unknown, -1, outside this map)."""
+        if spec == self.spec:
+            return self
+        cells = self.spec.world_to_cell(np.stack([a.ravel() for a in spec.cell_centres()], axis=1))
+        inside = self.spec.in_bounds(cells)
+        data = np.full(spec.height * spec.width, OCC_UNKNOWN, dtype=np.int8)
+        data[inside] = self.data[cells[inside, 0], cells[inside, 1]]
+        return OccupancyGrid(spec, data.reshape(spec.shape), self.origin_yaw, self.frame_id)
+
 
 def cost_to_occupancy(costs: np.ndarray) -> np.ndarray:
     """uint8 Nav2 costs -> int8 OccupancyGrid values (Nav2's costmap publisher table)."""

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from costmap.combine import CombinationMethod
-from costmap.grid import NO_INFORMATION, GridSpec, Window
+from costmap.grid import GridSpec, Window
 from costmap.layer import Layer, LayerInputs
 from costmap.occupancy import OccupancyGrid, occupancy_to_cost
 
@@ -15,14 +15,7 @@ def static_costs(grid: OccupancyGrid, spec: GridSpec, track_unknown_space: bool 
 
     Cells of ``spec`` outside the map read NO_INFORMATION (or FREE when unknown space is not tracked).
     """
-    costs = occupancy_to_cost(grid.data, track_unknown_space=track_unknown_space)
-    if grid.spec == spec:
-        return costs
-    cells = grid.spec.world_to_cell(np.stack([a.ravel() for a in spec.cell_centres()], axis=1))
-    inside = grid.spec.in_bounds(cells)
-    out = np.full(spec.height * spec.width, NO_INFORMATION if track_unknown_space else 0, dtype=np.uint8)
-    out[inside] = costs[cells[inside, 0], cells[inside, 1]]
-    return out.reshape(spec.shape)
+    return occupancy_to_cost(grid.resampled(spec).data, track_unknown_space=track_unknown_space)
 
 
 class StaticLayer(Layer):

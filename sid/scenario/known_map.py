@@ -64,16 +64,10 @@ def known_map(obstacles: Sequence[Obstacle], spec: GridSpec, static_map: Occupan
     Without a map file every other cell is unknown (-1): the static layer reads it as free unless unknown space is
     tracked (``layers.obstacle.track_unknown_space``), so the LiDAR layer decides there, as without obstacles.
     """
-    data = np.full(spec.shape, OCC_UNKNOWN, dtype=np.int8)
-    if static_map is not None:
-        if static_map.spec == spec:
-            data[...] = static_map.data
-        else:
-            xs, ys = spec.cell_centres()
-            cells = static_map.spec.world_to_cell(np.stack([xs.ravel(), ys.ravel()], axis=1))
-            inside = static_map.spec.in_bounds(cells)
-            flat = data.reshape(-1)
-            flat[inside] = static_map.data[cells[inside, 0], cells[inside, 1]]
+    if static_map is None:
+        data = np.full(spec.shape, OCC_UNKNOWN, dtype=np.int8)
+    else:
+        data = static_map.resampled(spec).data.copy()
     data[obstacle_mask(obstacles, spec)] = OCC_OCCUPIED
     frame = "map" if static_map is None else static_map.frame_id
     return OccupancyGrid(spec, data, frame_id=frame)
