@@ -1,0 +1,49 @@
+"""The robot's pose in the map and the frames sid's outputs are given in (REP-105 names).
+
+``map``: the fixed world frame of a deployment (a scenario's frame, a SLAM map). ``base_footprint``: the robot's
+ground frame, x forward, y left, z up, origin on the ground below the robot's centre. sid's single-frame outputs
+are in the ground frame below the camera (``sid.perception.mount``); with the default mount (camera above the
+robot's centre, facing forward) that is ``base_footprint``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from sid.checks import check_numbers
+
+MAP_FRAME = "map"
+BASE_FRAME = "base_footprint"
+
+
+@dataclass(frozen=True)
+class RobotPose:
+    """Pose of ``base_footprint`` in the map: position (x, y) in metres, heading yaw in radians (CCW from map +x)."""
+
+    x: float
+    y: float
+    yaw: float
+
+    def __post_init__(self) -> None:
+        check_numbers("robot pose", self, ("x", "y", "yaw"))
+
+    @property
+    def rotation(self) -> np.ndarray:
+        """2x2 rotation taking base_footprint vectors to map vectors."""
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        return np.array([[c, -s], [s, c]])
+
+    def to_map(self, points: np.ndarray) -> np.ndarray:
+        """(N, 2) base_footprint points (m) -> (N, 2) map points (m)."""
+        return np.asarray(points, dtype=float).reshape(-1, 2) @ self.rotation.T + np.array([self.x, self.y])
+
+    def to_base(self, points: np.ndarray) -> np.ndarray:
+        """(N, 2) map points (m) -> (N, 2) base_footprint points (m)."""
+        return (np.asarray(points, dtype=float).reshape(-1, 2) - np.array([self.x, self.y])) @ self.rotation
+
+    def yaw_to_map(self, yaw: float) -> float:
+        """A heading in base_footprint (rad) -> the same heading in the map, wrapped to (-pi, pi]."""
+        return math.remainder(yaw + self.yaw, math.tau)
