@@ -1,4 +1,5 @@
-"""``sid eval fformation DIR...``: score the group detector on F-formation benchmark datasets."""
+"""``sid eval fformation DIR...``: score the group detector on F-formation benchmark datasets; ``sid eval tracking``:
+score the trackers on the synthetic sequences."""
 
 from __future__ import annotations
 
@@ -13,7 +14,9 @@ from sid.cli.groups import add_group_params, group_params_from
 from sid.experiments.fformation import (
     DEFAULT_THRESHOLDS,
     LIKELY_METRES_M,
+    Fold,
     LabelledFrame,
+    cross_validate,
     load_dataset,
     median_neighbour_distance,
     parse_threshold,
@@ -52,8 +55,17 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="tolerances in (0, 1], e.g. --T 2/3 1 after the DIRs (default: 2/3 1)",
     )
     ff.add_argument("--table", action="store_true", help="print a readable table instead of JSON")
+    ff.add_argument(
+        "--grid",
+        nargs="+",
+        type=_grid_item,
+        metavar="FIELD=V1,V2",
+        help="cross-validate instead: for each DIR left out, choose the values (of these GroupParams fields, e.g. "
+        "group_price=0.5,0.65,0.8) with the best mean F1 at the first T on the other DIRs, and score them on it",
+    )
     add_group_params(ff)
     ff.set_defaults(func=run)
+    add_tracking_parser(tasks)
 
 
 def _threshold(text: str) -> float:
@@ -61,6 +73,18 @@ def _threshold(text: str) -> float:
         return parse_threshold(text)
     except ValueError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def _grid_item(text: str) -> tuple[str, list[float]]:
+    """'group_price=0.5,0.8' -> ('group_price', [0.5, 0.8])."""
+    name, _, values = text.partition("=")
+    try:
+        numbers = [float(v) for v in values.split(",")]
+    except ValueError:
+        numbers = []
+    if not name or not numbers:
+        raise argparse.ArgumentTypeError(f"expected FIELD=V1,V2,... (numbers), got {text!r}")
+    return name.replace("-", "_"), numbers
 
 
 def run(args: argparse.Namespace) -> int:
@@ -72,6 +96,10 @@ def run(args: argparse.Namespace) -> int:
             datasets[name] = load_dataset(folder, 1.0 if args.scale is None else args.scale)
             if args.scale is None:
                 _warn_if_not_metres(name, datasets[name])
+        if args.grid:
+            folds, table = cross_validate(datasets, dict(args.grid), params, args.thresholds[0])
+            print(_folds(folds, table) if args.table else json.dumps(_folds_json(folds, table, args.grid), indent=2))
+            return 0
         scores = evaluate_fformation(datasets, params, args.thresholds)
     except ValueError as exc:
         print(f"sid eval fformation: {exc}", file=sys.stderr)
@@ -79,7 +107,9 @@ def run(args: argparse.Namespace) -> int:
     if args.table:
         print(_table(scores))
     else:
-        settings = {k: v if math.isfinite(v) else str(v) for k, v in dataclasses.asdict(params).items()}
+        settings = {
+            k: v if isinstance(v, str) or math.isfinite(v) else str(v) for k, v in dataclasses.asdict(params).items()
+        }
         print(json.dumps({"params": settings, "scores": scores}, indent=2))
     return 0
 
@@ -104,6 +134,29 @@ def _dataset_name(folder: str, taken: dict) -> str:
     return name
 
 
+def _folds(folds: list[Fold], table: dict[tuple[float, ...], dict[str, float]]) -> str:
+    """Each fold's choice and scores, then the spread of the held-out F1."""
+    lines = [f"{'held out':<16} {'F1 there':>8} {'F1 others':>9}  chosen"]
+    for fold in folds:
+        chosen = " ".join(f"{k}={v:g}" for k, v in fold.chosen.items())
+        lines.append(f"{fold.held_out:<16} {fold.held_out_f1:>8.3f} {fold.train_f1:>9.3f}  {chosen}")
+    held = [fold.held_out_f1 for fold in folds]
+    lines.append(
+        f"held-out F1 {min(held):.3f}-{max(held):.3f} (spread {max(held) - min(held):.3f}), {len(table)} grid points"
+    )
+    return "\n".join(lines)
+
+
+def _folds_json(
+    folds: list[Fold], table: dict[tuple[float, ...], dict[str, float]], grid: list[tuple[str, list[float]]]
+) -> dict:
+    names = [name for name, _ in grid]
+    return {
+        "folds": [dataclasses.asdict(fold) for fold in folds],
+        "grid": [dict(zip(names, values, strict=True)) | {"f1": scores} for values, scores in table.items()],
+    }
+
+
 def _table(scores: dict[str, dict[str, dict[str, float]]]) -> str:
     lines = [f"{'dataset':<16} {'T':>4} {'frames':>6} {'precision':>9} {'recall':>7} {'F1':>6}"]
     for name, by_threshold in scores.items():
@@ -111,4 +164,74 @@ def _table(scores: dict[str, dict[str, dict[str, float]]]) -> str:
             lines.append(
                 f"{name:<16} {threshold:>4} {s['frames']:>6} {s['precision']:>9.3f} {s['recall']:>7.3f} {s['f1']:>6.3f}"
             )
+    return "\n".join(lines)
+
+
+def add_tracking_parser(tasks: argparse._SubParsersAction) -> None:
+    """``sid eval tracking``: the options of ``sid.experiments.tracking.TrackingEvalSettings``."""
+    from sid.experiments.tracking import TrackingEvalSettings
+    from sid.synthetic.sequence import SEQUENCES
+
+    defaults = TrackingEvalSettings()
+    parser = tasks.add_parser(
+        "tracking",
+        help="people and group tracking on the synthetic sequences (MOTA, IDF1, group F1, flicker)",
+        description="Renders the built-in synthetic sequences, runs the per-frame pipeline and the tracking stream on "
+        "them and prints MOTA / IDF1 (py-motmetrics), group F1 with and without tracking, frames in which walkers "
+        "are called a conversation, and the costmap flicker of the per-frame and the tracked layers "
+        "(docs/tracking.md). Takes a few minutes; progress on stderr.",
+    )
+    parser.add_argument(
+        "--sequences", nargs="+", choices=SEQUENCES, default=list(defaults.sequences), metavar="NAME",
+        help=f"which sequences (default: all of {', '.join(SEQUENCES)})",
+    )  # fmt: skip
+    parser.add_argument("--fps", type=float, default=defaults.fps, help=f"frame rate in Hz ({defaults.fps:g})")
+    parser.add_argument("--frames", type=int, default=None, help="at most this many frames per sequence (all)")
+    parser.add_argument("--seed", type=int, default=defaults.seed, help=f"noise seed ({defaults.seed})")
+    parser.add_argument(
+        "--flicker-frames", type=int, default=defaults.flicker_frames,
+        help=f"frames of the flicker layout {defaults.flicker_layout} ({defaults.flicker_frames})",
+    )  # fmt: skip
+    parser.add_argument("--table", action="store_true", help="print a readable table instead of JSON")
+    parser.set_defaults(func=run_tracking)
+
+
+def run_tracking(args: argparse.Namespace) -> int:
+    from sid.experiments.progress import ProgressBar
+    from sid.experiments.tracking import MissingDependencyError, TrackingEvalSettings, evaluate_tracking
+
+    try:
+        settings = TrackingEvalSettings(
+            sequences=tuple(args.sequences), fps=args.fps, seed=args.seed, frames=args.frames,
+            flicker_frames=args.flicker_frames,
+        )  # fmt: skip
+        result = evaluate_tracking(settings, ProgressBar("tracking"))
+    except (ValueError, MissingDependencyError) as exc:
+        print(f"sid eval tracking: {exc}", file=sys.stderr)
+        return 2
+    print(_tracking_table(result) if args.table else json.dumps(result, indent=2))
+    return 0
+
+
+def _tracking_table(result: dict) -> str:
+    rows = [*result["sequences"].items(), ("overall", result["overall"])]
+    lines = [
+        f"{'sequence':<18} {'MOTA':>6} {'IDF1':>6} {'IDsw':>5} {'IDtr':>5} {'FN':>4} {'FP':>4} "
+        f"{'group F1 2/3 raw / tracked':>27} {'walkers in conv. raw / tracked':>31}"
+    ]
+    for name, s in rows:
+        f1 = s.get("group_f1_T2/3", {})
+        walkers = s.get("frames_walkers_in_a_conversation", {})
+        groups = f"{f1['without_tracking']['f1']:.3f} / {f1['with_tracking']['f1']:.3f}" if f1 else "-"
+        conv = f"{walkers['without_tracking']} / {walkers['with_tracking']}" if walkers else "-"
+        lines.append(
+            f"{name:<18} {s['mota']:>6.3f} {s['idf1']:>6.3f} {s['id_switches']:>5} {s['id_transfers']:>5} "
+            f"{s['misses']:>4} {s['false_positives']:>4} {groups:>27} {conv:>31}"
+        )
+    flicker = result["flicker"]
+    lines.append(
+        f"flicker ({flicker['layout']}, {flicker['pairs_scored']} frame pairs, cells changing by > "
+        f"{flicker['threshold']}, miss rate {flicker['miss_rate']:g}): per-frame layer "
+        f"{flicker['per_frame']['changed_cells_total']}, tracked layer {flicker['tracked']['changed_cells_total']}"
+    )
     return "\n".join(lines)

@@ -1,6 +1,7 @@
 """``sid groups FILE|-``: detect conversational groups in JSON-lines frames of people.
 
-Input, one frame per line (world frame, metres, radians; theta may be null or absent = unknown facing):
+Input, one frame per line (world frame, metres, radians; theta may be null or absent = unknown facing; the optional
+orientation_quality in [0, 1] weighs the facing, default 1 when theta is given):
     {"frame": 0, "people": [{"id": 1, "x": 1.0, "y": 0.2, "theta": 3.1}, ...]}
 Output, one line per good input line, flushed as it is written:
     {"frame": 0, "groups": [{"members": [1, 2], "interest_point": [x, y], "area": a, "spread": d,
@@ -20,8 +21,9 @@ import sys
 from collections.abc import Iterable, Iterator
 from typing import IO, Any, TextIO
 
+from sid.checks import check_limit
 from sid.documents import is_number
-from sid.perception.groups import Group, GroupParams, detect_groups
+from sid.perception.groups import GROUP_METHODS, Group, GroupParams, detect_groups
 from sid.perception.people import Person
 
 
@@ -39,9 +41,19 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 
 def add_group_params(parser: argparse.ArgumentParser) -> None:
-    """One option per GroupParams field (--eps, --min-samples, ...), defaulting to the record's defaults."""
+    """One option per GroupParams field (--method, --group-price, --eps, ...), defaulting to the record's defaults."""
     group = parser.add_argument_group("group detector parameters (metres, square metres, radians)")
     for field in dataclasses.fields(GroupParams):
+        if field.name == "method":
+            group.add_argument(
+                "--method",
+                "--group-method",
+                dest="group_method",
+                choices=GROUP_METHODS,
+                default=field.default,
+                help=f"{_field_help(field.name)} (default {field.default}; docs/groups.md)",
+            )
+            continue
         kind = int if isinstance(field.default, int) else float
         group.add_argument(
             "--" + field.name.replace("_", "-"),
@@ -153,6 +165,9 @@ def _frames(lines: Iterable[str | bytes]) -> Iterator[tuple[int, dict[str, Any],
         except (json.JSONDecodeError, ValueError) as exc:
             yield number, {}, f"not valid JSON ({exc})"
             continue
+        except RecursionError:
+            yield number, {}, "not valid JSON (nested too deeply)"
+            continue
         try:
             yield number, _parse_frame(data), None
         except ValueError as exc:
@@ -170,6 +185,7 @@ def _parse_frame(data: Any) -> dict[str, Any]:
         raise ValueError("missing 'people'")
     if not isinstance(data["people"], list):
         raise ValueError("'people' must be a list")
+    check_limit("people", len(data["people"]), "people", "people")  # before any work on them (sid.checks.Limits)
     return {"frame": data.get("frame"), "people": [_parse_person(p, k) for k, p in enumerate(data["people"])]}
 
 
@@ -184,11 +200,16 @@ def _parse_person(data: Any, index: int) -> Person:
     if isinstance(person_id, bool) or not isinstance(person_id, int):
         raise ValueError(f"{where}: id must be an integer, got {person_id!r}")
     values = {}
-    for key in ("x", "y", "theta"):
+    for key in ("x", "y", "theta", "orientation_quality"):
         value = data.get(key)
-        if key == "theta" and value is None:
+        if key in ("theta", "orientation_quality") and value is None:
             continue
         if not is_number(value):
             raise ValueError(f"{where} (id {person_id}): {key} must be a finite number, got {value!r}")
         values[key] = float(value)
-    return Person(person_id, values["x"], values["y"], values.get("theta"))
+    theta = values.get("theta")
+    # A given facing is taken at full quality unless the line says otherwise (as in scenario files).
+    quality = values.get("orientation_quality", 0.0 if theta is None else 1.0)
+    if not 0.0 <= quality <= 1.0:
+        raise ValueError(f"{where} (id {person_id}): orientation_quality must lie in [0, 1], got {quality!r}")
+    return Person(person_id, values["x"], values["y"], theta, quality)

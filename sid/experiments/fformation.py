@@ -12,14 +12,19 @@ groups of one are dropped on both sides; a truth group is found when some detect
 precision = TP / (TP + FP), recall = TP / (TP + FN) (nothing detected and no truth: P = R = 1; truth but nothing
 detected: P = 1, R = 0; detections but no truth: P = 0, R = 1); a dataset scores the mean precision and mean recall
 over its frames, and F1 = 2PR / (P + R).
+
+``cross_validate`` chooses detector parameters leaving one dataset out at a time (docs/groups.md).
 """
 
 from __future__ import annotations
 
+import dataclasses
+import itertools
 import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import scipy.io
@@ -171,6 +176,59 @@ def evaluate(
     return result
 
 
+@dataclass
+class Fold:
+    """One cross-validation fold: the held-out dataset, the grid point chosen on the others (field -> value), the
+    chosen point's mean F1 on those others, and its F1 on the held-out set."""
+
+    held_out: str
+    chosen: dict[str, float]
+    train_f1: float
+    held_out_f1: float
+
+
+def cross_validate(
+    datasets: Mapping[str, Sequence[LabelledFrame]],
+    grid: Mapping[str, Sequence[float]],
+    base: GroupParams | None = None,
+    threshold: float = 2 / 3,
+) -> tuple[list[Fold], dict[tuple[float, ...], dict[str, float]]]:
+    """Leave-one-dataset-out choice of ``GroupParams`` fields over ``grid`` (field -> candidate values, the other
+    fields from ``base``): per held-out dataset, the grid point with the best mean F1 at ``threshold`` over the
+    other datasets (ties: the first in grid order), scored on the held-out one.
+
+    Returns the folds and every grid point's F1 per dataset (keyed by its values in ``grid``'s field order).
+    Needs at least two datasets; raises ValueError for an unknown field or an empty grid.
+    """
+    if len(datasets) < 2:
+        raise ValueError("fformation: cross-validation needs at least two datasets")
+    base = base or GroupParams()
+    numeric = {f.name for f in dataclasses.fields(GroupParams) if f.name != "method"}
+    unknown = sorted(set(grid) - numeric)
+    if unknown or not grid or not all(grid.values()):
+        raise ValueError(f"fformation: the grid needs values for numeric fields of GroupParams, got {dict(grid)}")
+    names = list(grid)
+    table: dict[tuple[float, ...], dict[str, float]] = {}
+    for values in itertools.product(*(grid[n] for n in names)):
+        # Whole-number fields (min_samples, radius_steps) take the value as an int; GroupParams refuses a fraction.
+        changes: dict[str, Any] = {
+            n: int(v) if isinstance(getattr(base, n), int) and float(v).is_integer() else v
+            for n, v in zip(names, values, strict=True)
+        }
+        params = dataclasses.replace(base, **changes)
+        table[values] = {
+            name: score(frames, [[g.members for g in detect_groups(f.people, params)] for f in frames], threshold).f1
+            for name, frames in datasets.items()
+        }
+    folds = []
+    for held_out in datasets:
+        others = [n for n in datasets if n != held_out]
+        best = max(table, key=lambda v: float(np.mean([table[v][n] for n in others])))
+        train = float(np.mean([table[best][n] for n in others]))
+        folds.append(Fold(held_out, dict(zip(names, best, strict=True)), train, table[best][held_out]))
+    return folds, table
+
+
 def format_threshold(threshold: float) -> str:
     """'2/3' for 2/3, '1' for 1, else the decimal."""
     for num, den in ((2, 3), (1, 1), (1, 2), (3, 4), (1, 3)):
@@ -235,8 +293,14 @@ def _people(cell: np.ndarray, scale: float, where: str) -> list[Person]:
         raise ValueError(f"fformation: {where}: features must be N x 4 [id, x, y, theta], got shape {rows.shape}")
     if not np.all(np.isfinite(rows[:, :3])):
         raise ValueError(f"fformation: {where}: non-finite id or position")
+    # An annotated facing is taken at full quality (1), a missing one is unknown (None, quality 0).
     return [
-        Person(int(r[0]), float(r[1]) * scale, float(r[2]) * scale, float(r[3]) if math.isfinite(r[3]) else None)
+        Person(
+            int(r[0]),
+            float(r[1]) * scale,
+            float(r[2]) * scale,
+            *((float(r[3]), 1.0) if math.isfinite(r[3]) else (None, 0.0)),
+        )
         for r in rows
     ]
 

@@ -137,7 +137,8 @@ def _frames(source: str, rows: Iterable[dict[str, str]]) -> list[LoggedFrame]:
         logged = frame.groups[-1]
         logged.members = logged.members | {person_id}
         theta = math.radians(values["Person Orientation"])
-        frame.people.append(Person(person_id, values["Person X"], values["Person Y"], theta))
+        # A logged facing is taken at full quality, as `sid groups` takes a line without orientation_quality.
+        frame.people.append(Person(person_id, values["Person X"], values["Person Y"], theta, 1.0))
         previous = (message, group, person, centre)
     # A file may end in the middle of a message (a group with one logged member): drop such frames.
     return [f for f in frames if all(len(g.members) >= 2 for g in f.groups)]
@@ -172,8 +173,10 @@ def compare(frames: Sequence[LoggedFrame], params: GroupParams | None = None) ->
 
 def authors_params() -> GroupParams:
     """The authors' settings in our detector's terms: eps 3 m, 20 m rays, area 0.5 m^2, D 3 m, one candidate per
-    cluster, no face-to-face rule. (Their DBSCAN also used the yaw in radians as a third coordinate.)"""
+    cluster (the paper method), no face-to-face rule. (Their DBSCAN also used the yaw in radians as a third
+    coordinate.)"""
     return GroupParams(
+        method="paper",
         eps=3.0,
         area_threshold=0.5,
         spread_threshold=3.0,

@@ -1,12 +1,18 @@
-"""Conversational groups (the paper's Algorithm 1): records and detection.
+"""Conversational groups: records, and detection by one of three methods (``GroupParams.method``).
 
 All coordinates are in the world frame (metres, REP-103, see ``sid.perception.people``); angles in radians.
 
-Per frame: DBSCAN on the people's positions; per cluster, each person with a known facing casts a ray (a segment
-of ``ray_length``) from their position along their facing; where two rays cross, the two people look at a common
-point. The convex hull of the crossings is the interaction zone (area A, centroid = interest point), and D is the
-mean distance of the members to the interest point. While A or D exceed their thresholds, the member whose
-removal helps most is dropped; a cluster that ends under both thresholds is a group.
+- ``ospace`` (default): people are assigned to shared o-spaces by minimising a description-length cost
+  (``sid.perception.ospace``; docs/groups.md); each group's zone, interest point and spread are then those of the
+  paper (below), computed on its members' rays, or the fitted o-space centre when no two members' rays meet.
+- ``rays``: the paper's Algorithm 1 with the two additions described below.
+- ``paper``: the literal Algorithm 1, one candidate per DBSCAN cluster (``rays`` with ``meeting_radius=math.inf``).
+
+The ray method. Per frame: DBSCAN on the people's positions; per cluster, each person with a known facing casts a
+ray (a segment of ``ray_length``) from their position along their facing; where two rays cross, the two people
+look at a common point. The convex hull of the crossings is the interaction zone (area A, centroid = interest
+point), and D is the mean distance of the members to the interest point. While A or D exceed their thresholds, the
+member whose removal helps most is dropped; a cluster that ends under both thresholds is a group.
 
 Choices the paper leaves open, decided here:
 - People with unknown facing (theta None) count in DBSCAN (they are there, and link neighbours) but cast no ray,
@@ -32,13 +38,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
-from functools import lru_cache
+from dataclasses import dataclass, replace
+from functools import cached_property, lru_cache
 
 import numpy as np
 
 from sid.checks import check_number, check_numbers
 from sid.perception.cluster import dbscan_labels
+from sid.perception.ospace import OSpaceModel, find_ospaces
 from sid.perception.people import Person
 
 # |sin| of the angle between two rays below which they count as parallel (their crossing is rounding noise).
@@ -47,12 +54,42 @@ _PARALLEL = 1e-9
 _DEGENERATE_AREA = 1e-9
 
 
+GROUP_METHODS = ("ospace", "rays", "paper")
+
+
 @dataclass(frozen=True)
 class GroupParams:
     """Parameters of the group detector (metres, square metres, radians).
 
     Defaults come from the geometry of conversations; the F-formation benchmarks then checked that none sits on a
-    cliff (scores and one-at-a-time sensitivity: docs/parameters.md).
+    cliff (scores and one-at-a-time sensitivity: docs/parameters.md; the o-space method: docs/groups.md).
+
+    method: 'ospace' (people assigned to shared o-spaces, the default), 'rays' (the paper's ray crossings with two
+      additions) or 'paper' (Algorithm 1 as written); the module docstring says more.
+
+    The o-space method (``method='ospace'``):
+
+    radius_min: smallest o-space radius R (m), the distance from a member to the group's centre. 0.3: two people
+      face to face stand at least 0.6 m apart.
+    radius_max: largest o-space radius R (m). 0.8: n people on a circle 0.8-1 m apart have radius
+      1 / (2 sin(pi / n)) (0.8-1.0 m at n = 6); chosen by cross-validation among 0.8-1.0 (docs/groups.md).
+    radius_steps: proposals per person, at radii evenly spaced over that range. 4: one per 0.2 m.
+    group_price: price (m^2) of describing a group, and of each person left alone: two people form a group only
+      when the squared distances of their proposals p + R f from the centre sum to less than it (n people: n - 1
+      prices). Chosen by
+      cross-validation (docs/groups.md).
+    unknown_facing_cost: a person without facing may join a group formed by others when standing on its circle; the
+      unexplained facing costs as much as a proposal this far (m) from the centre. 0.5: its square, 0.25 m^2, leaves
+      room under the price for standing 0.6 m off the circle; a doubtful facing then gains nothing over a clear one
+      that points 0.5 m wide.
+    body_radius: a member's line to the centre must pass farther than this (m) from everyone else (the o-space is
+      exclusive). Chosen by cross-validation (docs/groups.md).
+    facing_weight_floor: the facing weight is floor + (1 - floor) x orientation_quality: a doubtful facing counts
+      less, the rest of its cost is that of an unknown facing. 0.5: quality 0 with a theta still counts half. Readers
+      of facings without a quality (scenario files, `sid groups` lines, the benchmarks' annotations) give them 1;
+      ``Person``'s default quality is 0.
+
+    The ray methods (``method='rays'`` or ``'paper'``):
 
     eps: DBSCAN neighbourhood radius (m). 2.0: a member of a conversation stands within ~1.5 m of a neighbour, so
       2 m keeps any group in one cluster; clusters only bound the work, the ray geometry splits them.
@@ -71,9 +108,17 @@ class GroupParams:
     meeting_radius: crossings closer than this (m, single linkage) belong to one candidate group; each candidate
       is then pruned as in the paper. 0.6: the crossings of one o-space with facing errors of ~30 degrees scatter
       by ~D tan(30 deg) = 0.6 m. ``math.inf`` makes each DBSCAN cluster one candidate, exactly the paper's
-      Algorithm 1, which fails in crowded scenes.
+      Algorithm 1, which fails in crowded scenes (``method='paper'`` sets it).
     """
 
+    method: str = "ospace"
+    radius_min: float = 0.3
+    radius_max: float = 0.8
+    radius_steps: int = 4
+    group_price: float = 0.65
+    unknown_facing_cost: float = 0.5
+    body_radius: float = 0.1
+    facing_weight_floor: float = 0.5
     eps: float = 2.0
     min_samples: int = 2
     area_threshold: float = 0.5
@@ -83,6 +128,10 @@ class GroupParams:
     meeting_radius: float = 0.6
 
     def __post_init__(self) -> None:
+        if self.method not in GROUP_METHODS:
+            raise ValueError(f"groups: method must be one of {', '.join(GROUP_METHODS)}, got {self.method!r}")
+        self.ospace_model  # noqa: B018 - builds (and so checks) the o-space fields, once per record
+        check_number("groups", "facing_weight_floor", self.facing_weight_floor, low=0, low_open=True, high=1)
         check_numbers("groups", self, ("eps", "spread_threshold", "ray_length"), low=0, low_open=True, unit="metres")
         check_number("groups", "area_threshold", self.area_threshold, low=0, unit="square metres")
         if isinstance(self.min_samples, bool) or int(self.min_samples) != self.min_samples or self.min_samples < 1:
@@ -93,6 +142,25 @@ class GroupParams:
         )
         right_angle = math.pi / 2
         check_number("groups", "facing_tolerance", self.facing_tolerance, low=0, high=right_angle, high_open=True)
+
+    @cached_property
+    def ospace_model(self) -> OSpaceModel:
+        """The o-space method's constants (ValueError naming a bad field); built once per record."""
+        try:
+            return OSpaceModel(
+                self.radius_min,
+                self.radius_max,
+                self.radius_steps,
+                self.group_price,
+                self.unknown_facing_cost,
+                self.body_radius,
+            )
+        except ValueError as exc:
+            names = {"price": "group_price", "unknown_cost": "unknown_facing_cost"}
+            message = str(exc).replace("ospace: ", "groups: ", 1)
+            for old, new in names.items():
+                message = message.replace(f"groups: {old} ", f"groups: {new} ", 1)
+            raise ValueError(message) from None
 
 
 @dataclass
@@ -127,15 +195,20 @@ class _Geometry:
 
 
 def detect_groups(people: Sequence[Person], params: GroupParams = GroupParams()) -> list[Group]:
-    """Interacting groups among ``people`` (world frame), in the order of their DBSCAN clusters.
+    """Interacting groups among ``people`` (world frame) by ``params.method``.
 
-    Members are listed in input order. Raises ValueError naming the person for a non-finite position or yaw,
-    and for duplicate ids. Fewer than two people give no group.
+    Members are listed in input order; groups in order of their first member (``ospace``) or of their DBSCAN
+    clusters (``rays``, ``paper``). Raises ValueError naming the person for a non-finite position or yaw, and for
+    duplicate ids. Fewer than two people give no group.
     """
     people = list(people)
     ids, positions, facing = _as_arrays(people)
     if len(people) < 2:
         return []
+    if params.method == "ospace":
+        return _ospace_groups(people, ids, positions, facing, params)
+    if params.method == "paper" and not math.isinf(params.meeting_radius):
+        params = replace(params, meeting_radius=math.inf)
     labels = dbscan_labels(np.column_stack((positions.real, positions.imag)), params.eps, params.min_samples)
     has_ray = ~np.isnan(facing)
     groups: list[Group] = []
@@ -143,6 +216,43 @@ def detect_groups(people: Sequence[Person], params: GroupParams = GroupParams())
         cluster = np.flatnonzero((labels == label) & has_ray)
         if len(cluster) >= 2:
             groups.extend(_groups_in_cluster([ids[i] for i in cluster], positions[cluster], facing[cluster], params))
+    return groups
+
+
+def _ospace_groups(
+    people: list[Person], ids: list[int], positions: np.ndarray, facing: np.ndarray, params: GroupParams
+) -> list[Group]:
+    """The o-space method's groups, each with the paper's zone geometry on its members' rays (see the module
+    docstring)."""
+    quality = np.clip([p.orientation_quality for p in people], 0.0, 1.0)
+    floor = params.facing_weight_floor
+    found = find_ospaces(positions, facing, floor + (1.0 - floor) * quality, params.ospace_model)
+    label = np.full(len(people), -1)
+    for k, ospace in enumerate(found):
+        label[ospace.members] = k
+    # The rays of every two members of one group, computed in one call for all groups.
+    i, j = _pairs(len(people))
+    same = (label[i] == label[j]) & (label[i] >= 0)
+    meetings = _ray_meetings(positions, facing, params, (i[same], j[same]))
+    meeting_group = label[meetings.first]
+    groups = []
+    for k, ospace in enumerate(found):
+        members = ospace.members
+        crossings = meetings.points[meeting_group == k]
+        if len(crossings):
+            geometry = _zone(crossings, positions[members])
+        else:  # no two members' rays meet: the fitted o-space centre
+            spread = float(np.abs(positions[members] - ospace.centre).mean())
+            geometry = _Geometry(0.0, ospace.centre, np.array([[ospace.centre.real, ospace.centre.imag]]), spread)
+        groups.append(
+            Group(
+                members=tuple(ids[i] for i in members),
+                interest_point=(geometry.centre.real, geometry.centre.imag),
+                area=geometry.area,
+                zone=geometry.zone,
+                spread=geometry.spread,
+            )
+        )
     return groups
 
 
@@ -179,10 +289,15 @@ def _pairs(k: int) -> tuple[np.ndarray, np.ndarray]:
     return np.triu_indices(k, 1)
 
 
-def _ray_meetings(positions: np.ndarray, facing: np.ndarray, params: GroupParams) -> _Meetings:
-    """Where the rays of each pair meet (see the module docstring). 2D vectors are complex numbers, so that
-    conj(a) * b = dot(a, b) + i cross(a, b)."""
-    i, j = _pairs(len(positions))
+def _ray_meetings(
+    positions: np.ndarray,
+    facing: np.ndarray,
+    params: GroupParams,
+    pairs: tuple[np.ndarray, np.ndarray] | None = None,
+) -> _Meetings:
+    """Where the rays of each pair (all pairs unless given, i < j) meet (see the module docstring). 2D vectors are
+    complex numbers, so that conj(a) * b = dot(a, b) + i cross(a, b)."""
+    i, j = _pairs(len(positions)) if pairs is None else pairs
     pi, pj, fi, fj = positions[i], positions[j], facing[i], facing[j]
     d_conj = (pj - pi).conjugate()
     # Rays p_i + s f_i and p_j + t f_j meet where s f_i - t f_j = d = p_j - p_i: s = cross(d, f_j) / cross(f_i, f_j)
@@ -256,7 +371,12 @@ def _with_meetings(members: np.ndarray, meetings: _Meetings) -> np.ndarray:
 
 
 def _geometry(members: np.ndarray, meetings: _Meetings, positions: np.ndarray) -> _Geometry:
-    crossings = meetings.points[_active(members, meetings)]
+    """The zone of the crossings between ``members`` (bool mask)."""
+    return _zone(meetings.points[_active(members, meetings)], positions[members])
+
+
+def _zone(crossings: np.ndarray, member_positions: np.ndarray) -> _Geometry:
+    """Hull area, centre, zone polygon of ``crossings`` (complex, at least one) and the members' spread around it."""
     hull = _convex_hull(crossings.tolist()) if len(crossings) >= 3 else []
     area, centre = _shoelace(hull) if len(hull) >= 3 else (0.0, 0j)
     if area > _DEGENERATE_AREA:
@@ -265,7 +385,6 @@ def _geometry(members: np.ndarray, meetings: _Meetings, positions: np.ndarray) -
         area = 0.0
         centre = complex(crossings.sum() / len(crossings))
         zone = _segment_ends(crossings, centre)
-    member_positions = positions[members]
     spread = float(np.abs(member_positions - centre).sum() / len(member_positions))
     return _Geometry(area, centre, zone, spread)
 

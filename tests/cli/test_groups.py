@@ -75,8 +75,11 @@ def test_strict_stops_at_the_first_bad_line_keeping_earlier_output(tmp_path, cap
 
 def test_group_params_come_from_the_options(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(sys, "stdin", io.StringIO(json.dumps(PAIR) + "\n"))
-    code, out, _ = run_sid(["groups", "-", "--spread-threshold", "0.3"], capsys)
+    code, out, _ = run_sid(["groups", "-", "--method", "rays", "--spread-threshold", "0.3"], capsys)
     assert code == 0 and json.loads(out[0])["groups"] == []  # D = 0.4 m > 0.3 m
+    monkeypatch.setattr(sys, "stdin", io.StringIO(json.dumps(PAIR) + "\n"))
+    code, out, _ = run_sid(["groups", "-", "--group-price", "0.01"], capsys)
+    assert code == 0 and json.loads(out[0])["groups"] == []  # the o-space method: the pair costs more than that
     code, _, err = run_sid(["groups", "-", "--eps", "-1"], capsys)
     assert code == 2 and "eps must be a positive" in err
     code, _, err = run_sid(["groups", str(tmp_path / "missing.jsonl")], capsys)
@@ -164,6 +167,36 @@ def test_eval_fformation_prints_json_and_a_table(tmp_path, capsys):
     code, out, _ = run_sid(["eval", "fformation", str(tiny), "--scale", "0.01", "--table", "--T", "0.5"], capsys)
     assert code == 0 and out[0].split() == ["dataset", "T", "frames", "precision", "recall", "F1"]
     assert out[1].split() == ["Tiny", "1/2", "3", "1.000", "0.667", "0.800"]
+
+
+def test_orientation_quality_is_read_and_checked(capsys, monkeypatch):
+    # A pair 1.6 m apart, the second looking 70 degrees off: a clear facing is refused, a doubtful one joins.
+    people = [{"id": 1, "x": 0.0, "y": 0.0, "theta": 0.0}, {"id": 2, "x": 1.6, "y": 0.0, "theta": math.radians(250)}]
+    lines = [
+        {"frame": 0, "people": people},
+        {"frame": 1, "people": [people[0], people[1] | {"orientation_quality": 0}]},
+    ]
+    lines.append({"frame": 2, "people": [people[0], people[1] | {"orientation_quality": 1.5}]})
+    monkeypatch.setattr(sys, "stdin", io.StringIO("\n".join(json.dumps(line) for line in lines) + "\n"))
+    code, out, err = run_sid(["groups", "-"], capsys)
+    assert code == 0 and [json.loads(line)["groups"] != [] for line in out] == [False, True]
+    assert "line 3: people[1] (id 2): orientation_quality must lie in [0, 1], got 1.5" in err
+
+
+def test_eval_fformation_cross_validates_over_a_grid(tmp_path, capsys):
+    for name in ("A", "B"):
+        write_sequence(tmp_path / name, tiny_frames(), {1: [[1, 2]], 2: [[1, 2, 3]]})
+    dirs = [str(tmp_path / "A"), str(tmp_path / "B")]
+    code, out, _ = run_sid(["eval", "fformation", *dirs, "--scale", "0.01", "--grid", "group_price=0.01,0.65"], capsys)
+    report = json.loads("\n".join(out))
+    assert code == 0 and [f["chosen"] for f in report["folds"]] == [{"group_price": 0.65}] * 2
+    assert report["grid"][0] == {"group_price": 0.01, "f1": {"A": 0.0, "B": 0.0}}
+    code, out, _ = run_sid(
+        ["eval", "fformation", *dirs, "--scale", "0.01", "--table", "--grid", "group_price=0.65"], capsys
+    )
+    assert code == 0 and out[-1].startswith("held-out F1 1.000-1.000")
+    code, _, err = run_sid(["eval", "fformation", *dirs, "--grid", "stride=1"], capsys)
+    assert code == 2 and "numeric fields of GroupParams" in err
 
 
 def test_eval_fformation_reports_malformed_data(tmp_path, capsys):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -10,8 +11,10 @@ import shapely
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from sid.perception.groups import Group, GroupParams, _convex_hull, _shoelace, detect_groups
+from sid.perception.groups import GROUP_METHODS, Group, GroupParams, _convex_hull, _shoelace, detect_groups
 from sid.perception.people import Person
+
+RAYS = GroupParams(method="rays")
 
 
 def circle(n: int, radius: float, centre=(0.0, 0.0), start_deg: float = 0.0, first_id: int = 0) -> list[Person]:
@@ -51,8 +54,8 @@ def test_four_people_on_a_circle_facing_its_centre():
     assert groups[0].area == 0.0 and groups[0].spread == pytest.approx(0.8)
 
 
-def test_three_side_by_side_facing_the_same_way_are_no_group():
-    assert detect_groups([Person(i, 2.0, -0.6 + 0.6 * i, 0.0) for i in range(3)]) == []
+def test_three_side_by_side_facing_the_same_way_are_no_group_for_the_rays():
+    assert detect_groups([Person(i, 2.0, -0.6 + 0.6 * i, 0.0) for i in range(3)], RAYS) == []
 
 
 def test_circle_of_three_plus_a_fourth_behind_facing_away_is_a_group_of_three():
@@ -81,7 +84,7 @@ def test_three_rays_bounding_a_triangle_give_its_area_and_centroid():
     # y = 0 (A facing +x), x = 0 (B facing +y) and x - y = 0.4 (C facing (-1, -1)) bound the triangle
     # (0, 0), (0.4, 0), (0, -0.4): area 0.08 m^2, centroid (0.4/3, -0.4/3).
     people = [Person(1, -1.0, 0.0, 0.0), Person(2, 0.0, -1.0, math.pi / 2), Person(3, 1.2, 0.8, -3 * math.pi / 4)]
-    params = GroupParams(eps=3.0, spread_threshold=1.5, area_threshold=0.5, ray_length=3.0)
+    params = GroupParams(method="rays", eps=3.0, spread_threshold=1.5, area_threshold=0.5, ray_length=3.0)
     [group] = detect_groups(people, params)
     assert group.members == (1, 2, 3)
     assert group.area == pytest.approx(0.08)
@@ -91,7 +94,7 @@ def test_three_rays_bounding_a_triangle_give_its_area_and_centroid():
     expected_spread = np.mean([np.hypot(*(np.array([p.x, p.y]) - centre)) for p in people])
     assert group.spread == pytest.approx(expected_spread)
     # The same scene with a smaller area threshold is pruned to a pair (area 0).
-    [pair] = detect_groups(people, GroupParams(eps=3.0, spread_threshold=1.5, area_threshold=0.05, ray_length=3.0))
+    [pair] = detect_groups(people, replace(params, area_threshold=0.05))
     assert pair.members == (1, 2) and pair.area == 0.0  # dropping C leaves the smallest D (1.0 m)
 
 
@@ -100,7 +103,7 @@ def test_collinear_crossings_give_area_zero_and_their_mean():
     # crossings lie on the line y = 0: A on it facing +x, B and C crossing it at x = 1 and x = 2.
     people = [Person(1, 0.0, 0.0, 0.0), Person(2, 1.0, -0.5, math.pi / 2), Person(3, 2.0, 0.5, -math.pi / 2)]
     [group] = detect_groups(
-        people, GroupParams(spread_threshold=2.0, facing_tolerance=0.0, ray_length=3.0, meeting_radius=math.inf)
+        people, GroupParams(method="paper", spread_threshold=2.0, facing_tolerance=0.0, ray_length=3.0)
     )
     assert group.area == 0.0
     assert group.interest_point == pytest.approx((1.5, 0.0))
@@ -112,12 +115,10 @@ def test_pruning_removes_the_member_whose_crossings_spread_the_zone():
     # three members' rays at (0.90, 0.10), (0, -0.31) and (0.33, -0.19): with the centre, a 0.153 m^2 zone.
     # Dropping the fourth leaves area 0 and D = 0.8 m, the best of the four removals.
     people = [*circle(3, 0.8, start_deg=90), Person(7, 2.5, 0.6, math.radians(200))]
-    loose = GroupParams(eps=3.0, area_threshold=1.0, spread_threshold=1.5, ray_length=3.0, meeting_radius=math.inf)
+    loose = GroupParams(method="paper", eps=3.0, area_threshold=1.0, spread_threshold=1.5, ray_length=3.0)
     [group] = detect_groups(people, loose)
     assert group.members == (0, 1, 2, 7) and group.area == pytest.approx(0.153, abs=0.001)
-    [group] = detect_groups(
-        people, GroupParams(eps=3.0, area_threshold=0.05, spread_threshold=1.5, ray_length=3.0, meeting_radius=math.inf)
-    )
+    [group] = detect_groups(people, replace(loose, area_threshold=0.05))
     assert group.members == (0, 1, 2)
     assert group.interest_point == pytest.approx((0.0, 0.0), abs=1e-9) and group.area == 0.0
 
@@ -129,10 +130,10 @@ def test_two_conversations_in_one_cluster_are_both_found():
     assert sorted(g.members for g in groups) == [(0, 1, 2), (10, 11)]
 
 
-def test_people_with_unknown_facing_cast_no_ray_and_are_not_members():
+def test_people_with_unknown_facing_cast_no_ray_and_are_not_members_for_the_rays():
     people = [*circle(3, 0.8), Person(5, 0.3, 0.2, None)]
-    assert [g.members for g in detect_groups(people)] == [(0, 1, 2)]
-    assert detect_groups([Person(1, 0.0, 0.0, None), Person(2, 0.8, 0.0, None)]) == []
+    assert [g.members for g in detect_groups(people, RAYS)] == [(0, 1, 2)]
+    assert detect_groups([Person(1, 0.0, 0.0, None), Person(2, 0.8, 0.0, None)], RAYS) == []
 
 
 def test_far_apart_people_are_not_clustered():
@@ -180,17 +181,86 @@ def random_scene(seed: int) -> list[Person]:
 @settings(max_examples=200, deadline=None)
 @given(st.integers(0, 2**32 - 1), st.floats(-math.pi, math.pi), st.floats(-20, 20), st.floats(-20, 20))
 @example(9322, 0.0, -13.0, 10.0)  # a near-degenerate zone (7e-8 m^2) whose centroid lost 1e-6 m to cancellation
-def test_rotating_and_translating_the_scene_moves_the_groups_with_it(seed, angle, tx, ty):
+@pytest.mark.parametrize("method", GROUP_METHODS)
+def test_rotating_and_translating_the_scene_moves_the_groups_with_it(method, seed, angle, tx, ty):
     people = random_scene(seed)
     c, s = math.cos(angle), math.sin(angle)
     moved = [Person(p.id, c * p.x - s * p.y + tx, s * p.x + c * p.y + ty, p.theta + angle) for p in people]
-    before, after = detect_groups(people), detect_groups(moved)
+    params = GroupParams(method=method)
+    before, after = detect_groups(people, params), detect_groups(moved, params)
     assert [g.members for g in after] == [g.members for g in before]
     for g, h in zip(before, after, strict=True):
         x, y = g.interest_point
         assert h.interest_point == pytest.approx((c * x - s * y + tx, s * x + c * y + ty), abs=1e-6)
         assert h.area == pytest.approx(g.area, abs=1e-6)
         assert h.spread == pytest.approx(g.spread, abs=1e-6)
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.randoms(use_true_random=False))
+def test_permuting_the_people_gives_the_same_groups(seed, shuffler):
+    people = random_scene(seed)
+    shuffled = list(people)
+    shuffler.shuffle(shuffled)
+    groups = {frozenset(g.members): g.interest_point for g in detect_groups(people)}
+    again = {frozenset(g.members): g.interest_point for g in detect_groups(shuffled)}
+    assert again.keys() == groups.keys()
+    for members, point in groups.items():
+        assert again[members] == pytest.approx(point, abs=1e-9)
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.floats(-math.pi, math.pi), st.floats(-math.pi, math.pi))
+def test_a_far_away_stranger_changes_nothing(seed, where, facing):
+    people = random_scene(seed)  # everyone within 6 m of the origin
+    stranger = Person(999, 20 * math.cos(where), 20 * math.sin(where), facing, 1.0)
+    assert [g.members for g in detect_groups([*people, stranger])] == [g.members for g in detect_groups(people)]
+
+
+# --- the o-space method -----------------------------------------------------------------------------------------
+
+
+def test_facings_off_by_40_degrees_still_form_one_group():
+    # Four people on a 0.7 m circle, each looking 40 degrees left of the centre (quantised annotations are off by
+    # up to 45): the rays meet pairwise at four spots and split them into pairs; the o-space holds all four.
+    people = []
+    for k, a in enumerate(np.radians([45, 135, 225, 315])):
+        people.append(Person(k, 0.7 * math.cos(a), 0.7 * math.sin(a), float(a + math.pi + math.radians(40)), 1.0))
+    assert len(detect_groups(people, RAYS)) == 2
+    [group] = detect_groups(people)
+    assert group.members == (0, 1, 2, 3)
+    assert np.hypot(*group.interest_point) < 0.5
+
+
+def test_a_member_whose_line_to_the_centre_passes_through_another_is_refused():
+    # A pair face to face 1.2 m apart; a third person stands right behind one of them facing the same way: the
+    # third's line to the centre passes through the member in front.
+    pair = [Person(1, 0.0, 0.0, 0.0, 1.0), Person(2, 1.2, 0.0, math.pi, 1.0)]
+    behind = Person(3, -0.5, 0.0, 0.0, 1.0)
+    assert [g.members for g in detect_groups([*pair, behind])] == [(1, 2)]
+
+
+def test_a_person_with_unknown_facing_on_the_circle_joins_but_two_such_people_are_no_group():
+    people = [*circle(3, 0.8, start_deg=90), Person(7, 0.0, -0.8, None)]
+    assert [g.members for g in detect_groups(people)] == [(0, 1, 2, 7)]
+    assert detect_groups([Person(1, 0.0, 0.0, None), Person(2, 0.8, 0.0, None)]) == []
+
+
+def test_a_doubtful_facing_counts_less():
+    # A pair 1.6 m apart whose second member looks 70 degrees away: with a clear facing that is too far off to join,
+    # with a doubtful one (quality 0) the position on the circle carries it.
+    pair = [Person(1, 0.0, 0.0, 0.0, 1.0), Person(2, 1.6, 0.0, math.pi + math.radians(70), 1.0)]
+    assert detect_groups(pair) == []
+    pair[1].orientation_quality = 0.0
+    assert [g.members for g in detect_groups(pair)] == [(1, 2)]
+
+
+def test_a_hundred_people_in_one_crowd_are_grouped_circle_by_circle():
+    people = []
+    for k in range(25):  # circles of 4, centres 2.4 m apart: one DBSCAN cluster at eps 2 m
+        people += circle(4, 0.8, centre=(2.4 * (k % 5), 2.4 * (k // 5)), start_deg=20, first_id=4 * k)
+    groups = detect_groups(people)
+    assert sorted(g.members for g in groups) == [tuple(range(4 * k, 4 * k + 4)) for k in range(25)]
 
 
 # --- bad input --------------------------------------------------------------------------------------------------
@@ -227,6 +297,13 @@ def test_bad_people_are_rejected_naming_the_person(people, message):
         ("ray_length", -2.0),
         ("facing_tolerance", 2.0),
         ("meeting_radius", 0.0),
+        ("method", "graphcut"),
+        ("radius_min", 0.0),
+        ("radius_max", 0.1),
+        ("radius_steps", 0),
+        ("group_price", 0.0),
+        ("body_radius", -0.1),
+        ("facing_weight_floor", 0.0),
     ],
 )
 def test_bad_params_are_rejected(field, value):
