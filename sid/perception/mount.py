@@ -1,8 +1,10 @@
-"""Camera optical frame <-> world frame.
+"""Camera optical frame <-> the robot's ground frame (``base_footprint``, REP-105).
 
-Camera optical frame: x right, y down, z forward (metres). World frame (REP-103, the paper's top view): origin on
-the ground directly below the camera, x forward (the camera's depth axis projected on the ground), y left, z up.
-With no tilt: world x = z_cam, world y = -x_cam, world z = height - y_cam.
+Camera optical frame: x right, y down, z forward (metres). Robot frame: ``base_footprint`` (REP-103/105): origin on
+the ground below the robot's centre, x forward, y left, z up. The mount places the camera's optical centre at
+(x, y, height) in it (x, y are the same in ``base_link``, which sits straight above ``base_footprint``), turned by
+``yaw`` about z and pitched down by ``tilt``. With the default mount (x = y = yaw = 0) the origin lies on the ground
+directly below the camera and, with no tilt: x = z_cam, y = -x_cam, z = height - y_cam.
 """
 
 from __future__ import annotations
@@ -11,36 +13,48 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sid.checks import check_number
+from sid.checks import check_number, check_numbers
 
 
 @dataclass(frozen=True)
 class CameraMount:
-    """Camera pose on the robot: height of the optical centre above the ground (m) and downward pitch (rad).
+    """Camera pose on the robot: height of the optical centre above the ground (m), downward pitch ``tilt`` (rad),
+    the optical centre's position (x, y) on ``base_footprint`` / ``base_link`` (m) and the heading ``yaw`` of its
+    optical axis relative to the robot's x axis (rad, counter-clockwise).
 
-    tilt > 0 means the camera looks down. The paper's D435i stood 0.9 m high, level.
+    tilt > 0 means the camera looks down. The paper's D435i stood 0.9 m high, level, facing forward.
     """
 
     height: float = 0.9
     tilt: float = 0.0
+    x: float = 0.0
+    y: float = 0.0
+    yaw: float = 0.0
 
     def __post_init__(self) -> None:
         check_number("camera mount", "height", self.height, unit="metres")
         half_turn = np.pi / 2
         check_number("camera mount", "tilt", self.tilt, low=-half_turn, high=half_turn, low_open=True, high_open=True)
+        check_numbers("camera mount", self, ("x", "y"), unit="metres")
+        check_number("camera mount", "yaw", self.yaw, unit="radians")
 
     @property
     def rotation(self) -> np.ndarray:
-        """3x3 rotation whose columns are the camera's x, y, z axes in the world frame."""
+        """3x3 rotation whose columns are the camera's x, y, z axes in ``base_footprint``."""
         c, s = np.cos(self.tilt), np.sin(self.tilt)
-        right, down, forward = (0.0, -1.0, 0.0), (-s, 0.0, -c), (c, 0.0, -s)
+        cy, sy = np.cos(self.yaw), np.sin(self.yaw)
+        right, down, forward = (sy, -cy, 0.0), (-s * cy, -s * sy, -c), (c * cy, c * sy, -s)
         return np.array([right, down, forward]).T
 
+    @property
+    def position(self) -> np.ndarray:
+        """(3,) the optical centre in ``base_footprint`` (m)."""
+        return np.array([self.x, self.y, self.height])
+
     def camera_to_world(self, points: np.ndarray) -> np.ndarray:
-        """(N, 3) camera-frame points -> (N, 3) world-frame points."""
-        return np.asarray(points, dtype=float).reshape(-1, 3) @ self.rotation.T + np.array([0.0, 0.0, self.height])
+        """(N, 3) camera-frame points -> (N, 3) ``base_footprint`` points."""
+        return np.asarray(points, dtype=float).reshape(-1, 3) @ self.rotation.T + self.position
 
     def world_to_camera(self, points: np.ndarray) -> np.ndarray:
-        """(N, 3) world-frame points -> (N, 3) camera-frame points."""
-        shifted = np.asarray(points, dtype=float).reshape(-1, 3) - np.array([0.0, 0.0, self.height])
-        return shifted @ self.rotation
+        """(N, 3) ``base_footprint`` points -> (N, 3) camera-frame points."""
+        return (np.asarray(points, dtype=float).reshape(-1, 3) - self.position) @ self.rotation

@@ -1,8 +1,8 @@
-"""The person record: where someone stands and which way they face, in the world frame.
+"""The person record: where someone stands and which way they face, on the ground plane.
 
-World frame (REP-103, the paper's top view of the ground): x forward along the camera's depth axis, y to the
-left, z up; origin on the ground below the camera. theta is the yaw of the facing direction, counter-clockwise
-from +x, in radians; a person at (x, y) faces (cos theta, sin theta).
+Frames follow REP-103/105: ``base_footprint`` (the robot's ground frame, x forward, y left, z up) or ``map``; the
+record does not say which (``sid.perception.pipeline.FrameResult.frame_id`` does). theta is the yaw of the facing
+direction, counter-clockwise from +x, in radians; a person at (x, y) faces (cos theta, sin theta).
 """
 
 from __future__ import annotations
@@ -14,11 +14,12 @@ import numpy as np
 
 @dataclass
 class Person:
-    """One person in the world frame.
+    """One person on the ground plane (base_footprint or map, metres, radians).
 
     theta is None when the orientation is unknown (too few keypoints, degenerate geometry).
     orientation_quality in [0, 1]: how planar the keypoints are (1 = clean plane, 0 = unknown).
-    keypoints_world: optional (17, 3) world-frame keypoints, NaN rows where a keypoint was unusable.
+    keypoints_world: optional (17, 3) keypoints in the same frame (z up from the ground), NaN rows where a keypoint
+    was unusable.
     """
 
     id: int
@@ -34,5 +35,5 @@ class Person:
 
     @property
     def facing(self) -> np.ndarray | None:
-        """Unit facing vector in the world frame, or None when unknown."""
+        """Unit facing vector (same frame), or None when unknown."""
         return None if self.theta is None else np.array([np.cos(self.theta), np.sin(self.theta)])

@@ -1,9 +1,9 @@
 """The robot's pose in the map and the frames sid's outputs are given in (REP-105 names).
 
 ``map``: the fixed world frame of a deployment (a scenario's frame, a SLAM map). ``base_footprint``: the robot's
-ground frame, x forward, y left, z up, origin on the ground below the robot's centre. sid's single-frame outputs
-are in the ground frame below the camera (``sid.perception.mount``); with the default mount (camera above the
-robot's centre, facing forward) that is ``base_footprint``.
+ground frame, x forward, y left, z up, origin on the ground below the robot's centre. The pipeline lifts people
+into ``base_footprint`` through the camera mount (``sid.perception.mount``) and, when the frame carries the robot's
+pose, moves them into ``map`` (``person_to_map``).
 """
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sid.checks import check_numbers
+from sid.perception.people import Person
 
 MAP_FRAME = "map"
 BASE_FRAME = "base_footprint"
@@ -47,3 +48,12 @@ class RobotPose:
     def yaw_to_map(self, yaw: float) -> float:
         """A heading in base_footprint (rad) -> the same heading in the map, wrapped to (-pi, pi]."""
         return math.remainder(yaw + self.yaw, math.tau)
+
+    def person_to_map(self, person: Person) -> Person:
+        """The same person with position, facing and 3D keypoints moved from base_footprint to the map (heights
+        unchanged)."""
+        (x, y), keypoints = self.to_map(person.position)[0], person.keypoints_world
+        if keypoints is not None:
+            keypoints = np.column_stack([self.to_map(keypoints[:, :2]), keypoints[:, 2]])
+        theta = None if person.theta is None else self.yaw_to_map(person.theta)
+        return Person(person.id, float(x), float(y), theta, person.orientation_quality, keypoints)

@@ -3,9 +3,12 @@
 >>> for frame in SyntheticSource("S3", frames=10, seed=0):
 ...     frame.depth, frame.truth.people[0].x
 
-Specs (``sid detect --source synthetic:SPEC``): a layout name (``S1``..``S5``, see ``sid.synthetic.layouts``) or
-the path of a scene / costmap scenario file (JSON or YAML, see ``sid.synthetic.scene``). Frames show a static
-scene; each frame draws fresh depth and keypoint noise, reproducibly from ``seed`` and the frame index.
+Specs (``sid detect --source synthetic:SPEC``): a layout name (``S1``..``S5``, see ``sid.synthetic.layouts``), a
+built-in sequence name (``crossing_walkers``, ``drive_past_group``, ``walking_pairs``, see
+``sid.synthetic.sequence``), or the path of a scene file (static, see ``sid.synthetic.scene``) or of a costmap
+scenario file (JSON or YAML; people and robot may move, see docs/scenario.md). Frames of a scenario carry the robot's
+pose, so the pipeline reports in the scenario's map frame; frame ``i`` shows time ``i / fps`` (s). Each frame draws
+fresh depth and keypoint noise, reproducibly from ``seed`` and the frame index.
 """
 
 from __future__ import annotations
@@ -15,33 +18,36 @@ from pathlib import Path
 from typing import Any
 
 from sid.perception.frame import Frame
+from sid.scenario.loader import Scenario
 from sid.sources import SourceError
 from sid.synthetic.layouts import LAYOUTS, layout
 from sid.synthetic.noise import DepthNoise, KeypointNoise
 from sid.synthetic.scene import Scene
 from sid.synthetic.sensor import SyntheticCamera
+from sid.synthetic.sequence import SEQUENCES, Sequence, builtin_sequence, load_scene_file
 
 PREFIX = "synthetic:"
+DEFAULT_FRAMES = 30  # frames of a static scene when none are asked for
 
 
-def scene_from_spec(spec: str) -> Scene:
-    """A layout name (S1-S5, case-insensitive) or a scene/scenario file path, with or without ``synthetic:``.
+def scene_from_spec(spec: str) -> Scene | Sequence:
+    """A layout name (S1-S5, case-insensitive), a built-in sequence name or a scene/scenario file path, with or
+    without ``synthetic:``.
 
-    Raises ``SourceError`` naming the problem (unknown layout, missing or malformed file)."""
+    Raises ``SourceError`` naming the problem (unknown name, missing or malformed file)."""
     name = spec[len(PREFIX) :] if spec.startswith(PREFIX) else spec
+    known = f"layouts {', '.join(LAYOUTS)}; sequences {', '.join(SEQUENCES)}"
     if not name:
-        raise SourceError(
-            f"synthetic source: empty spec; use synthetic:LAYOUT ({', '.join(LAYOUTS)}) or synthetic:FILE"
-        )
+        raise SourceError(f"synthetic source: empty spec; use synthetic:NAME ({known}) or synthetic:FILE")
     if name.upper() in LAYOUTS:
         return layout(name)
+    if name in SEQUENCES:
+        return builtin_sequence(name)
     path = Path(name)
     if not path.is_file():
-        raise SourceError(
-            f"synthetic source: {name!r} is neither a layout ({', '.join(LAYOUTS)}) nor an existing scene file"
-        )
+        raise SourceError(f"synthetic source: {name!r} is neither a built-in scene ({known}) nor an existing file")
     try:
-        return Scene.from_file(path)
+        return load_scene_file(path)
     except ValueError as exc:
         raise SourceError(f"synthetic source: {exc}") from None
 
@@ -49,8 +55,9 @@ def scene_from_spec(spec: str) -> Scene:
 class SyntheticSource:
     """Iterable of ``frames`` synthetic ``Frame``s of one scene, ground truth in ``frame.truth``.
 
-    scene_or_spec: a ``Scene``, a ``sid.scenario.loader.Scenario`` (seen from the robot's start pose, see
-    ``Scene.from_scenario``) or a spec string (see ``scene_from_spec``). seed: noise seed. noise / keypoint_noise:
+    scene_or_spec: a static ``Scene``, a moving ``Sequence``, a ``sid.scenario.loader.Scenario`` (as a
+    ``Sequence``) or a spec string (see ``scene_from_spec``). frames: how many (None: ``DEFAULT_FRAMES`` of a static
+    scene, or a sequence until everyone has stopped, ``duration * fps + 1``). seed: noise seed. noise / keypoint_noise:
     depth and 2D keypoint noise (defaults: ``DepthNoise()``, ``KeypointNoise()``; ``DepthNoise.exact()`` and
     ``KeypointNoise(0, 0)`` for perfect data). Further keyword options go to ``SyntheticCamera`` (``registered``,
     ``calibration``, ``shaded_color``, ``occlusion_margin``, ``self_occlusion_margin``, ``fps``, ``group_params``).
@@ -58,28 +65,33 @@ class SyntheticSource:
 
     def __init__(
         self,
-        scene_or_spec: Scene | str | Any,
-        frames: int = 30,
+        scene_or_spec: Scene | Sequence | str | Any,
+        frames: int | None = None,
         seed: int = 0,
         noise: DepthNoise | None = None,
         keypoint_noise: KeypointNoise | None = None,
         **camera_options: Any,
     ):
-        if isinstance(scene_or_spec, Scene):
+        self.scene: Scene | Sequence
+        if isinstance(scene_or_spec, (Scene, Sequence)):
             self.scene = scene_or_spec
         elif isinstance(scene_or_spec, (str, Path)):
             self.scene = scene_from_spec(str(scene_or_spec))
-        elif hasattr(scene_or_spec, "robot") and isinstance(getattr(scene_or_spec, "people", None), list):
-            self.scene = Scene.from_scenario(scene_or_spec)
+        elif isinstance(scene_or_spec, Scenario):
+            self.scene = Sequence.from_scenario(scene_or_spec)
         else:
             raise TypeError(
-                f"synthetic source: expected a Scene, a spec string or a scenario, got {type(scene_or_spec).__name__}"
+                "synthetic source: expected a Scene, a Sequence, a spec string or a scenario, got "
+                f"{type(scene_or_spec).__name__}"
             )
+        self.seed = int(seed)
+        self.camera = SyntheticCamera(noise=noise, keypoint_noise=keypoint_noise, **camera_options)
+        if frames is None:
+            duration = self.scene.duration if isinstance(self.scene, Sequence) else 0.0
+            frames = round(duration * self.camera.fps) + 1 if duration > 0 else DEFAULT_FRAMES
         if int(frames) != frames or frames < 0:
             raise ValueError(f"synthetic source: frames must be a whole number >= 0, got {frames}")
         self.frames = int(frames)
-        self.seed = int(seed)
-        self.camera = SyntheticCamera(noise=noise, keypoint_noise=keypoint_noise, **camera_options)
 
     def __len__(self) -> int:
         return self.frames

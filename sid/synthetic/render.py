@@ -169,13 +169,31 @@ class RayCaster:
         """(H, W, 3) world-frame point seen at each pixel of the background (NaN where nothing is hit)."""
         return self._bg_world
 
-    def render(self, bodies: Sequence[Sequence[Capsule]], shading: bool = False) -> Rendering:
-        """Depth, labels (body index = position in ``bodies``) and optionally shading of world-frame bodies."""
-        depth = self._bg_depth.copy()
+    def render(
+        self,
+        bodies: Sequence[Sequence[Capsule]],
+        shading: bool = False,
+        labels: Sequence[int] | None = None,
+        base: Rendering | None = None,
+    ) -> Rendering:
+        """Depth, labels and optionally shading of world-frame bodies.
+
+        labels: each body's label (default: its position in ``bodies``). base: a rendering of other bodies by this
+        caster (made with the same ``shading``) to draw these over instead of the empty background, so bodies that
+        do not move are cast once.
+        """
+        if base is not None and shading and base.shade is None:
+            raise ValueError("render: shading over a base rendering needs a base made with shading=True")
+        depth = (self._bg_depth if base is None else base.depth).copy()
         depth[depth == 0] = np.inf
-        label = self._bg_label.copy()
+        label = (self._bg_label if base is None else base.label).copy()
+        labels = range(len(bodies)) if labels is None else labels
+        if len(labels) != len(bodies):
+            raise ValueError(f"render: {len(labels)} labels for {len(bodies)} bodies")
         shapes = [
-            (index, shape.transformed(self.world_to_camera)) for index, body in enumerate(bodies) for shape in body
+            (index, shape.transformed(self.world_to_camera))
+            for index, body in zip(labels, bodies, strict=True)
+            for shape in body
         ]
         windows = [self._pixel_box(shape) for _, shape in shapes]
         # Which shape is nearest at each pixel (-1: background); only needed to shade the visible surfaces.
@@ -186,7 +204,7 @@ class RayCaster:
         depth[np.isinf(depth)] = 0.0
         shade = None
         if shading:
-            shade = self._bg_shade.copy()
+            shade = (self._bg_shade if base is None or base.shade is None else base.shade).copy()
             assert nearest is not None  # made when shading
             for number, ((_, shape), window) in enumerate(zip(shapes, windows, strict=True)):
                 if window is not None:

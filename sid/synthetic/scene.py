@@ -1,13 +1,11 @@
-"""What a synthetic scene holds: people standing on the ground, the groups they form, the camera mount and the
-background. World frame (REP-103, ``sid.perception.mount``): origin on the ground below the camera, x forward, y left,
-z up;
-metres and radians.
+"""What a static synthetic scene holds: people standing on the ground, the groups they form, the camera mount and
+the background. Frame: the robot's ``base_footprint`` (REP-103/105, ``sid.perception.mount``; with the default mount
+the origin is on the ground below the camera), x forward, y left, z up; metres and radians.
 
 Scene files (JSON or YAML) hold ``{"name": ..., "people": [{"x", "y", "theta"[, "id", "height"]}, ...],
 "groups": [[id, ...], ...], "camera": {"height": 0.9, "tilt": 0.0}, "wall_distance": 5.0}``; only ``people`` is
-required (``yaw`` is accepted for ``theta``). A costmap scenario file (it has a ``robot`` section) works too: it is
-read by ``sid.scenario.loader`` and its people are seen from the robot's start pose (see ``Scene.from_scenario``);
-its obstacles are not rendered.
+required (``yaw`` is accepted for ``theta``). Costmap scenario files (they have a ``robot`` section) describe scenes
+in the map frame, possibly moving: ``sid.synthetic.sequence`` reads them.
 """
 
 from __future__ import annotations
@@ -22,7 +20,6 @@ from sid.checks import check_numbers
 from sid.documents import load_document
 from sid.perception.mount import CameraMount
 from sid.perception.people import Person
-from sid.scenario.loader import Scenario, scenario_from_dict
 
 
 @dataclass(frozen=True)
@@ -85,22 +82,22 @@ class Scene:
 
     @classmethod
     def from_file(cls, path: str | Path) -> Scene:
-        """Read a scene or costmap scenario file (.json, or YAML for any other suffix; see the module docstring)."""
+        """Read a scene file (.json, or YAML for any other suffix; see the module docstring)."""
         path = Path(path)
         try:
             data = load_document(path)
         except ValueError as exc:
             raise ValueError(f"scene {exc}") from None
         try:
-            return cls.from_dict(data, default_name=path.stem, base_dir=path.parent)
+            return cls.from_dict(data, default_name=path.stem)
         except ValueError as exc:
             raise ValueError(f"scene {path}: {exc}") from None
 
     @classmethod
-    def from_dict(cls, data: Any, default_name: str = "scene", base_dir: Path | None = None) -> Scene:
+    def from_dict(cls, data: Any, default_name: str = "scene") -> Scene:
         """Build a scene from the parsed file content (see the module docstring)."""
         if isinstance(data, dict) and "robot" in data:
-            return cls.from_scenario(scenario_from_dict(data, base_dir, default_name))
+            raise ValueError("a costmap scenario file (it has a robot): read it with sid.synthetic.sequence")
         if not isinstance(data, dict) or not isinstance(data.get("people"), list) or not data["people"]:
             raise ValueError('expected an object with a non-empty "people" list')
         people = tuple(_person(entry, index) for index, entry in enumerate(data["people"]))
@@ -128,31 +125,6 @@ class Scene:
             raise ValueError(f"scene {name}: people {unknown} have no facing direction (theta is None)")
         known = tuple(ScenePerson(p.id, p.x, p.y, float(p.theta)) for p in people if p.theta is not None)
         return cls(name, known, groups, **options)
-
-    @classmethod
-    def from_scenario(cls, scenario: Scenario, mount: CameraMount | None = None) -> Scene:
-        """The people of a ``sid.scenario.loader.Scenario`` as the robot's camera sees them from its start pose.
-
-        Positions and facings are moved from the map frame into the frame of the robot's start pose (x along its
-        heading), the camera's world frame. No groups are declared; a wall stands 1 m behind the farthest person
-        (at least 5 m away) so that people have a background.
-        """
-        x0, y0, yaw = scenario.robot.start
-        c, s = np.cos(yaw), np.sin(yaw)
-        people = []
-        for person in scenario.people:
-            if person.theta is None:
-                raise ValueError(f"scenario {scenario.name}: person {person.id} has no facing direction (theta)")
-            dx, dy = person.x - x0, person.y - y0
-            people.append(
-                ScenePerson(
-                    person.id, c * dx + s * dy, -s * dx + c * dy, float(np.angle(np.exp(1j * (person.theta - yaw))))
-                )
-            )
-        if not people:
-            raise ValueError(f"scenario {scenario.name}: no people to render")
-        wall = max(5.0, max(p.x for p in people) + 1.0)
-        return cls(scenario.name, tuple(people), (), mount or CameraMount(), wall)
 
     def to_dict(self) -> dict[str, Any]:
         return {

@@ -1,7 +1,11 @@
 """A virtual RealSense D435i: renders a scene into an RGB-D ``Frame`` with its ground truth attached.
 
-Cameras: the colour camera's optical frame is the one ``scene.mount`` places in the world (the frame the pipeline
-lifts keypoints into); the depth camera sits ``depth_to_color`` away from it (p_color = R p_depth + t). Defaults are
+Scenes: a static ``Scene`` (people in the robot's frame, base_footprint; frames carry no robot pose) or a moving
+``Sequence`` (people and robot in the map frame; frame ``index`` shows time ``index / fps`` and carries the robot's
+pose). Ground truth is in the same frame as the scene (``FrameTruth.frame_id``).
+
+Cameras: the colour camera's optical frame is the one the mount places on the robot (the frame the pipeline
+lifts keypoints from); the depth camera sits ``depth_to_color`` away from it (p_color = R p_depth + t). Defaults are
 typical D435i values: colour 1280x720 with fx = fy = 910 px, depth 848x480 with fx = fy = 420 px, the depth
 camera 15 mm to the left of the colour camera (depth -> colour translation +15 mm along x).
 
@@ -9,8 +13,9 @@ Per frame: exact depth from a ray caster (``render``), then D435-like noise (``n
 keypoints are the skeleton's joints projected with the colour intrinsics, flagged invisible when outside the
 colour image or hidden behind another person, flagged self-occluded when deep behind the person's own body (a face
 seen from behind, the far shoulder of someone in profile), and observed with ``noise.KeypointNoise`` (pixel noise,
-dropped keypoints). Scenes are static, so the exact renders are computed once per scene and reused; each frame draws its
-own noise from ``numpy.random.default_rng([seed, index])``, so any frame can be regenerated alone.
+dropped keypoints). The exact render of the people as the camera sees them is kept and reused while they (and the robot)
+stand still; each frame draws its own noise from ``numpy.random.default_rng([seed, index])``, so any frame can be
+regenerated alone.
 """
 
 from __future__ import annotations
@@ -25,11 +30,13 @@ from sid.perception.frame import Frame
 from sid.perception.groups import GroupParams
 from sid.perception.keypoints import NUM_KEYPOINTS
 from sid.perception.mount import CameraMount
+from sid.perception.robot_pose import BASE_FRAME, MAP_FRAME, RobotPose
 from sid.perception.skeleton import skeleton_world
 from sid.synthetic.body import body_capsules
 from sid.synthetic.noise import DepthNoise, KeypointNoise
-from sid.synthetic.render import LABEL_GROUND, LABEL_NONE, LABEL_WALL, Background, RayCaster, Rendering
-from sid.synthetic.scene import Scene
+from sid.synthetic.render import LABEL_GROUND, LABEL_NONE, LABEL_WALL, Background, Capsule, RayCaster, Rendering
+from sid.synthetic.scene import Scene, ScenePerson
+from sid.synthetic.sequence import Sequence
 from sid.synthetic.truth import TruthGroup, truth_groups
 
 D435I_COLOR = Intrinsics(1280, 720, 910.0, 910.0, 639.5, 359.5)
@@ -48,7 +55,9 @@ def d435i_calibration(registered: bool = False) -> Calibration:
 class TruthPerson:
     """Ground truth of one person in one frame.
 
-    x, y (m), theta (rad), height (m): world frame. keypoints_world (17, 3): joints, world frame.
+    x, y (m), theta (rad), height (m), keypoints_world (17, 3) joints (m), vx, vy (m/s): in the truth's frame
+    (``FrameTruth.frame_id``). walking: moving along a path (else standing, velocity 0). in_view: at least one
+    keypoint visible (in the colour image and not hidden behind someone else).
     keypoints_px (17, 2): their exact colour-image pixels (u, v); NaN behind the camera. visible (17,): inside the
     colour image and not hidden behind another person. self_occluded (17,): behind the person's own body surface
     by more than the camera's ``self_occlusion_margin`` (a pose model still guesses these, less confidently; see
@@ -69,21 +78,28 @@ class TruthPerson:
     observed_px: np.ndarray = field(repr=False)
     observed: np.ndarray = field(repr=False)
     box: np.ndarray = field(repr=False)
+    vx: float = 0.0
+    vy: float = 0.0
+    walking: bool = False
+    in_view: bool = True
 
 
 @dataclass
 class FrameTruth:
-    """What a synthetic frame shows: the scene's name, people and groups, and the camera mount used."""
+    """What a synthetic frame shows: the scene's name, people and groups (the conversations that hold at the
+    frame's time), the camera mount used, and the frame of positions: ``"map"`` for a ``Sequence``,
+    ``"base_footprint"`` for a static ``Scene``."""
 
     scene: str
     people: list[TruthPerson]
     groups: list[TruthGroup]
     mount: CameraMount
+    frame_id: str = BASE_FRAME
 
 
 @dataclass
 class _SceneRender:
-    """Everything about a scene that does not change from frame to frame."""
+    """The exact images and keypoints of people as the camera sees them (keypoints in base_footprint)."""
 
     depth: Rendering
     color: np.ndarray
@@ -92,16 +108,61 @@ class _SceneRender:
     visible: list[np.ndarray]
     self_occluded: list[np.ndarray]
     boxes: list[np.ndarray]
-    groups: list[TruthGroup]
 
 
-@dataclass
+@dataclass(eq=False)
+class _StillLayer:
+    """Depth and shaded colour renders of the people who stand still in the camera's view (``key``: which people,
+    as (index, pose), and which views), and the colour render painted for one robot pose (``painted``)."""
+
+    key: tuple
+    depth: Rendering
+    color: Rendering | None
+    painted: tuple[RobotPose | None, np.ndarray] | None = None
+
+
+@dataclass(eq=False)
+class _Floor:
+    """The empty scene's colour image with a plain light floor, and the floor's pixels: flat indices into the image
+    and their robot-frame ground coordinates x, y (m)."""
+
+    image: np.ndarray
+    pixels: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+
+    @classmethod
+    def of(cls, rendering: Rendering, background_world: np.ndarray) -> _Floor:
+        """From a colour caster's empty rendering and the world point of each background pixel."""
+        label = rendering.label
+        image = np.empty(label.shape + (3,), dtype=np.uint8)
+        image[label == LABEL_NONE] = _SKY
+        image[label == LABEL_WALL] = _WALL
+        ground = label == LABEL_GROUND
+        image[ground] = _GROUND_LIGHT
+        floor = background_world[ground]
+        return cls(image, np.flatnonzero(ground), floor[:, 0].copy(), floor[:, 1].copy())
+
+    def painted(self, pose: RobotPose | None) -> np.ndarray:
+        """(H, W, 3) uint8 RGB of the empty scene: the floor checkered in ``_CHECKER_M`` squares fixed to the map
+        (the robot at ``pose``), or to the robot when ``pose`` is None; a plain wall; the sky."""
+        x, y = self.x, self.y
+        if pose is not None:
+            c, s = np.float32(np.cos(pose.yaw)), np.float32(np.sin(pose.yaw))
+            x, y = c * self.x - s * self.y + np.float32(pose.x), s * self.x + c * self.y + np.float32(pose.y)
+        dark = (np.floor(x / _CHECKER_M) + np.floor(y / _CHECKER_M)) % 2 == 1
+        image = self.image.copy()
+        image.reshape(-1, 3)[self.pixels[dark]] = _GROUND_DARK
+        return image
+
+
+@dataclass(eq=False)
 class _Views:
-    """The cameras' ray casters for one mount and background, and the colour image of the empty scene."""
+    """The cameras' ray casters for one mount and background, and the colour camera's empty floor."""
 
     depth: RayCaster
     color: RayCaster | None
-    backdrop: np.ndarray | None
+    floor: _Floor | None
 
 
 # Flat colours (RGB) of the first people; more people cycle through them.
@@ -157,7 +218,10 @@ class SyntheticCamera:
         check_number("synthetic camera", "fps", fps, low=0, low_open=True)
         self.fps = float(fps)
         self.group_params = group_params or GroupParams()
-        self._cached: tuple[Scene, _SceneRender] | None = None
+        self._cached: tuple[tuple, _SceneRender] | None = None
+        self._still: _StillLayer | None = None
+        self._bodies: dict[ScenePerson, tuple[np.ndarray, list[Capsule]]] = {}
+        self._cached_groups: tuple[tuple, list[TruthGroup]] | None = None
         self._views: dict[tuple[CameraMount, float | None], _Views] = {}
 
     @property
@@ -167,7 +231,7 @@ class SyntheticCamera:
     def world_to_color(self, mount: CameraMount) -> Extrinsics:
         """World -> colour-camera optical frame for this mount."""
         rotation = mount.rotation.T
-        return Extrinsics(rotation, -rotation @ np.array([0.0, 0.0, mount.height]))
+        return Extrinsics(rotation, -rotation @ mount.position)
 
     def world_to_depth(self, mount: CameraMount) -> Extrinsics:
         """World -> depth-camera optical frame (the colour frame when depth is registered)."""
@@ -178,49 +242,100 @@ class SyntheticCamera:
         rotation = d2c.rotation.T @ to_color.rotation
         return Extrinsics(rotation, d2c.rotation.T @ (to_color.translation - d2c.translation))
 
-    def capture(self, scene: Scene, index: int = 0, seed: int = 0) -> Frame:
-        """Frame ``index`` of ``scene``: noisy depth (depth grid, float32 m), colour image, truth."""
-        render = self._render_scene(scene)
+    def capture(self, scene: Scene | Sequence, index: int = 0, seed: int = 0) -> Frame:
+        """Frame ``index`` of ``scene`` (a ``Sequence`` at time ``index / fps``): noisy depth (depth grid, float32
+        m), colour image, truth, and for a ``Sequence`` the robot's pose."""
+        time = index / self.fps
+        pose: RobotPose | None = None
+        velocities: dict[int, tuple[float, float]] = {}
+        if isinstance(scene, Sequence):
+            moment = scene.at(time)
+            pose, people, seen, groups = moment.robot_pose, moment.people, moment.seen_people, moment.groups
+            velocities = {i: (m.vx, m.vy) for i, m in moment.states.items()}
+            driving = scene.robot.at(time).moving
+            moving = tuple(driving or moment.states[p.id].moving for p in people)
+        else:
+            people, seen, groups = scene.people, scene.people, scene.groups
+            moving = (False,) * len(people)
+        render = self._render_scene(scene, seen, moving, pose)
         rng = np.random.default_rng([seed, index])
         depth = self.noise.apply(render.depth.depth, self.sensor_focal_px, rng, image_focal_px=self.depth_intrinsics.fx)
-        people = []
-        for i, person in enumerate(scene.people):
+        truth_people = []
+        for i, person in enumerate(people):
             observed_px, kept = self.keypoint_noise.apply(render.keypoints_px[i], rng)
-            people.append(
+            keypoints = render.keypoints_world[i]
+            if pose is not None:
+                keypoints = np.column_stack([pose.to_map(keypoints[:, :2]), keypoints[:, 2]])
+            vx, vy = velocities.get(person.id, (0.0, 0.0))
+            truth_people.append(
                 TruthPerson(
                     person.id,
                     person.x,
                     person.y,
                     person.theta,
                     person.height,
-                    render.keypoints_world[i],
+                    keypoints,
                     render.keypoints_px[i],
                     render.visible[i],
                     render.self_occluded[i],
                     observed_px,
                     render.visible[i] & kept,
                     render.boxes[i],
+                    vx,
+                    vy,
+                    vx != 0.0 or vy != 0.0,
+                    bool(render.visible[i].any()),
                 )
             )
-        truth = FrameTruth(scene.name, people, render.groups, scene.mount)
-        return Frame(index, render.color.copy(), depth, self.calibration, index / self.fps, truth)
+        truth = FrameTruth(
+            scene.name,
+            truth_people,
+            self._truth_groups(people, groups),
+            scene.mount,
+            BASE_FRAME if pose is None else MAP_FRAME,
+        )
+        return Frame(index, render.color.copy(), depth, self.calibration, time, truth, pose)
 
     def exact_depth(self, scene: Scene) -> Rendering:
         """The noise-free depth and label images of ``scene`` in the depth grid (labels: person index in
         ``scene.people``, or ``render.LABEL_*``)."""
-        return self._render_scene(scene).depth
+        return self._render_scene(scene, scene.people, (False,) * len(scene.people), None).depth
 
-    def _render_scene(self, scene: Scene) -> _SceneRender:
-        if self._cached is not None and self._cached[0] == scene:
+    def _truth_groups(self, people: tuple[ScenePerson, ...], groups: tuple[tuple[int, ...], ...]) -> list[TruthGroup]:
+        """The groups' exact geometry, kept while their members stay where they are."""
+        members = {m for g in groups for m in g}
+        people = tuple(p for p in people if p.id in members)
+        key = (people, groups)
+        if self._cached_groups is None or self._cached_groups[0] != key:
+            self._cached_groups = (key, truth_groups(people, groups, self.group_params))
+        return self._cached_groups[1]
+
+    def _render_scene(
+        self,
+        scene: Scene | Sequence,
+        people: tuple[ScenePerson, ...],
+        moving: tuple[bool, ...],
+        pose: RobotPose | None,
+    ) -> _SceneRender:
+        """The exact render of ``people`` (base_footprint) with the scene's mount and background. ``moving``: which
+        of them move in the camera's view; the others are cast once and kept while they stay (``_StillLayer``).
+        pose: the robot's pose in the map, which the floor's pattern is fixed to (None: fixed to the robot)."""
+        wall = scene.wall_distance if isinstance(scene, Scene) else None
+        key = (people, scene.mount, wall, pose)
+        if self._cached is not None and self._cached[0] == key:
             return self._cached[1]
-        keypoints_world = [skeleton_world(p.x, p.y, p.theta, p.height) for p in scene.people]
-        bodies = [body_capsules(kp, p.height) for kp, p in zip(keypoints_world, scene.people, strict=True)]
-        views = self._cameras(scene)
-        depth = views.depth.render(bodies)
+        self._bodies = {p: self._bodies.get(p) or _body(p) for p in people}
+        keypoints_world = [self._bodies[p][0] for p in people]
+        bodies = [self._bodies[p][1] for p in people]
+        views = self._cameras(scene.mount, wall)
+        movers = [i for i, m in enumerate(moving) if m]
+        still = self._still_layer(views, pose, tuple((i, p) for i, p in enumerate(people) if not moving[i]), bodies)
+        depth = views.depth.render([bodies[i] for i in movers], labels=movers, base=still.depth)
         color_intr = self.calibration.color
         if views.color is not None:
-            assert views.backdrop is not None  # made together with the colour caster
-            color = _paint(views.color.render(bodies, shading=True), views.backdrop)
+            assert still.color is not None and still.painted is not None  # made with the colour caster
+            shaded = views.color.render([bodies[i] for i in movers], shading=True, labels=movers, base=still.color)
+            color = _paint(shaded, still.painted[1], still.color)
         else:
             color = np.full((color_intr.height, color_intr.width, 3), 128, dtype=np.uint8)
         to_depth, to_color = views.depth.world_to_camera, self.world_to_color(scene.mount)
@@ -231,26 +346,46 @@ class SyntheticCamera:
             by_others, by_self = self._occlusion(kp, i, depth, to_depth)
             visible.append(_inside(px, color_intr) & ~by_others)
             self_occluded.append(by_self)
-            boxes.append(_body_box(kp, scene.people[i].height, to_color, color_intr))
-        groups = truth_groups(scene, self.group_params)
-        render = _SceneRender(depth, color, keypoints_world, keypoints_px, visible, self_occluded, boxes, groups)
-        self._cached = (scene, render)
+            boxes.append(_body_box(kp, people[i].height, to_color, color_intr))
+        render = _SceneRender(depth, color, keypoints_world, keypoints_px, visible, self_occluded, boxes)
+        self._cached = (key, render)
         return render
 
-    def _cameras(self, scene: Scene) -> _Views:
-        """Ray casters (and the painted background) for the scene's mount and wall, kept for the next scenes
-        (variations of a layout share them)."""
-        key = (scene.mount, scene.wall_distance)
+    def _still_layer(
+        self,
+        views: _Views,
+        pose: RobotPose | None,
+        still: tuple[tuple[int, ScenePerson], ...],
+        bodies: list[list[Capsule]],
+    ) -> _StillLayer:
+        """The renders of the people who do not move (index, person), kept while they and the views stay, and
+        painted over the floor as seen from ``pose`` (repainted when the robot moves)."""
+        key = (still, views)
+        if self._still is None or self._still.key != key:
+            labels = [i for i, _ in still]
+            chosen = [bodies[i] for i in labels]
+            color = None if views.color is None else views.color.render(chosen, shading=True, labels=labels)
+            self._still = _StillLayer(key, views.depth.render(chosen, labels=labels), color)
+        layer = self._still
+        if layer.color is not None and (layer.painted is None or layer.painted[0] != pose):
+            assert views.floor is not None  # made with the colour caster
+            layer.painted = (pose, _paint(layer.color, views.floor.painted(pose)))
+        return layer
+
+    def _cameras(self, mount: CameraMount, wall_distance: float | None) -> _Views:
+        """Ray casters (and the painted background) for a mount and wall, kept for the next scenes (variations of
+        a layout share them)."""
+        key = (mount, wall_distance)
         if key not in self._views:
             if len(self._views) >= _MAX_CACHED_VIEWS:
                 self._views.clear()
-            background = Background(ground=True, wall_distance=scene.wall_distance)
-            depth = RayCaster(self.depth_intrinsics, self.world_to_depth(scene.mount), background)
-            color, backdrop = None, None
+            background = Background(ground=True, wall_distance=wall_distance)
+            depth = RayCaster(self.depth_intrinsics, self.world_to_depth(mount), background)
+            color, floor = None, None
             if self.shaded_color:
-                color = RayCaster(self.calibration.color, self.world_to_color(scene.mount), background)
-                backdrop = _backdrop(color.render([], shading=True), color.background_world)
-            self._views[key] = _Views(depth, color, backdrop)
+                color = RayCaster(self.calibration.color, self.world_to_color(mount), background)
+                floor = _Floor.of(color.render([], shading=True), color.background_world)
+            self._views[key] = _Views(depth, color, floor)
         return self._views[key]
 
     def _occlusion(
@@ -270,6 +405,12 @@ class SyntheticCamera:
         if self.self_occlusion_margin is not None:
             by_self[inside] = (label == index) & (in_front > self.self_occlusion_margin)
         return by_others, by_self
+
+
+def _body(person: ScenePerson) -> tuple[np.ndarray, list[Capsule]]:
+    """(17, 3) joints and the capsules of one person's body (same frame as the person)."""
+    keypoints = skeleton_world(person.x, person.y, person.theta, person.height)
+    return keypoints, body_capsules(keypoints, person.height)
 
 
 def _inside(px: np.ndarray, intr: Intrinsics) -> np.ndarray:
@@ -300,24 +441,15 @@ def _body_box(keypoints: np.ndarray, height: float, to_color: Extrinsics, intr: 
     return box
 
 
-def _backdrop(rendering: Rendering, background_world: np.ndarray) -> np.ndarray:
-    """(H, W, 3) uint8 RGB of the empty scene: a checkered floor, a plain wall, the sky."""
-    label = rendering.label
-    image = np.empty(label.shape + (3,), dtype=np.uint8)
-    image[label == LABEL_NONE] = _SKY
-    image[label == LABEL_WALL] = _WALL
-    ground = label == LABEL_GROUND
-    cells = np.floor(background_world[ground][:, :2] / _CHECKER_M).astype(int).sum(axis=1) % 2
-    image[ground] = np.where(cells[:, None] == 0, _GROUND_LIGHT, _GROUND_DARK)
-    return image
+def _paint(rendering: Rendering, backdrop: np.ndarray, under: Rendering | None = None) -> np.ndarray:
+    """RGB uint8 image: people in flat colours shaded by the viewing angle, in front of the backdrop.
 
-
-def _paint(rendering: Rendering, backdrop: np.ndarray) -> np.ndarray:
-    """RGB uint8 image: people in flat colours shaded by the viewing angle, in front of the backdrop."""
+    under: the base rendering ``rendering`` was drawn over (``RayCaster.render(base=...)``); ``backdrop`` is then
+    ``under`` painted, and only the pixels the new bodies took (their labels differ) are painted over it."""
     label, shade = rendering.label, rendering.shade
     assert shade is not None, "_paint needs a rendering made with shading=True"
     image = backdrop.copy()
-    people = label >= 0
+    people = label >= 0 if under is None else label != under.label
     colors = PERSON_COLORS[label[people] % len(PERSON_COLORS)]
     image[people] = np.clip(colors * (0.35 + 0.65 * shade[people])[:, None], 0, 255).astype(np.uint8)
     return image

@@ -10,10 +10,11 @@ the interest point is the centre (S4 included: its two outer members' rays cross
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 from sid.perception.groups import GroupParams, detect_groups
-from sid.synthetic.scene import Scene
+from sid.synthetic.scene import ScenePerson
 
 
 @dataclass(frozen=True)
@@ -28,12 +29,15 @@ class TruthGroup:
     detectable: bool
 
 
-def truth_groups(scene: Scene, params: GroupParams | None = None) -> list[TruthGroup]:
-    """The scene's groups with their exact interest points and areas (see the module docstring)."""
+def truth_groups(
+    people: Sequence[ScenePerson], groups: Sequence[tuple[int, ...]], params: GroupParams | None = None
+) -> list[TruthGroup]:
+    """The ``groups`` (person ids) among ``people`` with their exact interest points and areas (see the module
+    docstring), in the people's frame."""
     params = params or GroupParams()
-    by_id = {p.id: p for p in scene.people}
+    by_id = {p.id: p for p in people}
     result = []
-    for members in scene.groups:
+    for members in groups:
         found = [
             g for g in detect_groups([by_id[i].as_person() for i in members], params) if set(g.members) == set(members)
         ]

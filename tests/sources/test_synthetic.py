@@ -12,6 +12,7 @@ from sid.perception.align import depth_at_color_pixels
 from sid.perception.camera import Calibration, deproject, project
 from sid.perception.frame import Frame
 from sid.perception.keypoints import KP
+from sid.perception.robot_pose import RobotPose
 from sid.sources import SourceError, open_source
 from sid.sources.synthetic import SyntheticSource, scene_from_spec, synthetic_source
 from sid.synthetic.layouts import layout
@@ -20,6 +21,7 @@ from sid.synthetic.pose import TruthPose
 from sid.synthetic.render import LABEL_NONE
 from sid.synthetic.scene import Scene, ScenePerson
 from sid.synthetic.sensor import FrameTruth, SyntheticCamera
+from sid.synthetic.sequence import Sequence
 from tests.conftest import REPO_ROOT
 
 TORSO = [KP["left_shoulder"], KP["right_shoulder"], KP["left_hip"], KP["right_hip"]]
@@ -166,7 +168,9 @@ def test_specs_scenarios_and_errors(tmp_path: Path) -> None:
     path.write_text(json.dumps({"people": [{"x": 2.0, "y": 0.4, "theta": -1.5}, {"x": 2.0, "y": -0.4, "theta": 1.5}]}))
     source = synthetic_source(f"synthetic:{path}", frames=2, seed=1)
     assert len(source) == 2 and [p.id for p in source.scene.people] == [0, 1]
-    with pytest.raises(SourceError, match="neither a layout"):
+    assert len(source.scene.people) == 2 and not isinstance(source.scene, Sequence) and source[0].robot_pose is None
+    assert len(SyntheticSource("S1")) == 30  # a static scene: 30 frames unless asked
+    with pytest.raises(SourceError, match="neither a built-in scene .*crossing_walkers"):
         synthetic_source("synthetic:S7")
     with pytest.raises(SourceError, match="empty spec"):
         synthetic_source("synthetic:")
@@ -178,6 +182,7 @@ def test_specs_scenarios_and_errors(tmp_path: Path) -> None:
     if example.is_file():  # a costmap scenario file, through open_source as `sid detect` does
         frame = next(iter(open_source(f"synthetic:{example}", frames=1)))
         assert frame.truth.scene == "conversation" and len(frame.truth.people) == 4
+        assert frame.robot_pose == RobotPose(0.0, 0.0, 0.0) and frame.truth.frame_id == "map"
     with pytest.raises(ValueError, match="frames"):
         SyntheticSource("S1", frames=-1)
     with pytest.raises(TypeError, match="Scene"):

@@ -12,6 +12,7 @@ import yaml
 from sid.perception.people import Person
 from sid.synthetic.layouts import LAYOUTS, VARIATIONS, layout, variations
 from sid.synthetic.scene import Scene
+from sid.synthetic.sequence import Sequence, load_scene_file
 from tests.conftest import REPO_ROOT
 
 
@@ -109,7 +110,7 @@ def test_yaw_defaults_and_people_records(tmp_path: Path) -> None:
         Scene.from_people("p", [Person(5, 2.0, 0.0, None)])
 
 
-def test_scenario_files_are_seen_from_the_robot_start(tmp_path: Path) -> None:
+def test_scenario_files_are_sequences_seen_from_the_robot(tmp_path: Path) -> None:
     scenario = {
         "name": "turned",
         "map": {"resolution": 0.1, "origin": [-5.0, -5.0], "size": [10.0, 10.0]},
@@ -118,19 +119,24 @@ def test_scenario_files_are_seen_from_the_robot_start(tmp_path: Path) -> None:
     }
     path = tmp_path / "scenario.json"
     path.write_text(json.dumps(scenario))
-    scene = Scene.from_file(path)
-    assert scene.name == "turned" and [p.id for p in scene.people] == [7, 8]
+    with pytest.raises(ValueError, match="costmap scenario file"):
+        Scene.from_file(path)
+    sequence = load_scene_file(path)
+    assert isinstance(sequence, Sequence) and sequence.name == "turned" and sequence.duration == 0
+    moment = sequence.at(0.0)
     # The robot at (1, 1) looks along +y: person 7 is 2 m straight ahead, facing the robot's right (-pi/2).
-    assert (scene.people[0].x, scene.people[0].y) == pytest.approx((2.0, 0.0))
-    assert scene.people[0].theta == pytest.approx(-np.pi / 2)
-    assert scene.wall_distance == pytest.approx(5.0)
+    seen = moment.seen_people[0]
+    assert (seen.id, seen.x, seen.y) == pytest.approx((7, 2.0, 0.0))
+    assert seen.theta == pytest.approx(-np.pi / 2)
+    assert (moment.people[0].x, moment.people[0].y, moment.people[0].theta) == (1.0, 3.0, 0.0)
     scenario["people"][0].pop("theta")
     path.write_text(json.dumps(scenario))
-    with pytest.raises(ValueError, match="person 7 has no facing"):
-        Scene.from_file(path)
+    with pytest.raises(ValueError, match=r"people \[7\] have no facing direction"):
+        load_scene_file(path)
     examples = REPO_ROOT / "examples" / "conversation.json"
-    if examples.is_file():  # the repository's example scenario renders as is (person 4 stands 6 m away)
-        assert len(Scene.from_file(examples).people) == 4
+    if examples.is_file():  # the repository's example scenario renders as is
+        example = load_scene_file(examples)
+        assert isinstance(example, Sequence) and len(example.people) == 4
 
 
 @pytest.mark.parametrize(

@@ -129,3 +129,26 @@ def test_shapes_behind_or_around_the_camera_do_not_break_the_render() -> None:
     assert not np.any(rendering.label == 0)
     seen = rendering.label == 1
     assert seen.any() and np.all(rendering.depth[seen] > 0)
+
+
+def test_bodies_drawn_over_a_base_rendering_match_one_render_of_all() -> None:
+    caster = _caster()
+    people = [(2.0, 0.3, 3.0), (3.0, -0.1, 0.5), (2.6, 0.0, -2.0)]  # the third stands between the other two
+    bodies = []
+    for x, y, theta in people:
+        keypoints = skeleton_world(x, y, theta, 1.7)
+        bodies.append(body_capsules(keypoints, 1.7))
+    for shading in (False, True):
+        whole = caster.render(bodies, shading=shading)
+        base = caster.render(bodies[:2], shading=shading)
+        layered = caster.render(bodies[2:], shading=shading, labels=[2], base=base)
+        np.testing.assert_array_equal(layered.depth, whole.depth)
+        np.testing.assert_array_equal(layered.label, whole.label)
+        if shading:
+            assert layered.shade is not None and whole.shade is not None
+            np.testing.assert_array_equal(layered.shade, whole.shade)
+    assert {0, 1, 2} <= set(np.unique(whole.label).tolist())
+    with pytest.raises(ValueError, match="2 labels for 1 bodies"):
+        caster.render(bodies[2:], labels=[2, 3])
+    with pytest.raises(ValueError, match="base made with shading=True"):
+        caster.render(bodies[2:], shading=True, labels=[2], base=caster.render(bodies[:2]))
