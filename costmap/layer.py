@@ -20,11 +20,13 @@ from costmap.scan import LaserScan
 from sid.checks import check_numbers
 from sid.perception.groups import Group
 from sid.perception.people import Person
+from sid.tracking.records import Tracks
 
 
 @dataclass(frozen=True)
 class LayerInputs:
-    """What the layers see in one frame: people and their groups (world frame) and, when there is one, a 2D scan.
+    """What the layers see in one frame: people and their groups (world frame), when there is one a 2D scan, and
+    when a tracker runs its tracked people and groups (``tracks``, same frame; read by the tracked-people layer).
 
     People need finite poses and distinct ids. New kinds of input (tracked people, a robot pose, ...) are new fields
     with a default, so existing layers and callers are unaffected.
@@ -33,6 +35,7 @@ class LayerInputs:
     people: Sequence[Person] = ()
     groups: Sequence[Group] = ()
     scan: LaserScan | None = None
+    tracks: Tracks | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "people", tuple(self.people))

@@ -16,6 +16,7 @@ from costmap.layers.inflation import InflationLayer, InflationParams
 from costmap.layers.obstacle import ObstacleLayer, ObstacleParams
 from costmap.layers.social import SocialLayer, SocialParams
 from costmap.layers.static import StaticLayer
+from costmap.layers.tracked import TrackedPeopleLayer, TrackedPeopleParams
 from costmap.occupancy import OccupancyGrid
 
 
@@ -69,10 +70,12 @@ PLUGINS: dict[str, Factory] = {
     "static": _static,
     "lidar": lambda c: ObstacleLayer(c.spec, c.params.obstacle, c.people_clear_radius),
     "social": lambda c: SocialLayer(c.spec, c.params.social, c.body_radius),
+    "tracked_people": lambda c: TrackedPeopleLayer(c.spec, TrackedPeopleParams(c.params.social), c.body_radius),
     "inflation": lambda c: InflationLayer(c.spec, c.params.inflation, c.robot_radius),
 }
 
-PEOPLE_LAYERS = frozenset({"social"})  # layers that draw the people themselves, so their LiDAR marks are cleared
+# Layers that draw the people themselves, so their LiDAR marks are cleared.
+PEOPLE_LAYERS = frozenset({"social", "tracked_people"})
 
 
 def layered_costmap(

@@ -6,7 +6,8 @@ Each stage lives in its own module and can be used alone; the names a robotics u
 >>> import sid
 >>> pipeline = sid.Pipeline(sid.image_pose(sid.load_pose_estimator("yolo11n-pose-256.onnx")), sid.CameraMount(0.9))
 >>> for frame in sid.open_source("recording.db3"):
-...     result = pipeline(frame)  # result.people, result.groups (world frame)
+...     result = pipeline(frame)  # result.people, result.groups (result.frame_id: "map" or "base_footprint")
+>>> stream = sid.SocialStream(pipeline, costmap_grid_spec)  # tracks and a costmap that holds still, frame after frame
 >>> scenario = sid.load_scenario("examples/conversation.json")
 >>> layered = sid.build_costmap(scenario)
 >>> result = sid.plan(sid.planning_problem(scenario, layered.master), planner="bitstar", time_limit=0.5, seed=1)
@@ -43,6 +44,11 @@ _EXPORTS: dict[str, str] = {
     "plan": "planner.facade",
     "PlanResult": "planner.facade",
     "PlanningProblem": "planner.problem",
+    "RobotPose": "sid.perception.robot_pose",
+    "SocialStream": "sid.stream",
+    "StreamUpdate": "sid.stream",
+    "PeopleTracker": "sid.tracking.tracker",
+    "TrackingParams": "sid.tracking.session",
 }
 
 __all__ = sorted(_EXPORTS)
@@ -63,11 +69,16 @@ if TYPE_CHECKING:  # what type checkers see; ``as`` marks each as re-exported
     from sid.perception.pipeline import Pipeline as Pipeline
     from sid.perception.pipeline import image_pose as image_pose
     from sid.perception.pose import load_pose_estimator as load_pose_estimator
+    from sid.perception.robot_pose import RobotPose as RobotPose
     from sid.scenario.build import build_costmap as build_costmap
     from sid.scenario.build import planning_problem as planning_problem
     from sid.scenario.loader import Scenario as Scenario
     from sid.scenario.loader import load_scenario as load_scenario
     from sid.sources import open_source as open_source
+    from sid.stream import SocialStream as SocialStream
+    from sid.stream import StreamUpdate as StreamUpdate
+    from sid.tracking.session import TrackingParams as TrackingParams
+    from sid.tracking.tracker import PeopleTracker as PeopleTracker
 
 
 def __getattr__(name: str) -> Any:

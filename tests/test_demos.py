@@ -92,6 +92,15 @@ def synthetic_scene(out: str, cwd: Path) -> None:
         _picture(cwd / "synthetic_scene" / name)
 
 
+def track_people(out: str, cwd: Path) -> None:
+    assert re.search(r"^t = +\d+\.\d s \(map\)", out, re.M)  # positions in the map frame: the frames carry a pose
+    walking = re.findall(r"^  group (\d+): walking, members \[(\d+), (\d+)\]", out, re.M)
+    assert {g for g, *_ in walking} and len({g for g, *_ in walking}) == 2  # the pair in file, the pair side by side
+    assert "conversation" not in out  # walkers are never a conversation
+    tracks = {int(i) for i in re.findall(r"^  track (\d+):", out, re.M)}
+    assert len(tracks) == 4  # four people, four track ids: none lost and renumbered
+
+
 PROMISES: dict[str, Callable[[str, Path], None]] = {
     check.__name__: check
     for check in (
@@ -102,6 +111,7 @@ PROMISES: dict[str, Callable[[str, Path], None]] = {
         pose_on_image,
         social_costmap,
         synthetic_scene,
+        track_people,
     )
 }
 

@@ -3,20 +3,22 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import sys
+from collections.abc import Sized
 from pathlib import Path
-from typing import TextIO
+from typing import TYPE_CHECKING, TextIO
 
 import cv2
 import numpy as np
 
 from costmap.grid import Costmap2D, GridSpec
-from costmap.render import CameraView, render_costmap
-from sid.cli.common import OutputFolderError, check_output_folder, fail
+from sid.cli.common import OutputFolderError, check_output_folder, clear_owned, fail, signals_deferred
+from sid.documents import write_atomically
 from sid.perception.camera import Calibration
 from sid.perception.frame import Frame
-from sid.perception.groups import GroupParams
+from sid.perception.groups import GROUP_METHODS, GroupParams
 from sid.perception.lifting import LiftParams
 from sid.perception.mount import CameraMount
 from sid.perception.overlay import draw_detections
@@ -24,7 +26,13 @@ from sid.perception.pipeline import FrameResult, Pipeline, PoseFn, image_pose
 from sid.perception.pose.contracts import PoseModelError
 from sid.perception.pose.session import PROVIDER_CHOICES
 from sid.sources import RECORDING_SUFFIXES, FrameReadError, SourceError, open_source, skip_unreadable
+from sid.tracking import SessionUpdate, TrackingError, TrackingSession, ViewCone, camera_fov, camera_view_cone
 
+if TYPE_CHECKING:  # costmap.render (the costmap layers, shapely) is imported only for --out: start-up time
+    from costmap.render import CameraView
+
+OUTPUTS = ("detections.jsonl", "overlay_*.png", "topview_*.png")
+"""What ``sid detect --out`` writes (and clears there first, nothing else)."""
 TOP_VIEW = GridSpec.from_size(0.05, (-0.5, -3.5), (7.5, 7.0))  # world frame: 7 m ahead of the camera, 3.5 m each side
 
 
@@ -72,6 +80,19 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help=f"keypoint confidence threshold (default {LiftParams().min_score})",
     )
     parser.add_argument("--no-keypoints", action="store_true", help="leave 3D keypoints out of the JSON lines")
+    parser.add_argument(
+        "--no-tracking",
+        action="store_true",
+        help="print each frame's own detections (per-frame person ids, groups of that frame alone) instead of "
+        "tracks with stable ids, velocities and standing / walking states (the default, except for a source of "
+        "one frame, where there is nothing to track; docs/tracking.md)",
+    )
+    parser.add_argument(
+        "--group-method",
+        choices=GROUP_METHODS,
+        default=GroupParams.method,
+        help="group detector: 'ospace' (default), 'rays' or 'paper' (the paper's Algorithm 1); docs/groups.md",
+    )
     parser.set_defaults(func=run)
 
 
@@ -118,17 +139,18 @@ def _skip_reason(frame: Frame) -> str | None:
 def camera_view(calibration: Calibration, mount: CameraMount) -> CameraView:
     """The colour camera seen from above: at the world origin, its field of view bounded by the image's left and
     right edges on the principal row."""
-    color = calibration.color
-    edges = np.array([[-0.5 - color.cx, 0.0, color.fx], [color.width - 0.5 - color.cx, 0.0, color.fx]])
-    world = edges @ mount.rotation.T
-    left, right = np.arctan2(world[:, 1], world[:, 0])
-    return CameraView(0.0, 0.0, float(left + right) / 2, float(left - right))
+    from costmap.render import CameraView
+
+    return CameraView(0.0, 0.0, *camera_fov(calibration, mount))
 
 
-def _write_pictures(out: Path, frame: Frame, result: FrameResult, mount: CameraMount) -> None:
+def _pictures(frame: Frame, result: FrameResult, mount: CameraMount) -> dict[str, bytes]:
+    """A frame's overlay and top view, encoded as PNG, by file name."""
+    from costmap.render import render_costmap
+
     by_id = {p.id: p for p in result.people}
     people = [by_id.get(i) for i in range(len(result.detections))]
-    cv2.imwrite(str(out / f"overlay_{frame.index:06d}.png"), draw_detections(frame.color, result.detections, people))
+    overlay = draw_detections(frame.color, result.detections, people)
     top = render_costmap(
         Costmap2D.filled(TOP_VIEW),
         result.people,
@@ -138,7 +160,8 @@ def _write_pictures(out: Path, frame: Frame, result: FrameResult, mount: CameraM
         camera=camera_view(frame.calibration, mount),
         scale=6,
     )
-    cv2.imwrite(str(out / f"topview_{frame.index:06d}.png"), top)
+    images = {f"overlay_{frame.index:06d}.png": overlay, f"topview_{frame.index:06d}.png": top}
+    return {name: cv2.imencode(".png", image)[1].tobytes() for name, image in images.items()}
 
 
 def _count(n: int, one: str, many: str) -> str:
@@ -150,6 +173,29 @@ def _emit(record: dict, streams: list[TextIO]) -> None:
     for stream in streams:
         stream.write(line + "\n")
         stream.flush()
+
+
+def _view(frame: Frame, pipeline: Pipeline) -> ViewCone:
+    """The camera's field of view on the ground, in the frame of the pipeline's output for ``frame``."""
+    return camera_view_cone(frame.calibration, pipeline.mount, frame.robot_pose, pipeline.lift_params.max_range)
+
+
+def _tracked_json(record: dict, tracked: SessionUpdate) -> dict:
+    """A frame's JSON line with its people and groups replaced by the tracks (ids: track ids), each person's 3D
+    keypoints taken from the detection it matched (null when missed), and ``reset`` when the trackers were."""
+    by_id = {person["id"]: person for person in record["people"]}
+    with_keypoints = any("keypoints" in person for person in record["people"])
+    people = []
+    for track in tracked.people:
+        person = track.to_json()
+        if with_keypoints:
+            person["keypoints"] = by_id[track.detection]["keypoints"] if track.detection in by_id else None
+        people.append(person)
+    record |= {"people": people, "groups": [group.to_json() for group in tracked.groups]}
+    record["timing_ms"] |= {k: round(v, 3) for k, v in tracked.timing_ms.items()}
+    if tracked.reset is not None:
+        record["reset"] = tracked.reset
+    return record
 
 
 def run(args: argparse.Namespace) -> int:
@@ -168,7 +214,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         lift = LiftParams() if args.keypoint_threshold is None else LiftParams(min_score=args.keypoint_threshold)
         mount = CameraMount(args.camera_height, args.camera_tilt)
-        pipeline = Pipeline(_pose(args), mount, lift, GroupParams())
+        pipeline = Pipeline(_pose(args), mount, lift, GroupParams(method=args.group_method))
         options = _source_options(args)
         source = open_source(args.source, **options)
     except (SourceError, PoseModelError, ValueError, OSError) as exc:
@@ -178,6 +224,9 @@ def run(args: argparse.Namespace) -> int:
     streams: list[TextIO] = [sys.stdout]
     if args.out is not None:
         args.out.mkdir(parents=True, exist_ok=True)
+        cleared = clear_owned(args.out, OUTPUTS)  # an earlier run's files, so none is mistaken for this run's
+        if cleared:
+            print(f"detect: removed {len(cleared)} file(s) of an earlier run from {args.out}", file=sys.stderr)
         streams.append((args.out / "detections.jsonl").open("w"))
 
     done = skipped = 0
@@ -187,7 +236,9 @@ def run(args: argparse.Namespace) -> int:
         skipped += 1
         print(f"detect: frame {error.index}: skipped, {error}", file=sys.stderr)
 
-    interrupted = False
+    interrupted = 0  # the exit code of the signal that stopped the run
+    single = isinstance(source, Sized) and len(source) == 1
+    tracking = None if args.no_tracking or single else TrackingSession(group_params=pipeline.group_params)
     totals: list[float] = []
     try:
         for frame in skip_unreadable(source, report):
@@ -197,18 +248,33 @@ def run(args: argparse.Namespace) -> int:
             result = None if reason else pipeline(frame)
             if result is not None and not result.people:
                 reason = "no people"
+                if tracking is not None:  # tracks still age through a frame without people
+                    with contextlib.suppress(TrackingError):  # such a frame is skipped anyway
+                        tracking.update(result, _view(frame, pipeline))
             if reason or result is None:  # result is None only when there is a reason
                 skipped += 1
                 print(f"detect: frame {frame.index}: skipped, {reason}", file=sys.stderr)
                 continue
+            record = result.to_json(keypoints=not args.no_keypoints)
+            if tracking is not None:
+                try:
+                    record = _tracked_json(record, tracking.update(result, _view(frame, pipeline)))
+                except TrackingError as exc:
+                    skipped += 1
+                    print(f"detect: frame {frame.index}: skipped, {exc}", file=sys.stderr)
+                    continue
+            pictures = _pictures(frame, result, mount) if args.out is not None else {}
+            with signals_deferred():  # a frame's line and both its pictures, or none of them
+                _emit(record, streams)
+                for name, png in pictures.items():
+                    write_atomically(args.out / name, png)
             done += 1
             totals.append(result.timing_ms["total"])
-            _emit(result.to_json(keypoints=not args.no_keypoints), streams)
-            if args.out is not None:
-                _write_pictures(args.out, frame, result, mount)
-    except KeyboardInterrupt:
-        interrupted = True
+    except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (sid.cli.common.Terminated)
+        interrupted = 128 + int(getattr(exc, "signal_number", 2))
         print("detect: interrupted, output flushed", file=sys.stderr)
+    except OSError as exc:  # e.g. the disk filled up
+        return fail("sid detect", exc)
     except SourceError as exc:
         print(f"detect: source stopped: {exc}", file=sys.stderr)
         return 1
@@ -220,4 +286,4 @@ def run(args: argparse.Namespace) -> int:
             close()
     median = f", median {np.median(totals):.2f} ms per frame" if totals else ""
     print(f"detect: {done} frames with people, {skipped} skipped{median}", file=sys.stderr)
-    return 130 if interrupted else 0
+    return interrupted

@@ -2,7 +2,9 @@
 
 Stages: ``pose`` (the pose model, or ``TruthPose`` on synthetic frames), ``lift`` (keypoint depth, 3D keypoints,
 world positions and facing directions; depth is looked up sparsely at the keypoints, so the full frame is never
-aligned) and ``group`` (the paper's Algorithm 1). All outputs are in the world frame of ``sid.perception.mount``.
+aligned) and ``group`` (the paper's Algorithm 1). Outputs are in the map frame when the frame carries the robot's
+pose (``Frame.robot_pose``), else in ``base_footprint`` (through ``sid.perception.mount``); ``FrameResult.frame_id``
+says which (``sid.perception.robot_pose``).
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from sid.perception.keypoints import PoseDetection
 from sid.perception.lifting import LiftParams, lift_people
 from sid.perception.mount import CameraMount
 from sid.perception.people import Person
+from sid.perception.robot_pose import BASE_FRAME, MAP_FRAME, RobotPose
 
 PoseFn = Callable[[Frame], list[PoseDetection]]
 
@@ -35,7 +38,11 @@ def image_pose(estimator: Callable[[np.ndarray], list[PoseDetection]]) -> PoseFn
 
 @dataclass
 class FrameResult:
-    """What the pipeline found in one frame (world frame, metres, radians) and how long each stage took (ms)."""
+    """What the pipeline found in one frame and how long each stage took (ms).
+
+    people and groups (positions and keypoints in metres, facings in radians) are in ``frame_id``: ``"map"`` when
+    the robot's pose was known (``robot_pose``, base_footprint in the map), else ``"base_footprint"``.
+    """
 
     frame: int
     timestamp: float
@@ -43,12 +50,17 @@ class FrameResult:
     people: list[Person]
     groups: list[Group]
     timing_ms: dict[str, float] = field(default_factory=dict)
+    frame_id: str = BASE_FRAME
+    robot_pose: RobotPose | None = None
 
     def to_json(self, keypoints: bool = True) -> dict:
         """The JSON-lines record of ``sid detect``."""
+        pose = self.robot_pose
         return {
             "frame": self.frame,
             "timestamp": self.timestamp,
+            "frame_id": self.frame_id,
+            "robot_pose": None if pose is None else {"x": pose.x, "y": pose.y, "yaw": pose.yaw},
             "people": [_person_json(p, keypoints) for p in self.people],
             "groups": [group_json(g) for g in self.groups],
             "timing_ms": {k: round(v, 3) for k, v in self.timing_ms.items()},
@@ -84,22 +96,35 @@ def _person_json(person: Person, keypoints: bool) -> dict:
 
 @dataclass
 class Pipeline:
-    """Pose -> people -> groups for one frame at a time. Stateless between frames."""
+    """Pose -> people -> groups for one frame at a time, in the map when the frame has a robot pose (else in
+    base_footprint). Stateless between frames."""
 
     pose: PoseFn
     mount: CameraMount = field(default_factory=CameraMount)
     lift_params: LiftParams = field(default_factory=LiftParams)
     group_params: GroupParams = field(default_factory=GroupParams)
+    group: bool = True
+    """False: skip the group stage (``groups`` empty, no "group" timing), e.g. when a tracker groups the tracks."""
 
     def __call__(self, frame: Frame) -> FrameResult:
         t0 = time.perf_counter()
         detections = self.pose(frame)
         t1 = time.perf_counter()
         people = lift_people(detections, frame.depth, frame.calibration, self.mount, self.lift_params)
+        pose = frame.robot_pose
+        if pose is not None:
+            people = [pose.person_to_map(p) for p in people]
         t2 = time.perf_counter()
-        groups = detect_groups(people, self.group_params)
+        groups = detect_groups(people, self.group_params) if self.group else []
         t3 = time.perf_counter()
-        timing = {"pose": t1 - t0, "lift": t2 - t1, "group": t3 - t2, "total": t3 - t0}
+        timing = {"pose": t1 - t0, "lift": t2 - t1} | ({"group": t3 - t2} if self.group else {}) | {"total": t3 - t0}
         return FrameResult(
-            frame.index, frame.timestamp, detections, people, groups, {k: v * 1e3 for k, v in timing.items()}
+            frame.index,
+            frame.timestamp,
+            detections,
+            people,
+            groups,
+            {k: v * 1e3 for k, v in timing.items()},
+            BASE_FRAME if pose is None else MAP_FRAME,
+            pose,
         )

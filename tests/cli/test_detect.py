@@ -34,7 +34,7 @@ def test_pipeline_finds_the_s1_pair_where_the_truth_puts_it():
 def test_frame_result_json_has_the_documented_fields():
     frame = SyntheticSource("S3", frames=1, seed=0)[0]
     record = Pipeline(TruthPose())(frame).to_json()
-    assert set(record) == {"frame", "timestamp", "people", "groups", "timing_ms"}
+    assert set(record) == {"frame", "timestamp", "frame_id", "robot_pose", "people", "groups", "timing_ms"}
     person = record["people"][0]
     assert set(person) == {"id", "x", "y", "theta", "keypoints", "orientation_quality"}
     assert len(person["keypoints"]) == 17
@@ -54,7 +54,7 @@ def _lines(text: str) -> list[dict]:
 
 def test_detect_streams_json_lines_and_writes_pictures(tmp_path, capsys):
     out = tmp_path / "out"
-    assert main(["detect", "--source", "synthetic:S5", "--frames", "3", "--out", str(out)]) == 0
+    assert main(["detect", "--source", "synthetic:S5", "--frames", "3", "--out", str(out), "--no-tracking"]) == 0
     captured = capsys.readouterr()
     records = _lines(captured.out)
     assert [r["frame"] for r in records] == [0, 1, 2]
@@ -85,6 +85,13 @@ def test_detect_top_view_shows_the_camera_and_only_what_it_draws(tmp_path):
     assert PERSON in colours and CAMERA in colours
     for absent in (GOAL, START, SCAN, INSCRIBED_COLOUR):  # no robot, scan or costs drawn: none in the legend either
         assert absent not in colours, f"colour {absent} is drawn, yet nothing it stands for is on the map"
+
+
+@pytest.mark.parametrize("method", ["ospace", "rays", "paper"])
+def test_detect_takes_the_group_method(method, capsys):
+    assert main(["detect", "--source", "synthetic:S1", "--frames", "1", "--group-method", method, "--no-tracking"]) == 0
+    (record,) = _lines(capsys.readouterr().out)
+    assert [sorted(g["members"]) for g in record["groups"]] == [[0, 1]]
 
 
 def test_detect_needs_a_model_for_real_sources(tmp_path, capsys):

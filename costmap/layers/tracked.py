@@ -1,0 +1,75 @@
+"""The tracked-people layer: the social layer's costs drawn from tracks (``LayerInputs.tracks``), not detections.
+
+It reads the tracker's people and groups (``sid.tracking``), so a person missed for a frame, or a facing that jitters,
+does not make the costs blink: tracks persist through short misses and their positions and facings are smoothed.
+
+- standing people: as the social layer (``costmap.layers.social``): a LETHAL body and the asymmetric personal-space
+  Gaussian along the smoothed facing.
+- walking people: the body, and the personal-space Gaussian turned along their velocity with its front stretched
+  to ``sigma_front + lookahead * speed``: the cells they are about to cross cost more, as the velocity-scaled
+  proxemic costs of ROS's social_navigation_layers do.
+- conversations: the social layer's group zone, from the tracked members' positions and the last o-space polygon.
+  Walking groups get no zone: their members' stretched costs already cover where they go.
+
+Costs never exceed 252 except the bodies (254), as in the social layer; combined by ``max_nonzero`` likewise.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+from costmap.combine import CombinationMethod
+from costmap.grid import FREE_SPACE, GridSpec, Window, union
+from costmap.layer import Layer, LayerInputs
+from costmap.layers.social import SocialParams, _zone_hull, paint_body, paint_group, paint_person
+from sid.checks import check_number
+
+
+@dataclass(frozen=True)
+class TrackedPeopleParams:
+    """The social layer's parameters (``social``) plus ``lookahead``: seconds of a walker's motion over which its
+    cost is stretched ahead (sigma ahead = sigma_front + lookahead * speed, m)."""
+
+    social: SocialParams = field(default_factory=SocialParams)
+    lookahead: float = 1.0
+
+    def __post_init__(self) -> None:
+        check_number("tracked people layer", "lookahead", self.lookahead, low=0, unit="seconds")
+
+
+class TrackedPeopleLayer(Layer):
+    """Rebuilt from the current tracks at every update (nothing stale is kept); no tracks given: an empty layer."""
+
+    name = "tracked_people"
+    combination: CombinationMethod = "max_nonzero"
+
+    def __init__(self, spec: GridSpec, params: TrackedPeopleParams | None = None, body_radius: float = 0.2) -> None:
+        check_number("tracked people layer", "body_radius", body_radius, low=0, low_open=True, unit="metres")
+        super().__init__(spec)
+        self.params = params or TrackedPeopleParams()
+        self.body_radius = float(body_radius)
+        self._painted: Window | None = None
+
+    def update(self, inputs: LayerInputs, changed: Window | None) -> Window | None:
+        """Repaint the layer for the tracked people and groups of ``inputs.tracks``."""
+        tracks = inputs.tracks
+        people = [] if tracks is None else [p.as_person() for p in tracks.people]
+        by_id = {p.id: p for p in people}
+        conversations = [] if tracks is None else [g.as_group() for g in tracks.groups if g.kind == "conversation"]
+        hulls = [_zone_hull(group, by_id) for group in conversations]  # raises on a bad group before any change
+        previous = self._painted
+        if previous is not None:
+            self.costs[previous.slices] = FREE_SPACE
+        social = self.params.social
+        painted = [paint_group(self.costs, self.spec, hull, social) for hull in hulls]
+        for track in () if tracks is None else tracks.people:
+            person = by_id[track.id]
+            params = social
+            if track.walking:
+                person.theta = math.atan2(track.vy, track.vx)
+                params = replace(social, sigma_front=social.sigma_front + self.params.lookahead * track.speed)
+            painted.append(paint_person(self.costs, self.spec, person, params))
+        painted += [paint_body(self.costs, self.spec, person, self.body_radius) for person in people]
+        self._painted = union(*painted)
+        return union(previous, self._painted)

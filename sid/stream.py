@@ -1,0 +1,119 @@
+"""The streaming object: one call per frame keeps people, groups and the social costmap up to date.
+
+``SocialStream.update(frame, robot_pose)`` runs the stateless per-frame pipeline (``sid.perception.pipeline``), then
+the people and group trackers (``sid.tracking.session``), then the layered costmap (``costmap``) on the tracks, and
+returns a ``StreamUpdate``. Positions are in the map frame when a robot pose is known (``robot_pose``, else
+``frame.robot_pose``), else in ``base_footprint`` (right only while the robot stands still).
+
+Resets (documented, not errors; ``StreamUpdate.reset`` says why): a jump of the robot pose, or a pose that appears
+or disappears (``sid.tracking.session``). Errors (``TrackingError``, raised before the pipeline runs, nothing
+changed): a frame not after the last one in time, a non-finite timestamp, a robot pose that is not a finite
+``RobotPose``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from dataclasses import dataclass
+
+from costmap.grid import GridSpec
+from costmap.layer import LayerInputs
+from costmap.layered import LayeredCostmap
+from costmap.plugins import CostmapParams, layered_costmap
+from costmap.scan import LaserScan
+from sid.perception.frame import Frame
+from sid.perception.pipeline import FrameResult, Pipeline
+from sid.perception.robot_pose import RobotPose
+from sid.tracking.records import TrackedGroup, TrackedPerson, Tracks
+from sid.tracking.session import TrackingParams, TrackingSession
+from sid.tracking.view import ViewCone, camera_view_cone
+
+STREAM_PLUGINS = ("static", "lidar", "tracked_people", "inflation")
+"""The layers of the costmap a stream builds from a ``GridSpec``: the tracked-people layer instead of the social one."""
+
+
+@dataclass
+class StreamUpdate:
+    """The stream's state after one frame.
+
+    frame_id: the frame of every position ("map" or "base_footprint"). timestamp: the frame's (s). people, groups:
+    confirmed tracks. costmap: the LayeredCostmap after the update (``costmap.master.costs``: the combined uint8 grid).
+    result: the per-frame pipeline's raw result. timing_ms: per stage ("pose", "lift", "group" from the pipeline,
+    then "track", "track_groups", "costmap", and "total"). reset: why the trackers were reset at this frame (None:
+    they were not).
+    """
+
+    frame_id: str
+    timestamp: float
+    people: list[TrackedPerson]
+    groups: list[TrackedGroup]
+    costmap: LayeredCostmap
+    result: FrameResult
+    timing_ms: dict[str, float]
+    reset: str | None = None
+
+
+class SocialStream:
+    """Pipeline -> trackers -> costmap, frame after frame.
+
+    ``costmap``: a ready ``LayeredCostmap`` (its layers read ``LayerInputs.tracks``, or people and groups, which
+    the stream fills with the tracks: a "social" layer draws tracked people too), or a ``GridSpec`` (in the frame
+    of the positions, the map when poses are given) from which one is built with ``costmap_params`` (default:
+    ``STREAM_PLUGINS`` with default parameters). ``params``: the trackers' (``sid.tracking.session``).
+    The group tracker groups the tracks itself: a pipeline built with ``group=False`` skips the per-frame
+    grouping it would otherwise also do (``StreamUpdate.result.groups`` is then empty).
+    """
+
+    def __init__(
+        self,
+        pipeline: Pipeline,
+        costmap: LayeredCostmap | GridSpec,
+        costmap_params: CostmapParams | None = None,
+        params: TrackingParams | None = None,
+    ) -> None:
+        self.pipeline = pipeline
+        if isinstance(costmap, GridSpec):
+            costmap = layered_costmap(costmap, costmap_params or CostmapParams(plugins=STREAM_PLUGINS))
+        elif costmap_params is not None:
+            raise ValueError("stream: costmap_params only apply when the costmap is built from a GridSpec")
+        self.costmap = costmap
+        self.tracking = TrackingSession(params, pipeline.group_params)
+
+    def reset(self) -> None:
+        """Forget every track and group (ids keep counting up); the costmap empties at the next update."""
+        self.tracking.reset()
+
+    def update(self, frame: Frame, robot_pose: RobotPose | None = None, scan: LaserScan | None = None) -> StreamUpdate:
+        """One frame: pipeline, trackers, costmap. ``robot_pose``: base_footprint in the map at the frame's time
+        (None: ``frame.robot_pose``). ``scan``: a 2D scan for the LiDAR layer, in the costmap's frame."""
+        start = time.perf_counter()
+        pose = frame.robot_pose if robot_pose is None else robot_pose
+        self.tracking.check(frame.timestamp, pose, f"stream: frame {frame.index}")
+        if pose is not frame.robot_pose:
+            frame = dataclasses.replace(frame, robot_pose=pose)
+        result = self.pipeline(frame)
+        tracked = self.tracking.update(result, self.view(frame))
+        t0 = time.perf_counter()
+        conversations = [g.as_group() for g in tracked.groups if g.kind == "conversation"]
+        tracks = Tracks(tracked.people, tracked.groups)
+        self.costmap.update(LayerInputs([p.as_person() for p in tracked.people], conversations, scan, tracks))
+        t1 = time.perf_counter()
+        timing = result.timing_ms | tracked.timing_ms | {"costmap": (t1 - t0) * 1e3, "total": (t1 - start) * 1e3}
+        return StreamUpdate(
+            result.frame_id,
+            frame.timestamp,
+            tracked.people,
+            tracked.groups,
+            self.costmap,
+            result,
+            timing,
+            tracked.reset,
+        )
+
+    def view(self, frame: Frame) -> ViewCone:
+        """The colour camera's field of view on the ground at ``frame`` (from its robot pose: in the map, else in
+        base_footprint), up to the pipeline's lifting range."""
+        return camera_view_cone(
+            frame.calibration, self.pipeline.mount, frame.robot_pose, self.pipeline.lift_params.max_range
+        )

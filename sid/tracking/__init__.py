@@ -1,0 +1,36 @@
+"""People and groups over time: a ground-plane multi-person tracker and a group tracker on its tracks.
+
+- ``records``: ``TrackedPerson``, ``TrackedGroup`` and ``Tracks`` (both at one frame), what the trackers report.
+- ``motion``: the constant-velocity Kalman filter, stepped for all tracks at once.
+- ``view``: the camera's field of view on the ground (``ViewCone``).
+- ``tracker``: ``PeopleTracker`` (stable ids, confirmation, timeouts, smoothed facing, standing / walking).
+- ``groups``: ``GroupTracker`` (stable group ids, hysteresis, walking groups that are never an o-space).
+- ``session``: ``TrackingSession``, both trackers over the pipeline's per-frame results, with resets on pose jumps.
+
+Use ``sid.stream.SocialStream`` to run them with the pipeline and the costmap; docs/tracking.md has the measurements.
+"""
+
+from sid.tracking.groups import GroupTracker, GroupTrackerParams
+from sid.tracking.records import GroupKind, MotionState, TrackedGroup, TrackedPerson, Tracks
+from sid.tracking.session import SessionUpdate, TrackingParams, TrackingSession
+from sid.tracking.tracker import PeopleTracker, TrackerParams, TrackingError
+from sid.tracking.view import ViewCone, camera_fov, camera_view_cone
+
+__all__ = [
+    "GroupKind",
+    "GroupTracker",
+    "GroupTrackerParams",
+    "MotionState",
+    "PeopleTracker",
+    "SessionUpdate",
+    "TrackedGroup",
+    "TrackedPerson",
+    "TrackerParams",
+    "TrackingError",
+    "TrackingParams",
+    "TrackingSession",
+    "Tracks",
+    "ViewCone",
+    "camera_fov",
+    "camera_view_cone",
+]

@@ -1,0 +1,240 @@
+"""Groups over time: stable group ids, hysteresis, members who walk away, and people walking together.
+
+Per frame (``GroupTracker.update``), on the tracked people (``sid.tracking.tracker``):
+
+- conversations: ``sid.perception.groups.detect_groups`` on the standing tracks (smoothed positions and facings).
+  Walking tracks are left out, so people walking together are never an o-space, whatever their facings.
+- walking groups: walking tracks within ``walk_distance`` of each other whose velocities differ by at most
+  ``walk_velocity_difference`` (side by side or in file), joined transitively (connected components).
+- each candidate is matched to a group track of its kind by member overlap (Jaccard index >= ``min_overlap``,
+  ``scipy.optimize.linear_sum_assignment`` on 1 - overlap); an unmatched candidate starts a tentative group.
+- a group is reported once it was found in ``confirm_hits`` of its last ``confirm_window`` frames; it survives
+  frames in which it is not found for up to ``miss_timeout`` seconds, keeping its last geometry, but a member who
+  leaves (track deleted, starts walking for a conversation or stops for a walking group, or goes farther than
+  ``leave_distance`` from the interest point, or is found in another group) leaves the group at once, and one
+  not found with the group for ``miss_timeout`` leaves too; fewer than two members end it.
+- only standing tracks whose velocity is settled (``max_speed_sigma``) take part in conversations.
+
+Group ids count up from 1 and are never reused, also across ``reset``.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import connected_components
+
+from sid.checks import check_number, check_numbers
+from sid.perception.groups import GroupParams, detect_groups
+from sid.tracking.records import GroupKind, TrackedGroup, TrackedPerson
+
+_NO_ZONE = np.zeros((0, 2))
+
+
+@dataclass(frozen=True)
+class GroupTrackerParams:
+    """Parameters of ``GroupTracker`` (metres, seconds, m/s; measured in docs/tracking.md).
+
+    confirm_hits of confirm_window: a group is reported after being found in that many of its last frames.
+    miss_timeout: seconds a reported group survives while not found. min_overlap: the Jaccard index of member sets
+    above which a candidate continues a group. leave_distance: a member of a conversation farther than this from
+    its interest point (m) has left. walk_distance (m), walk_velocity_difference (m/s): walkers closer than this,
+    whose velocities differ by less than that, walk together. max_speed_sigma: a standing track joins conversations
+    only once its velocity is known within this (m/s, ``TrackedPerson.speed_sigma``): a track just started may be a
+    walker whose motion is not yet seen.
+    """
+
+    confirm_hits: int = 3
+    confirm_window: int = 5
+    miss_timeout: float = 1.0
+    min_overlap: float = 0.5
+    leave_distance: float = 1.6
+    walk_distance: float = 2.0
+    walk_velocity_difference: float = 0.4
+    max_speed_sigma: float = 0.4
+
+    def __post_init__(self) -> None:
+        for name in ("confirm_hits", "confirm_window"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or int(value) != value or value < 1:
+                raise ValueError(f"group tracker: {name} must be a whole number >= 1, got {value}")
+        if self.confirm_hits > self.confirm_window:
+            raise ValueError(
+                f"group tracker: confirm_hits ({self.confirm_hits}) must not exceed confirm_window "
+                f"({self.confirm_window})"
+            )
+        check_number("group tracker", "miss_timeout", self.miss_timeout, low=0, unit="seconds")
+        check_number("group tracker", "min_overlap", self.min_overlap, low=0, high=1, low_open=True)
+        check_numbers("group tracker", self, ("leave_distance", "walk_distance"), low=0, low_open=True, unit="metres")
+        check_numbers("group tracker", self, ("walk_velocity_difference", "max_speed_sigma"), low=0, unit="m/s")
+
+
+@dataclass
+class _Candidate:
+    """A group found in this frame: kind, members (track ids) and geometry."""
+
+    kind: GroupKind
+    members: frozenset[int]
+    interest_point: tuple[float, float]
+    zone: np.ndarray
+    area: float
+    spread: float
+
+
+@dataclass
+class _GroupTrack:
+    """A group over time: its last candidate, its members (track id -> when last found in the group, s)."""
+
+    id: int
+    found: _Candidate
+    members: dict[int, float]
+    last_seen: float
+    history: deque[bool] = field(default_factory=deque)
+    confirmed: bool = False
+
+
+class GroupTracker:
+    """Keeps groups of tracked people across frames. State lives between calls."""
+
+    def __init__(self, params: GroupTrackerParams | None = None, group_params: GroupParams | None = None) -> None:
+        self.params = params or GroupTrackerParams()
+        self.group_params = group_params or GroupParams()
+        self._next_id = 1
+        self._tracks: list[_GroupTrack] = []
+
+    def reset(self) -> None:
+        """Forget every group (ids keep counting up)."""
+        self._tracks = []
+
+    def update(self, people: Sequence[TrackedPerson], timestamp: float) -> list[TrackedGroup]:
+        """The confirmed groups among ``people`` (this frame's tracks) at ``timestamp`` (s)."""
+        by_id = {p.id: p for p in people}
+        if len(by_id) != len(people):
+            raise ValueError("group tracker: a track id appears twice in one frame")
+        candidates = self._conversations(people) + _walking_groups(people, self.params)
+        matched = self._match(candidates)
+        found_now = {m for candidate in candidates for m in candidate.members}
+        p = self.params
+        kept: list[_GroupTrack] = []
+        for track in self._tracks:
+            candidate = matched.get(track.id)
+            track.history.append(candidate is not None)
+            while len(track.history) > p.confirm_window:
+                track.history.popleft()
+            found = frozenset() if candidate is None else candidate.members
+            if candidate is not None:
+                track.found, track.last_seen = candidate, timestamp
+                track.members |= dict.fromkeys(found, timestamp)
+            elif timestamp - track.last_seen > p.miss_timeout:
+                continue
+            track.members = {
+                m: seen
+                for m, seen in track.members.items()
+                if m in found
+                or (
+                    m not in found_now  # found in another group now: moved there
+                    and timestamp - seen <= p.miss_timeout
+                    and self._stays(track, by_id.get(m))
+                )
+            }
+            track.confirmed |= sum(track.history) >= p.confirm_hits
+            if len(track.members) >= 2:
+                kept.append(track)
+        self._tracks = kept
+        return [_report(track, by_id) for track in self._tracks if track.confirmed]
+
+    def _conversations(self, people: Sequence[TrackedPerson]) -> list[_Candidate]:
+        settled = self.params.max_speed_sigma
+        standing = [p.as_person() for p in people if not p.walking and p.speed_sigma <= settled]
+        return [
+            _Candidate(
+                "conversation",
+                frozenset(g.members),
+                (float(g.interest_point[0]), float(g.interest_point[1])),
+                np.asarray(g.zone, dtype=float).reshape(-1, 2),
+                float(g.area),
+                float(g.spread),
+            )
+            for g in detect_groups(standing, self.group_params)
+        ]
+
+    def _match(self, candidates: list[_Candidate]) -> dict[int, _Candidate]:
+        """Group track id -> the candidate continuing it; new tentative tracks for the others."""
+        matched: dict[int, _Candidate] = {}
+        used: set[int] = set()
+        if self._tracks and candidates:
+            overlap = np.array([[_jaccard(t, c) for c in candidates] for t in self._tracks])
+            rows, cols = linear_sum_assignment(-overlap)
+            for row, col in zip(rows.tolist(), cols.tolist(), strict=True):
+                if overlap[row, col] >= self.params.min_overlap:
+                    matched[self._tracks[row].id] = candidates[col]
+                    used.add(col)
+        for col, candidate in enumerate(candidates):
+            if col not in used:
+                track = _GroupTrack(self._next_id, candidate, {}, -np.inf)
+                self._next_id += 1
+                self._tracks.append(track)
+                matched[track.id] = candidate
+        return matched
+
+    def _stays(self, track: _GroupTrack, person: TrackedPerson | None) -> bool:
+        """Whether a member of a group not found this frame is still in it."""
+        if person is None:
+            return False
+        if track.found.kind == "walking":
+            return person.walking
+        x, y = track.found.interest_point
+        return not person.walking and np.hypot(person.x - x, person.y - y) <= self.params.leave_distance
+
+
+def _jaccard(track: _GroupTrack, candidate: _Candidate) -> float:
+    if track.found.kind != candidate.kind:
+        return 0.0
+    members = track.members.keys()
+    return len(members & candidate.members) / len(members | candidate.members)
+
+
+def _walking_groups(people: Sequence[TrackedPerson], params: GroupTrackerParams) -> list[_Candidate]:
+    walkers = [p for p in people if p.walking]
+    if len(walkers) < 2:
+        return []
+    position = np.array([[p.x, p.y] for p in walkers])
+    velocity = np.array([[p.vx, p.vy] for p in walkers])
+    near = np.linalg.norm(position[:, None] - position[None], axis=2) <= params.walk_distance
+    alike = np.linalg.norm(velocity[:, None] - velocity[None], axis=2) <= params.walk_velocity_difference
+    count, labels = connected_components(csr_matrix(near & alike), directed=False)
+    out = []
+    for label in range(count):
+        rows = np.flatnonzero(labels == label)
+        if len(rows) < 2:
+            continue
+        centre = position[rows].mean(axis=0)
+        spread = float(np.linalg.norm(position[rows] - centre, axis=1).mean())
+        members = frozenset(walkers[i].id for i in rows.tolist())
+        out.append(_Candidate("walking", members, (float(centre[0]), float(centre[1])), _NO_ZONE, 0.0, spread))
+    return out
+
+
+def _report(track: _GroupTrack, by_id: dict[int, TrackedPerson]) -> TrackedGroup:
+    members = sorted(track.members)
+    velocity = np.mean([[by_id[m].vx, by_id[m].vy] for m in members], axis=0)
+    found = track.found
+    interest = found.interest_point
+    if found.kind == "walking":  # walkers move on: the centroid of this frame, not of the last time found
+        interest = tuple(np.mean([[by_id[m].x, by_id[m].y] for m in members], axis=0).tolist())
+    return TrackedGroup(
+        track.id,
+        found.kind,
+        tuple(members),
+        (float(interest[0]), float(interest[1])),
+        found.zone,
+        found.area,
+        found.spread,
+        (float(velocity[0]), float(velocity[1])),
+        track.last_seen,
+    )

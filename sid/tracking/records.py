@@ -1,0 +1,133 @@
+"""What the trackers report: people and groups with identities that last across frames.
+
+Positions and velocities are in the frame the tracker was fed (the map frame when a ``sid.stream.SocialStream``
+runs it: REP-103, metres, m/s); yaws in radians, counter-clockwise from +x; times in seconds (frame timestamps).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+
+from sid.perception.groups import Group
+from sid.perception.people import Person
+from sid.perception.pipeline import group_json
+
+MotionState = Literal["standing", "walking"]
+GroupKind = Literal["conversation", "walking"]
+
+
+@dataclass(frozen=True)
+class TrackedPerson:
+    """One confirmed person track at the current frame.
+
+    id: the track id, never reused by the tracker that made it. (x, y): filtered position (m); (vx, vy): velocity
+    (m/s). theta: smoothed facing (rad), None while no facing was ever measured. state: "standing" or "walking"
+    (speed with hysteresis, ``TrackerParams``). visible: detected in this frame. in_view: the predicted position
+    lies in the camera's field of view (True when the tracker was given no view). last_seen: timestamp (s) of the
+    last detection. detection: the id of the person of this frame's input it was matched to (None when missed).
+    position_sigma, speed_sigma: standard deviations of the position (m) and velocity (m/s) estimates along each
+    axis (a new track's velocity is unknown: ``TrackerParams.initial_speed_sigma``).
+    """
+
+    id: int
+    x: float
+    y: float
+    vx: float
+    vy: float
+    theta: float | None
+    state: MotionState
+    visible: bool
+    in_view: bool
+    last_seen: float
+    detection: int | None
+    position_sigma: float
+    speed_sigma: float
+
+    @property
+    def speed(self) -> float:
+        """|velocity| (m/s)."""
+        return math.hypot(self.vx, self.vy)
+
+    @property
+    def walking(self) -> bool:
+        return self.state == "walking"
+
+    def as_person(self) -> Person:
+        """The track as a per-frame ``Person`` (id = track id; orientation quality 1 when the facing is known)."""
+        return Person(self.id, self.x, self.y, self.theta, 0.0 if self.theta is None else 1.0)
+
+    def to_json(self) -> dict[str, Any]:
+        """The track as plain JSON (``sid detect``): id, x, y, theta, velocity [vx, vy], state, visible."""
+        return {
+            "id": self.id,
+            "x": round(self.x, 4),
+            "y": round(self.y, 4),
+            "theta": None if self.theta is None else round(self.theta, 4),
+            "velocity": [round(self.vx, 3), round(self.vy, 3)],
+            "state": self.state,
+            "visible": self.visible,
+        }
+
+
+@dataclass(frozen=True, eq=False)  # compared by identity: ``zone`` is an array
+class TrackedGroup:
+    """One confirmed group at the current frame.
+
+    id: the group track id, never reused. kind: "conversation" (an o-space: people standing and facing a common
+    point, found by ``sid.perception.groups.detect_groups``) or "walking" (people moving together, side by side or
+    in file; never an o-space). members: track ids (``TrackedPerson.id``), sorted. interest_point: the o-space centre
+    (conversation) or the members' centroid (walking), (x, y) in m. zone: the o-space polygon of the last frame the
+    group was detected in, (K, 2) counter-clockwise (empty for walking groups). area (m^2), spread (m): as in
+    ``Group``. velocity: the members' mean velocity (m/s). last_seen: timestamp (s) of the last detection.
+    """
+
+    id: int
+    kind: GroupKind
+    members: tuple[int, ...]
+    interest_point: tuple[float, float]
+    zone: np.ndarray
+    area: float
+    spread: float
+    velocity: tuple[float, float]
+    last_seen: float
+
+    def as_group(self) -> Group:
+        """The group as a per-frame ``Group`` whose members are track ids."""
+        return Group(self.members, self.interest_point, self.area, self.zone, self.spread)
+
+    def to_json(self) -> dict[str, Any]:
+        """The group as plain JSON (``sid detect``): id, kind, members (track ids), the geometry of ``sid groups``,
+        velocity [vx, vy]."""
+        return {
+            "id": self.id,
+            "kind": self.kind,
+            **group_json(self.as_group()),
+            "velocity": [round(self.velocity[0], 3), round(self.velocity[1], 3)],
+        }
+
+
+@dataclass(frozen=True)
+class Tracks:
+    """What the trackers hold at one frame: confirmed people and groups (``costmap.layer.LayerInputs.tracks``).
+
+    Every group member must be one of the people; ids are distinct.
+    """
+
+    people: Sequence[TrackedPerson] = ()
+    groups: Sequence[TrackedGroup] = ()
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "people", tuple(self.people))
+        object.__setattr__(self, "groups", tuple(self.groups))
+        ids = {p.id for p in self.people}
+        if len(ids) != len(self.people):
+            raise ValueError("tracks: a track id appears twice")
+        for group in self.groups:
+            missing = sorted(set(group.members) - ids)
+            if missing:
+                raise ValueError(f"tracks: group {group.id} has members {missing} that are not among the people")

@@ -1,0 +1,117 @@
+"""People and groups tracked over a stream of per-frame results, with the resets a moving robot needs.
+
+``TrackingSession.update(result, view)`` feeds one ``FrameResult`` (``sid.perception.pipeline``) to the people
+tracker and its tracks to the group tracker. Resets (documented, not errors): both trackers forget everything,
+and ``SessionUpdate.reset`` says why, when the robot pose jumps (moves faster than ``max_robot_speed`` or turns
+faster than ``max_turn_rate``, plus a tolerance: a relocalisation puts every track in the wrong place) or when the
+frame the results are given in changes (a pose that appears or disappears). Errors (``TrackingError``, nothing
+changed): a result not after the last one in time, a non-finite timestamp or robot pose.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+from sid.checks import check_number, check_numbers
+from sid.perception.groups import GroupParams
+from sid.perception.pipeline import FrameResult
+from sid.perception.robot_pose import RobotPose
+from sid.tracking.groups import GroupTracker, GroupTrackerParams
+from sid.tracking.records import TrackedGroup, TrackedPerson
+from sid.tracking.tracker import PeopleTracker, TrackerParams, TrackingError
+from sid.tracking.view import ViewCone
+
+
+@dataclass(frozen=True)
+class TrackingParams:
+    """The two trackers' parameters, and what counts as a jump of the robot pose: it moves more than
+    ``max_robot_speed`` (m/s) x dt + ``jump_tolerance`` (m), or turns more than ``max_turn_rate`` (rad/s) x dt +
+    ``yaw_tolerance`` (rad), between consecutive frames dt seconds apart."""
+
+    tracker: TrackerParams = field(default_factory=TrackerParams)
+    groups: GroupTrackerParams = field(default_factory=GroupTrackerParams)
+    max_robot_speed: float = 2.0
+    jump_tolerance: float = 0.3
+    max_turn_rate: float = 3.0
+    yaw_tolerance: float = 0.3
+
+    def __post_init__(self) -> None:
+        names = ("max_robot_speed", "jump_tolerance", "max_turn_rate", "yaw_tolerance")
+        check_numbers("tracking", self, names, low=0)
+
+
+@dataclass
+class SessionUpdate:
+    """Confirmed people and groups after one result, why the trackers were reset at it (None: they were not), and
+    the time (ms) the two trackers took ("track", "track_groups")."""
+
+    people: list[TrackedPerson]
+    groups: list[TrackedGroup]
+    reset: str | None
+    timing_ms: dict[str, float]
+
+
+class TrackingSession:
+    """People and group trackers over consecutive ``FrameResult``s. State lives between calls."""
+
+    def __init__(self, params: TrackingParams | None = None, group_params: GroupParams | None = None) -> None:
+        self.params = params or TrackingParams()
+        self.people = PeopleTracker(self.params.tracker)
+        self.groups = GroupTracker(self.params.groups, group_params)
+        self._last: tuple[float, str, RobotPose | None] | None = None  # timestamp, frame id and pose of the last
+
+    def reset(self) -> None:
+        """Forget every track and group (ids keep counting up) and the last frame."""
+        self.people.reset()
+        self.groups.reset()
+        self._last = None
+
+    def check(self, timestamp: float, pose: RobotPose | None, what: str = "frame") -> None:
+        """Raise TrackingError unless ``timestamp`` (s) is finite and after the last one, and ``pose`` (None allowed)
+        a finite RobotPose; ``what`` names the input in the message."""
+        check_number(what, "timestamp", timestamp, unit="seconds", error=TrackingError)
+        if self._last is not None and timestamp <= self._last[0]:
+            raise TrackingError(
+                f"{what} is out of time order: its timestamp {timestamp} s is not after the last one, {self._last[0]} s"
+            )
+        if pose is not None:
+            if not isinstance(pose, RobotPose):
+                raise TrackingError(f"{what}: robot_pose must be a RobotPose, got {type(pose).__name__}")
+            check_numbers(f"{what}: robot pose", pose, ("x", "y", "yaw"), error=TrackingError)
+
+    def update(self, result: FrameResult, view: ViewCone | None = None) -> SessionUpdate:
+        """Track the people and groups of ``result``; ``view``: the camera's field of view in ``result.frame_id``
+        (None: everything counts as in view)."""
+        self.check(result.timestamp, result.robot_pose, f"frame {result.frame}")
+        reset = self._reset_reason(result)
+        if reset is not None:
+            self.people.reset()
+            self.groups.reset()
+        self._last = (result.timestamp, result.frame_id, result.robot_pose)
+        t0 = time.perf_counter()
+        people = self.people.update(result.people, result.timestamp, view)
+        t1 = time.perf_counter()
+        groups = self.groups.update(people, result.timestamp)
+        t2 = time.perf_counter()
+        return SessionUpdate(people, groups, reset, {"track": (t1 - t0) * 1e3, "track_groups": (t2 - t1) * 1e3})
+
+    def _reset_reason(self, result: FrameResult) -> str | None:
+        """Why the tracks no longer hold at this result (None: they do)."""
+        if self._last is None:
+            return None
+        last_time, last_frame_id, last_pose = self._last
+        if result.frame_id != last_frame_id:
+            return f"positions changed from the {last_frame_id} frame to the {result.frame_id} frame"
+        pose = result.robot_pose
+        if pose is None or last_pose is None:
+            return None
+        p, dt = self.params, result.timestamp - last_time
+        moved = math.hypot(pose.x - last_pose.x, pose.y - last_pose.y)
+        turned = abs(math.remainder(pose.yaw - last_pose.yaw, math.tau))
+        if moved > p.max_robot_speed * dt + p.jump_tolerance:
+            return f"the robot pose jumped {moved:.2f} m in {dt:.3f} s"
+        if turned > p.max_turn_rate * dt + p.yaw_tolerance:
+            return f"the robot pose turned {turned:.2f} rad in {dt:.3f} s"
+        return None

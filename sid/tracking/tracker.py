@@ -1,0 +1,269 @@
+"""Multi-person tracking on the ground plane: stable ids, constant-velocity motion, standing / walking.
+
+Per frame (``PeopleTracker.update``): every track is predicted to the frame's timestamp (``sid.tracking.motion``);
+tracks not detected for longer than their timeout are deleted (``timeout`` in the camera's view,
+``out_of_view_timeout`` out of it: nobody looked there); detections are assigned to tracks by position alone with
+``scipy.optimize.linear_sum_assignment`` on the distance to each prediction, within a gate that grows with the
+track's uncertainty; matched tracks are corrected; a tentative track that is missed is deleted, and one detected
+``confirm_hits`` times is confirmed; every unmatched detection starts a tentative track. Facing is smoothed on the
+circle (an exponential average of unit vectors), and the state switches to walking above ``walk_speed`` and back
+to standing below ``stand_speed``.
+
+Only confirmed tracks are reported. Track ids count up from 1 and are never reused, also across ``reset``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+from sid.checks import check_number, check_numbers
+from sid.perception.people import Person
+from sid.tracking.motion import MotionStates
+from sid.tracking.records import TrackedPerson
+from sid.tracking.view import ViewCone
+
+
+class TrackingError(ValueError):
+    """Input a tracker cannot use: a frame out of time order, a non-finite position, an id given twice."""
+
+
+@dataclass(frozen=True)
+class TrackerParams:
+    """Parameters of ``PeopleTracker`` (metres, seconds, m/s; measured in docs/tracking.md).
+
+    measurement_sigma: noise of a detected position (m), per axis. acceleration_sigma: how hard people change
+    velocity (m/s^2, white-noise acceleration). initial_speed_sigma: the velocity uncertainty of a new track (m/s).
+    gate_sigmas, min_gate, max_gate: a detection may join a track when it lies within gate_sigmas standard
+    deviations of the prediction, bounded to [min_gate, max_gate] (m). confirm_hits: detections that confirm a
+    track. timeout: seconds a confirmed track in view survives without a detection; out_of_view_timeout: the same
+    outside the camera's view. walk_speed, stand_speed: speeds (m/s) above which a standing track walks and below
+    which a walking track stands (hysteresis). facing_tau: time constant (s) of the facing average. heading_gate: a
+    walking track faster than walk_speed, missed in the last frame, takes no detection facing more than this (rad) away
+    from its velocity.
+    """
+
+    measurement_sigma: float = 0.1
+    acceleration_sigma: float = 0.5
+    initial_speed_sigma: float = 1.0
+    gate_sigmas: float = 3.0
+    min_gate: float = 0.5
+    max_gate: float = 1.5
+    confirm_hits: int = 3
+    timeout: float = 1.0
+    out_of_view_timeout: float = 4.0
+    walk_speed: float = 0.5
+    stand_speed: float = 0.3
+    facing_tau: float = 0.3
+    heading_gate: float = 2.0
+
+    def __post_init__(self) -> None:
+        positive = ("measurement_sigma", "acceleration_sigma", "initial_speed_sigma", "gate_sigmas", "min_gate")
+        check_numbers("tracker", self, positive, low=0, low_open=True)
+        check_number("tracker", "max_gate", self.max_gate, low=self.min_gate, unit="metres")
+        check_numbers("tracker", self, ("timeout", "out_of_view_timeout", "facing_tau"), low=0, unit="seconds")
+        check_number("tracker", "heading_gate", self.heading_gate, low=0, high=math.pi, low_open=True, unit="radians")
+        check_number("tracker", "walk_speed", self.walk_speed, low=0, low_open=True, unit="m/s")
+        check_number("tracker", "stand_speed", self.stand_speed, low=0, high=self.walk_speed, unit="m/s")
+        if isinstance(self.confirm_hits, bool) or int(self.confirm_hits) != self.confirm_hits or self.confirm_hits < 1:
+            raise ValueError(f"tracker: confirm_hits must be a whole number >= 1, got {self.confirm_hits}")
+
+
+class PeopleTracker:
+    """Tracks people across frames (positions in one fixed frame, e.g. the map). State lives between calls."""
+
+    def __init__(self, params: TrackerParams | None = None) -> None:
+        self.params = params or TrackerParams()
+        self._next_id = 1
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget every track and the last timestamp (ids keep counting up)."""
+        self._time: float | None = None
+        self._motion = MotionStates()
+        self._ids = np.zeros(0, dtype=np.int64)
+        self._hits = np.zeros(0, dtype=np.int64)
+        self._confirmed = np.zeros(0, dtype=bool)
+        self._walking = np.zeros(0, dtype=bool)
+        self._last_hit = np.zeros(0)
+        self._facing = np.zeros((0, 2))  # unit vectors, NaN while unknown
+        self._detection = np.zeros(0, dtype=np.intp)  # index of this frame's matched detection, -1: none
+        self._in_view = np.zeros(0, dtype=bool)  # the predicted position lies in the camera's view
+
+    @property
+    def timestamp(self) -> float | None:
+        """Timestamp (s) of the last update, None before the first or after a reset."""
+        return self._time
+
+    def __len__(self) -> int:
+        """Tracks held, tentative ones included."""
+        return len(self._ids)
+
+    def update(self, people: Sequence[Person], timestamp: float, view: ViewCone | None = None) -> list[TrackedPerson]:
+        """Bring the tracks to the frame at ``timestamp`` (s) with its detected ``people``; the confirmed tracks.
+
+        ``view``: the camera's field of view in the same frame as the positions (None: everything is in view).
+        Raises TrackingError, changing nothing, when the timestamp is not after the last one, a position or a
+        facing is not finite, or two people share an id.
+        """
+        positions, facing, ids = _measurements(people)
+        check_number("tracker", "timestamp", timestamp, unit="seconds", error=TrackingError)
+        if self._time is not None and timestamp <= self._time:
+            raise TrackingError(
+                f"tracker: frames out of time order, timestamp {timestamp} s is not after the last one, {self._time} s"
+            )
+        p = self.params
+        r, q = p.measurement_sigma**2, p.acceleration_sigma**2
+        dt = 0.0 if self._time is None else timestamp - self._time
+        self._time = float(timestamp)
+        self._motion.predict(dt, q)
+        self._in_view = np.ones(len(self._ids), dtype=bool) if view is None else view.contains(self._motion.position)
+        self._keep(~self._expired(timestamp))
+        rows, cols = self._assign(positions, facing, r)
+        self._motion.correct(rows, positions[cols], r)
+        self._smooth_facing(rows, facing[cols], dt)
+        self._hits[rows] += 1
+        self._last_hit[rows] = timestamp
+        self._confirmed |= self._hits >= p.confirm_hits
+        self._detection[:] = -1
+        self._detection[rows] = cols
+        self._keep(self._confirmed | (self._detection >= 0))  # a tentative track dies at its first miss
+        if len(cols) < len(ids):
+            unmatched = np.ones(len(ids), dtype=bool)
+            unmatched[cols] = False
+            self._start(np.flatnonzero(unmatched), positions, facing, timestamp)
+        velocity, speed_sigma = self._motion.velocity, np.sqrt(self._motion.covariance[:, 2])
+        speed = np.sqrt(velocity[:, 0] ** 2 + velocity[:, 1] ** 2)
+        # a young track's velocity is mostly noise: it must exceed walk_speed by its own standard deviation
+        self._walking = np.where(self._walking, speed > p.stand_speed, speed - speed_sigma > p.walk_speed)
+        return self._report(ids)
+
+    def _expired(self, now: float) -> np.ndarray:
+        """(N,) bool: the tracks undetected for longer than their timeout (in view or out of it)."""
+        p = self.params
+        return now - self._last_hit > np.where(self._in_view, p.timeout, p.out_of_view_timeout)
+
+    def _assign(self, positions: np.ndarray, facing: np.ndarray, r: float) -> tuple[np.ndarray, np.ndarray]:
+        """Rows of tracks and columns of detections matched by minimum total distance, each within its gate.
+
+        A walking track faster than ``walk_speed`` that was missed in the last frame also refuses a detection facing
+        more than ``heading_gate`` away from its heading: walkers face where they go, and this keeps a track that
+        coasts out of view from taking over someone walking the other way into view where it left."""
+        if not len(self._ids) or not len(positions):
+            return np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp)
+        p = self.params
+        gate = np.clip(p.gate_sigmas * np.sqrt(self._motion.innovation_variance(r)), p.min_gate, p.max_gate)
+        d = self._motion.position[:, None, :] - positions[None, :, :]
+        distance = np.sqrt(d[..., 0] ** 2 + d[..., 1] ** 2)
+        allowed = distance <= gate[:, None]
+        velocity = self._motion.velocity
+        speed = np.sqrt(velocity[:, 0] ** 2 + velocity[:, 1] ** 2)
+        # coasting (missed in the last frame) walkers: one seen all along who turns round is still that person
+        striding = self._walking & (speed > p.walk_speed) & (self._detection < 0)
+        if striding.any():
+            heading = velocity[striding] / speed[striding, None]
+            turned = heading @ facing.T < math.cos(p.heading_gate)  # NaN facing: False, allowed
+            allowed[striding] &= ~turned
+        rows, cols = linear_sum_assignment(np.where(allowed, distance, _FORBIDDEN))
+        ok = allowed[rows, cols]
+        return rows[ok], cols[ok]
+
+    def _smooth_facing(self, rows: np.ndarray, measured: np.ndarray, dt: float) -> None:
+        """Average measured facings (K, 2) unit vectors (NaN: none) into the tracks ``rows`` on the unit circle."""
+        tau = self.params.facing_tau
+        weight = 1.0 - math.exp(-dt / tau) if tau > 0 else 1.0
+        old = self._facing[rows]
+        mixed = (1 - weight) * old + weight * measured
+        mixed = np.where(np.isnan(old), measured, np.where(np.isnan(measured), old, mixed))
+        norm = np.sqrt(mixed[:, 0] ** 2 + mixed[:, 1] ** 2)
+        flat = ~(norm > 1e-9)  # exactly opposite facings average to nothing: take the new one
+        mixed[flat] = measured[flat]
+        norm[flat] = 1.0
+        self._facing[rows] = mixed / norm[:, None]
+
+    def _start(self, cols: np.ndarray, positions: np.ndarray, facing: np.ndarray, timestamp: float) -> None:
+        """Tentative tracks for the detections ``cols``."""
+        k = len(cols)
+        p = self.params
+        self._motion.append(positions[cols], p.measurement_sigma**2, p.initial_speed_sigma**2)
+        self._ids = np.concatenate((self._ids, np.arange(self._next_id, self._next_id + k)))
+        self._next_id += k
+        self._hits = np.concatenate((self._hits, np.ones(k, dtype=np.int64)))
+        self._confirmed = np.concatenate((self._confirmed, np.full(k, p.confirm_hits <= 1)))
+        self._walking = np.concatenate((self._walking, np.zeros(k, dtype=bool)))
+        self._last_hit = np.concatenate((self._last_hit, np.full(k, timestamp)))
+        self._detection = np.concatenate((self._detection, cols))
+        self._in_view = np.concatenate((self._in_view, np.ones(k, dtype=bool)))  # just detected
+        self._facing = np.concatenate((self._facing, facing[cols]))
+
+    def _keep(self, mask: np.ndarray) -> None:
+        if mask.all():
+            return
+        self._motion.keep(mask)
+        self._ids, self._hits, self._confirmed = self._ids[mask], self._hits[mask], self._confirmed[mask]
+        self._walking, self._last_hit = self._walking[mask], self._last_hit[mask]
+        self._detection, self._facing, self._in_view = self._detection[mask], self._facing[mask], self._in_view[mask]
+
+    def _report(self, ids: list[int]) -> list[TrackedPerson]:
+        rows = np.flatnonzero(self._confirmed)
+        in_view = self._in_view[rows].tolist()
+        sigma = np.sqrt(self._motion.covariance[rows][:, [0, 2]]).tolist()
+        facing = self._facing[rows]
+        theta = [None if t != t else t for t in np.arctan2(facing[:, 1], facing[:, 0]).tolist()]  # NaN -> None
+        detection = self._detection[rows].tolist()
+        return [
+            TrackedPerson(
+                track_id,
+                x,
+                y,
+                vx,
+                vy,
+                th,
+                "walking" if walking else "standing",
+                d >= 0,
+                seen,
+                last,
+                ids[d] if d >= 0 else None,
+                sd[0],
+                sd[1],
+            )
+            for track_id, (x, y), (vx, vy), th, walking, d, seen, last, sd in zip(
+                self._ids[rows].tolist(),
+                self._motion.position[rows].tolist(),
+                self._motion.velocity[rows].tolist(),
+                theta,
+                self._walking[rows].tolist(),
+                detection,
+                in_view,
+                self._last_hit[rows].tolist(),
+                sigma,
+                strict=True,
+            )
+        ]
+
+
+_FORBIDDEN = 1e9  # the cost of a pair outside the gate (any real distance is far smaller)
+
+
+def _measurements(people: Sequence[Person]) -> tuple[np.ndarray, np.ndarray, list[int]]:
+    """Positions (N, 2) m, facings (N, 2) unit vectors (NaN: unknown) and ids of ``people``; TrackingError on bad
+    values."""
+    ids = [int(p.id) for p in people]
+    try:
+        positions = np.array([(p.x, p.y) for p in people], dtype=float).reshape(-1, 2)
+        theta = np.array([np.nan if p.theta is None else p.theta for p in people], dtype=float)
+        known = [p.theta is not None for p in people]
+    except (TypeError, ValueError):
+        positions, theta, known = np.full((len(people), 2), np.nan), np.full(len(people), np.nan), [True] * len(people)
+    if not (np.isfinite(positions).all() and np.isfinite(theta[known]).all()):
+        for person in people:  # name the first bad one
+            names = ("x", "y") if person.theta is None else ("x", "y", "theta")
+            check_numbers(f"tracker: person {person.id}", person, names, error=TrackingError)
+    if len(set(ids)) != len(ids):
+        twice = sorted({i for i in ids if ids.count(i) > 1})
+        raise TrackingError(f"tracker: person id {twice[0]} appears twice in one frame")
+    return positions, np.column_stack((np.cos(theta), np.sin(theta))), ids

@@ -1,0 +1,63 @@
+"""The camera's field of view on the ground: where the tracker can expect to see people.
+
+A track whose predicted position lies outside the view was not missed by the detector, it was not looked at, so
+the tracker keeps it longer (``TrackerParams.out_of_view_timeout``) than one missed in plain view.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from sid.checks import check_number, check_numbers
+from sid.perception.camera import Calibration
+from sid.perception.mount import CameraMount
+from sid.perception.robot_pose import RobotPose
+
+
+@dataclass(frozen=True)
+class ViewCone:
+    """A horizontal field of view on the ground: apex (x, y) in m, optical-axis yaw and full opening ``fov`` in rad,
+    and the range (m) beyond which people are not expected to be detected. Same frame as the tracked positions."""
+
+    x: float
+    y: float
+    yaw: float
+    fov: float
+    max_range: float = 8.0
+
+    def __post_init__(self) -> None:
+        check_numbers("view", self, ("x", "y", "yaw"))
+        check_number("view", "fov", self.fov, low=0, high=2 * math.pi, low_open=True, unit="radians")
+        check_number("view", "max_range", self.max_range, low=0, low_open=True, allow_inf=True, unit="metres")
+
+    def contains(self, points: np.ndarray) -> np.ndarray:
+        """(N,) bool: which of the (N, 2) points lie inside the cone."""
+        d = np.asarray(points, dtype=float).reshape(-1, 2) - (self.x, self.y)
+        distance = np.sqrt(d[:, 0] ** 2 + d[:, 1] ** 2)
+        along = d[:, 0] * math.cos(self.yaw) + d[:, 1] * math.sin(self.yaw)  # cos(off-axis angle) * distance
+        return (along >= distance * math.cos(self.fov / 2)) & (distance <= self.max_range)
+
+
+def camera_fov(calibration: Calibration, mount: CameraMount) -> tuple[float, float]:
+    """(yaw of the optical axis, horizontal opening) of the colour camera seen from above, in the mount's ground
+    frame (rad): bounded by the image's left and right edges on the principal row."""
+    color = calibration.color
+    edges = np.array([[-0.5 - color.cx, 0.0, color.fx], [color.width - 0.5 - color.cx, 0.0, color.fx]])
+    world = edges @ mount.rotation.T
+    left, right = np.arctan2(world[:, 1], world[:, 0])
+    return float(left + right) / 2, float(left - right)
+
+
+def camera_view_cone(
+    calibration: Calibration, mount: CameraMount, pose: RobotPose | None = None, max_range: float = 6.0
+) -> ViewCone:
+    """The colour camera's field of view on the ground, up to ``max_range`` (m): in the map when the robot's
+    ``pose`` is given, else in base_footprint."""
+    yaw, fov = camera_fov(calibration, mount)
+    x, y = mount.x, mount.y
+    if pose is not None:
+        (x, y), yaw = pose.to_map(np.array([x, y]))[0].tolist(), pose.yaw_to_map(yaw)
+    return ViewCone(x, y, yaw, fov, max_range)

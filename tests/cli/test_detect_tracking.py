@@ -1,0 +1,42 @@
+"""``sid detect`` with tracking (the default) and with ``--no-tracking``."""
+
+from __future__ import annotations
+
+import json
+
+from sid.cli import main
+
+
+def _lines(text: str) -> list[dict]:
+    return [json.loads(line) for line in text.splitlines() if line.startswith("{")]
+
+
+def test_detect_reports_tracks_with_stable_ids_velocities_and_groups(capsys) -> None:
+    assert main(["detect", "--source", "synthetic:S1", "--frames", "14", "--no-keypoints"]) == 0
+    records = _lines(capsys.readouterr().out)
+    assert len(records) == 14 and all(r["frame_id"] == "base_footprint" for r in records)
+    assert records[0]["people"] == []  # a track is reported from its third detection on
+    ids = [sorted(p["id"] for p in r["people"]) for r in records[2:]]
+    assert all(i == ids[0] for i in ids) and len(ids[0]) == 2
+    person = records[-1]["people"][0]
+    assert set(person) == {"id", "x", "y", "theta", "velocity", "state", "visible"}
+    assert person["state"] == "standing" and len(person["velocity"]) == 2 and person["visible"]
+    (group,) = records[-1]["groups"]
+    assert group["kind"] == "conversation" and group["members"] == ids[0]
+    assert {"id", "interest_point", "zone", "velocity"} <= group.keys()
+    assert len({r["groups"][0]["id"] for r in records if r["groups"]}) == 1
+    assert {"track", "track_groups"} <= records[-1]["timing_ms"].keys()
+
+
+def test_detect_keeps_each_persons_keypoints_from_the_matched_detection(capsys) -> None:
+    assert main(["detect", "--source", "synthetic:S1", "--frames", "4"]) == 0
+    record = _lines(capsys.readouterr().out)[-1]
+    assert all(len(p["keypoints"]) == 17 for p in record["people"])
+
+
+def test_no_tracking_gives_each_frames_own_detections(capsys) -> None:
+    assert main(["detect", "--source", "synthetic:S1", "--frames", "2", "--no-tracking", "--no-keypoints"]) == 0
+    records = _lines(capsys.readouterr().out)
+    for record in records:
+        assert sorted(p["id"] for p in record["people"]) == [0, 1]
+        assert "velocity" not in record["people"][0] and "id" not in record["groups"][0]

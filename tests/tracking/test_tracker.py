@@ -1,0 +1,201 @@
+"""PeopleTracker on detection sequences generated here (positions in metres, one fixed frame)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from sid.perception.people import Person
+from sid.tracking import PeopleTracker, TrackerParams, TrackingError, ViewCone
+
+FPS = 15.0
+
+
+def _frames(seconds: float, noise: float = 0.05, seed: int = 0) -> list[tuple[float, list[Person]]]:
+    """Two people standing 3 m apart facing each other, and a walker crossing between them at 1.2 m/s (+y)."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for k in range(int(seconds * FPS)):
+        t = k / FPS
+        truth = [(3.0, -1.5, math.pi / 2), (3.0, 1.5, -math.pi / 2), (4.0, -3.0 + 1.2 * t, math.pi / 2)]
+        order = rng.permutation(3)  # detection order (and so detection ids) changes every frame
+        people = [
+            Person(int(i), x + rng.normal(0, noise), y + rng.normal(0, noise), theta + rng.normal(0, 0.1))
+            for i, (x, y, theta) in zip(range(3), (truth[j] for j in order), strict=True)
+        ]
+        out.append((t, people))
+    return out
+
+
+def _by_truth(people: list[Person]) -> dict[int, Person]:
+    """Detections keyed by which truth person they show (nearest of the three truth paths' x, y signs)."""
+    return {(0 if p.x < 3.5 and p.y < 0 else 1 if p.x < 3.5 else 2): p for p in people}
+
+
+def test_ids_stay_stable_and_states_and_velocities_are_right() -> None:
+    tracker = PeopleTracker()
+    seen: dict[int, set[int]] = {0: set(), 1: set(), 2: set()}
+    for t, people in _frames(4.0):
+        tracks = tracker.update(people, t)
+        if t < 1.0:
+            continue
+        assert len(tracks) == 3
+        truth_of = {p.id: k for k, p in _by_truth(people).items()}
+        for track in tracks:
+            assert track.visible and track.detection is not None
+            seen[truth_of[track.detection]].add(track.id)
+            if truth_of[track.detection] == 2:
+                assert track.state == "walking"
+                assert track.vy == pytest.approx(1.2, abs=0.25) and abs(track.vx) < 0.25
+            else:
+                assert track.state == "standing" and track.speed < 0.3
+    assert all(len(ids) == 1 for ids in seen.values()), seen
+    assert len(set.union(*seen.values())) == 3
+
+
+def test_a_track_is_reported_from_its_kth_detection_and_a_single_blip_never() -> None:
+    tracker = PeopleTracker(TrackerParams(confirm_hits=3))
+    counts = [len(tracker.update([Person(0, 2.0, 0.0)], k / FPS)) for k in range(4)]
+    assert counts == [0, 0, 1, 1]
+    blip = PeopleTracker()
+    assert blip.update([Person(0, 2.0, 0.0)], 0.0) == []
+    for k in range(1, 10):
+        assert blip.update([], k / FPS) == []
+    assert len(blip) == 0
+
+
+def _confirmed(tracker: PeopleTracker, x: float, y: float, frames: int = 5) -> float:
+    for k in range(frames):
+        tracker.update([Person(0, x, y)], k / FPS)
+    return (frames - 1) / FPS
+
+
+def test_a_missed_track_in_view_lives_until_the_timeout() -> None:
+    tracker = PeopleTracker(TrackerParams(timeout=1.0))
+    t0 = _confirmed(tracker, 2.0, 0.0)
+    view = ViewCone(0.0, 0.0, 0.0, math.radians(90))
+    alive = [(k / FPS, bool(tracker.update([], t0 + k / FPS, view))) for k in range(1, 30)]
+    assert all(alive_ for dt, alive_ in alive if dt <= 1.0)
+    assert not any(alive_ for dt, alive_ in alive if dt > 1.0 + 1e-9)
+
+
+def test_people_who_leave_the_view_are_kept_longer_and_keep_their_id() -> None:
+    params = TrackerParams(timeout=0.5, out_of_view_timeout=3.0)
+    tracker = PeopleTracker(params)
+    view = ViewCone(0.0, 0.0, 0.0, math.radians(60))
+    t0 = _confirmed(tracker, 2.0, 2.0)  # 45 degrees to the left: outside the 60-degree view
+    (first,) = tracker.update([Person(0, 2.0, 2.0)], t0 + 1 / FPS, view)
+    assert not first.in_view
+    t = t0 + 1 / FPS
+    for k in range(1, int(2.0 * FPS)):  # 2 s unseen, out of view: kept
+        (track,) = tracker.update([], t + k / FPS, view)
+        assert track.id == first.id and not track.visible
+    (back,) = tracker.update([Person(5, 2.05, 1.95)], t + 2.0, view)
+    assert back.id == first.id and back.visible and back.detection == 5
+    for k in range(1, int(3.5 * FPS)):
+        last = tracker.update([], t + 2.0 + k / FPS, view)
+    assert last == []
+
+
+def test_facing_is_smoothed_on_the_circle() -> None:
+    tracker = PeopleTracker()
+    tracks = []
+    for k in range(20):
+        theta = math.pi - 0.05 if k % 2 else -math.pi + 0.05  # both near pi: a plain mean would give 0
+        tracks = tracker.update([Person(0, 2.0, 0.0, theta)], k / FPS)
+    (track,) = tracks
+    assert track.theta is not None
+    assert abs(math.remainder(track.theta - math.pi, math.tau)) < 0.05
+
+
+def test_unknown_facing_stays_unknown_until_measured() -> None:
+    tracker = PeopleTracker()
+    for k in range(4):
+        tracks = tracker.update([Person(0, 2.0, 0.0, None)], k / FPS)
+    assert tracks[0].theta is None
+    (track,) = tracker.update([Person(0, 2.0, 0.0, 1.0)], 4 / FPS)
+    assert track.theta == pytest.approx(1.0)
+
+
+def test_frames_out_of_time_order_are_refused_and_change_nothing() -> None:
+    tracker = PeopleTracker()
+    t = _confirmed(tracker, 2.0, 0.0)
+    for bad in (t, t - 0.5, math.nan):
+        with pytest.raises(TrackingError, match="timestamp"):
+            tracker.update([Person(0, 2.0, 0.0)], bad)
+    assert tracker.timestamp == t
+    (track,) = tracker.update([Person(0, 2.0, 0.0)], t + 1 / FPS)
+    assert track.id == 1
+
+
+@pytest.mark.parametrize(
+    ("people", "message"),
+    [
+        ([Person(0, math.nan, 0.0)], "person 0: x must be a finite number"),
+        ([Person(3, 1.0, 0.0, math.inf)], "person 3: theta must be a finite number"),
+        ([Person(1, 1.0, 0.0), Person(1, 3.0, 0.0)], "person id 1 appears twice"),
+    ],
+)
+def test_bad_detections_are_refused_naming_the_problem(people: list[Person], message: str) -> None:
+    tracker = PeopleTracker()
+    with pytest.raises(TrackingError, match=message):
+        tracker.update(people, 0.0)
+    assert len(tracker) == 0 and tracker.timestamp is None
+
+
+def test_empty_frames_age_the_tracks() -> None:
+    tracker = PeopleTracker(TrackerParams(timeout=0.2))
+    t = _confirmed(tracker, 2.0, 0.0)
+    assert len(tracker.update([], t + 0.1)) == 1
+    assert tracker.update([], t + 0.3) == []
+
+
+def test_ids_are_never_reused_also_after_a_reset() -> None:
+    tracker = PeopleTracker()
+    _confirmed(tracker, 2.0, 0.0)
+    first = tracker.update([Person(0, 2.0, 0.0)], 1.0)[0].id
+    tracker.reset()
+    assert tracker.timestamp is None and len(tracker) == 0
+    _confirmed(tracker, 2.0, 0.0)
+    assert tracker.update([Person(0, 2.0, 0.0)], 1.0)[0].id > first
+
+
+def test_parameters_are_checked() -> None:
+    with pytest.raises(ValueError, match="stand_speed"):
+        TrackerParams(walk_speed=0.3, stand_speed=0.5)
+    with pytest.raises(ValueError, match="confirm_hits"):
+        TrackerParams(confirm_hits=0)
+    with pytest.raises(ValueError, match="max_gate"):
+        TrackerParams(min_gate=1.0, max_gate=0.5)
+
+
+def test_the_view_cone_contains_what_it_should() -> None:
+    view = ViewCone(1.0, 1.0, math.pi / 2, math.radians(90), max_range=5.0)
+    inside = view.contains(np.array([[1.0, 3.0], [1.5, 2.5], [1.0, 0.0], [1.0, 7.0], [3.0, 1.5]]))
+    assert inside.tolist() == [True, True, False, False, False]
+
+
+def test_a_walker_track_does_not_take_over_someone_walking_the_other_way() -> None:
+    tracker = PeopleTracker()
+    for k in range(15):  # walking +y at 1.2 m/s, facing +y
+        (first,) = tracker.update([Person(0, 3.0, -1.0 + 1.2 * k / FPS, math.pi / 2)], k / FPS) or [None]
+    assert first is not None and first.walking
+    t = 14 / FPS
+    tracker.update([], t + 1 / FPS)  # missed once: the track coasts on
+    x, y = 3.0, -1.0 + 1.2 * (t + 2 / FPS)
+    tracks = tracker.update([Person(0, x, y, -math.pi / 2)], t + 2 / FPS)  # someone there walking the other way
+    assert [p.id for p in tracks] == [first.id] and not tracks[0].visible
+
+
+def test_a_walker_who_stops_and_turns_round_keeps_the_id() -> None:
+    tracker = PeopleTracker()
+    y = -1.0
+    for k in range(40):
+        speed = max(0.0, 1.2 - 2.0 * max(0.0, k / FPS - 1.0))  # walks 1 s, then slows down to a stop in 0.6 s
+        y += speed / FPS
+        theta = math.pi / 2 if speed > 0 else -math.pi / 2  # turns round once stopped
+        tracks = tracker.update([Person(0, 3.0, y, theta)], k / FPS)
+    (track,) = tracks
+    assert track.id == 1 and track.state == "standing" and track.visible
