@@ -1,0 +1,153 @@
+"""``sid simulate SCENE [--out DIR]``: drive a simulated robot with its camera and LiDAR in the loop past people,
+with or without the social layer; ``--sweep SCENE... --seeds K`` runs many and summarises them. See
+docs/simulate.md."""
+
+from __future__ import annotations
+
+import argparse
+import shlex
+import sys
+import time
+from pathlib import Path
+
+from sid.cli.common import (
+    INPUT_ERRORS,
+    add_planner_option,
+    check_output_folder,
+    fail,
+    print_written,
+    staged_output,
+)
+from sid.experiments.progress import ProgressBar
+from sid.experiments.simulate.loop import PERCEPTIONS, RunOptions
+from sid.experiments.simulate.scenes import SCENE_ORDER, load_scene, scene_list
+
+RUN_FILES = ("run.json", "run.mp4", "run.gif")
+"""The files one run writes into --out (run.gif with --gif): an earlier run's are replaced or removed."""
+SWEEP_FILES = ("simulate.md", "simulate.json", "simulate.png")
+"""The files a sweep writes into --out."""
+
+SUMMARY_KEYS = (
+    "success",
+    "reason",
+    "collisions",
+    "time_to_goal_s",
+    "path_length_m",
+    "min_person_distance_m",
+    "ospace_intrusion_m",
+    "crosses_group",
+    "replans",
+)
+
+
+def _seed(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if not 0 <= value < 2**31:
+        raise argparse.ArgumentTypeError(f"expected a whole number from 0 to {2**31 - 1}, got {text!r}")
+    return value
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "simulate",
+        help="drive a simulated robot past people with perception in the loop, with or without the social layer",
+        description=__doc__.replace("``", ""),
+    )
+    parser.add_argument("scene", nargs="?", help=f"a built-in scene ({', '.join(SCENE_ORDER)}) or a scenario file")
+    parser.add_argument("--out", default=None, help="output folder for run.json and run.mp4 (sweeps: the report)")
+    parser.add_argument("--no-social", action="store_true", help="the robot without recognition (LiDAR + inflation)")
+    add_planner_option(parser)
+    parser.set_defaults(planner="grid")
+    parser.add_argument(
+        "--seed", type=_seed, default=0, metavar="N",
+        help="0: the scene as written (default); N >= 1: people jittered by 5 cm / 5 deg, and the sensor noise, from N",
+    )  # fmt: skip
+    parser.add_argument("--model", default=None, metavar="M.onnx", help="a pose model instead of TruthPose")
+    parser.add_argument(
+        "--perception", choices=PERCEPTIONS, default="camera",
+        help="camera: rendered frames through the real pipeline and trackers (default); exact: true poses of the "
+        "people in view",
+    )  # fmt: skip
+    parser.add_argument("--unknown-map", action="store_true", help="no known map: the LiDAR discovers obstacles too")
+    parser.add_argument("--gif", action="store_true", help="also write run.gif (half size, every other frame)")
+    parser.add_argument("--list", action="store_true", help="list the built-in scenes and exit")
+    sweep = parser.add_argument_group("sweeps")
+    sweep.add_argument("--sweep", nargs="+", default=None, metavar="SCENE", help="scenes (or 'all') to sweep")
+    sweep.add_argument("--seeds", type=int, default=5, metavar="K", help="seeds per scene and mode (5)")
+    sweep.add_argument("--workers", type=int, default=1, metavar="N", help="parallel worker processes (1)")
+    sweep.add_argument(
+        "--ray", default=None, metavar="ADDRESS",
+        help="run on a Ray cluster ('local' starts one here, 'auto' joins a running head); needs sid[cluster]",
+    )  # fmt: skip
+    parser.set_defaults(func=run)
+
+
+def _options(args: argparse.Namespace) -> RunOptions:
+    return RunOptions(
+        social=not args.no_social,
+        planner=args.planner,
+        seed=args.seed,
+        model=None if args.model is None else Path(args.model),
+        perception=args.perception,
+        unknown_map=args.unknown_map,
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.list:
+        for name, description in scene_list():
+            print(f"{name:10s} {description}")
+        return 0
+    if args.sweep:
+        return _sweep(args)
+    if args.scene is None:
+        return fail("sid simulate", ValueError("give a scene (see --list), or --sweep SCENE..."))
+    from sid.experiments.simulate.run import write_run
+
+    try:
+        options = _options(args)
+        if args.model is not None and not Path(args.model).is_file():
+            raise ValueError(f"--model {args.model}: no such file")
+        out = None if args.out is None else check_output_folder(args.out)
+        world = load_scene(args.scene)
+        if out is None:
+            record = write_run(world, options, None, gif=args.gif, progress=ProgressBar("simulate"))
+        else:  # whole files only, even when interrupted; an earlier run's files go
+            with staged_output(out, RUN_FILES) as staged:
+                record = write_run(world, options, staged.path, gif=args.gif, progress=ProgressBar("simulate"))
+    except (*INPUT_ERRORS, OSError) as exc:
+        return fail("sid simulate", exc)
+    for key in SUMMARY_KEYS:
+        value = record[key]
+        print(f"{key:22s} {round(value, 3) if isinstance(value, float) else value}")
+    if out is not None:
+        print_written(out / name for name in ("run.json", "run.mp4", *(("run.gif",) if args.gif else ())))
+    return 0 if record["success"] else 1
+
+
+def _sweep(args: argparse.Namespace) -> int:
+    from sid.experiments.simulate.report import sweep_markdown, write_sweep_report
+    from sid.experiments.simulate.sweep import run_sweep, sweep_jobs
+
+    scenes = list(SCENE_ORDER) if args.sweep == ["all"] else args.sweep
+    command = "sid " + " ".join(shlex.quote(a) for a in sys.argv[1:]) if sys.argv[1:] else "sid simulate"
+    try:
+        options = _options(args)
+        if args.out is not None:
+            check_output_folder(args.out)
+        jobs = sweep_jobs(scenes, args.seeds, options)
+        executor = f"Ray at {args.ray}" if args.ray else f"{args.workers} worker process(es)"
+        start = time.perf_counter()
+        records = run_sweep(jobs, args.workers, args.ray, ProgressBar("sweep"))
+        wall = time.perf_counter() - start
+        print(sweep_markdown(records, command, wall, executor))
+        if args.out is not None:
+            with staged_output(args.out, SWEEP_FILES) as staged:
+                written = write_sweep_report(records, staged.path, command, wall, executor).values()
+            print_written(staged.final(path) for path in written)
+    except (*INPUT_ERRORS, OSError) as exc:
+        return fail("sid simulate", exc)
+    return 0

@@ -1,0 +1,58 @@
+"""The metrics of a driven run, measured on the trajectory against the people and groups where they truly were at
+each step (the groups ``sid.perception.groups.detect_groups`` finds on the exact positions, as in
+``sid.experiments.harness``), whatever the robot saw.
+
+Each step's segment (from the robot's position at t to its position at t + dt) is measured with ``planner.metrics``
+against the people and groups of time t: length inside any group's interaction zone (``ospace_intrusion_m``,
+summed), whether it crosses the segment between two members (``crosses_group``), and its distance to every person's
+centre (``min_person_distance_m``: the smallest over the run). Map frame, metres, seconds.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from shapely.geometry import LineString
+from shapely.ops import unary_union
+
+from planner.metrics import PERSONAL_DISTANCE_M, crosses_group, group_zones, min_distance_to_points, path_length
+from sid.experiments.simulate.loop import RunTrace
+
+
+def run_metrics(trace: RunTrace, straight_m: float) -> dict:
+    """The run's record (JSON-ready): outcome, social metrics, replans, planning time and the trajectory.
+
+    ``straight_m``: straight-line distance from start to goal (m), for ``length_ratio``.
+    """
+    trajectory = np.array(trace.trajectory, dtype=float).reshape(-1, 4)
+    xy = trajectory[:, 1:3]
+    intrusion, crosses, nearest, personal = 0.0, False, math.inf, 0
+    for i, (people, groups) in enumerate(trace.truth):
+        segment = xy[i : i + 2]
+        positions = np.array([(p.x, p.y) for p in people], dtype=float).reshape(-1, 2)
+        distance = min_distance_to_points(segment, positions)
+        nearest = min(nearest, distance)
+        personal += distance < PERSONAL_DISTANCE_M
+        if groups and len(segment) == 2:
+            zones = unary_union(group_zones(people, groups))
+            intrusion += float(LineString(segment).intersection(zones).length)
+            crosses = crosses or crosses_group(segment, people, groups)
+    length = path_length(xy)
+    return {
+        "success": trace.success,
+        "reason": trace.reason,
+        "collisions": trace.collisions,
+        "time_to_goal_s": round(trace.time_s, 3) if trace.success else None,
+        "time_s": round(trace.time_s, 3),
+        "path_length_m": length,
+        "length_ratio": length / straight_m if trace.success and straight_m > 0 else None,
+        "min_person_distance_m": nearest if math.isfinite(nearest) else None,
+        "ospace_intrusion_m": intrusion,
+        "crosses_group": crosses,
+        "personal_space_fraction": personal / max(len(trace.truth), 1),
+        "replans": trace.replans,
+        "plans": trace.plans,
+        "planning_time_s": trace.planning_time_s,
+        "trajectory": [[round(v, 4) for v in row] for row in trace.trajectory],
+    }

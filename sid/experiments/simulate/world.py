@@ -1,0 +1,154 @@
+"""The simulated world: a scenario (map, obstacles, people and their scripted walks, robot task), the robot's limits and
+the run's settings, read from one scenario file; and the ground-truth geometry the simulation measures against.
+
+A simulation file is a scenario file (docs/scenario.md: people may walk along ``people[i].path``) with one more,
+optional block, ``simulation``: ``max_speed`` (m/s, 0.5), ``max_turn_rate`` (rad/s, 1.5), ``max_accel`` (m/s^2,
+1.0), ``time_limit_s`` (60), ``rate_hz`` (10), ``goal_tolerance_m`` (0.25), ``description`` (text for ``--list``).
+
+Seeds (``jittered``): seed 0 is the scene as written; seed k >= 1 moves every standing person by Gaussian jitter of
+``JITTER_XY_M`` and turns them by ``JITTER_THETA_RAD`` (drawn from ``[k, 7]``), so that sweeps over seeds see
+slightly different conversations, as real people never stand twice alike.
+
+World frame = the map frame (REP-103), metres, radians, seconds.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from shapely.geometry import LineString, Point, Polygon
+from shapely.ops import unary_union
+
+from sid.documents import is_number, load_document
+from sid.experiments.simulate.robot import DriveLimits
+from sid.perception.people import Person
+from sid.scenario.loader import Scenario, ScenarioError, scenario_from_dict
+from sid.scenario.obstacles import BoxObstacle, CircleObstacle, Obstacle
+
+JITTER_XY_M = 0.05
+JITTER_THETA_RAD = math.radians(5.0)
+SIM_FIELDS = ("max_speed", "max_turn_rate", "max_accel", "time_limit_s", "rate_hz", "goal_tolerance_m", "description")
+
+
+@dataclass(frozen=True)
+class SimSettings:
+    """Per-scene settings of a run: the robot's limits, time limit (s), control rate (Hz), goal tolerance (m)."""
+
+    limits: DriveLimits = field(default_factory=DriveLimits)
+    time_limit_s: float = 60.0
+    rate_hz: float = 10.0
+    goal_tolerance_m: float = 0.25
+    description: str = ""
+
+
+@dataclass
+class SimWorld:
+    """A scenario (``people`` at time 0, ``walks``: their scripted motion) and the run's settings."""
+
+    scenario: Scenario
+    settings: SimSettings
+
+    def people_at(self, t: float) -> list[Person]:
+        """Every person's true pose at time ``t`` (s): standing, or walking and facing the way they go."""
+        people = []
+        for p in self.scenario.people:
+            if p.id not in self.scenario.walks:
+                people.append(p)
+                continue
+            state = self.scenario.walks[p.id].at(t)
+            people.append(Person(p.id, state.x, state.y, state.yaw, 0.0 if state.yaw is None else 1.0))
+        return people
+
+
+def jittered(world: SimWorld, seed: int) -> SimWorld:
+    """The world of ``seed`` (see the module docstring): the same world for seed 0."""
+    if seed == 0:
+        return world
+    rng = np.random.default_rng([seed, 7])
+    people = []
+    for p in world.scenario.people:
+        dx, dy, turn = rng.normal(0.0, [JITTER_XY_M, JITTER_XY_M, JITTER_THETA_RAD])
+        if p.id in world.scenario.walks:
+            people.append(p)
+            continue
+        theta = None if p.theta is None else math.remainder(p.theta + turn, math.tau)
+        people.append(Person(p.id, p.x + dx, p.y + dy, theta, p.orientation_quality))
+    return SimWorld(replace(world.scenario, people=people), world.settings)
+
+
+def _fail(name: str, expected: str, value: Any) -> ScenarioError:
+    return ScenarioError(f"{name}: expected {expected}, got {value!r}")
+
+
+def _settings(data: Any) -> SimSettings:
+    if not isinstance(data, dict):
+        raise _fail("simulation", "a mapping", data)
+    unknown = sorted(set(data) - set(SIM_FIELDS))
+    if unknown:
+        raise ScenarioError(f"simulation.{unknown[0]}: unknown field; known fields: {', '.join(SIM_FIELDS)}")
+    for key, value in data.items():
+        if key != "description" and (not is_number(value) or value <= 0):
+            raise _fail(f"simulation.{key}", "a positive number", value)
+    description = data.get("description", "")
+    if not isinstance(description, str):
+        raise _fail("simulation.description", "a string", description)
+    limits = {k: float(data[k]) for k in ("max_speed", "max_turn_rate", "max_accel") if k in data}
+    numbers = {k: float(data[k]) for k in ("time_limit_s", "rate_hz", "goal_tolerance_m") if k in data}
+    return SimSettings(limits=DriveLimits(**limits), description=description, **numbers)
+
+
+def world_from_dict(data: Any, base_dir: Path | None = None, default_name: str = "scenario") -> SimWorld:
+    """A SimWorld from a parsed simulation file (see the module docstring); errors name the field."""
+    if not isinstance(data, dict):
+        raise _fail("scenario", "a mapping", data)
+    data = copy.deepcopy(data)
+    settings = _settings(data.pop("simulation", {}))
+    scenario = scenario_from_dict(data, base_dir, default_name)
+    return SimWorld(scenario, replace(settings, limits=replace(settings.limits, radius=scenario.robot.radius)))
+
+
+def load_world(path: str | Path) -> SimWorld:
+    """Read a simulation (or plain scenario) file; errors name the file and the field."""
+    path = Path(path)
+    try:
+        data = load_document(path, "scenario file")
+    except ValueError as exc:
+        raise ScenarioError(str(exc)) from None
+    try:
+        return world_from_dict(data, base_dir=path.parent, default_name=path.stem)
+    except ScenarioError as exc:
+        raise ScenarioError(f"{path}: {exc}") from exc
+
+
+# --- ground-truth geometry -------------------------------------------------------------------------------------
+
+
+def obstacle_geometry(obstacles: list[Obstacle]) -> Any:
+    """The declared obstacles as one shapely geometry (walls as lines, boxes and circles as areas)."""
+    shapes: list[Any] = []
+    for ob in obstacles:
+        if isinstance(ob, BoxObstacle):
+            (x0, y0), (x1, y1) = ob.min, ob.max
+            shapes.append(Polygon([(x0, y0), (x1, y0), (x1, y1), (x0, y1)]))
+        elif isinstance(ob, CircleObstacle):
+            shapes.append(Point(ob.center).buffer(ob.radius, 64))
+        else:
+            shapes.append(LineString(ob.points))
+    return unary_union(shapes) if shapes else None
+
+
+def collision(
+    xy: tuple[float, float], radius: float, obstacles: Any, people: list[Person], body_radius: float
+) -> str | None:
+    """What the robot's disc (centre ``xy``, ``radius``) overlaps: "obstacle", "person N", or None."""
+    if obstacles is not None and obstacles.distance(Point(xy)) < radius:
+        return "obstacle"
+    for p in people:
+        if math.hypot(p.x - xy[0], p.y - xy[1]) < radius + body_radius:
+            return f"person {p.id}"
+    return None

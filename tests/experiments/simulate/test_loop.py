@@ -1,0 +1,82 @@
+"""Closed-loop runs on small worlds (exact perception unless the test is about the camera; a few seconds each)."""
+
+import copy
+
+import pytest
+
+from sid.experiments.simulate.loop import RunOptions, simulate
+from sid.experiments.simulate.metrics import run_metrics
+from sid.experiments.simulate.world import world_from_dict
+from tests.experiments.simulate.tiny import TINY, tiny_world
+
+EXACT = RunOptions(perception="exact")
+
+
+def test_with_the_social_layer_the_robot_goes_around_the_pair_and_without_it_cuts_through():
+    world = tiny_world()
+    with_ = run_metrics(simulate(world, EXACT), 4.0)
+    without = run_metrics(simulate(world, RunOptions(social=False)), 4.0)
+    for run in (with_, without):
+        assert run["success"] and run["collisions"] == 0
+        assert run["trajectory"][0][1:3] == [0.0, 0.0]
+    assert with_["ospace_intrusion_m"] == 0.0 and not with_["crosses_group"]
+    assert without["ospace_intrusion_m"] > 0.5 and without["crosses_group"]
+    assert with_["min_person_distance_m"] > without["min_person_distance_m"]
+    assert with_["time_to_goal_s"] <= 10.0
+
+
+def test_a_start_inside_an_obstacle_ends_at_once_with_the_reason():
+    world = tiny_world(obstacles=[*TINY["obstacles"], {"type": "box", "min": [-0.3, -0.3], "max": [0.3, 0.3]}])
+    trace = simulate(world, EXACT)
+    assert not trace.success and trace.time_s == 0.0
+    assert "start" in trace.reason and "in collision" in trace.reason
+
+
+def test_an_unreachable_goal_ends_at_once_with_the_reason():
+    wall = {"type": "segment", "points": [[3.5, -2.0], [3.5, 2.0]]}
+    trace = simulate(tiny_world(obstacles=[*TINY["obstacles"], wall]), EXACT)
+    assert not trace.success and trace.time_s == 0.0
+    assert "separate free regions" in trace.reason
+
+
+def test_people_blocking_the_corridor_for_good_end_at_the_time_limit():
+    people = [{"id": i + 1, "x": 2.0, "y": y, "theta": 3.1416} for i, y in enumerate((-1.35, -0.45, 0.45, 1.35))]
+    trace = simulate(tiny_world(people=people, simulation={"time_limit_s": 2.0}), RunOptions(social=False))
+    assert not trace.success and trace.collisions == 0
+    assert trace.time_s == pytest.approx(2.0)
+    assert trace.reason.startswith("time limit (2 s) reached: no path")
+
+
+def test_the_unknown_map_is_discovered_by_the_lidar():
+    box = {"type": "box", "min": [1.5, -0.5], "max": [2.5, 0.5]}
+    world = tiny_world(obstacles=[*TINY["obstacles"], box], people=[])
+    run = run_metrics(simulate(world, RunOptions(social=False, unknown_map=True)), 4.0)
+    assert run["success"] and run["collisions"] == 0
+
+
+def test_camera_runs_repeat_exactly():
+    world = tiny_world(simulation={"time_limit_s": 1.5})
+    first, again = (simulate(world, RunOptions(seed=3)) for _ in range(2))
+    assert first.trajectory == again.trajectory and first.reason == again.reason
+    assert len(first.trajectory) == 16 and first.plans == again.plans
+
+
+def test_a_walker_that_runs_into_the_robot_is_a_collision():
+    data = copy.deepcopy(TINY)
+    data["people"] = [{"id": 1, "x": 3.0, "y": 0.0, "theta": 3.1416, "path": [[-0.4, 0.0]], "speed": 1.5}]
+    data["simulation"] = {"max_speed": 0.1, "time_limit_s": 5.0}
+    trace = simulate(world_from_dict(data), RunOptions(social=False))
+    assert not trace.success and trace.collisions == 1
+    assert trace.reason.startswith("collision with person 1")
+
+
+def test_an_onnx_pose_model_runs_in_the_loop(tmp_path):
+    pytest.importorskip("onnx")
+    import numpy as np
+
+    from tests.pose_models import build_yolo_pose_model, yolo_candidate
+
+    keypoints = np.column_stack([np.full(17, 128.0), np.linspace(60.0, 200.0, 17)])
+    model = build_yolo_pose_model(tmp_path / "pose.onnx", yolo_candidate([128, 128, 60, 160], 0.9, keypoints)[:, None])
+    trace = simulate(tiny_world(simulation={"time_limit_s": 0.3}), RunOptions(model=model))
+    assert trace.reason == "time limit (0.3 s) reached" and len(trace.trajectory) == 4

@@ -1,0 +1,69 @@
+"""``sid simulate``: one run with its files, the scene list, bad input."""
+
+import json
+
+import imageio_ffmpeg
+import numpy as np
+import pytest
+
+from sid.cli import main
+from sid.experiments.simulate.video import VideoWriter
+from tests.experiments.simulate.tiny import TINY
+
+RUN_KEYS = {"success", "collisions", "time_to_goal_s", "path_length_m", "min_person_distance_m",
+            "ospace_intrusion_m", "crosses_group", "replans", "trajectory"}  # fmt: skip
+
+
+@pytest.fixture
+def scene(tmp_path):
+    path = tmp_path / "tiny.json"
+    path.write_text(json.dumps(TINY | {"simulation": {"max_speed": 1.0, "time_limit_s": 0.5}}))
+    return str(path)
+
+
+def test_a_run_writes_run_json_and_a_video(scene, tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["simulate", scene, "--out", str(out), "--gif"]) == 1  # the time limit ends it before the goal
+    record = json.loads((out / "run.json").read_text())
+    assert set(record) >= RUN_KEYS
+    assert record["success"] is False and record["reason"].startswith("time limit (0.5 s)")
+    assert len(record["trajectory"]) == 6 and record["trajectory"][0] == [0.0, 0.0, 0.0, 0.0]
+    frames = list(imageio_ffmpeg.read_frames(str(out / "run.mp4")))
+    meta, images = frames[0], frames[1:]
+    assert len(images) == 5 and meta["size"][0] > 1000  # the map, its legend and the camera column
+    assert (out / "run.gif").stat().st_size > 0
+    printed = capsys.readouterr().out
+    assert "ospace_intrusion_m" in printed and f"wrote {out / 'run.mp4'}" in printed
+
+
+def test_without_out_only_the_summary_is_printed(scene, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(["simulate", scene, "--no-social"]) == 1
+    assert "collisions" in capsys.readouterr().out
+    assert not list(tmp_path.glob("run.*"))
+
+
+def test_list_and_bad_input(capsys, tmp_path):
+    assert main(["simulate", "--list"]) == 0
+    assert "paper " in capsys.readouterr().out
+    assert main(["simulate", "nowhere"]) == 2
+    assert "neither a built-in scene" in capsys.readouterr().err
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(TINY | {"simulation": {"max_sped": 1}}))
+    assert main(["simulate", str(bad)]) == 2
+    assert "simulation.max_sped: unknown field" in capsys.readouterr().err
+    assert main(["simulate", "paper", "--model", str(tmp_path / "none.onnx")]) == 2
+    assert main(["simulate"]) == 2
+
+
+def test_the_video_writer_pads_odd_frames(tmp_path):
+    frame = np.zeros((31, 41, 3), np.uint8)
+    frame[:, :20] = (0, 0, 255)  # BGR red on the left
+    with VideoWriter(tmp_path / "v.mp4", 10.0) as writer:
+        for _ in range(3):
+            writer.add(frame)
+    reader = imageio_ffmpeg.read_frames(str(tmp_path / "v.mp4"))
+    meta = next(reader)
+    assert tuple(meta["size"]) == (42, 32)
+    first = np.frombuffer(next(reader), np.uint8).reshape(32, 42, 3)
+    assert first[15, 5, 0] > 200 and first[15, 5, 2] < 60  # RGB: red stays red

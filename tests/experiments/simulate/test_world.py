@@ -1,0 +1,51 @@
+import copy
+
+import pytest
+
+from sid.experiments.simulate.world import collision, obstacle_geometry, world_from_dict
+from sid.perception.people import Person
+from sid.scenario.loader import BoxObstacle, ScenarioError, SegmentObstacle
+from tests.experiments.simulate.tiny import TINY, tiny_world
+
+
+def test_the_simulation_block_sets_the_limits_and_the_robot_radius_comes_from_the_scenario():
+    world = tiny_world(simulation={"max_turn_rate": 2.0, "rate_hz": 5.0, "description": "d"})
+    limits = world.settings.limits
+    assert (limits.max_speed, limits.max_turn_rate, limits.radius) == (1.0, 2.0, 0.25)
+    assert world.settings.rate_hz == 5.0 and world.settings.description == "d"
+    assert world.settings.time_limit_s == 10.0
+
+
+@pytest.mark.parametrize(
+    ("simulation", "message"),
+    [
+        ({"max_sped": 1.0}, "simulation.max_sped: unknown field"),
+        ({"time_limit_s": 0}, "simulation.time_limit_s: expected a positive number"),
+        ({"description": 3}, "simulation.description: expected a string"),
+    ],
+)
+def test_a_bad_simulation_block_is_named(simulation, message):
+    with pytest.raises(ScenarioError, match=message):
+        tiny_world(simulation=simulation)
+
+
+def test_walkers_move_along_their_path_and_face_the_way_they_go():
+    data = copy.deepcopy(TINY)
+    data["people"] = [{"id": 7, "x": 1.0, "y": -1.0, "theta": 0.0, "path": [[1.0, 1.0]], "speed": 1.0,
+                       "start_time": 1.0}]  # fmt: skip
+    world = world_from_dict(data)
+    before, during, after = (world.people_at(t)[0] for t in (0.5, 2.0, 5.0))
+    assert (before.x, before.y, before.theta) == (1.0, -1.0, 0.0)
+    assert (during.x, during.y) == pytest.approx((1.0, 0.0))
+    assert during.theta == pytest.approx(1.5708, abs=1e-4)
+    assert (after.x, after.y) == pytest.approx((1.0, 1.0))
+
+
+def test_collision_with_obstacles_and_people():
+    walls = obstacle_geometry([SegmentObstacle(((0.0, 1.0), (5.0, 1.0))), BoxObstacle((3.0, -2.0), (4.0, -1.0))])
+    people = [Person(3, 2.0, 0.0, 0.0)]
+    assert collision((0.5, 0.8), 0.25, walls, people, 0.2) == "obstacle"
+    assert collision((3.5, -0.8), 0.25, walls, people, 0.2) == "obstacle"
+    assert collision((1.6, 0.0), 0.25, walls, people, 0.2) == "person 3"
+    assert collision((1.5, 0.0), 0.25, walls, people, 0.2) is None
+    assert collision((0.0, 0.0), 0.25, None, [], 0.2) is None
