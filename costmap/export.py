@@ -1,4 +1,12 @@
-"""Everything ``sid costmap`` writes for one costmap: map_server files, .npz, .mcap and a picture."""
+"""Everything ``sid costmap`` writes for one costmap: map_server files, .npz, .mcap and a picture; and the
+``nav_msgs/OccupancyGrid`` filter mask that Nav2's KeepoutFilter reads back as the same costs (``sid ros``).
+
+Nav2's costmap filters turn a mask value v in 0..100 into the cost round(v * 254 / 100) (-1: no information, the
+cell is left alone) and raise a master cell to it when higher. ``keepout_mask`` picks, per cost c, the value
+v = round(c * 100 / 254), so a cost comes back within 1.27 of itself (240, a group zone, comes back as 239; 254
+as 254). This differs from the costmap publisher's table (``costmap.occupancy``), which the filters would read
+back as up to 7 % less.
+"""
 
 from __future__ import annotations
 
@@ -7,11 +15,13 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import cv2
+import numpy as np
 
+from costmap.grid import LETHAL, NO_INFORMATION, Costmap2D
 from costmap.layered import LayeredCostmap
 from costmap.mapfile import write_map
 from costmap.npz import save_npz
-from costmap.occupancy import OccupancyGrid, cost_to_occupancy, costmap_to_occupancy
+from costmap.occupancy import OCC_OCCUPIED, OCC_UNKNOWN, OccupancyGrid, cost_to_occupancy, costmap_to_occupancy
 from costmap.render import Outline, RobotTask, render_costmap
 from costmap.rosbag import write_occupancy_mcap
 
@@ -51,3 +61,21 @@ def export_costmap(
     if not cv2.imwrite(str(paths["png"]), render_costmap(layered, robot=robot, title=title, outlines=outlines)):
         raise OSError(f"{paths['png']}: cannot write the picture")
     return paths
+
+
+def keepout_mask(costmap: Costmap2D, frame_id: str = "map") -> OccupancyGrid:
+    """A costmap as a KeepoutFilter mask: cost c -> round(c * 100 / 254), 255 (unknown) -> -1 (see the docstring)."""
+    costs = costmap.costs.astype(np.float64)
+    data = np.rint(costs * OCC_OCCUPIED / LETHAL).astype(np.int8)
+    data[costmap.costs == NO_INFORMATION] = OCC_UNKNOWN
+    return OccupancyGrid(costmap.spec, data, frame_id=frame_id)
+
+
+def filter_mask_cost(data: np.ndarray) -> np.ndarray:
+    """The uint8 costs Nav2's costmap filters read from mask values: v in 0..100 -> round(v * 254 / 100),
+    -1 -> 255 (no information: the filter leaves that cell alone)."""
+    values = np.asarray(data)
+    if values.dtype != np.int8 or np.any((values < OCC_UNKNOWN) | (values > OCC_OCCUPIED)):
+        raise ValueError("filter mask: values must be int8 in -1..100")
+    costs = np.floor(values.astype(np.float64) * LETHAL / OCC_OCCUPIED + 0.5).astype(np.int16)
+    return np.where(values == OCC_UNKNOWN, NO_INFORMATION, costs).astype(np.uint8)

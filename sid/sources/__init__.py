@@ -4,6 +4,9 @@
 
 - ``"realsense"``: a live RealSense camera (``sid.sources.realsense.RealSenseSource``);
 - ``"FILE.db3"`` / ``"FILE.bag"``: a RealSense recording (librealsense 2.59+ writes .db3, older versions .bag);
+- ``"FILE.db3"`` / ``"FILE.mcap"`` / a rosbag2 folder (with ``metadata.yaml``): a ``ros2 bag record`` of
+  realsense2_camera topics (``sid.sources.rosbag2.Rosbag2Source``); a .db3 is librealsense's when its topics live
+  under ``/device_N/``;
 - a directory: a folder of colour + depth images (``sid.sources.folder.FolderSource``);
 - ``"synthetic:SCENARIO"``: rendered people (``sid.sources.synthetic``).
 
@@ -20,7 +23,8 @@ from typing import Any
 
 from sid.perception.frame import Frame
 
-RECORDING_SUFFIXES = (".db3", ".bag")
+RECORDING_SUFFIXES = (".db3", ".bag", ".mcap")
+ROSBAG2_METADATA = "metadata.yaml"
 
 
 class SourceError(RuntimeError):
@@ -42,7 +46,7 @@ class FrameReadError(SourceError):
 def open_source(spec: str, **options: Any) -> Iterable[Frame]:
     """The source named by ``spec`` (see the module docstring); ``options`` go to that source's constructor."""
     if not isinstance(spec, str) or not spec:
-        raise SourceError("source: empty spec; use realsense, FILE.db3, FILE.bag, DIR or synthetic:SCENARIO")
+        raise SourceError("source: empty spec; use realsense, FILE.db3, FILE.bag, FILE.mcap, DIR or synthetic:SCENARIO")
     if spec.startswith("synthetic:"):
         from sid.sources.synthetic import synthetic_source
 
@@ -53,14 +57,37 @@ def open_source(spec: str, **options: Any) -> Iterable[Frame]:
     if path.suffix.lower() in RECORDING_SUFFIXES:
         if not path.exists():
             raise SourceError(f"recording {path} does not exist")
-        return _realsense()(path, **options)
+        if path.suffix.lower() == ".bag" or _librealsense_db3(path):
+            return _realsense()(path, **options)
+        return _rosbag2(path, options)
+    if (path / ROSBAG2_METADATA).is_file():
+        return _rosbag2(path, options)
     if path.is_dir():
         from sid.sources.folder import FolderSource
 
         return FolderSource(path, **options)
     if not path.exists():
         raise SourceError(f"source {spec!r}: no such file or directory (use realsense, FILE.db3, DIR, synthetic:...)")
-    raise SourceError(f"source {spec!r}: not a recording (.db3/.bag) or a folder of frames")
+    raise SourceError(f"source {spec!r}: not a recording (.db3/.bag/.mcap), a rosbag2 folder or a folder of frames")
+
+
+def _librealsense_db3(path: Path) -> bool:
+    """A .db3 written by librealsense, or one rosbags cannot read (librealsense then has the last word)."""
+    from sid.sources.rosbag2 import is_librealsense_recording
+
+    try:
+        return path.suffix.lower() == ".db3" and is_librealsense_recording(path)
+    except SourceError:
+        return True
+
+
+def _rosbag2(path: Path, options: dict[str, Any]) -> Iterable[Frame]:
+    """A ``Rosbag2Source``. realsense2_camera bags carry depth already aligned to colour, so the RealSense sources'
+    ``align`` option (which ``sid detect`` passes to every recording) has nothing to choose and is dropped."""
+    from sid.sources.rosbag2 import Rosbag2Source
+
+    options.pop("align", None)
+    return Rosbag2Source(path, **options)
 
 
 def _realsense() -> Any:

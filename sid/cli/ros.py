@@ -1,0 +1,109 @@
+"""``sid ros``: the ROS 2 node that publishes the social costmap for Nav2 (rclpy is imported only when it runs)."""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import sys
+from collections.abc import Iterable
+from pathlib import Path
+
+from sid.cli.detect import positive_int
+from sid.perception.frame import Frame
+from sid.perception.pipeline import PoseFn, image_pose
+from sid.perception.pose.contracts import PoseModelError
+from sid.sources import SourceError, open_source
+
+INSTALL_HINT = (
+    "sid ros needs ROS 2's rclpy, which cannot be imported here ({error}). Source a ROS 2 installation "
+    "(`source /opt/ros/jazzy/setup.bash`), or install the Python wheels with `pip install 'sid[ros]'`; see "
+    "docs/ros2.md"
+)
+SYNTHETIC_FRAMES = 300
+SHARE = Path(__file__).resolve().parents[1] / "ros" / "data"
+"""sid/ros/data: sid.launch.py, sid_params.yaml, nav2_social_costmap.yaml."""
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "ros",
+        help="run the ROS 2 node that publishes the social costmap for Nav2",
+        description="Subscribe to realsense2_camera's colour, aligned depth and camera_info topics (or read --source), "
+        "track people and groups, and publish /social_costmap (a Nav2 KeepoutFilter mask), RViz markers and the "
+        "groups. Topics, frames and the costmap's size are ROS parameters (--ros-args --params-file FILE, or "
+        "-p NAME:=VALUE); see docs/ros2.md.",
+    )
+    parser.add_argument(
+        "--source", help="read frames from a sid source instead of topics: realsense | FILE | DIR | synthetic:SCENE"
+    )
+    parser.add_argument("--model", type=Path, help="pose model (.onnx); optional only for a synthetic --source")
+    parser.add_argument(
+        "--frames", type=positive_int, help=f"stop the --source after this many frames (synthetic: {SYNTHETIC_FRAMES})"
+    )
+    parser.add_argument(
+        "--rate",
+        type=float,
+        default=0.0,
+        metavar="HZ",
+        help="play the --source at most this fast (0: as fast as processed)",
+    )
+    parser.add_argument(
+        "--share", action="store_true", help="print the folder of the launch file and YAML files sid ships, and exit"
+    )
+    parser.add_argument(
+        "--ros-args",
+        dest="ros_args",
+        nargs=argparse.REMAINDER,
+        default=None,
+        help="everything after it goes to ROS (e.g. --ros-args --params-file sid.yaml -p costmap.width:=30.0)",
+    )
+    parser.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.share:
+        print(SHARE)
+        return 0
+    try:
+        import rclpy
+        from rclpy.signals import SignalHandlerOptions
+
+        from sid.ros.node import SocialCostmapNode, spin
+    except ImportError as exc:
+        print(INSTALL_HINT.format(error=exc), file=sys.stderr)
+        return 2
+    ros_args = ["--ros-args", *args.ros_args] if args.ros_args is not None else []
+    # sid's own handlers turn SIGINT and SIGTERM into KeyboardInterrupt (sid.cli.main); rclpy's would not.
+    rclpy.init(args=["sid", *ros_args], signal_handler_options=SignalHandlerOptions.NO)
+    node = None
+    try:
+        synthetic = args.source is not None and args.source.startswith("synthetic:")
+        pose = _pose(args.model, synthetic)
+        node = SocialCostmapNode(pose, camera_topics=args.source is None)
+        frames: Iterable[Frame] | None = None
+        if args.source is not None:
+            frames = open_source(args.source, **({"frames": args.frames or SYNTHETIC_FRAMES} if synthetic else {}))
+            if args.frames is not None and not synthetic:
+                frames = itertools.islice(frames, args.frames)
+        spin(node, frames, args.rate)
+    except (SourceError, PoseModelError, ValueError, OSError) as exc:
+        print(f"sid ros: {exc}", file=sys.stderr)
+        return 2
+    finally:
+        if node is not None:
+            node.node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+def _pose(model: Path | None, synthetic: bool) -> PoseFn:
+    """The pose model's function, or the synthetic frames' ground truth when there is no model."""
+    if model is not None:
+        from sid.perception.pose import load_pose_estimator
+
+        return image_pose(load_pose_estimator(model))
+    if synthetic:
+        from sid.synthetic.pose import TruthPose
+
+        return TruthPose()
+    raise SourceError("a pose model is needed for camera frames: --model FILE.onnx (see docs/models.md)")

@@ -1,0 +1,246 @@
+"""The ``sid ros`` node: camera frames in, a Nav2 KeepoutFilter mask of the social costmap out.
+
+Per frame (one call, ``SocialCostmapNode.on_frame``): the robot pose at the frame's time, then
+``sid.stream.SocialStream.update`` (pose -> people -> groups, the trackers, the tracked-people costmap layer), then
+the publications: the mask on ``costmap_topic`` (reliable, transient local, depth 1, in ``global_frame``), the
+``nav2_msgs/CostmapFilterInfo`` announcing it (when nav2_msgs is importable; latched), RViz markers, and the groups
+as JSON on ``groups_topic`` (plus REP-155's ``/humans/groups/tracked`` when hri_msgs is importable).
+
+Frames come from the camera topics (colour, aligned depth, camera_info; paired by stamp) or, with ``source``, from
+any sid source read in a thread. A frame that fails (bad image, no pose yet, out of time order) is logged and
+skipped; the node keeps running. Per-stage timing is logged at debug level.
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+import time
+from collections.abc import Iterable
+from dataclasses import fields
+from typing import Any
+
+import rclpy
+from nav_msgs.msg import OccupancyGrid, Odometry
+from rcl_interfaces.msg import ParameterDescriptor
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
+from rclpy.time import Time as RosTime
+from sensor_msgs.msg import CameraInfo, Image
+from std_msgs.msg import String
+from visualization_msgs.msg import MarkerArray
+
+from costmap.plugins import CostmapParams
+from sid.perception.camera import Intrinsics
+from sid.perception.frame import Frame
+from sid.perception.pipeline import Pipeline, PoseFn
+from sid.perception.robot_pose import RobotPose
+from sid.ros import messages
+from sid.ros.convert import grid_fields, groups_document, scene_markers, yaw_from_quaternion
+from sid.ros.params import NODE_NAME, PARAMETERS, NodeParams, ros_name
+from sid.sources import FrameReadError, skip_unreadable
+from sid.sources.ros_messages import StampPairer, intrinsics_from_camera_info, rgbd_frame, stamp_seconds
+from sid.stream import SocialStream, StreamUpdate
+
+LATCHED = QoSProfile(
+    history=HistoryPolicy.KEEP_LAST,
+    depth=1,
+    reliability=ReliabilityPolicy.RELIABLE,
+    durability=DurabilityPolicy.TRANSIENT_LOCAL,
+)
+"""What map topics offer, and Nav2's costmap filters expect of a mask and its filter info."""
+SPIN_WAIT = 0.2
+"""Longest wait (s) for a callback before the spin loop returns to Python (and to its signal handlers)."""
+COSTMAP_LAYERS = ("tracked_people",)
+"""Only sid's layer: Nav2's own costmaps keep their static, obstacle and inflation layers."""
+
+
+def _typed(value: Any, default: object) -> Any:
+    """A parameter value in the type of its default (a YAML ``20`` for a float parameter is 20.0)."""
+    kind: Any = type(default)
+    return kind(value)
+
+
+class SocialCostmapNode:
+    """The node (see the module docstring), as ``self.node``. ``pose``: the pose model. ``camera_topics``: subscribe
+    to the camera (False when frames come from ``feed``). Needs ``rclpy.init()`` first."""
+
+    def __init__(self, pose: PoseFn, camera_topics: bool = True) -> None:
+        self.node: Node = rclpy.create_node(NODE_NAME)
+        for name, default, description in PARAMETERS:
+            self.node.declare_parameter(
+                name, default, ParameterDescriptor(description=description, dynamic_typing=True)
+            )
+        values = {name: _typed(self.node.get_parameter(name).value, default) for name, default, _ in PARAMETERS}
+        self.params = p = NodeParams(**{f.name: values[ros_name(f.name)] for f in fields(NodeParams)})
+        costmap = CostmapParams(plugins=COSTMAP_LAYERS)
+        self.stream = SocialStream(Pipeline(pose, p.mount, group=False), p.grid, costmap)
+        self.frames = 0
+        self.costmap_pub = self.node.create_publisher(OccupancyGrid, p.costmap_topic, LATCHED)
+        self.markers_pub = self.node.create_publisher(MarkerArray, p.markers_topic, 10)
+        self.groups_pub = self.node.create_publisher(String, p.groups_topic, 10)
+        info_type = messages.filter_info_type()
+        if info_type is not None:
+            info = messages.filter_info(
+                info_type, p.costmap_topic, p.global_frame, self.node.get_clock().now().to_msg()
+            )
+            self.node.create_publisher(info_type, p.filter_info_topic, LATCHED).publish(info)
+        self.ids_type = messages.ids_list_type()
+        self.hri_pub = (
+            None if self.ids_type is None else self.node.create_publisher(self.ids_type, "/humans/groups/tracked", 10)
+        )
+        self.pose_source = self._pose_source()
+        self.odometry: Odometry | None = None
+        if self.pose_source == "tf":
+            import tf2_ros
+
+            self.tf_buffer = tf2_ros.Buffer()
+            self.tf_listener = tf2_ros.TransformListener(
+                self.tf_buffer, self.node, spin_thread=True
+            )  # waits never block it
+        elif self.pose_source == "odom":
+            self.node.create_subscription(Odometry, p.odom_topic, self._on_odometry, 10)
+        self.intrinsics: Intrinsics | None = None
+        self.pairer: StampPairer[Image] = StampPairer(p.sync_tolerance)
+        if camera_topics:
+            self.node.create_subscription(
+                CameraInfo, p.camera_info_topic, self._on_camera_info, qos_profile_sensor_data
+            )
+            self.node.create_subscription(
+                Image, p.color_topic, lambda m: self._on_image("color", m), qos_profile_sensor_data
+            )
+            self.node.create_subscription(
+                Image, p.depth_topic, lambda m: self._on_image("depth", m), qos_profile_sensor_data
+            )
+        self.node.get_logger().info(
+            f"publishing {p.costmap_topic} in {p.global_frame} ({p.grid.width}x{p.grid.height} cells of "
+            f"{p.grid.resolution} m); robot pose from {self.pose_source}; filter info: "
+            f"{'on ' + p.filter_info_topic if info_type else 'off (nav2_msgs not importable)'}"
+        )
+
+    def _pose_source(self) -> str:
+        chosen = self.params.pose_source
+        if chosen in ("auto", "tf"):
+            try:
+                import tf2_ros  # noqa: F401 - only whether it imports
+            except ImportError:
+                if chosen == "tf":
+                    raise ValueError("pose_source 'tf' needs tf2_ros, which is not importable") from None
+                return "odom"
+            return "tf"
+        return chosen
+
+    def _on_odometry(self, msg: Odometry) -> None:
+        self.odometry = msg
+
+    def _on_camera_info(self, msg: CameraInfo) -> None:
+        try:
+            self.intrinsics = intrinsics_from_camera_info(msg)
+        except ValueError as exc:
+            self.node.get_logger().error(f"{self.params.camera_info_topic}: {exc}", throttle_duration_sec=5.0)
+
+    def _on_image(self, stream: str, msg: Image) -> None:
+        pair = self.pairer.add(stream, stamp_seconds(msg.header), msg)
+        for dropped in self.pairer.dropped_colors:
+            self.node.get_logger().warning(f"colour image at {dropped.stamp:.3f} s has no depth image; skipped")
+        self.pairer.dropped_colors.clear()
+        if pair is None:
+            return
+        index, self.frames = self.frames, self.frames + 1
+        if self.intrinsics is None:
+            self.node.get_logger().warning("no camera_info yet; frame skipped", throttle_duration_sec=5.0)
+            return
+        color, depth = pair
+        try:
+            frame = rgbd_frame(index, color.item, depth.item, self.intrinsics, self.params.depth_scale)
+        except ValueError as exc:
+            self.node.get_logger().error(f"frame {index}: skipped, {exc}")
+            return
+        self.on_frame(frame, color.item.header.stamp)
+
+    def robot_pose(self, stamp: Any | None) -> RobotPose | None:
+        """base_frame's pose in global_frame at ``stamp`` (a builtin_interfaces/Time; None: the latest), or None
+        when it is not known yet."""
+        if self.pose_source == "none":
+            return RobotPose(0.0, 0.0, 0.0)
+        if self.pose_source == "odom":
+            odometry = self.odometry
+            if odometry is None:
+                return None
+            pose = odometry.pose.pose
+            q = pose.orientation
+            return RobotPose(pose.position.x, pose.position.y, yaw_from_quaternion(q.x, q.y, q.z, q.w))
+        import tf2_ros
+        from rclpy.duration import Duration
+
+        when = RosTime() if stamp is None else RosTime.from_msg(stamp)
+        try:
+            t = self.tf_buffer.lookup_transform(
+                self.params.global_frame,
+                self.params.base_frame,
+                when,
+                timeout=Duration(seconds=self.params.transform_timeout),
+            )
+        except tf2_ros.TransformException as exc:
+            self.node.get_logger().warning(f"no transform: {exc}", throttle_duration_sec=5.0)
+            return None
+        q = t.transform.rotation
+        return RobotPose(t.transform.translation.x, t.transform.translation.y, yaw_from_quaternion(q.x, q.y, q.z, q.w))
+
+    def on_frame(self, frame: Frame, stamp: Any | None = None) -> None:
+        """The per-frame work: pose, stream update, publications. ``stamp``: the images' header stamp (None: now,
+        for frames read from a source). A failing frame is logged and skipped."""
+        try:
+            pose = self.robot_pose(stamp)
+            if pose is None:
+                self.node.get_logger().warning(
+                    f"frame {frame.index}: skipped, no robot pose yet ({self.pose_source})", throttle_duration_sec=5.0
+                )
+                return
+            update = self.stream.update(frame, pose)
+            self.publish(update, stamp if stamp is not None else self.node.get_clock().now().to_msg())
+        except Exception as exc:  # a bad frame must not stop the node: report it and go on
+            self.node.get_logger().error(f"frame {frame.index}: skipped, {type(exc).__name__}: {exc}")
+            return
+        timing = ", ".join(f"{k} {v:.1f}" for k, v in update.timing_ms.items())
+        self.node.get_logger().debug(
+            f"frame {frame.index}: {len(update.people)} people, {len(update.groups)} groups; ms: {timing}"
+        )
+
+    def publish(self, update: StreamUpdate, stamp: Any) -> None:
+        """The mask, the markers and the groups of one update, stamped ``stamp``."""
+        frame_id = self.params.global_frame
+        self.costmap_pub.publish(messages.occupancy_grid(grid_fields(update.costmap.master, frame_id), stamp))
+        self.markers_pub.publish(messages.marker_array(scene_markers(update.people, update.groups), frame_id, stamp))
+        seconds = stamp.sec + stamp.nanosec * 1e-9
+        document = groups_document(seconds, frame_id, update.people, update.groups)
+        self.groups_pub.publish(String(data=json.dumps(document)))
+        if self.hri_pub is not None and self.ids_type is not None:
+            ids = [str(g.id) for g in update.groups]
+            self.hri_pub.publish(self.ids_type(header=messages.header(frame_id, stamp), ids=ids))
+
+    def feed(self, frames: Iterable[Frame], rate: float = 0.0) -> None:
+        """Run every frame of a sid source through ``on_frame`` (unreadable ones logged and skipped), at most
+        ``rate`` frames per second (0: as fast as they come)."""
+
+        def report(error: FrameReadError) -> None:
+            self.node.get_logger().error(f"frame {error.index}: skipped, {error}")
+
+        period = 1.0 / rate if rate > 0 else 0.0
+        for frame in skip_unreadable(frames, report):
+            start = time.monotonic()
+            if not rclpy.ok():
+                return
+            self.on_frame(frame)
+            time.sleep(max(0.0, period - (time.monotonic() - start)))
+        self.node.get_logger().info("source ended; the last costmap stays published")
+
+
+def spin(node: SocialCostmapNode, frames: Iterable[Frame] | None = None, rate: float = 0.0) -> None:
+    """Spin ``node`` until shutdown or KeyboardInterrupt; with ``frames``, feed them from a thread meanwhile.
+
+    Spins in short waits, so the signal handlers of ``sid.cli`` (SIGINT, SIGTERM -> KeyboardInterrupt) run."""
+    if frames is not None:
+        threading.Thread(target=node.feed, args=(frames, rate), daemon=True, name="sid-source").start()
+    while rclpy.ok():
+        rclpy.spin_once(node.node, timeout_sec=SPIN_WAIT)

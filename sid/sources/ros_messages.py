@@ -1,0 +1,173 @@
+"""ROS 2 camera messages -> sid records: ``sensor_msgs/Image`` pixels, ``sensor_msgs/CameraInfo`` intrinsics, and the
+pairing of colour and depth images by their header stamps.
+
+Works on any object with the messages' fields: rclpy messages (``sid ros``) and rosbags' deserialized messages
+(``sid.sources.rosbag2``) alike; nothing here imports ROS. Images follow realsense2_camera: colour ``rgb8`` or
+``bgr8`` (``rgba8``/``bgra8``/``mono8`` are read too), depth ``16UC1`` in depth units (millimetres by default,
+REP-118) or ``32FC1`` in metres; depth aligned to colour, so one CameraInfo (the colour camera's) calibrates both.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+from typing import Any, Generic, TypeVar
+
+import cv2
+import numpy as np
+
+from sid.checks import check_number
+from sid.perception.camera import Calibration, Intrinsics
+from sid.perception.frame import Frame
+
+# Colour encodings -> (channels, OpenCV conversion to RGB; None: already RGB).
+_COLOR = {
+    "rgb8": (3, None),
+    "bgr8": (3, cv2.COLOR_BGR2RGB),
+    "rgba8": (4, cv2.COLOR_RGBA2RGB),
+    "bgra8": (4, cv2.COLOR_BGRA2RGB),
+    "mono8": (1, cv2.COLOR_GRAY2RGB),
+}
+# Depth encodings -> numpy dtype (little-endian; is_bigendian flips it) and whether values are already metres.
+_DEPTH = {"16UC1": ("<u2", False), "mono16": ("<u2", False), "32FC1": ("<f4", True)}
+
+T = TypeVar("T")
+
+
+def stamp_seconds(header: Any) -> float:
+    """A ``std_msgs/Header`` stamp in seconds."""
+    return float(header.stamp.sec) + float(header.stamp.nanosec) * 1e-9
+
+
+def _pixels(msg: Any, dtype: str, channels: int) -> np.ndarray:
+    """The (height, width[, channels]) array of an Image message, row padding (``step``) removed."""
+    height, width, step = int(msg.height), int(msg.width), int(msg.step)
+    item = np.dtype(dtype)
+    if getattr(msg, "is_bigendian", False):
+        item = item.newbyteorder(">")
+    row = width * channels * item.itemsize
+    raw = np.frombuffer(msg.data, dtype=np.uint8)
+    if height <= 0 or width <= 0 or step < row or raw.size < height * step:
+        raise ValueError(
+            f"image {width}x{height} {msg.encoding}: step {step} and {raw.size} bytes of data do not hold it"
+        )
+    rows = raw[: height * step].reshape(height, step)[:, :row]
+    array = (
+        np.ascontiguousarray(rows).view(item).reshape((height, width, channels) if channels > 1 else (height, width))
+    )
+    return array.astype(item.newbyteorder("="), copy=False)
+
+
+def color_rgb(msg: Any) -> np.ndarray:
+    """A colour Image -> (H, W, 3) uint8 RGB. ValueError names an encoding that is not a colour one."""
+    if msg.encoding not in _COLOR:
+        raise ValueError(f"colour image encoding {msg.encoding!r} is not supported; use one of {', '.join(_COLOR)}")
+    channels, code = _COLOR[msg.encoding]
+    pixels = _pixels(msg, "u1", channels)
+    return pixels.copy() if code is None else cv2.cvtColor(pixels, code)
+
+
+def depth_metres(msg: Any, depth_scale: float) -> np.ndarray:
+    """A depth Image -> (H, W) float32 metres (0 = no reading). ``depth_scale``: metres per unit of 16UC1 depth."""
+    if msg.encoding not in _DEPTH:
+        raise ValueError(
+            f"depth image encoding {msg.encoding!r} is not supported; use 16UC1 (depth units) or 32FC1 (m)"
+        )
+    dtype, metres = _DEPTH[msg.encoding]
+    values = _pixels(msg, dtype, 1).astype(np.float32)
+    if metres:
+        return np.where(np.isfinite(values), values, np.float32(0.0))
+    return values * np.float32(depth_scale)
+
+
+def intrinsics_from_camera_info(msg: Any) -> Intrinsics:
+    """A CameraInfo -> pinhole intrinsics (fx, fy, cx, cy from the 3x3 ``k``, row-major). ValueError when unusable.
+
+    ROS pixel centres are at integer coordinates, as in sid (librealsense), so cx, cy carry over unchanged. The
+    distortion model and coefficients are kept; sid treats the camera as an ideal pinhole (realsense2_camera
+    reports zero distortion).
+    """
+    k = [float(v) for v in msg.k]
+    if len(k) != 9:
+        raise ValueError(f"camera_info: k must hold 9 numbers, got {len(k)}")
+    try:
+        return Intrinsics(
+            int(msg.width),
+            int(msg.height),
+            k[0],
+            k[4],
+            k[2],
+            k[5],
+            str(msg.distortion_model) or "none",
+            tuple(float(v) for v in msg.d),
+        )
+    except ValueError as exc:
+        raise ValueError(f"camera_info: {exc} (k = {k})") from None
+
+
+def rgbd_frame(
+    index: int, color: Any, depth: Any, intrinsics: Intrinsics, depth_scale: float, timestamp: float | None = None
+) -> Frame:
+    """A colour Image and the depth Image aligned to it -> ``Frame`` (registered depth, metres).
+
+    ``intrinsics``: the colour camera's (``intrinsics_from_camera_info``). ``timestamp`` defaults to the colour
+    image's stamp (s). ValueError when an encoding is unsupported or a size differs from the calibration's.
+    """
+    rgb, metres = color_rgb(color), depth_metres(depth, depth_scale)
+    expected = (intrinsics.height, intrinsics.width)
+    for name, image in (("colour", rgb), ("depth", metres)):
+        if image.shape[:2] != expected:
+            raise ValueError(
+                f"{name} image is {image.shape[1]}x{image.shape[0]}, camera_info says "
+                f"{intrinsics.width}x{intrinsics.height} (is the depth aligned to colour?)"
+            )
+    stamp = stamp_seconds(color.header) if timestamp is None else timestamp
+    return Frame(index, rgb, metres, Calibration(intrinsics, depth_scale=depth_scale), stamp)
+
+
+@dataclass
+class Stamped(Generic[T]):
+    """A message with its header stamp in seconds."""
+
+    stamp: float
+    item: T
+
+
+class StampPairer(Generic[T]):
+    """Pairs colour and depth messages whose stamps differ by at most ``tolerance`` seconds.
+
+    Feed each message as it comes (``add("color" | "depth", stamp, item)``); a message that completes a pair
+    returns it as (colour, depth). Messages of one stream older than a paired one can never pair; they are dropped
+    and, for colour, kept in ``dropped_colors`` (the caller reports them). At most ``keep`` messages wait per stream.
+    """
+
+    def __init__(self, tolerance: float, keep: int = 30) -> None:
+        check_number("stamp pairing", "tolerance", tolerance, low=0, unit="seconds")
+        self.tolerance = float(tolerance)
+        self.waiting: dict[str, deque[Stamped[T]]] = {"color": deque(maxlen=keep), "depth": deque(maxlen=keep)}
+        self.dropped_colors: list[Stamped[T]] = []
+
+    def add(self, stream: str, stamp: float, item: T) -> tuple[Stamped[T], Stamped[T]] | None:
+        if stream not in self.waiting:
+            raise ValueError(f"stamp pairing: stream must be 'color' or 'depth', got {stream!r}")
+        other = self.waiting["depth" if stream == "color" else "color"]
+        match = min(other, key=lambda m: abs(m.stamp - stamp), default=None)
+        new = Stamped(stamp, item)
+        if match is None or abs(match.stamp - stamp) > self.tolerance:
+            queue = self.waiting[stream]
+            if len(queue) == queue.maxlen and stream == "color":
+                self.dropped_colors.append(queue[0])
+            queue.append(new)
+            return None
+        color, depth = (new, match) if stream == "color" else (match, new)
+        self._forget_until(color.stamp, depth.stamp)
+        return color, depth
+
+    def _forget_until(self, color_stamp: float, depth_stamp: float) -> None:
+        colors, depths = self.waiting["color"], self.waiting["depth"]
+        while colors and colors[0].stamp <= color_stamp:
+            stale = colors.popleft()
+            if stale.stamp < color_stamp:
+                self.dropped_colors.append(stale)
+        while depths and depths[0].stamp <= depth_stamp:
+            depths.popleft()

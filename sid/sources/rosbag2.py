@@ -1,0 +1,197 @@
+"""rosbag2 recordings of realsense2_camera topics (.db3 or .mcap, a bag folder or its single file), read with rosbags.
+
+>>> for frame in Rosbag2Source("walk_bag"):  # ros2 bag record of /camera/camera/color/... and aligned depth
+...     frame.depth  # metres, registered to frame.color
+
+What is read: the colour ``sensor_msgs/Image`` (rgb8 or bgr8), the depth aligned to colour (16UC1 in depth units,
+or 32FC1 metres) and the colour ``sensor_msgs/CameraInfo`` (the intrinsics of both, since the depth is aligned).
+Topics default to realsense2_camera's names (``/camera/camera/...``, its 4.54+ default namespace); when those are
+absent the one Image topic ending in ``color/image_raw`` and the one ending in ``aligned_depth_to_color/image_raw``
+are used, with the colour topic's ``camera_info``. Colour and depth images are paired by header stamp.
+
+Frames are numbered by colour image (0-based). A colour image with no depth image within ``sync_tolerance``, or
+whose pixels cannot be used, raises ``FrameReadError`` and the source moves on. librealsense's own .db3
+recordings (topics under ``/device_0/``) are a different layout: ``is_librealsense_recording`` tells them apart
+and ``sid.sources.open_source`` sends them to ``sid.sources.realsense``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Iterator
+from pathlib import Path
+from typing import Any
+
+from rosbags.highlevel import AnyReader, AnyReaderError
+from rosbags.interfaces import Connection
+from rosbags.rosbag2 import ReaderError
+from rosbags.typesys import Stores, get_typestore
+
+from sid.checks import check_number
+from sid.perception.camera import Intrinsics
+from sid.perception.frame import Frame
+from sid.sources import FrameReadError, SourceError
+from sid.sources.ros_messages import Stamped, StampPairer, intrinsics_from_camera_info, rgbd_frame, stamp_seconds
+
+IMAGE = "sensor_msgs/msg/Image"
+CAMERA_INFO = "sensor_msgs/msg/CameraInfo"
+COLOR_TOPIC = "/camera/camera/color/image_raw"
+DEPTH_TOPIC = "/camera/camera/aligned_depth_to_color/image_raw"
+BAG_SUFFIXES = (".db3", ".mcap")
+_LIBREALSENSE_PREFIX = "/device_"
+
+
+def _reader(path: Path) -> AnyReader:
+    """An opened rosbags reader; bags without embedded message definitions (.db3) use ROS 2 Humble's types."""
+    reader = AnyReader([path], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
+    try:
+        reader.open()
+    except (AnyReaderError, ReaderError, OSError) as exc:
+        raise SourceError(f"cannot read rosbag2 recording {path}: {exc}") from None
+    return reader
+
+
+def is_librealsense_recording(path: str | Path) -> bool:
+    """True when the bag at ``path`` was written by librealsense (its topics live under ``/device_N/``)."""
+    reader = _reader(Path(path))
+    try:
+        return any(c.topic.startswith(_LIBREALSENSE_PREFIX) for c in reader.connections)
+    finally:
+        reader.close()
+
+
+def _pick(connections: list[Connection], msgtype: str, wanted: str | None, default: str, ending: str) -> Connection:
+    """The connection of topic ``wanted``; else ``default``; else the only ``msgtype`` topic ending in ``ending``."""
+    typed = [c for c in connections if c.msgtype == msgtype]
+    if wanted is not None:
+        named = [c for c in typed if c.topic == wanted]
+        if not named:
+            raise SourceError(f"no {msgtype} topic {wanted!r} in the bag; it has {_topics(typed, msgtype)}")
+        return named[0]
+    named = [c for c in typed if c.topic == default] or [c for c in typed if c.topic.endswith(ending)]
+    if len({c.topic for c in named}) != 1:
+        found = "none" if not named else "several"
+        raise SourceError(
+            f"{found} of the bag's {msgtype} topics end in {ending!r} ({_topics(typed, msgtype)}); name the topic"
+        )
+    return named[0]
+
+
+def _topics(connections: list[Connection], msgtype: str) -> str:
+    names = sorted({c.topic for c in connections})
+    return ", ".join(names) if names else f"no {msgtype} topics"
+
+
+def _first_camera_info(reader: AnyReader, info: Connection) -> Intrinsics:
+    """The intrinsics of the first CameraInfo on ``info`` (the calibration of the whole recording)."""
+    for connection, _, raw in reader.messages(connections=[info]):
+        try:
+            return intrinsics_from_camera_info(reader.deserialize(raw, connection.msgtype))
+        except ValueError as exc:
+            raise SourceError(f"{connection.topic}: {exc}") from None
+    raise SourceError(f"{info.topic} holds no message")
+
+
+class Rosbag2Source:
+    """Iterator of ``Frame``s from a rosbag2 recording of realsense2_camera topics (see the module docstring).
+
+    path: the bag folder (with metadata.yaml) or its .db3 / .mcap file. color_topic / depth_topic / info_topic:
+    override the topic names. depth_scale: metres per 16UC1 depth unit (0.001, realsense2_camera's millimetres).
+    sync_tolerance: largest stamp difference (s) of a colour and depth image taken as one frame.
+    """
+
+    def __init__(
+        self,
+        path: str | Path,
+        *,
+        color_topic: str | None = None,
+        depth_topic: str | None = None,
+        info_topic: str | None = None,
+        depth_scale: float = 0.001,
+        sync_tolerance: float = 0.015,
+    ) -> None:
+        self.path = Path(path)
+        if not self.path.exists():
+            raise SourceError(f"rosbag2 recording {self.path} does not exist")
+        check_number("rosbag2 source", "depth_scale", depth_scale, low=0, low_open=True, unit="metres per unit")
+        self.depth_scale = float(depth_scale)
+        self._pairer: StampPairer[Any] = StampPairer(sync_tolerance)
+        reader = _reader(self.path)
+        self._reader: AnyReader | None = reader
+        connections = list(reader.connections)
+        try:
+            self.color = _pick(connections, IMAGE, color_topic, COLOR_TOPIC, "color/image_raw")
+            self.depth = _pick(connections, IMAGE, depth_topic, DEPTH_TOPIC, "aligned_depth_to_color/image_raw")
+            namespace = self.color.topic.rsplit("/", 1)[0]
+            self.info = _pick(
+                connections, CAMERA_INFO, info_topic, f"{namespace}/camera_info", f"{namespace}/camera_info"
+            )
+            self.intrinsics = _first_camera_info(reader, self.info)
+        except SourceError as exc:
+            self.close()
+            raise SourceError(f"rosbag2 recording {self.path}: {exc}") from None
+        self._messages = reader.messages(connections=[self.color, self.depth])
+        self._colors = 0  # colour images seen: the next colour image's frame index
+        self._ready: list[Frame | FrameReadError] = []
+
+    def __iter__(self) -> Iterator[Frame]:
+        return self
+
+    def __next__(self) -> Frame:
+        while not self._ready:
+            if self._reader is None:
+                raise StopIteration
+            try:
+                connection, _, raw = next(self._messages)
+            except StopIteration:
+                self._ready.extend(self._unpaired(self._pairer.waiting["color"]))
+                self.close()
+                continue
+            self._add(connection, raw)
+        item = self._ready.pop(0)
+        if isinstance(item, FrameReadError):
+            raise item
+        return item
+
+    def _add(self, connection: Connection, raw: bytes) -> None:
+        """Deserialize one image and queue the frames and errors it completes, in frame order."""
+        assert self._reader is not None  # only called while the bag is open
+        msg: Any = self._reader.deserialize(raw, connection.msgtype)
+        stream = "color" if connection.topic == self.color.topic else "depth"
+        item: Any = msg
+        if stream == "color":
+            item = (self._colors, msg)
+            self._colors += 1
+        pair = self._pairer.add(stream, stamp_seconds(msg.header), item)
+        dropped, self._pairer.dropped_colors = self._pairer.dropped_colors, []
+        self._ready.extend(self._unpaired(dropped))
+        if pair is None:
+            return
+        (index, color), depth = pair[0].item, pair[1].item
+        try:
+            self._ready.append(rgbd_frame(index, color, depth, self.intrinsics, self.depth_scale))
+        except ValueError as exc:
+            self._ready.append(FrameReadError(f"{self.path}: frame {index}: {exc}", index, self.path))
+
+    def _unpaired(self, colors: Iterable[Stamped[Any]]) -> list[FrameReadError]:
+        """One FrameReadError per colour image (``item``: (frame index, message)) that found no depth image."""
+        return [
+            FrameReadError(
+                f"{self.path}: frame {m.item[0]}: no depth image within {self._pairer.tolerance:g} s of the colour "
+                f"image at {m.stamp:.3f} s",
+                m.item[0],
+                self.path,
+            )
+            for m in colors
+        ]
+
+    def close(self) -> None:
+        """Close the bag (idempotent)."""
+        if self._reader is not None:
+            reader, self._reader = self._reader, None
+            reader.close()
+
+    def __enter__(self) -> Rosbag2Source:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

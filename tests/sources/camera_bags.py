@@ -1,0 +1,94 @@
+"""realsense2_camera-style rosbag2 recordings for tests, written with rosbags: colour and aligned depth images plus
+the colour camera_info, under realsense2_camera's default topic names."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from pathlib import Path
+
+import cv2
+import numpy as np
+from rosbags.rosbag2 import StoragePlugin, Writer
+from rosbags.typesys import Stores, get_typestore
+
+from sid.perception.camera import Intrinsics
+
+NAMESPACE = "/camera/camera"
+COLOR = f"{NAMESPACE}/color/image_raw"
+DEPTH = f"{NAMESPACE}/aligned_depth_to_color/image_raw"
+INFO = f"{NAMESPACE}/color/camera_info"
+TYPES = get_typestore(Stores.ROS2_HUMBLE)
+
+
+def header(stamp_s: float, frame_id: str = "camera_color_optical_frame"):
+    sec, nanosec = divmod(round(stamp_s * 1e9), 1_000_000_000)
+    t = TYPES.types
+    return t["std_msgs/msg/Header"](stamp=t["builtin_interfaces/msg/Time"](sec=sec, nanosec=nanosec), frame_id=frame_id)
+
+
+def image(stamp_s: float, pixels: np.ndarray, encoding: str):
+    """A sensor_msgs/Image of ``pixels`` (uint8 H x W x C, or uint16 H x W), rows unpadded."""
+    pixels = np.ascontiguousarray(pixels)
+    height, width = pixels.shape[:2]
+    return TYPES.types["sensor_msgs/msg/Image"](
+        header=header(stamp_s),
+        height=height,
+        width=width,
+        encoding=encoding,
+        is_bigendian=0,
+        step=pixels.strides[0],
+        data=pixels.view(np.uint8).ravel(),
+    )
+
+
+def camera_info(stamp_s: float, intr: Intrinsics):
+    t = TYPES.types
+    k = np.array([intr.fx, 0, intr.cx, 0, intr.fy, intr.cy, 0, 0, 1], dtype=np.float64)
+    p = np.array([intr.fx, 0, intr.cx, 0, 0, intr.fy, intr.cy, 0, 0, 0, 1, 0], dtype=np.float64)
+    roi = t["sensor_msgs/msg/RegionOfInterest"](x_offset=0, y_offset=0, height=0, width=0, do_rectify=False)
+    return t["sensor_msgs/msg/CameraInfo"](
+        header=header(stamp_s),
+        height=intr.height,
+        width=intr.width,
+        distortion_model="plumb_bob",
+        d=np.zeros(5),
+        k=k,
+        r=np.eye(3).ravel(),
+        p=p,
+        binning_x=0,
+        binning_y=0,
+        roi=roi,
+    )
+
+
+def write_camera_bag(
+    path: Path,
+    frames: Iterable[tuple[np.ndarray, np.ndarray]],
+    intr: Intrinsics,
+    *,
+    mcap: bool = True,
+    encoding: str = "rgb8",
+    fps: float = 30.0,
+    skip_depth: Iterable[int] = (),
+) -> Path:
+    """Write (RGB uint8, depth uint16 mm) frames to a rosbag2 folder ``path``; returns the folder.
+
+    encoding: the colour encoding (rgb8 or bgr8). skip_depth: frame numbers recorded without their depth image.
+    """
+    skipped = set(skip_depth)
+    plugin = StoragePlugin.MCAP if mcap else StoragePlugin.SQLITE3
+    with Writer(path, version=8, storage_plugin=plugin) as writer:
+        color_c = writer.add_connection(COLOR, "sensor_msgs/msg/Image", typestore=TYPES)
+        depth_c = writer.add_connection(DEPTH, "sensor_msgs/msg/Image", typestore=TYPES)
+        info_c = writer.add_connection(INFO, "sensor_msgs/msg/CameraInfo", typestore=TYPES)
+        for number, (rgb, depth) in enumerate(frames):
+            stamp = 100.0 + number / fps
+            time_ns = round(stamp * 1e9)
+            pixels = cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR) if encoding == "bgr8" else rgb
+            messages = [(info_c, camera_info(stamp, intr), "sensor_msgs/msg/CameraInfo")]
+            messages.append((color_c, image(stamp, pixels, encoding), "sensor_msgs/msg/Image"))
+            if number not in skipped:
+                messages.append((depth_c, image(stamp + 0.002, depth, "16UC1"), "sensor_msgs/msg/Image"))
+            for connection, message, msgtype in messages:
+                writer.write(connection, time_ns, TYPES.serialize_cdr(message, msgtype))
+    return path

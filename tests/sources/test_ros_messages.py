@@ -1,0 +1,80 @@
+"""sid.sources.ros_messages: Image and CameraInfo fields -> arrays and intrinsics, and stamp pairing."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from sid.sources.ros_messages import StampPairer, color_rgb, depth_metres, intrinsics_from_camera_info, rgbd_frame
+
+
+def image(pixels: np.ndarray, encoding: str, pad: int = 0, bigendian: bool = False, stamp: float = 1.5):
+    """An Image-shaped record of ``pixels`` whose rows carry ``pad`` extra bytes."""
+    data = pixels.astype(pixels.dtype.newbyteorder(">" if bigendian else "<"))
+    rows = data.reshape(pixels.shape[0], -1).view(np.uint8)
+    padded = np.concatenate([rows, np.full((rows.shape[0], pad), 7, np.uint8)], axis=1)
+    sec = int(stamp)
+    header = SimpleNamespace(stamp=SimpleNamespace(sec=sec, nanosec=round((stamp - sec) * 1e9)))
+    return SimpleNamespace(
+        header=header,
+        height=pixels.shape[0],
+        width=pixels.shape[1],
+        encoding=encoding,
+        is_bigendian=int(bigendian),
+        step=padded.shape[1],
+        data=padded.tobytes(),
+    )
+
+
+def test_colour_encodings_and_row_padding() -> None:
+    rgb = np.random.default_rng(0).integers(0, 255, (4, 5, 3), dtype=np.uint8)
+    assert np.array_equal(color_rgb(image(rgb, "rgb8", pad=3)), rgb)
+    assert np.array_equal(color_rgb(image(rgb[..., ::-1].copy(), "bgr8")), rgb)
+    with pytest.raises(ValueError, match="'yuv422' is not supported"):
+        color_rgb(image(rgb, "yuv422"))
+    short = image(rgb, "rgb8")
+    short.data = short.data[:-1]
+    with pytest.raises(ValueError, match="do not hold it"):
+        color_rgb(short)
+
+
+def test_depth_in_units_or_metres_and_either_byte_order() -> None:
+    mm = np.array([[0, 1000], [2500, 65535]], np.uint16)
+    for bigendian in (False, True):
+        metres = depth_metres(image(mm, "16UC1", pad=2, bigendian=bigendian), 0.001)
+        assert metres.dtype == np.float32 and np.allclose(metres, [[0, 1.0], [2.5, 65.535]])
+    floats = np.array([[np.nan, 1.25]], np.float32)
+    assert depth_metres(image(floats, "32FC1"), 0.001).tolist() == [[0.0, 1.25]]  # NaN = no reading
+    with pytest.raises(ValueError, match="use 16UC1"):
+        depth_metres(image(mm.astype(np.uint8), "8UC1"), 0.001)
+
+
+def test_camera_info_and_frame() -> None:
+    info = SimpleNamespace(
+        width=5, height=4, k=[50, 0, 2, 0, 51, 1.5, 0, 0, 1], d=[0.0] * 5, distortion_model="plumb_bob"
+    )
+    intr = intrinsics_from_camera_info(info)
+    assert (intr.fx, intr.fy, intr.cx, intr.cy, intr.width, intr.height) == (50, 51, 2, 1.5, 5, 4)
+    info.k = [0.0] * 9
+    with pytest.raises(ValueError, match="camera_info: .*focal lengths"):
+        intrinsics_from_camera_info(info)
+    rgb, mm = np.zeros((4, 5, 3), np.uint8), np.full((4, 5), 1500, np.uint16)
+    frame = rgbd_frame(3, image(rgb, "rgb8"), image(mm, "16UC1"), intr, 0.001)
+    assert (frame.index, frame.timestamp, frame.calibration.depth) == (3, 1.5, None)
+    assert frame.depth[0, 0] == pytest.approx(1.5)
+    with pytest.raises(ValueError, match="depth image is 4x3, camera_info says 5x4"):
+        rgbd_frame(0, image(rgb, "rgb8"), image(mm[:3, :4], "16UC1"), intr, 0.001)
+
+
+def test_pairing_by_stamp() -> None:
+    pairer: StampPairer[str] = StampPairer(0.01)
+    assert pairer.add("color", 1.000, "c1") is None
+    assert pairer.add("color", 1.033, "c2") is None
+    pair = pairer.add("depth", 1.035, "d2")  # pairs with c2; c1 can never pair now
+    assert pair is not None and (pair[0].item, pair[1].item) == ("c2", "d2")
+    assert [m.item for m in pairer.dropped_colors] == ["c1"]
+    assert pairer.add("depth", 1.100, "d3") is None and pairer.add("color", 1.095, "c3") is not None
+    with pytest.raises(ValueError, match="'color' or 'depth'"):
+        pairer.add("ir", 1.0, "x")

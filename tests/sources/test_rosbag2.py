@@ -1,0 +1,133 @@
+"""rosbag2 recordings of realsense2_camera topics (sid.sources.rosbag2) and their dispatch by open_source."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from sid.cli import main
+from sid.perception.frame import Frame
+from sid.perception.pipeline import Pipeline
+from sid.sources import FrameReadError, SourceError, open_source, skip_unreadable
+from sid.sources.rosbag2 import Rosbag2Source, is_librealsense_recording
+from sid.sources.synthetic import SyntheticSource
+from sid.synthetic.pose import TruthPose
+from tests.conftest import realsense, shared_path
+from tests.sources.camera_bags import COLOR, write_camera_bag
+
+
+def synthetic_pairs(count: int) -> tuple[list[tuple[np.ndarray, np.ndarray]], list[Frame]]:
+    """(RGB, depth mm uint16) pairs of the S3 scene (three people) with registered depth, and the frames."""
+    frames = list(SyntheticSource("S3", frames=count, seed=3, registered=True))
+    pairs = [(f.color, np.round(f.depth * 1000).astype(np.uint16)) for f in frames]
+    return pairs, frames
+
+
+def write_folder(folder: Path, pairs: list[tuple[np.ndarray, np.ndarray]], intrinsics: dict) -> Path:
+    for sub in ("color", "depth"):
+        (folder / sub).mkdir(parents=True)
+    for number, (rgb, depth) in enumerate(pairs):
+        assert cv2.imwrite(str(folder / "color" / f"{number}.png"), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
+        assert cv2.imwrite(str(folder / "depth" / f"{number}.png"), depth)
+    (folder / "intrinsics.json").write_text(json.dumps(intrinsics))
+    return folder
+
+
+@pytest.mark.parametrize(("mcap", "encoding"), [(True, "rgb8"), (False, "bgr8")])
+def test_bag_gives_the_frames_and_people_of_the_same_folder(tmp_path: Path, mcap: bool, encoding: str) -> None:
+    pairs, synthetic = synthetic_pairs(3)
+    intr = synthetic[0].calibration.color
+    bag = write_camera_bag(tmp_path / "bag", pairs, intr, mcap=mcap, encoding=encoding)
+    folder = write_folder(tmp_path / "frames", pairs, intr.to_dict())
+    storage = next(bag.glob("*.mcap" if mcap else "*.db3"))
+    for spec in (bag, storage):  # the bag folder and its single storage file
+        from_bag, from_folder = list(open_source(str(spec))), list(open_source(str(folder)))
+        assert isinstance(open_source(str(spec)), Rosbag2Source)
+        assert [f.index for f in from_bag] == [0, 1, 2]
+        assert from_bag[1].timestamp == pytest.approx(100 + 1 / 30)
+        for a, b in zip(from_bag, from_folder, strict=True):
+            assert np.array_equal(a.color, b.color)
+            assert np.array_equal(a.depth, b.depth)
+            assert np.allclose(a.calibration.color.K, b.calibration.color.K)
+            assert a.calibration.depth is None and a.calibration.depth_scale == 0.001
+    # The same pose detections (the scene's truth, per frame index) give the same people from both sources.
+    truth = {f.index: TruthPose()(f) for f in synthetic}
+    pipeline = Pipeline(lambda frame: truth[frame.index])
+    bag_people = [[(p.x, p.y, p.theta) for p in pipeline(f).people] for f in open_source(str(bag))]
+    folder_people = [[(p.x, p.y, p.theta) for p in pipeline(f).people] for f in open_source(str(folder))]
+    assert len(bag_people[0]) == 3 and bag_people == folder_people
+
+
+def test_sid_detect_reads_a_bag_as_it_reads_the_folder(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The real five-people frame, twice, as a realsense2_camera bag and as a folder: the same JSON lines."""
+    real = shared_path("data", "rgbd", "five_people")
+    model = shared_path("models", "yolo11n-pose-256.onnx")
+    rgb = cv2.cvtColor(cv2.imread(str(real / "color.png")), cv2.COLOR_BGR2RGB)
+    depth = cv2.imread(str(real / "depth.png"), cv2.IMREAD_UNCHANGED)
+    intrinsics = json.loads((real / "intrinsics.json").read_text())
+    folder = write_folder(tmp_path / "frames", [(rgb, depth)] * 2, intrinsics)
+    from sid.perception.camera import Intrinsics
+
+    bag = write_camera_bag(tmp_path / "bag", [(rgb, depth)] * 2, Intrinsics.from_dict(intrinsics), encoding="bgr8")
+    outputs = []
+    for source in (bag, folder):
+        args = ["detect", "--source", str(source), "--model", str(model), "--no-keypoints", "--no-tracking"]
+        assert main(args) == 0
+        outputs.append([json.loads(line) for line in capsys.readouterr().out.splitlines()])
+    from_bag, from_folder = outputs
+    assert len(from_bag) == 2 and len(from_bag[0]["people"]) == 5
+    assert [r["people"] for r in from_bag] == [r["people"] for r in from_folder]
+    assert [r["groups"] for r in from_bag] == [r["groups"] for r in from_folder]
+
+
+def test_a_colour_image_without_depth_is_reported_and_skipped(tmp_path: Path) -> None:
+    pairs, synthetic = synthetic_pairs(3)
+    bag = write_camera_bag(tmp_path / "bag", pairs, synthetic[0].calibration.color, skip_depth=[1])
+    errors: list[FrameReadError] = []
+    frames = list(skip_unreadable(open_source(str(bag)), errors.append))
+    assert [f.index for f in frames] == [0, 2]
+    assert [e.index for e in errors] == [1]
+    assert "no depth image within 0.015 s" in str(errors[0])
+
+
+def test_unsupported_encoding_is_a_frame_error_naming_it(tmp_path: Path) -> None:
+    pairs, synthetic = synthetic_pairs(1)
+    bag = write_camera_bag(tmp_path / "bag", pairs, synthetic[0].calibration.color, encoding="yuv422")
+    with pytest.raises(FrameReadError, match="colour image encoding 'yuv422' is not supported"):
+        next(iter(open_source(str(bag))))
+
+
+def test_missing_topics_are_named(tmp_path: Path) -> None:
+    pairs, synthetic = synthetic_pairs(1)
+    bag = write_camera_bag(tmp_path / "bag", pairs, synthetic[0].calibration.color)
+    with pytest.raises(SourceError, match=f"no sensor_msgs/msg/Image topic '/nowhere'.*{COLOR}"):
+        Rosbag2Source(bag, color_topic="/nowhere")
+    with pytest.raises(SourceError, match="does not exist"):
+        open_source(str(tmp_path / "missing.mcap"))
+    (tmp_path / "junk.mcap").write_bytes(b"not a bag")
+    with pytest.raises(SourceError, match="cannot read rosbag2 recording"):
+        open_source(str(tmp_path / "junk.mcap"))
+
+
+def test_librealsense_db3_still_goes_to_the_realsense_source(tmp_path: Path) -> None:
+    realsense()
+    from sid.perception.camera import Calibration, Extrinsics, Intrinsics
+    from sid.sources.librealsense import record_synthetic
+    from sid.sources.realsense import RealSenseSource
+
+    intr = Intrinsics(64, 48, 50.0, 50.0, 31.5, 23.5)
+    pair = (np.zeros((48, 64, 3), np.uint8), np.full((48, 64), 1000, np.uint16))
+    recording = record_synthetic(tmp_path / "rs.db3", [pair] * 2, Calibration(intr, intr, Extrinsics()))
+    assert is_librealsense_recording(recording)
+    source = open_source(str(recording), align="none")
+    assert isinstance(source, RealSenseSource)
+    frames = list(skip_unreadable(source, lambda error: None))  # played to the end (closing it earlier can hang)
+    assert frames and frames[0].depth[10, 10] == pytest.approx(1.0)
+    bag = write_camera_bag(
+        tmp_path / "bag", synthetic_pairs(1)[0], synthetic_pairs(1)[1][0].calibration.color, mcap=False
+    )
+    assert not is_librealsense_recording(next(bag.glob("*.db3")))
