@@ -27,6 +27,9 @@ from planner.validity import check_path
 PLANNERS: tuple[str, ...] = (*OMPL_PLANNERS, "grid")
 """Every planner ``plan`` offers: OMPL's (``planner.ompl_planners``) and the grid planner."""
 DEFAULT_PLANNER = "bitstar"
+DEFAULT_SETTLE_S = 0.04
+"""``plan``'s default ``settle``: an anytime planner stops once its cost has not improved for this long (s).
+Measured over the navigation study's 36 tasks (docs/benchmarks.md, planning budget)."""
 MAX_SEED = 2**32 - 1
 """The largest seed ``plan`` takes: OMPL's seed is a ``std::uint_fast32_t``, 32 bits wide on some platforms."""
 UNAVAILABLE: dict[str, str] = {
@@ -118,19 +121,24 @@ def plan(
     seed: int | None = None,
     max_iterations: int | None = None,
     simplify: bool = True,
+    settle: float | None = DEFAULT_SETTLE_S,
 ) -> PlanResult:
     """Plan ``problem`` with the named planner (``PLANNERS``; ``"grid"`` is the Dijkstra + any-angle planner).
 
-    time_limit: seconds for the planner's solve(); seed / max_iterations: see the module docstring (the grid
-    planner is deterministic and ignores them). Raises PlanningError when the start or goal is outside the map,
-    in collision or unreachable, and ValueError for an unknown planner or a bad budget; a planner that finds no
-    path in its budget gives ``success=False`` with the reason in ``message``.
+    time_limit: seconds for the planner's solve(), at most; seed / max_iterations: see the module docstring (the grid
+    planner is deterministic and ignores them). settle: BIT* stops earlier, once its path's cost has not improved for
+    ``settle`` seconds (``planner.ompl_planners.solve_ompl``; ``DEFAULT_SETTLE_S``); None, or a ``max_iterations``
+    cap (whose runs must repeat exactly), uses the whole ``time_limit``. Raises PlanningError when the start or goal
+    is outside the map, in collision or unreachable, and ValueError for an unknown planner or a bad budget; a
+    planner that finds no path in its budget gives ``success=False`` with the reason in ``message``.
     """
     name = resolve_planner(planner)
     if not (math.isfinite(time_limit) and time_limit > 0):
         raise ValueError(f"time_limit must be a positive number of seconds, got {time_limit}")
     if max_iterations is not None and max_iterations < 1:
         raise ValueError(f"max_iterations must be at least 1, got {max_iterations}")
+    if settle is not None and not (math.isfinite(settle) and settle > 0):
+        raise ValueError(f"settle must be a positive number of seconds or None, got {settle}")
     t0 = time.perf_counter()
     if name != "grid":
         seed = secrets.randbelow(2**31 - 1) + 1 if seed is None else int(seed)
@@ -147,7 +155,8 @@ def plan(
         t_solve = time.perf_counter()
         raw, iterations, solve_time = grid_search(field), 0, time.perf_counter() - t_solve
     else:
-        raw, iterations, solve_time = solve_ompl(field, name, time_limit, max_iterations)
+        settle = None if max_iterations is not None else settle
+        raw, iterations, solve_time = solve_ompl(field, name, time_limit, max_iterations, settle)
     raw_cost = math.inf if raw is None else field.path_cost(raw)
     result = PlanResult(name, False, np.zeros((0, 2)), math.inf, 0.0, 0.0, solve_time, raw_cost, iterations, seed, "")
     if raw is None:

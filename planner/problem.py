@@ -162,26 +162,32 @@ class CostField:
         """J (M,) of straight segments p[i] -> q[i] (each (M, 2)) and whether each is plannable over its length.
 
         Same midpoint rule as ``segment_cost``; plannability is checked at the midpoints and the piece ends
-        (spacing at most half a cell).
+        (spacing at most half a cell). The smoother's inner loop: one flat pass over all samples, in cell units
+        (as ``segment_cost``: offsets times 1 / resolution, floored).
         """
         p = np.asarray(p, dtype=float).reshape(-1, 2)
         q = np.asarray(q, dtype=float).reshape(-1, 2)
+        if len(p) == 0:
+            return np.zeros(0), np.zeros(0, bool)
         d = q - p
         length = np.hypot(d[:, 0], d[:, 1])
         n = np.maximum(1, np.ceil(length * self._inv_res - 1e-9)).astype(np.int64)
         # Samples at t = k / (2n), k = 0..2n: even k are piece ends, odd k are the midpoints used for the cost.
         counts = 2 * n + 1
+        starts = np.cumsum(counts) - counts
         seg = np.repeat(np.arange(len(p)), counts)
-        k = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
-        t = k / (2.0 * n[seg])
-        pts = p[seg] + t[:, None] * d[seg]
-        rows, cols, inside = self.cells(pts)
-        ok = self.plannable[rows, cols] & inside
-        mid = (k % 2) == 1
-        weights = np.bincount(seg[mid], weights=self.weight[rows[mid], cols[mid]], minlength=len(p))
-        cost = length * (1.0 + weights / n)
-        plannable = np.logical_and.reduceat(ok, np.cumsum(counts) - counts) if len(p) else np.zeros(0, bool)
-        return cost, plannable
+        k = np.arange(len(seg)) - starts[seg]
+        inv = self._inv_res
+        step = d * (inv / (2.0 * n))[:, None]  # cells per sample
+        x = ((p[:, 0] - self._ox) * inv)[seg] + k * step[seg, 0]
+        y = ((p[:, 1] - self._oy) * inv)[seg] + k * step[seg, 1]
+        col, row = np.floor(x).astype(np.int64), np.floor(y).astype(np.int64)
+        inside = (row >= 0) & (row < self._h) & (col >= 0) & (col < self._w)
+        flat = np.clip(row, 0, self._h - 1) * self._w + np.clip(col, 0, self._w - 1)  # clipped, as ``cells``
+        ok = self.plannable.ravel()[flat] & inside
+        weights = self.weight.ravel()[flat] * (k % 2)  # midpoints only
+        cost = length * (1.0 + np.add.reduceat(weights, starts) / n)
+        return cost, np.logical_and.reduceat(ok, starts)
 
     def path_cost(self, path: np.ndarray) -> float:
         """J of a polyline (N, 2)."""

@@ -18,6 +18,9 @@ from planner.validity import interpolate
 
 _DIRECTIONS = np.array([[1, 0], [0, 1], [-1, 0], [0, -1], [1, 1], [-1, 1], [-1, -1], [1, -1]], float)
 _DIRECTIONS[4:] /= np.sqrt(2.0)
+DP_REACH = 12
+"""The last shortcut pass joins refined vertices (about 6 cells apart) at most this many apart: refinement has
+already bent the path, so longer shortcuts rarely pay, and all pairs cost O(N^2) segments."""
 
 
 def greedy_shortcut(field: CostField, path: np.ndarray, window: int = 64) -> np.ndarray:
@@ -39,14 +42,17 @@ def greedy_shortcut(field: CostField, path: np.ndarray, window: int = 64) -> np.
     return path[kept]
 
 
-def dp_shortcut(field: CostField, path: np.ndarray) -> np.ndarray:
-    """The cheapest polyline through a subsequence of the vertices (dynamic programming over all vertex pairs).
-    The path's own segments are always allowed, so the result never costs more. Meant for short paths (O(N^2))."""
+def dp_shortcut(field: CostField, path: np.ndarray, reach: int | None = None) -> np.ndarray:
+    """The cheapest polyline through a subsequence of the vertices (dynamic programming over vertex pairs at most
+    ``reach`` vertices apart; None: all pairs). The path's own segments are always allowed, so the result never costs
+    more. O(N * reach) segments (O(N^2) without a reach)."""
     path = np.asarray(path, dtype=float).reshape(-1, 2)
     n = len(path)
     if n <= 2:
         return path.copy()
     i, j = np.triu_indices(n, 1)
+    if reach is not None:
+        i, j = i[j - i <= reach], j[j - i <= reach]
     cost, ok = field.segments(path[i], path[j])
     ok |= j == i + 1
     matrix = np.full((n, n), np.inf)
@@ -66,32 +72,38 @@ def dp_shortcut(field: CostField, path: np.ndarray) -> np.ndarray:
 
 def refine(field: CostField, path: np.ndarray, max_step: float, min_step: float, sweeps: int = 4) -> np.ndarray:
     """Move interior vertices downhill in J: at step sizes from ``max_step`` halving to ``min_step`` (metres), try
-    the eight compass moves for every other vertex at once (alternate vertices share no segment) and keep each
-    move that lowers the cost of the vertex's two segments and keeps them plannable."""
+    the eight compass moves for every other vertex at once (alternate vertices share no segment) and move each vertex
+    to the move that lowers the cost of its two segments most while keeping them plannable (steepest descent). All
+    16 segments of every candidate move of a pass are priced in one ``CostField.segments`` call."""
     path = np.asarray(path, dtype=float).reshape(-1, 2).copy()
     n = len(path)
     if n <= 2:
         return path
     seg_cost = field.segments(path[:-1], path[1:])[0]
+    moves = len(_DIRECTIONS)
     step = max_step
     while step >= min_step:
         for _ in range(sweeps):
             moved = False
             for first in (1, 2):
                 idx = np.arange(first, n - 1, 2)
-                if len(idx) == 0:
+                k = len(idx)
+                if k == 0:
                     continue
-                for direction in _DIRECTIONS * step:
-                    candidate = path[idx] + direction
-                    c_in, ok_in = field.segments(path[idx - 1], candidate)
-                    c_out, ok_out = field.segments(candidate, path[idx + 1])
-                    better = ok_in & ok_out & (c_in + c_out < seg_cost[idx - 1] + seg_cost[idx] - 1e-9)
-                    if better.any():
-                        moved = True
-                        chosen = idx[better]
-                        path[chosen] = candidate[better]
-                        seg_cost[chosen - 1] = c_in[better]
-                        seg_cost[chosen] = c_out[better]
+                candidate = (path[idx][None, :, :] + (_DIRECTIONS * step)[:, None, :]).reshape(-1, 2)  # (8k, 2)
+                before, after = np.tile(path[idx - 1], (moves, 1)), np.tile(path[idx + 1], (moves, 1))
+                cost, ok = field.segments(np.concatenate([before, candidate]), np.concatenate([candidate, after]))
+                c_in, c_out = cost[: moves * k].reshape(moves, k), cost[moves * k :].reshape(moves, k)
+                total = np.where((ok[: moves * k] & ok[moves * k :]).reshape(moves, k), c_in + c_out, np.inf)
+                best = np.argmin(total, axis=0)
+                cols = np.arange(k)
+                better = total[best, cols] < seg_cost[idx - 1] + seg_cost[idx] - 1e-9
+                if better.any():
+                    moved = True
+                    chosen, pick = idx[better], best[better]
+                    path[chosen] = candidate.reshape(moves, k, 2)[pick, cols[better]]
+                    seg_cost[chosen - 1] = c_in[pick, cols[better]]
+                    seg_cost[chosen] = c_out[pick, cols[better]]
             if not moved:
                 break
         step /= 2
@@ -107,5 +119,5 @@ def smooth(field: CostField, path: np.ndarray) -> np.ndarray:
     res = field.resolution
     short = dp_shortcut(field, greedy_shortcut(field, path))
     refined = refine(field, interpolate(short, 6 * res), max_step=4 * res, min_step=res / 8)
-    result = dp_shortcut(field, refined)
+    result = dp_shortcut(field, refined, reach=DP_REACH)
     return result if field.path_cost(result) <= field.path_cost(path) else path.copy()

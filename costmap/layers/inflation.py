@@ -87,19 +87,55 @@ class InflationLayer(Layer):
         d2 = np.arange(self.cell_radius**2 + 2)
         self._cost_by_d2 = inflation_cost(np.sqrt(d2) * spec.resolution, inscribed_radius, params.cost_scaling_factor)
         self._cost_by_d2[-1] = FREE_SPACE
+        # The lethal cells ``costs`` was computed from (none yet: all FREE is right for them).
+        self._lethal = np.zeros(spec.shape, dtype=bool)
 
     def update(self, inputs: LayerInputs, changed: Window | None) -> Window | None:
         """Costs change within reach of whatever the layers before this one changed."""
         return None if changed is None else changed.grown(self.cell_radius, self.spec)
 
     def write(self, master: np.ndarray, window: Window) -> None:
-        """Inflate the lethal cells of ``master`` over ``window`` (from those within reach of it) and combine."""
+        """Bring the inflation costs up to date with the lethal cells of ``master`` and combine them over ``window``.
+
+        A cell's cost depends only on the lethal cells within ``cell_radius`` of it, so only the cells within reach of
+        a lethal cell that appeared or disappeared since the last write are recomputed (from the lethal cells within
+        reach of them): the cost of an update grows with the area that changed, not with the map, and every cell
+        gets the value a recomputation of the whole map would give (tests compare the two). Lethal cells change only
+        inside update windows, and each write compares the window grown by the reach, so none is missed.
+        """
         source = window.grown(self.cell_radius, self.spec)
-        inner = slice(window.row0 - source.row0, window.row1 - source.row0)
-        inner_cols = slice(window.col0 - source.col0, window.col1 - source.col0)
-        rows, cols = window.slices
-        self.costs[rows, cols] = self._inflate(master[source.slices] == LETHAL)[inner, inner_cols]
+        lethal = master[source.slices] == LETHAL
+        known = self._lethal[source.slices]
+        changed = lethal != known
+        if changed.any():
+            for affected in self._affected(changed, source):
+                reach = affected.grown(self.cell_radius, self.spec)
+                inner = slice(affected.row0 - reach.row0, affected.row1 - reach.row0)
+                inner_cols = slice(affected.col0 - reach.col0, affected.col1 - reach.col0)
+                inflated = self._inflate(master[reach.slices] == LETHAL)
+                self.costs[affected.slices] = inflated[inner, inner_cols]
+            known[...] = lethal
         super().write(master, window)
+
+    def _affected(self, changed: np.ndarray, source: Window) -> list[Window]:
+        """Windows (inside ``source``) holding every cell within reach of the ``changed`` cells (bool over
+        ``source``): the grid is cut into tiles of ``cell_radius`` cells, the tiles holding a change and their
+        neighbours are grouped into 8-connected clusters (scipy on the small tile grid) and each cluster's bounding
+        box is one window. A tile's neighbours reach at least ``cell_radius`` cells beyond it."""
+        t = max(self.cell_radius, 1)
+        rows, cols = np.nonzero(changed)
+        tiles = np.zeros((changed.shape[0] // t + 3, changed.shape[1] // t + 3), dtype=bool)
+        tiles[rows // t + 1, cols // t + 1] = True  # one empty tile of margin on every side
+        eight = np.ones((3, 3), dtype=bool)
+        labels, _ = ndimage.label(ndimage.binary_dilation(tiles, structure=eight), structure=eight)
+        windows = []
+        for tile_rows, tile_cols in ndimage.find_objects(labels):
+            # Tile i (margin included) covers rows (i - 1) * t .. i * t - 1 of ``source``.
+            row0, row1 = source.row0 + (tile_rows.start - 1) * t, source.row0 + (tile_rows.stop - 1) * t
+            col0, col1 = source.col0 + (tile_cols.start - 1) * t, source.col0 + (tile_cols.stop - 1) * t
+            windows.append(Window(max(row0, source.row0), min(row1, source.row1), max(col0, source.col0),
+                                  min(col1, source.col1)))  # fmt: skip
+        return windows
 
     def _inflate(self, lethal: np.ndarray) -> np.ndarray:
         """Nav2's cost for every cell of ``lethal`` (bool) within reach of a True cell, 0 beyond."""

@@ -24,11 +24,8 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-import shapely
-import shapely.affinity
 from shapely.geometry import MultiPoint, Polygon
 from shapely.geometry.base import BaseGeometry
-from shapely.geometry.polygon import orient
 
 from costmap.combine import CombinationMethod
 from costmap.grid import FREE_SPACE, LETHAL, MAX_NON_OBSTACLE, GridSpec, Window, union
@@ -98,23 +95,34 @@ def group_zone_polygon(
     return grown
 
 
-def _distance_to_hull(xs: np.ndarray, ys: np.ndarray, hull: BaseGeometry) -> np.ndarray:
+def _hull_ring(hull: BaseGeometry) -> tuple[np.ndarray, bool]:
+    """The vertices of a convex hull (Point, LineString or Polygon) as an (K, 2) array, a polygon's ring closed
+    and counter-clockwise (as shapely's ``orient(hull, 1.0)``), and whether it is a polygon."""
+    if not isinstance(hull, Polygon):
+        return np.asarray(hull.coords, dtype=float).reshape(-1, 2), False
+    ring = np.asarray(hull.exterior.coords, dtype=float)
+    x, y = ring[:, 0], ring[:, 1]
+    clockwise = float(np.dot(x[:-1], y[1:]) - np.dot(x[1:], y[:-1])) < 0  # shoelace: twice the signed area
+    return (ring[::-1] if clockwise else ring), True
+
+
+def _distance_to_hull(xs: np.ndarray, ys: np.ndarray, ring: np.ndarray, polygon: bool) -> np.ndarray:
     """Exact distance (m) from points (xs, ys broadcast together) to a convex hull (0 inside).
 
-    hull is a Point, LineString or convex Polygon.
+    ring, polygon: ``_hull_ring``'s vertices (a point, a polyline, or a closed counter-clockwise ring) and whether
+    they bound a polygon.
 
     Written out in numpy rather than ``shapely.distance``, which needs a point object per cell, and one pass per
     edge (keeping the running minimum) rather than all edges at once: both are faster (docs/parameters.md).
     """
-    polygon = isinstance(hull, Polygon)
-    coords = orient(hull, sign=1.0).exterior.coords if isinstance(hull, Polygon) else hull.coords
-    ring = np.asarray(coords)  # closed, CCW
     if len(ring) == 1:
         return np.hypot(xs - ring[0, 0], ys - ring[0, 1])
     shape = np.broadcast_shapes(np.shape(xs), np.shape(ys))
     best = np.full(shape, np.inf, dtype=np.result_type(xs, ys))
     inside = np.ones(shape, dtype=bool)
-    for (ax, ay), (bx, by) in zip(ring[:-1], ring[1:], strict=True):
+    # Python floats keep the arithmetic in the offsets' dtype (float32 from ``_local_axes``; numpy float64 scalars
+    # would promote it): within 1 cost unit of float64, at 1-2 of 640,000 cells (docs/benchmarks.md).
+    for (ax, ay), (bx, by) in zip(ring[:-1].tolist(), ring[1:].tolist(), strict=True):
         ex, ey = bx - ax, by - ay
         dx, dy = xs - ax, ys - ay
         if polygon:
@@ -136,10 +144,11 @@ def _person_box(person: Person, params: SocialParams) -> tuple[tuple[float, floa
         _reach(params.amplitude, s) for s in (params.sigma_front, params.sigma_rear, params.sigma_side)
     )
     c, s = np.cos(person.theta), np.sin(person.theta)
-    corners = np.array([[u, v] for u in (front, -rear) for v in (side, -side)])
-    xs = person.x + c * corners[:, 0] - s * corners[:, 1]
-    ys = person.y + s * corners[:, 0] + c * corners[:, 1]
-    return (xs.min(), ys.min()), (xs.max(), ys.max())
+    # The rectangle's corners (u along the facing, v sideways), in scalars: a person's box is per-frame overhead.
+    corners = [(u, v) for u in (front, -rear) for v in (side, -side)]
+    xs = [person.x + c * u - s * v for u, v in corners]
+    ys = [person.y + s * u + c * v for u, v in corners]
+    return (min(xs), min(ys)), (max(xs), max(ys))
 
 
 def _local_axes(spec: GridSpec, window: Window, x: float, y: float) -> tuple[np.ndarray, np.ndarray]:
@@ -156,15 +165,22 @@ def paint_person(costs: np.ndarray, spec: GridSpec, person: Person, params: Soci
         return None
     dx, dy = _local_axes(spec, window, person.x, person.y)
     if person.theta is None:
-        exponent = (dx * dx + dy * dy) * np.float32(0.5 / params.sigma_unknown**2)
+        exponent = dx * dx + dy * dy
+        exponent *= np.float32(0.5 / params.sigma_unknown**2)
     else:
         c, s = np.float32(np.cos(person.theta)), np.float32(np.sin(person.theta))
         u, v = c * dx + s * dy, c * dy - s * dx
         ku = np.where(u >= 0, np.float32(0.5 / params.sigma_front**2), np.float32(0.5 / params.sigma_rear**2))
-        exponent = u * u * ku + v * v * np.float32(0.5 / params.sigma_side**2)
-    cost = (np.float32(params.amplitude) * np.exp(-exponent)).astype(np.uint8)  # truncation = floor here
+        exponent = np.multiply(u, u, out=u)  # in place from here on: u^2 ku + v^2 / (2 sigma_side^2)
+        exponent *= ku
+        v *= v
+        v *= np.float32(0.5 / params.sigma_side**2)
+        exponent += v
+    np.negative(exponent, out=exponent)
+    cost = np.exp(exponent, out=exponent)
+    cost *= np.float32(params.amplitude)
     view = costs[window.slices]
-    np.maximum(view, cost, out=view)
+    np.maximum(view, cost.astype(np.uint8), out=view)  # truncation = floor here
     return window
 
 
@@ -183,8 +199,9 @@ def paint_group(costs: np.ndarray, spec: GridSpec, hull: BaseGeometry, params: S
         return None
     ox, oy = (x0 + x1) / 2, (y0 + y1) / 2
     dx, dy = _local_axes(spec, window, ox, oy)
-    local = shapely.affinity.translate(hull, -ox, -oy)
-    outside = np.maximum(_distance_to_hull(dx, dy, local) - np.float32(params.group_margin + 1e-6), 0)
+    ring, polygon = _hull_ring(hull)
+    ring = ring - (ox, oy)  # as the cell offsets: relative to the hull's centre
+    outside = np.maximum(_distance_to_hull(dx, dy, ring, polygon) - np.float32(params.group_margin + 1e-6), 0)
     falloff = np.exp(-(outside * outside) * np.float32(0.5 / params.group_sigma**2))
     view = costs[window.slices]
     np.maximum(view, (np.float32(params.group_cost) * falloff).astype(np.uint8), out=view)

@@ -15,6 +15,7 @@ raises ``FrameReadError`` naming the file, and iteration goes on with the next f
 from __future__ import annotations
 
 import re
+from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 
 import cv2
@@ -83,8 +84,8 @@ class FolderSource:
             raise FrameReadError(f"frame {name!r}: no colour image in {self.path / 'color'}", index, None)
         if depth_path is None:
             raise FrameReadError(f"frame {name!r}: no depth image {name}.png next to {color_path}", index, None)
-        bgr = cv2.imread(str(color_path), cv2.IMREAD_COLOR)
-        if bgr is None:
+        rgb = cv2.imread(str(color_path), cv2.IMREAD_COLOR_RGB)  # decoded straight to RGB: no conversion pass
+        if rgb is None:
             raise FrameReadError(f"cannot read colour image {color_path}", index, color_path)
         raw = cv2.imread(str(depth_path), cv2.IMREAD_UNCHANGED)
         if raw is None:
@@ -98,9 +99,9 @@ class FolderSource:
             )
         calib = self.calibration
         expected_color = (calib.color.height, calib.color.width)
-        if bgr.shape[:2] != expected_color:
+        if rgb.shape[:2] != expected_color:
             raise FrameReadError(
-                f"colour image {color_path} is {bgr.shape[1]}x{bgr.shape[0]}, the calibration says "
+                f"colour image {color_path} is {rgb.shape[1]}x{rgb.shape[0]}, the calibration says "
                 f"{calib.color.width}x{calib.color.height}",
                 index,
                 color_path,
@@ -113,28 +114,39 @@ class FolderSource:
                 depth_path,
             )
         depth = raw.astype(np.float32) * np.float32(calib.depth_scale)
-        return Frame(index, cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB), depth, calib, index / self.fps)
+        return Frame(index, rgb, depth, calib, index / self.fps)
 
     def __iter__(self) -> _Reader:
         return _Reader(self)
 
 
 class _Reader:
-    """Sequential iterator over a FolderSource that survives FrameReadError (it has already moved on)."""
+    """Sequential iterator over a FolderSource that survives FrameReadError (it has already moved on).
+
+    While the caller works on a frame, the next one is read in a background thread: OpenCV's PNG decoding releases
+    the GIL, so decoding overlaps the pose network and the rest of the frame (two PNG decodes are several
+    milliseconds a frame, docs/benchmarks.md). Frames still come in order, and a read error is raised for its own
+    frame.
+    """
 
     def __init__(self, source: FolderSource) -> None:
         self.source = source
         self.index = 0
+        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="sid-folder-read")
+        self._ahead: Future[Frame] | None = None  # the read of frame ``index``, when started
 
     def __iter__(self) -> _Reader:
         return self
 
     def __next__(self) -> Frame:
         if self.index >= len(self.source):
+            self._pool.shutdown(wait=False)
             raise StopIteration
         index = self.index
         self.index += 1
-        return self.source.read(index)
+        current = self._ahead or self._pool.submit(self.source.read, index)
+        self._ahead = self._pool.submit(self.source.read, self.index) if self.index < len(self.source) else None
+        return current.result()
 
 
 def _first_existing(folder: Path, stem: str) -> Path | None:

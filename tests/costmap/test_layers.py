@@ -7,7 +7,7 @@ import pytest
 import shapely
 
 from costmap.combine import combine
-from costmap.grid import FREE_SPACE, INSCRIBED, LETHAL, NO_INFORMATION, Costmap2D, GridSpec
+from costmap.grid import FREE_SPACE, INSCRIBED, LETHAL, NO_INFORMATION, Costmap2D, GridSpec, Window
 from costmap.layer import LayerInputs
 from costmap.layered import LayeredCostmap
 from costmap.layers.inflation import InflationLayer, InflationParams, distance_to_lethal_cells
@@ -98,6 +98,30 @@ def test_inflation_keeps_the_larger_cost_and_nav2_unknown_rule():
     master2[20, 20], master2[20, 28] = LETHAL, NO_INFORMATION
     InflationLayer(spec, InflationParams(0.55, inflate_unknown=True), 0.25).write(master2, spec.whole)
     assert master2[20, 28] == nav2_cost(0.40, 0.25, 10.0)
+
+
+def test_inflation_recomputed_around_changes_equals_a_whole_map_inflation():
+    """A layer recomputes only around lethal cells that appeared or disappeared. Over a sequence in which the master
+    changes only inside each write's window (as ``LayeredCostmap`` does): blobs that appear, move, vanish and touch
+    the map's edges, far apart and close together, and a wall that comes and goes, the layer's grid always equals
+    that of a new layer inflating the whole map."""
+    rng = np.random.default_rng(5)
+    spec = GridSpec.from_size(0.05, (0.0, 0.0), (12.0, 9.0))
+    layer = InflationLayer(spec, InflationParams(), inscribed_radius=0.22)
+    master = np.zeros(spec.shape, np.uint8)
+    for step in range(16):
+        r0, c0 = rng.integers(0, spec.height - 10), rng.integers(0, spec.width - 10)
+        r1, c1 = r0 + rng.integers(10, 90), c0 + rng.integers(10, 120)
+        window = Window(int(r0), int(min(r1, spec.height)), int(c0), int(min(c1, spec.width)))
+        view = master[window.slices]
+        view[rng.random(view.shape) < 0.3] = FREE_SPACE  # some marks vanish, others appear
+        view[rng.random(view.shape) < 0.01] = LETHAL
+        if step % 5 == 0:
+            view[:, :3] = LETHAL if step % 10 == 0 else FREE_SPACE  # a wall segment comes and goes
+        layer.write(master.copy(), window)
+        fresh = InflationLayer(spec, InflationParams(), inscribed_radius=0.22)
+        fresh.write(master.copy(), spec.whole)
+        np.testing.assert_array_equal(layer.costs, fresh.costs)
 
 
 def test_inflation_without_lethal_cells_is_zero():

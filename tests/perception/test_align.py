@@ -204,3 +204,37 @@ def test_sparse_lookup_on_a_realistic_d435i_pair() -> None:
     pixels = np.column_stack([rng.uniform(0, 1280, 68), rng.uniform(0, 720, 68)])
     dense = depth_at_color_pixels(align_depth_to_color(depth, calib), pixels, Calibration(color_intr))
     np.testing.assert_allclose(depth_at_color_pixels(depth, pixels, calib), dense, atol=2e-6, equal_nan=True)
+
+
+def test_window_search_stays_close_to_the_full_alignment_on_a_d435i_pair() -> None:
+    """``search="window"`` (the lift's default) against aligning the whole frame: on flat surfaces at 1.8 m and
+    3.5 m, keypoints away from the silhouette get the surface's colour-frame depth within a centimetre, and at most a
+    few keypoints next to the silhouette read the other surface."""
+    depth_intr = Intrinsics(848, 480, 426.0, 426.0, 423.5, 239.8)
+    color_intr = Intrinsics(1280, 720, 910.0, 910.0, 641.2, 358.9)
+    calib = Calibration(color_intr, depth_intr, Extrinsics(ROTATION, [0.015, 0.0003, 0.0002]))
+    rng = np.random.default_rng(3)
+    depth = (np.full((480, 848), 3.5) + rng.normal(0, 0.005, (480, 848))).astype(np.float32)
+    depth[150:400, 380:470] = 1.8 + rng.normal(0, 0.003, (250, 90))  # a person
+    depth[rng.random(depth.shape) < 0.02] = 0.0  # holes
+    pixels = np.column_stack([rng.uniform(0, 1280, 400), rng.uniform(0, 720, 400)])
+    pixels[5] = np.nan
+    dense = depth_at_color_pixels(align_depth_to_color(depth, calib), pixels, Calibration(color_intr))
+    window = depth_at_color_pixels(depth, pixels, calib, search="window")
+    assert np.isnan(window[5])
+    both = np.isfinite(dense) & np.isfinite(window)
+    assert both.sum() > 350
+    error = np.abs(window - dense)[both]
+    assert np.median(error) < 0.01
+    assert np.count_nonzero(error > 0.05) <= 8  # silhouette keypoints: 1.8 m against 3.5 m
+    # A keypoint well inside the person reads the person, one well outside the wall (colour-frame z, as dense).
+    person_u = (425.0 - depth_intr.cx) / depth_intr.fx * color_intr.fx + color_intr.cx  # the person's centre column
+    two = np.array([[person_u, 500.0], [200.0, 100.0]])
+    dense_two = depth_at_color_pixels(align_depth_to_color(depth, calib), two, Calibration(color_intr))
+    assert abs(dense_two[0] - 1.8) < 0.05 and abs(dense_two[1] - 3.5) < 0.1  # the person, the wall
+    np.testing.assert_allclose(depth_at_color_pixels(depth, two, calib, search="window"), dense_two, atol=0.01)
+
+
+def test_window_search_is_checked_by_name() -> None:
+    with pytest.raises(ValueError, match="unknown depth search 'fast'"):
+        depth_at_color_pixels(scene(seed=1), np.zeros((1, 2)), CALIB, search="fast")  # type: ignore[arg-type]

@@ -132,6 +132,24 @@ def test_tilted_mount_and_unregistered_depth():
     assert estimate_orientation(person.keypoints_world)[0] == pytest.approx(person.theta)
 
 
+def test_the_window_depth_search_places_people_as_the_exact_search_does():
+    """The lift's default depth lookup on unregistered depth (``depth_search="window"``) against the exact splat
+    search, on rendered frames of four people: same people, positions within 3 cm, facings within 5 degrees."""
+    camera = SyntheticCamera(shaded_color=False)
+    scene_ = Scene("four", tuple(ScenePerson(k, 2.6 + 0.6 * (k % 2), 0.8 * k - 1.2, math.radians(40 + 70 * k))
+                                 for k in range(4)), ())  # fmt: skip
+    for index in range(3):
+        frame = camera.capture(scene_, index)
+        detections = TruthPose()(frame)
+        window = lift_people(detections, frame.depth, frame.calibration, scene_.mount)
+        exact = lift_people(detections, frame.depth, frame.calibration, scene_.mount, LiftParams(depth_search="exact"))
+        assert [p.id for p in window] == [p.id for p in exact] and len(window) == 4
+        for a, b in zip(window, exact, strict=True):
+            assert math.hypot(a.x - b.x, a.y - b.y) < 0.03
+            assert a.theta is not None and b.theta is not None
+            assert abs((a.theta - b.theta + math.pi) % (2 * math.pi) - math.pi) < math.radians(5)
+
+
 def test_a_keypoint_reading_the_person_in_front_is_dropped():
     """The back person's left elbow lies inside the front person's box and reads their depth (0.4 m nearer, within
     the depth gate): it is dropped, and the back person's facing stays right."""
@@ -288,6 +306,7 @@ def test_bad_input_is_rejected():
         ("ear_separation", -0.1),
         ("min_pair_fraction", 1.5),
         ("far_side_score_gap", -0.1),
+        ("depth_search", "fast"),
     ]:
         with pytest.raises(ValueError, match=field):
             LiftParams(**{field: value})

@@ -18,7 +18,7 @@ from planner import ompl_planners
 from planner.facade import PLANNERS, plan, resolve_planner
 from planner.ompl_planners import OMPL_PLANNERS
 from planner.problem import CostField, PlanningError, PlanningProblem
-from planner.smoothing import smooth
+from planner.smoothing import dp_shortcut, refine, smooth
 from planner.validity import check_path, interpolate
 
 RADIUS = 0.25
@@ -164,6 +164,34 @@ def test_smoothing_keeps_paths_valid_and_never_raises_cost(walls):
                 assert check_path(field, smoothed).valid
 
 
+def test_refine_and_a_short_reach_shortcut_never_raise_cost_and_keep_vertices(walls):
+    field = CostField(walls)
+    raw = plan(walls, "rrtconnect", seed=4, simplify=False).path
+    dense = interpolate(raw, 0.3)
+    refined = refine(field, dense, max_step=0.2, min_step=0.00625)
+    assert len(refined) == len(dense) and np.array_equal(refined[[0, -1]], dense[[0, -1]])  # ends stay
+    assert field.path_cost(refined) <= field.path_cost(dense) + 1e-9 and check_path(field, refined).valid
+    for reach in (2, 12, None):
+        short = dp_shortcut(field, refined, reach=reach)
+        assert field.path_cost(short) <= field.path_cost(refined) + 1e-9
+        assert all((refined == vertex).all(axis=1).any() for vertex in short)  # a subsequence of the vertices
+    # A longer reach can only find a cheaper (or equal) subsequence.
+    costs = [field.path_cost(dp_shortcut(field, refined, reach=r)) for r in (2, 12, None)]
+    assert costs[0] >= costs[1] - 1e-9 >= costs[2] - 2e-9
+
+
+def test_bitstar_stops_once_its_cost_settles_and_other_planners_use_their_budget(walls):
+    settled = plan(walls, "bitstar", time_limit=30.0, seed=3)
+    assert settled.success and settled.solve_time_s < 15.0  # stopped by the settle rule, not by the 30 s budget
+    whole = plan(walls, "bitstar", time_limit=0.3, seed=3, settle=None)
+    assert whole.solve_time_s >= 0.3
+    rrt = plan(walls, "rrtstar", time_limit=0.3, seed=3)  # RRT* is not stopped early (SETTLING_PLANNERS)
+    assert rrt.solve_time_s >= 0.3
+    for bad in (0.0, -1.0, math.nan):
+        with pytest.raises(ValueError, match="settle must be a positive number of seconds"):
+            plan(walls, "bitstar", settle=bad)
+
+
 # ---- impossible problems and bad input -----------------------------------------------------------------------
 
 
@@ -237,7 +265,7 @@ def test_a_timed_run_is_replayed_by_its_seed_and_iteration_count(walls, name, re
     does not depend on the machine's load; the replay runs on the real clock with a generous budget."""
     clock = itertools.count()
     monkeypatch.setattr(ompl_planners, "time", SimpleNamespace(perf_counter=lambda: next(clock) * 0.3 / readings))
-    timed = plan(walls, name, time_limit=0.3, seed=21)
+    timed = plan(walls, name, time_limit=0.3, seed=21, settle=None)  # no early stop: the budget runs out
     assert next(clock) > readings  # the fake clock ran the budget out
     monkeypatch.undo()
     replay = plan(walls, name, time_limit=30.0, seed=21, max_iterations=timed.iterations)

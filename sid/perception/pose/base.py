@@ -106,9 +106,23 @@ class Letterbox:
         """Resample ``color`` (H, W, 3) uint8 into the model input (bilinear, ``fill`` grey outside the image).
 
         One ``cv2.warpAffine`` both resizes and pads, so the pixels follow exactly the map of ``to_input``
-        (``cv2.resize`` would round the resized size and scale the two axes slightly differently).
+        (``cv2.resize`` would round the resized size and scale the two axes slightly differently). When the image
+        shrinks to fill whole pixels of the input exactly (640x480 into 256x256: 256x192 at scale 0.4, 32-pixel bands),
+        ``cv2.resize`` samples at the same positions and is 2-3x faster (0.14 against 0.41 ms here, busy machine);
+        its fixed-point weights round differently, by at most one grey level (6 % of the pixels of the real
+        five-people frame), and then ``cv2.copyMakeBorder`` pads.
         """
         in_h, in_w = self.input_size
+        h, w = color.shape[:2]
+        size = (self.scale * w, self.scale * h)
+        # Shrinking only: upscaling samples beyond the edge pixels' centres, where warpAffine blends ``fill`` in.
+        exact_fit = all(float(v).is_integer() for v in (*size, self.pad_x, self.pad_y)) and self.scale <= 1
+        inside = min(self.pad_x, self.pad_y) >= 0 and self.pad_x + size[0] <= in_w and self.pad_y + size[1] <= in_h
+        if exact_fit and inside:
+            resized = cv2.resize(color, (int(size[0]), int(size[1])), interpolation=cv2.INTER_LINEAR)
+            top, left = int(self.pad_y), int(self.pad_x)
+            bottom, right = in_h - top - int(size[1]), in_w - left - int(size[0])
+            return cv2.copyMakeBorder(resized, top, bottom, left, right, cv2.BORDER_CONSTANT, value=(fill, fill, fill))
         return cv2.warpAffine(
             color,
             self.matrix(),

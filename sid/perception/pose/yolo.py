@@ -90,8 +90,8 @@ class YoloPose:
 
     def decode(self, output: np.ndarray, letterbox: Letterbox, image_hw: Sequence[int]) -> list[PoseDetection]:
         """[1, 56, N] candidates -> people above the score threshold after NMS, best first, in image pixels."""
-        candidates = output.reshape(56, -1).T
-        candidates = candidates[candidates[:, 4] >= self.score_threshold]
+        output = output.reshape(56, -1)
+        candidates = output[:, output[4] >= self.score_threshold].T  # the few above the threshold, then transposed
         if len(candidates) == 0:
             return []
         xy = candidates[:, [0, 1]]

@@ -31,7 +31,8 @@ from sid.experiments.bench import (
     select,
 )
 from sid.experiments.bench.report import PAPER_COLUMN
-from sid.perception.groups import detect_groups
+from sid.perception.cluster import dbscan_labels
+from sid.perception.groups import GroupParams, detect_groups
 from sid.perception.people import Person
 from tests.conftest import shared_path
 
@@ -125,9 +126,16 @@ def test_selection_patterns_and_missing_models_note(tmp_path):
     names = [b.name for b in items]
     assert not any(n.startswith("pose/") for n in names)
     assert any("pose benchmarks skipped" in note for note in ctx.notes)
-    assert [b.name for b in select(items, "group")] == [f"group/{n}" for n in (2, 3, 4, 6, 20)]
+    assert [b.name for b in select(items, "group")] == [f"group/{n}" for n in (2, 3, 4, 6, 20, 100)]
+    assert [b.name for b in select(items, "group_rays/100")] == ["group/100", "group_rays/100"]
+    assert "group_paper/100" not in [b.name for b in items] and "group_baseline/20" in [b.name for b in items]
     assert [b.name for b in select(items, "group_baseline/6")] == ["group/6", "group_baseline/6"]
-    assert [b.name for b in select(items, "align/*")] == ["align/rectangle", "align/point", "align/sparse_4x17"]
+    assert [b.name for b in select(items, "align/*")] == [
+        "align/rectangle",
+        "align/point",
+        "align/sparse_4x17",
+        "align/window_4x17",
+    ]
     assert len(select(items, None)) == len(items)
     with pytest.raises(ValueError, match="matches no benchmark"):
         select(items, "pose")
@@ -159,11 +167,15 @@ def test_harness_counts_runs_and_restores_the_collector():
         RunSettings(warmup=0, min_runs=5, max_runs=2, budget_s=1.0)
 
 
-def test_grouping_scene_is_seeded_and_split_into_circles():
+@pytest.mark.parametrize("method", ["ospace", "rays"])
+def test_grouping_scene_is_seeded_one_crowd_of_circles(method):
     people = grouping_scene(20)
     assert len(people) == 20 and len({p.id for p in people}) == 20
     assert [(p.x, p.theta) for p in people] == [(p.x, p.theta) for p in grouping_scene(20)]
-    assert [g.members for g in baseline_groups(people)] == [tuple(range(k, k + 4)) for k in range(0, 20, 4)]
+    labels = dbscan_labels(np.array([[p.x, p.y] for p in people]), GroupParams().eps, GroupParams().min_samples)
+    assert set(labels.tolist()) == {0}, "one crowd"
+    found = [g.members for g in detect_groups(people, GroupParams(method=method))]
+    assert sorted(found) == [tuple(range(k, k + 4)) for k in range(0, 20, 4)]
 
 
 # --- the authors' approach against ours on easy scenes ------------------------------------------------------------

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 import pytest
 from hypothesis import given
@@ -84,6 +85,25 @@ def test_warp_resamples_exactly_where_the_map_says(letterbox):
     assert np.abs(warped[..., 1] - expected_v)[inside].max() <= 1.0
     outside = (source[..., 0] < -1) | (source[..., 0] > w) | (source[..., 1] < -1) | (source[..., 1] > h)
     assert np.all(warped[outside] == 0)
+
+
+@pytest.mark.parametrize(
+    ("image_hw", "input_hw"), [((480, 640), (256, 256)), ((480, 640), (192, 320)), ((90, 60), (96, 64))]
+)
+def test_whole_pixel_letterbox_resizes_within_one_grey_level_of_warp_affine(image_hw, input_hw):
+    """When the image fills whole input pixels, ``warp`` resizes and pads instead of ``cv2.warpAffine``: the same
+    sampling positions, the padding bands exactly, the interpolated values within one grey level."""
+    letterbox = Letterbox.fit(image_hw, input_hw)
+    image = np.random.default_rng(0).integers(0, 256, (*image_hw, 3), dtype=np.uint8)
+    image = cv2.GaussianBlur(image, (0, 0), 2.0)  # camera-like content, not pure noise
+    in_h, in_w = input_hw
+    reference = cv2.warpAffine(image, letterbox.matrix(), (in_w, in_h), flags=cv2.INTER_LINEAR,
+                               borderMode=cv2.BORDER_CONSTANT, borderValue=(114, 114, 114))  # fmt: skip
+    fast = letterbox.warp(image, 114)
+    assert fast.shape == reference.shape and fast.dtype == np.uint8
+    assert np.abs(fast.astype(int) - reference.astype(int)).max() <= 1
+    top, left = int(letterbox.pad_y), int(letterbox.pad_x)
+    assert np.all(fast[:top] == 114) and np.all(fast[:, :left] == 114)
 
 
 def test_bad_letterbox_arguments_are_named():

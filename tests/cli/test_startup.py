@@ -1,0 +1,41 @@
+"""``sid COMMAND`` imports the module of that command only: start-up time counts in ``sid detect``'s frame rate."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from sid.cli import COMMANDS, main
+
+REPO = Path(__file__).resolve().parents[2]
+PROBE = """
+import sys
+from sid.cli import main
+try:
+    main([{command!r}, "--help"])
+except SystemExit:
+    pass
+print(sorted(m for m in sys.modules if m.startswith("sid.cli.")))
+"""
+
+
+@pytest.mark.parametrize("command", ["groups", "detect"])
+def test_a_command_imports_only_its_own_module(command: str) -> None:
+    done = subprocess.run([sys.executable, "-c", PROBE.format(command=command)], cwd=REPO, capture_output=True,
+                          text=True, timeout=300, check=True)  # fmt: skip
+    loaded = eval(done.stdout.strip().splitlines()[-1])  # a printed list of module names
+    assert f"sid.cli.{command}" in loaded
+    assert not {f"sid.cli.{other}" for other in COMMANDS if other != command} & set(loaded)
+
+
+def test_help_and_unknown_commands_still_list_every_command(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit):
+        main(["--help"])
+    listing = capsys.readouterr().out
+    assert all(command in listing for command in COMMANDS)
+    with pytest.raises(SystemExit):
+        main(["nope"])
+    assert "invalid choice: 'nope'" in capsys.readouterr().err
