@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from sid.checks import check_number, check_numbers
+from sid.checks import check_limit, check_number, check_numbers
 
 FREE_SPACE = 0
 MAX_NON_OBSTACLE = 252
@@ -85,11 +85,16 @@ class GridSpec:
         check_numbers("map", self, ("origin_x", "origin_y"), unit="metres")
         if self.width <= 0 or self.height <= 0:
             raise ValueError(f"map.size must give at least one cell, got {self.width}x{self.height} cells")
+        _check_cells(self.width, self.height)
 
     @classmethod
     def from_size(cls, resolution: float, origin: tuple[float, float], size_m: tuple[float, float]) -> GridSpec:
-        """A grid covering ``size_m`` (width, height in metres) from ``origin``."""
+        """A grid covering ``size_m`` (width, height in metres) from ``origin``; LimitError (a ValueError) above
+        ``Limits.map_cells`` cells, before any number of cells is formed."""
         check_number("map", "resolution", resolution, low=0, low_open=True, unit="metres")
+        for name, metres in zip(("width", "height"), size_m, strict=True):
+            check_number("map", name, metres, low=0, unit="metres")
+        _check_cells(*(round(s / resolution, 0) for s in size_m))
         width, height = (int(round(s / resolution)) for s in size_m)
         return cls(float(resolution), float(origin[0]), float(origin[1]), width, height)
 
@@ -169,6 +174,11 @@ class GridSpec:
         """World x and y of every cell centre (of the whole grid or of a ``window``), each (rows, cols)."""
         xs, ys = self.cell_axes(window)
         return np.meshgrid(xs[0], ys[:, 0])
+
+
+def _check_cells(width: float, height: float) -> None:
+    """LimitError when a grid of ``width`` x ``height`` cells exceeds ``Limits.map_cells``."""
+    check_limit("map.size", width * height, "map_cells", "cells", f"{width:.6g} x {height:.6g} = ")
 
 
 @dataclass

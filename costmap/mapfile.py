@@ -14,14 +14,17 @@ map_server loads exactly the values written. (map_saver's trinary output would k
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import cv2
 import numpy as np
 import yaml
+from PIL import Image, UnidentifiedImageError
 
 from costmap.grid import GridSpec
 from costmap.occupancy import OCC_OCCUPIED, OCC_UNKNOWN, OccupancyGrid
+from sid.checks import check_limit
 from sid.documents import is_number, load_document
 
 MODES = ("trinary", "scale", "raw")
@@ -90,10 +93,32 @@ def _shade(image: np.ndarray, mode: str) -> tuple[np.ndarray, np.ndarray]:
     return colour.mean(axis=2), opaque
 
 
+def _check_image_size(path: Path, image: Path) -> None:
+    """MapFileError when the image's header declares more pixels than ``Limits.map_cells``, read before any pixel
+    is decoded (Pillow reads headers lazily); formats Pillow does not know are left to OpenCV."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+            with Image.open(image) as header:
+                width, height = header.size
+    except Image.DecompressionBombError as exc:  # Pillow's own bound, far above the default limit
+        raise MapFileError(f"{path}: map image {image}: {exc}") from None
+    except (OSError, UnidentifiedImageError, ValueError, SyntaxError):  # unreadable: OpenCV says so below
+        return
+    try:
+        check_limit("map image", width * height, "map_cells", "pixels", f"{width} x {height} = ")
+    except ValueError as exc:
+        raise MapFileError(f"{path}: {image}: {exc}") from None
+
+
 def read_map(path: str | Path) -> OccupancyGrid:
-    """Load a map_server YAML + image (PGM, PNG, ...) into an OccupancyGrid, exactly as map_server would."""
+    """Load a map_server YAML + image (PGM, PNG, ...) into an OccupancyGrid, exactly as map_server would.
+
+    MapFileError naming the file: unreadable or malformed YAML, a bad field, an image that cannot be read or one
+    larger than ``sid.checks.Limits.map_cells`` pixels (refused from its header, before decoding)."""
     path = Path(path)
     meta = _read_metadata(path)
+    _check_image_size(path, meta["image"])
     image = cv2.imread(str(meta["image"]), cv2.IMREAD_UNCHANGED)
     if image is None or image.size == 0:
         raise MapFileError(f"{path}: cannot read map image {meta['image']} (missing or not an image)")

@@ -1,13 +1,65 @@
-"""Checks of the numbers in parameter records, with one error message format: ``"owner: name must be ..., got v"``.
+"""Checks of the numbers in parameter records, with one error message format: ``"owner: name must be ..., got v"``,
+and the size limits of inputs (``Limits``), checked where a value enters and before anything is allocated for it.
 
 Records call these from ``__post_init__`` so that a bad value fails where it is set, naming the field.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import os
 from collections.abc import Iterable
+from dataclasses import dataclass
 from typing import Any
+
+LIMITS_ENV = "SID_LIMITS"
+"""The environment variable that raises (or lowers) limits: ``SID_LIMITS="map_cells=16000000,people=300"``."""
+
+
+@dataclass(frozen=True)
+class Limits:
+    """The largest inputs sid accepts; each bounds the memory and time one value can make a command spend.
+
+    map_cells: cells of a grid (a scenario's map, a map image's pixels); 4e6 is 100 x 100 m at 5 cm, where
+    ``sid plan --planner grid`` peaks near 1.5 GB (docs/robustness.md).
+    lidar_beams: beams of a simulated scan (100000 beams: about 0.6 GB and 20 s for ``sid costmap``).
+    scan_cells: beams x the longest LiDAR range in cells (``lidar.range_max`` or ``raytrace_max_range``), the
+    samples a simulated scan and the LiDAR layer's ray tracing take (720 beams x 10 m at 5 cm: 144000).
+    people: people in one frame (a scenario, a ``sid groups`` line); grouping time grows faster than the square.
+    Raise one with ``SID_LIMITS="NAME=VALUE,..."`` (an environment variable, read at each check).
+    """
+
+    map_cells: int = 4_000_000
+    lidar_beams: int = 100_000
+    scan_cells: int = 20_000_000
+    people: int = 100
+
+
+class LimitError(ValueError):
+    """An input above a limit of ``Limits``; the message names the field, the value, the limit and how to raise it."""
+
+
+def limits() -> Limits:
+    """The limits in force: ``Limits()`` with the values of ``$SID_LIMITS`` (``NAME=VALUE`` pairs, comma-separated;
+    ValueError naming the variable for a malformed one)."""
+    text = os.environ.get(LIMITS_ENV, "").strip()
+    if not text:
+        return Limits()
+    names = [f.name for f in dataclasses.fields(Limits)]
+    values: dict[str, int] = {}
+    for item in text.split(","):
+        name, _, value = (part.strip() for part in item.partition("="))
+        if name not in names:
+            raise ValueError(f"${LIMITS_ENV}: unknown limit {name!r} in {text!r}; known limits: {', '.join(names)}")
+        try:
+            number = float(value)
+        except ValueError:
+            number = math.nan
+        if not (math.isfinite(number) and number >= 1 and number == int(number)):
+            raise ValueError(f"${LIMITS_ENV}: {name} must be a whole number >= 1, got {value!r}")
+        values[name] = int(number)
+    return Limits(**values)
 
 
 def check_number(
@@ -57,3 +109,17 @@ def _rule(low: float | None, high: float | None, low_open: bool, high_open: bool
     elif high is not None:
         number += f" {'<' if high_open else '<='} {high:g}"
     return number + (" (or inf)" if allow_inf else "")
+
+
+def check_limit(field: str, count: float, limit: str, unit: str, detail: str = "") -> None:
+    """Raise LimitError when ``count`` (of ``unit``, e.g. cells) exceeds the limit named ``limit``.
+
+    ``field`` names the input (e.g. "map.size") and ``detail`` how the count arises (e.g. "20000 x 20000 = "); the
+    message gives the count, the limit and the variable that raises it.
+    """
+    allowed = getattr(limits(), limit)
+    if not count <= allowed:
+        raise LimitError(
+            f"{field}: {detail}{count:,.0f} {unit} is more than the limit of {allowed:,} {unit} ({limit}; raise it "
+            f"with {LIMITS_ENV}={limit}=N)"
+        )

@@ -1,13 +1,20 @@
-"""Reading the project's JSON / YAML input files (scenarios, scenes) with one rule and one set of errors."""
+"""Reading the project's JSON / YAML input files (scenarios, scenes) with one rule and one set of errors, and writing
+output files whole (a temporary file in the same folder, then a rename)."""
 
 from __future__ import annotations
 
 import json
 import math
+import os
+import tempfile
 from pathlib import Path
 from typing import Any, TypeGuard
 
 import yaml
+
+
+class InputWarning(UserWarning):
+    """An input sid accepts but changes (e.g. a map sampled onto other cells); ``sid`` prints it on one line."""
 
 
 def load_document(path: str | Path, kind: str = "file") -> Any:
@@ -49,3 +56,22 @@ def decode_text(raw: bytes, what: str) -> str:
 def is_number(value: Any) -> TypeGuard[int | float]:
     """Whether a parsed JSON / YAML value is a finite number (an int or a float; booleans do not count)."""
     return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+
+
+TEMPORARY_PREFIX = ".sid-partial-"
+"""Names of the temporary files and folders sid writes outputs through; a killed run may leave one behind."""
+
+
+def write_atomically(path: str | Path, data: bytes) -> Path:
+    """Write ``data`` to ``path`` whole or not at all: into a temporary file in the same folder, then
+    ``os.replace`` (atomic on POSIX and Windows), so a reader never sees a half-written file, even after a kill."""
+    path = Path(path)
+    handle, temporary = tempfile.mkstemp(prefix=TEMPORARY_PREFIX, dir=path.parent)
+    try:
+        with os.fdopen(handle, "wb") as file:
+            file.write(data)
+        os.replace(temporary, path)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+    return path

@@ -56,3 +56,35 @@ def test_check_numbers_reports_the_first_bad_field():
     check_numbers("params", Params(), ("a",), low=0)
     with pytest.raises(ValueError, match="params: b must be"):
         check_numbers("params", Params(), ("a", "b", "c"), low=0)
+
+
+# Limits (issue 15): sizes checked before any allocation, raised with one environment variable.
+def test_limit_error_names_field_value_limit_and_how_to_raise_it():
+    from sid.checks import LimitError, check_limit
+
+    with pytest.raises(LimitError) as error:
+        check_limit("lidar.beams", 10**9, "lidar_beams", "beams")
+    assert str(error.value) == (
+        "lidar.beams: 1,000,000,000 beams is more than the limit of 100,000 beams (lidar_beams; raise it with "
+        "SID_LIMITS=lidar_beams=N)"
+    )
+
+
+def test_sid_limits_raises_a_limit(monkeypatch):
+    from sid.checks import Limits, check_limit, limits
+
+    monkeypatch.setenv("SID_LIMITS", "people=5000, map_cells=1e8")
+    assert limits() == Limits(map_cells=100_000_000, people=5000)
+    check_limit("people", 4000, "people", "people")  # no error
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [("peple=5", "unknown limit 'peple'"), ("people=0", "people must be a whole number >= 1"), ("people=1.5", "whole")],
+)
+def test_a_malformed_sid_limits_is_named(monkeypatch, text, message):
+    from sid.checks import limits
+
+    monkeypatch.setenv("SID_LIMITS", text)
+    with pytest.raises(ValueError, match=rf"\$SID_LIMITS: .*{message}"):
+        limits()

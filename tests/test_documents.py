@@ -83,3 +83,20 @@ def test_yaml_errors_are_one_line(tmp_path, raw):
     with pytest.raises(ValueError, match="map.yaml: not valid YAML") as error:
         load_document(path)
     assert "\n" not in str(error.value) and "<unicode string>" not in str(error.value)
+
+
+def test_write_atomically_replaces_whole_and_leaves_no_temporary_file(tmp_path):
+    from sid.documents import write_atomically
+
+    path = tmp_path / "a.png"
+    path.write_bytes(b"old")
+    assert write_atomically(path, b"new") == path
+    assert path.read_bytes() == b"new" and [p.name for p in tmp_path.iterdir()] == ["a.png"]
+
+
+def test_write_atomically_into_a_missing_folder_fails_and_writes_nothing(tmp_path):
+    from sid.documents import write_atomically
+
+    with pytest.raises(OSError):
+        write_atomically(tmp_path / "missing" / "a.png", b"x")
+    assert list(tmp_path.iterdir()) == []

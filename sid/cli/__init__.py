@@ -8,26 +8,73 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
+import warnings
+from typing import TextIO
+
+from sid.checks import limits
+from sid.cli.common import signals_as_interrupts
+from sid.documents import InputWarning
 
 # Each module provides ``add_parser(subparsers)``; the parser it adds sets ``func(args) -> int``.
-COMMANDS: tuple[str, ...] = ("detect", "groups", "eval", "costmap", "plan", "demo", "compare", "reproduce", "bench")
+COMMANDS: tuple[str, ...] = (
+    "detect",
+    "groups",
+    "eval",
+    "costmap",
+    "plan",
+    "demo",
+    "simulate",
+    "compare",
+    "reproduce",
+    "bench",
+    "ros",
+)
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The parser of every subcommand, or of ``command`` alone: each subcommand's module imports what it runs
+    (onnxruntime, OMPL, the costmap, ...), so ``sid detect`` does not pay for the planners' imports at start-up."""
     parser = argparse.ArgumentParser(prog="sid", description=__doc__.split("\n")[0].strip('"` '))
     subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for name in COMMANDS:
+    for name in COMMANDS if command is None else (command,):
         importlib.import_module(f"sid.cli.{name}").add_parser(subparsers)
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    """Run one command; its exit code. SIGINT and SIGTERM stop it cleanly (exit 130 / 143: every file it wrote is
+    whole), and ``InputWarning``s print as one ``sid COMMAND: warning: ...`` line."""
+    argv = sys.argv[1:] if argv is None else argv
+    known = argv[0] if argv and argv[0] in COMMANDS else None  # else: help, or an error listing every command
+    args = build_parser(known).parse_args(argv)
+    command = f"sid {args.command}"
     try:
-        return int(args.func(args) or 0)
-    except KeyboardInterrupt:
-        print("sid: interrupted", file=sys.stderr)
-        return 130
+        limits()  # a malformed $SID_LIMITS is said once, before any work
+    except ValueError as exc:
+        print(f"{command}: {exc}", file=sys.stderr)
+        return 2
+    default_show = warnings.showwarning
+
+    def show(
+        message: Warning | str,
+        category: type[Warning],
+        filename: str,
+        lineno: int,
+        file: TextIO | None = None,
+        line: str | None = None,
+    ) -> None:
+        if issubclass(category, InputWarning):
+            print(f"{command}: warning: {message}", file=sys.stderr)
+        else:
+            default_show(message, category, filename, lineno, file, line)
+
+    with warnings.catch_warnings(), signals_as_interrupts():
+        warnings.showwarning = show
+        try:
+            return int(args.func(args) or 0)
+        except KeyboardInterrupt as exc:
+            print(f"{command}: interrupted", file=sys.stderr)
+            return 128 + int(getattr(exc, "signal_number", 2))
 
 
 if __name__ == "__main__":

@@ -9,7 +9,7 @@ import sys
 from dataclasses import asdict
 from pathlib import Path
 
-from sid.cli.common import check_output_folder, fail
+from sid.cli.common import check_output_folder, fail, staged_output
 from sid.cli.detect import positive_int
 from sid.experiments.bench import (
     FULL,
@@ -140,7 +140,8 @@ def run(args: argparse.Namespace) -> int:
     report = build_report(machine, run_settings, result.stages, ctx.notes, result.failures)
     comparison = format_comparison(old, report) if old is not None else None
     try:
-        json_path, md_path = write_report(report, args.out, comparison)
+        with staged_output(args.out, ()) as staged:
+            json_path, md_path = (staged.final(p) for p in write_report(report, staged.path, comparison))
     except OSError as exc:
         return fail("sid bench", exc)
     print(markdown(report, comparison), end="")

@@ -3,14 +3,22 @@
 from __future__ import annotations
 
 import argparse
+import fnmatch
+import os
+import shutil
+import signal
 import sys
 import tempfile
-from collections.abc import Iterable
+import threading
+from collections.abc import Iterable, Iterator, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 
 from costmap.mapfile import MapFileError
 from planner.facade import DEFAULT_PLANNER, MAX_SEED, PLANNERS
 from planner.problem import DEFAULT_COST_WEIGHT, PlanningError
+from sid.documents import TEMPORARY_PREFIX
 from sid.experiments.harness import Comparison, goal_zone_warning
 from sid.scenario.loader import ScenarioError
 
@@ -118,3 +126,95 @@ def print_written(paths: Iterable[object]) -> None:
     """One ``wrote PATH`` line per file written."""
     for path in paths:
         print(f"wrote {path}")
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised in the main thread like Ctrl-C so that the same clean-up runs (exit 128 + 15)."""
+
+    signal_number = signal.SIGTERM
+
+
+def _terminate(signum: int, frame: object) -> None:
+    raise Terminated()
+
+
+@contextmanager
+def signals_as_interrupts() -> Iterator[None]:
+    """While a command runs, SIGTERM raises ``Terminated`` (a KeyboardInterrupt), as SIGINT raises
+    KeyboardInterrupt; the previous handler comes back afterwards. Only the main thread can install handlers: in
+    another one (a command run from a worker thread) this does nothing."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _terminate)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+@contextmanager
+def signals_deferred() -> Iterator[None]:
+    """SIGINT and SIGTERM held back (blocked, then delivered) while a set of files is moved into place, so an
+    interruption lands before or after the whole set, never inside it (e.g. an overlay without its top view)."""
+    signals = {signal.SIGINT, signal.SIGTERM}
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, signals)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+
+
+def clear_owned(folder: Path, owned: Sequence[str], keep: Iterable[str] = ()) -> list[Path]:
+    """Delete the files in ``folder`` whose names match a pattern of ``owned`` (what a command writes, e.g.
+    ``overlay_*.png``) and are not in ``keep``, and temporary files a killed run left; never anything else.
+    Returns the deleted files."""
+    kept = set(keep)
+    removed = []
+    for entry in sorted(folder.iterdir()) if folder.is_dir() else []:
+        if entry.name in kept:
+            continue
+        partial = entry.name.startswith(TEMPORARY_PREFIX)
+        ours = any(fnmatch.fnmatchcase(entry.name, pattern) for pattern in owned)
+        if partial and entry.is_dir():
+            shutil.rmtree(entry, ignore_errors=True)
+            removed.append(entry)
+        elif (partial or ours) and entry.is_file():
+            entry.unlink()
+            removed.append(entry)
+    return removed
+
+
+@dataclass(frozen=True)
+class StagedOutput:
+    """A temporary folder (``path``) inside the output folder (``folder``) that a command writes its files into."""
+
+    folder: Path
+    path: Path
+
+    def final(self, written: str | Path) -> Path:
+        """Where a file written under ``path`` ends up in ``folder``."""
+        return self.folder / Path(written).relative_to(self.path)
+
+
+@contextmanager
+def staged_output(folder: str | Path, owned: Sequence[str]) -> Iterator[StagedOutput]:
+    """Write a command's files whole, as one set: the command writes into a temporary folder inside ``folder``
+    (created if missing); when it finishes, the files it wrote replace those of an earlier run (``os.replace``
+    each, signals deferred), and files of ``owned`` patterns an earlier run left but this one did not write are
+    deleted. When it fails or is interrupted, ``folder`` keeps the earlier run's files and the temporary folder goes.
+    """
+    out = Path(folder)
+    out.mkdir(parents=True, exist_ok=True)
+    staged = StagedOutput(out, Path(tempfile.mkdtemp(prefix=TEMPORARY_PREFIX, dir=out)))
+    try:
+        yield staged
+        written = sorted(p for p in staged.path.rglob("*") if p.is_file())
+        with signals_deferred():
+            for path in written:
+                target = staged.final(path)
+                target.parent.mkdir(parents=True, exist_ok=True)
+                os.replace(path, target)
+            clear_owned(out, owned, keep={p.name for p in written} | {staged.path.name})
+    finally:
+        shutil.rmtree(staged.path, ignore_errors=True)

@@ -8,7 +8,7 @@ import sys
 
 from planner.facade import PLANNERS
 from planner.problem import DEFAULT_COST_WEIGHT
-from sid.cli.common import INPUT_ERRORS, check_output_folder, fail, print_written
+from sid.cli.common import INPUT_ERRORS, check_output_folder, fail, print_written, staged_output
 from sid.experiments.compare import BY_SCENARIO, format_summary, write_comparison
 from sid.experiments.harness import prepare, run_matrix, summarise
 from sid.experiments.progress import ProgressBar
@@ -46,7 +46,8 @@ def run(args: argparse.Namespace) -> int:
     print(format_summary(summarise([run.record() for run in runs], BY_SCENARIO)))
     title = f"Planner comparison: {len(tasks)} scenario(s), {args.runs} seeds, {args.time:g} s budget"
     try:
-        paths = write_comparison(runs, args.out, title)
+        with staged_output(args.out, ()) as staged:
+            paths = {key: staged.final(path) for key, path in write_comparison(runs, staged.path, title).items()}
     except OSError as exc:
         return fail("sid compare", exc)
     print_written(paths.values())

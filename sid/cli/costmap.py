@@ -6,7 +6,14 @@ import argparse
 
 from costmap.export import export_costmap
 from costmap.mapfile import MapFileError
-from sid.cli.common import OutputFolderError, add_scenario_arguments, check_output_folder, fail, print_written
+from sid.cli.common import (
+    OutputFolderError,
+    add_scenario_arguments,
+    check_output_folder,
+    fail,
+    print_written,
+    staged_output,
+)
 from sid.scenario.build import build_costmap
 from sid.scenario.loader import ScenarioError, load_scenario
 from sid.scenario.obstacles import outline
@@ -31,7 +38,13 @@ def run(args: argparse.Namespace) -> int:
         return fail("sid costmap", exc)
     kind = "without recognition" if args.no_social else "social"
     outlines = [outline(ob) for ob in scenario.obstacles]
-    paths = export_costmap(layered, args.out, robot=scenario.robot, title=f"{scenario.name}: {kind}", outlines=outlines)
+    try:
+        with staged_output(args.out, ()) as staged:
+            title = f"{scenario.name}: {kind}"
+            written = export_costmap(layered, staged.path, robot=scenario.robot, title=title, outlines=outlines)
+    except (OSError, ValueError) as exc:
+        return fail("sid costmap", exc)
+    paths = {key: staged.final(path) for key, path in written.items()}
     counts = {name: int((grid > 0).sum()) for name, grid in layered.grids.items()}
     print(
         f"{scenario.name}: {layered.spec.width}x{layered.spec.height} cells at {layered.spec.resolution} m, "

@@ -12,6 +12,7 @@ from sid.cli.common import (
     check_output_folder,
     fail,
     print_written,
+    staged_output,
     warn_goal_zone,
 )
 from sid.experiments.demo import DEMO_ITERATIONS, DEMO_SEED, run_demo
@@ -36,16 +37,17 @@ def run(args: argparse.Namespace) -> int:
     try:
         check_output_folder(args.out)
         scenario = load_scenario(args.scenario) if args.scenario else None
-        comparison = run_demo(
-            args.out,
-            scenario,
-            planner=args.planner,
-            time_limit=args.time,
-            seed=args.seed,
-            max_iterations=args.iterations,
-            cost_weight=args.cost_weight,
-            progress=lambda line: print(line, flush=True),
-        )
+        with staged_output(args.out, ("scenario.json",)) as staged:  # scenario.json: only for the built-in one
+            comparison = run_demo(
+                staged.path,
+                scenario,
+                planner=args.planner,
+                time_limit=args.time,
+                seed=args.seed,
+                max_iterations=args.iterations,
+                cost_weight=args.cost_weight,
+                progress=lambda line: print(line, flush=True),
+            )
     except (*INPUT_ERRORS, OSError) as exc:
         return fail("sid demo", exc)
     warn_goal_zone("sid demo", comparison)
@@ -53,5 +55,5 @@ def run(args: argparse.Namespace) -> int:
     print(format_table(comparison))
     print()
     names = ("comparison.png", "metrics.json") + (() if args.scenario else ("scenario.json",))
-    print_written(f"{args.out}/{name}" for name in names)
+    print_written(staged.folder / name for name in names)
     return 0 if all(run.result.success for run in comparison.runs.values()) else 1

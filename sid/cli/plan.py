@@ -13,6 +13,7 @@ from sid.cli.common import (
     check_output_folder,
     fail,
     print_written,
+    staged_output,
     warn_goal_zone,
 )
 from sid.experiments.scenario_plan import plan_scenario, write_plan
@@ -51,7 +52,8 @@ def run(args: argparse.Namespace) -> int:
         return fail("sid plan", exc)
     warn_goal_zone("sid plan", comparison)
     try:
-        files = write_plan(comparison, args.out)
+        with staged_output(args.out, ()) as staged:
+            files = {key: staged.final(path) for key, path in write_plan(comparison, staged.path).items()}
     except OSError as exc:
         return fail("sid plan", exc)
     (run,) = comparison.runs.values()

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 from planner.facade import PLANNERS
 from planner.problem import DEFAULT_COST_WEIGHT
-from sid.cli.common import check_output_folder, fail, print_written
+from sid.cli.common import check_output_folder, fail, print_written, staged_output
 from sid.experiments.navigation import NAV_LAYOUTS, NavSettings, navigation_tasks, run_navigation
 from sid.experiments.progress import ProgressBar
 from sid.synthetic.layouts import LAYOUTS, VARIATIONS
@@ -151,7 +151,10 @@ def table1_command(args: argparse.Namespace) -> int:
         )
         check_output_folder(args.out)  # fail before the run, not after it
         result = run_table1(settings, progress=ProgressBar("table1"))
-        paths = write_table1_report(result, args.out, _command())
+        with staged_output(args.out, ()) as staged:
+            paths = {
+                key: staged.final(path) for key, path in write_table1_report(result, staged.path, _command()).items()
+            }
     except (ValueError, OSError) as exc:
         return fail("sid reproduce", exc)
     print(table1_markdown(result, _command()))
@@ -172,7 +175,9 @@ def navigation_command(args: argparse.Namespace) -> int:
         tasks = navigation_tasks(seeds, layouts)
         check_output_folder(args.out)
         result = run_navigation(tasks, settings, progress=ProgressBar("navigation"))
-        paths = write_navigation_report(result, args.out, seeds, _command())
+        with staged_output(args.out, ("navigation_example.png",)) as staged:  # written only when a task has one
+            written = write_navigation_report(result, staged.path, seeds, _command())
+            paths = {key: staged.final(path) for key, path in written.items()}
     except (ValueError, OSError) as exc:
         return fail("sid reproduce", exc)
     print(navigation_markdown(result, seeds, _command()))

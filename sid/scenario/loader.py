@@ -7,6 +7,8 @@ docs/scenario.md ("Scenario file"). A malformed file raises ``ScenarioError`` na
 from __future__ import annotations
 
 import dataclasses
+import math
+import warnings
 from collections.abc import Callable
 from collections.abc import Set as AbstractSet
 from dataclasses import dataclass, field
@@ -20,10 +22,13 @@ from costmap.layers.inflation import InflationParams
 from costmap.layers.obstacle import ObstacleParams
 from costmap.layers.social import SocialParams
 from costmap.mapfile import MapFileError, read_map
+from costmap.occupancy import OccupancyGrid
 from costmap.plugins import PLUGINS, CostmapParams
-from sid.documents import is_number, load_document
+from sid.checks import LimitError, check_limit
+from sid.documents import InputWarning, is_number, load_document
 from sid.perception.groups import GroupParams
 from sid.perception.people import Person
+from sid.scenario.motion import Trajectory
 from sid.scenario.obstacles import BoxObstacle, CircleObstacle, Obstacle, SegmentObstacle
 
 __all__ = [
@@ -43,11 +48,23 @@ __all__ = [
 
 @dataclass(frozen=True)
 class RobotSpec:
-    """Start and goal poses (x, y, yaw) and the radius of the robot's disc footprint."""
+    """Start and goal poses (x, y, yaw) and the radius of the robot's disc footprint (m).
+
+    path / speed: waypoints (map frame, m) the robot drives through from ``start`` at ``speed`` (m/s), facing its
+    direction of travel (synthetic scenes: the camera's motion); no path = it stays at ``start``.
+    """
 
     start: tuple[float, float, float]
     goal: tuple[float, float, float]
     radius: float = 0.25
+    path: tuple[tuple[float, float], ...] = ()
+    speed: float = 0.5
+
+    @property
+    def trajectory(self) -> Trajectory:
+        """The pose of ``base_footprint`` in the map over time (``sid.scenario.motion``)."""
+        x, y, yaw = self.start
+        return Trajectory(x, y, yaw, self.path, self.speed)
 
 
 @dataclass(frozen=True)
@@ -66,6 +83,10 @@ class LidarSpec:
 
 @dataclass
 class Scenario:
+    """A navigation task (see docs/scenario.md). ``people`` stand where the file puts them (their start poses);
+    ``walks``: person id -> scripted motion of the people that walk (``people[i].path``); ``conversations``:
+    declared conversational groups (person ids), the ground truth of synthetic scenes."""
+
     name: str
     grid: GridSpec
     robot: RobotSpec
@@ -75,6 +96,12 @@ class Scenario:
     static_map: Path | None = None
     group_params: GroupParams = field(default_factory=GroupParams)
     layers: CostmapParams = field(default_factory=CostmapParams)
+    walks: dict[int, Trajectory] = field(default_factory=dict)
+    conversations: tuple[tuple[int, ...], ...] = ()
+
+    def trajectory(self, person: Person) -> Trajectory:
+        """The motion of ``person`` (one of ``people``): its walk, or standing still at its position."""
+        return self.walks.get(person.id) or Trajectory(person.x, person.y, person.theta)
 
 
 class ScenarioError(ValueError):
@@ -134,7 +161,7 @@ def _list(value: Any, name: str) -> list:
 
 
 def _params(value: Any, name: str, cls: type) -> Any:
-    """A parameter dataclass from a mapping of its fields, typed by the defaults (bool, int or float)."""
+    """A parameter dataclass from a mapping of its fields, typed by the defaults (bool, int, float or str)."""
     defaults = {f.name: getattr(cls(), f.name) for f in dataclasses.fields(cls)}
     data = _mapping(value, name, set(defaults))
     kwargs: dict[str, Any] = {}
@@ -146,6 +173,10 @@ def _params(value: Any, name: str, cls: type) -> Any:
             kwargs[key] = raw
         elif isinstance(default, int):
             kwargs[key] = _integer(raw, key_name, 0)
+        elif isinstance(default, str):  # a choice, e.g. groups.method; the record names the accepted values
+            if not isinstance(raw, str):
+                raise _fail(key_name, "a string", raw)
+            kwargs[key] = raw
         else:
             kwargs[key] = _number(raw, key_name)
     try:
@@ -181,7 +212,10 @@ def _grid(value: Any, static: GridSpec | None) -> GridSpec:
     size = (width, height)
     if min(size) < resolution:
         raise ScenarioError(f"map.size: {size} m is smaller than one {resolution} m cell")
-    return GridSpec.from_size(resolution, (origin[0], origin[1]), size)
+    try:
+        return GridSpec.from_size(resolution, (origin[0], origin[1]), size)
+    except ValueError as exc:  # above Limits.map_cells
+        raise ScenarioError(str(exc)) from None
 
 
 def _obstacle(value: Any, name: str) -> Obstacle:
@@ -207,8 +241,11 @@ def _obstacle(value: Any, name: str) -> Obstacle:
     raise _fail(f"{name}.type", '"segment", "circle" or "box"', kind)
 
 
+PERSON_FIELDS = {"id", "x", "y", "theta", "orientation_quality", "path", "speed", "start_time"}
+
+
 def _person(value: Any, name: str, index: int) -> Person:
-    data = _mapping(value, name, {"id", "x", "y", "theta", "orientation_quality"}, {"x", "y"})
+    data = _mapping(value, name, PERSON_FIELDS, {"x", "y"})
     pid = _integer(data.get("id", index + 1), f"{name}.id", 0)
     x, y = _number(data["x"], f"{name}.x"), _number(data["y"], f"{name}.y")
     theta = data.get("theta")
@@ -222,6 +259,61 @@ def _person(value: Any, name: str, index: int) -> Person:
     return Person(pid, x, y, theta, quality)
 
 
+def _path(value: Any, name: str, grid: GridSpec, start: tuple[float, float]) -> tuple[tuple[float, float], ...]:
+    """Waypoints [[x, y], ...] inside the map, each different from the point before it (``start`` first)."""
+    if not isinstance(value, list) or not value:
+        raise _fail(name, "a non-empty list of [x, y] waypoints", value)
+    points: list[tuple[float, float]] = []
+    for i, raw in enumerate(value):
+        point = _xy(raw, f"{name}[{i}]")
+        _inside(grid, point, f"{name}[{i}]")
+        if point == (points[-1] if points else start):
+            raise ScenarioError(f"{name}[{i}]: {list(point)} repeats the point before it")
+        points.append(point)
+    return tuple(points)
+
+
+def _motion(data: dict, name: str, grid: GridSpec, start: tuple[float, float], speed: float) -> dict[str, Any]:
+    """``path``, ``speed`` (m/s) and, for people, ``start_time`` (s) of a mover's mapping, checked."""
+    if "path" not in data:
+        extra = sorted({"speed", "start_time"} & set(data))
+        if extra:
+            raise ScenarioError(f"{name}.{extra[0]}: only meaningful with a path")
+        return {}
+    motion: dict[str, Any] = {
+        "path": _path(data["path"], f"{name}.path", grid, start),
+        "speed": _number(data.get("speed", speed), f"{name}.speed", positive=True),
+    }
+    if "start_time" in data:
+        motion["start_time"] = _number(data["start_time"], f"{name}.start_time", minimum=0.0)
+    return motion
+
+
+def _walk(value: dict, name: str, grid: GridSpec, person: Person) -> Trajectory | None:
+    motion = _motion(value, name, grid, (person.x, person.y), Trajectory.speed)
+    return Trajectory(person.x, person.y, person.theta, **motion) if motion else None
+
+
+def _conversations(value: Any, people: list[Person]) -> tuple[tuple[int, ...], ...]:
+    """Declared groups: lists of at least two known person ids, nobody in two groups."""
+    ids = {p.id for p in people}
+    seen: dict[int, int] = {}
+    groups = []
+    for g, raw in enumerate(_list(value, "conversations")):
+        name = f"conversations[{g}]"
+        if not isinstance(raw, list) or len(raw) < 2:
+            raise _fail(name, "a list of at least two person ids", raw)
+        for member in raw:
+            pid = _integer(member, f"{name}", 0)
+            if pid not in ids:
+                raise ScenarioError(f"{name}: person {pid} is not in people")
+            if pid in seen:
+                raise ScenarioError(f"{name}: person {pid} is already in conversations[{seen[pid]}]")
+            seen[pid] = g
+        groups.append(tuple(raw))
+    return tuple(groups)
+
+
 def _pose(value: Any, name: str) -> tuple[float, float, float]:
     pose = _point(value, name, (2, 3))
     return (pose[0], pose[1], pose[2] if len(pose) == 3 else 0.0)
@@ -233,7 +325,96 @@ def _inside(grid: GridSpec, xy: tuple[float, ...], name: str) -> None:
         raise ScenarioError(f"{name}: ({xy[0]}, {xy[1]}) is outside the map (x {x0:g}..{x1:g}, y {y0:g}..{y1:g})")
 
 
-TOP_LEVEL = {"name", "map", "obstacles", "static_map", "people", "robot", "lidar", "groups", "layers"}
+# --- limits: sizes checked where they enter, before anything is allocated for them (sid.checks.Limits) ------
+
+
+def _limit(field: str, count: float, limit: str, unit: str, detail: str = "") -> None:
+    try:
+        check_limit(field, count, limit, unit, detail)
+    except LimitError as exc:
+        raise ScenarioError(str(exc)) from None
+
+
+def _near_map(grid: GridSpec, obstacle: Obstacle, name: str) -> None:
+    """Obstacle coordinates within one map diagonal of the map (a wall crossing the map can end there); farther
+    ones would make rasterising a wall unbounded, and coordinates past 2^63 cells cannot be cells at all."""
+    reach = math.hypot(*grid.size_m)
+    if isinstance(obstacle, SegmentObstacle):
+        points = {f"{name}.points[{i}]": p for i, p in enumerate(obstacle.points)}
+    elif isinstance(obstacle, CircleObstacle):
+        points = {f"{name}.center": obstacle.center}
+        if obstacle.radius > reach:
+            raise ScenarioError(f"{name}.radius: {obstacle.radius:g} m is more than the map's diagonal ({reach:g} m)")
+    else:
+        points = {f"{name}.min": obstacle.min, f"{name}.max": obstacle.max}
+    x0, y0, x1, y1 = grid.bounds
+    for field_name, (x, y) in points.items():
+        if not (x0 - reach <= x <= x1 + reach and y0 - reach <= y <= y1 + reach):
+            raise ScenarioError(
+                f"{field_name}: ({x:g}, {y:g}) lies farther from the map (x {x0:g}..{x1:g}, y {y0:g}..{y1:g}) than "
+                f"its diagonal ({reach:g} m); obstacle points must lie within that distance"
+            )
+
+
+def _check_scan(grid: GridSpec, lidar: LidarSpec, layers: CostmapParams) -> None:
+    """The simulated scan's size: beams (Limits.lidar_beams), and beams x the longest range in cells
+    (Limits.scan_cells), the samples the scan and the LiDAR layer's ray tracing take."""
+    _limit("lidar.beams", lidar.beams, "lidar_beams", "beams")
+    longest = max(lidar.range_max, layers.obstacle.raytrace_max_range)
+    cells = math.ceil(longest / grid.resolution)
+    detail = f"{lidar.beams} beams x {cells:,} cells of range ({longest:g} m at {grid.resolution:g} m) = "
+    _limit("lidar", lidar.beams * cells, "scan_cells", "beam cells", detail)
+
+
+def _check_inflation(grid: GridSpec, layers: CostmapParams) -> None:
+    """An inflation radius within the map's diagonal: costs cannot spread farther than the map, and Nav2's cost
+    table grows with the square of the radius in cells."""
+    radius, reach = layers.inflation.inflation_radius, math.hypot(*grid.size_m)
+    if radius > reach:
+        raise ScenarioError(
+            f"layers.inflation.inflation_radius: {radius:g} m is more than the map's diagonal ({reach:g} m), the "
+            "farthest any cost can spread; use at most that"
+        )
+
+
+def _static_map(path: Path) -> OccupancyGrid:
+    """The ``static_map`` file, refused when its origin is rotated: Nav2's map_server ignores the yaw, so the map
+    would lie differently in Nav2 than the file says (docs/scenario.md, "The known map")."""
+    try:
+        static = read_map(path)
+    except MapFileError as exc:
+        raise ScenarioError(f"static_map: {exc}") from exc
+    if static.origin_yaw != 0:
+        raise ScenarioError(
+            f"static_map: {path}: origin yaw {static.origin_yaw:g} rad: a rotated map is not supported (Nav2's "
+            "map_server ignores the yaw); rotate the image and set the yaw to 0"
+        )
+    return static
+
+
+def _warn_resampled(static: GridSpec, grid: GridSpec, path: Path) -> None:
+    """Say that the static map is sampled onto the scenario's grid when their cells differ (nearest cell)."""
+    if static.resolution != grid.resolution:
+        warnings.warn(
+            f"static_map: {path}: {static.resolution:g} m cells sampled onto the scenario's {grid.resolution:g} m "
+            "cells (nearest cell)",
+            InputWarning,
+            stacklevel=2,
+        )
+
+
+TOP_LEVEL = {
+    "name",
+    "map",
+    "obstacles",
+    "static_map",
+    "people",
+    "conversations",
+    "robot",
+    "lidar",
+    "groups",
+    "layers",
+}
 
 
 def scenario_from_dict(data: Any, base_dir: Path | None = None, default_name: str = "scenario") -> Scenario:
@@ -249,28 +430,38 @@ def scenario_from_dict(data: Any, base_dir: Path | None = None, default_name: st
         if not isinstance(raw, str) or not raw:
             raise _fail("static_map", "a path to a map_server YAML file", raw)
         static_map = Path(raw) if Path(raw).is_absolute() or base_dir is None else base_dir / raw
-        try:
-            static_spec = read_map(static_map).spec
-        except MapFileError as exc:
-            raise ScenarioError(f"static_map: {exc}") from exc
+        static_spec = _static_map(static_map).spec
     grid = _grid(data.get("map"), static_spec)
+    if static_map is not None and static_spec is not None:
+        _warn_resampled(static_spec, grid, static_map)
 
     obstacles = [_obstacle(o, f"obstacles[{i}]") for i, o in enumerate(_list(data.get("obstacles", []), "obstacles"))]
-    people = [_person(p, f"people[{i}]", i) for i, p in enumerate(_list(data.get("people", []), "people"))]
+    for i, obstacle in enumerate(obstacles):
+        _near_map(grid, obstacle, f"obstacles[{i}]")
+    people_data = _list(data.get("people", []), "people")
+    _limit("people", len(people_data), "people", "people")
+    people = [_person(p, f"people[{i}]", i) for i, p in enumerate(people_data)]
     seen: dict[int, int] = {}
+    walks: dict[int, Trajectory] = {}
     for i, person in enumerate(people):
         if person.id in seen:
             raise ScenarioError(f"people[{i}].id: {person.id} is already used by people[{seen[person.id]}]")
         seen[person.id] = i
         _inside(grid, (person.x, person.y), f"people[{i}]")
+        walk = _walk(people_data[i], f"people[{i}]", grid, person)
+        if walk is not None:
+            walks[person.id] = walk
+    conversations = _conversations(data.get("conversations", []), people)
 
-    robot_data = _mapping(data["robot"], "robot", {"start", "goal", "radius"}, {"start", "goal"})
+    robot_data = _mapping(data["robot"], "robot", {"start", "goal", "radius", "path", "speed"}, {"start", "goal"})
+    start = _pose(robot_data["start"], "robot.start")
+    _inside(grid, start, "robot.start")
     robot = RobotSpec(
-        _pose(robot_data["start"], "robot.start"),
+        start,
         _pose(robot_data["goal"], "robot.goal"),
         _number(robot_data.get("radius", RobotSpec.radius), "robot.radius", positive=True),
+        **_motion(robot_data, "robot", grid, (start[0], start[1]), RobotSpec.speed),
     )
-    _inside(grid, robot.start, "robot.start")
     _inside(grid, robot.goal, "robot.goal")
 
     lidar_data = _mapping(data.get("lidar", {}), "lidar", {f.name for f in dataclasses.fields(LidarSpec)})
@@ -294,6 +485,8 @@ def scenario_from_dict(data: Any, base_dir: Path | None = None, default_name: st
         layers = CostmapParams(**sections)
     except ValueError as exc:
         raise ScenarioError(f"layers.{exc}") from exc
+    _check_scan(grid, lidar, layers)
+    _check_inflation(grid, layers)
 
     return Scenario(
         name=name,
@@ -305,6 +498,8 @@ def scenario_from_dict(data: Any, base_dir: Path | None = None, default_name: st
         static_map=static_map,
         group_params=_params(data.get("groups", {}), "groups", GroupParams),
         layers=layers,
+        walks=walks,
+        conversations=conversations,
     )
 
 

@@ -69,6 +69,18 @@ def test_unknown_orientation_and_parameter_blocks():
     assert s.layers.inflation.inflation_radius == 0.8 and s.layers.obstacle.track_unknown_space
 
 
+def test_groups_block_chooses_the_detection_method():
+    data = copy.deepcopy(BASE)
+    data["groups"] = {"method": "rays", "ray_length": 2.0}
+    s = scenario_from_dict(data)
+    assert s.group_params.method == "rays" and s.group_params.ray_length == 2.0
+    assert scenario_from_dict(copy.deepcopy(BASE)).group_params.method == "ospace"
+    for method, message in ((3, "groups.method: expected a string"), ("graphcut", "method must be one of")):
+        data["groups"] = {"method": method}
+        with pytest.raises(ScenarioError, match=message):
+            scenario_from_dict(data)
+
+
 def test_yaml_files_load_too(tmp_path):
     path = tmp_path / "s.yaml"
     path.write_text(yaml.safe_dump(BASE))

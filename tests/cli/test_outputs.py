@@ -1,0 +1,114 @@
+"""Outputs are written whole (issue 15): through a temporary file or folder and a rename; a run into an existing
+``--out`` replaces or clears only what the command writes; SIGINT and SIGTERM leave every file whole."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import cv2
+import pytest
+
+from sid.cli import main
+from sid.cli.common import clear_owned, staged_output
+from sid.documents import TEMPORARY_PREFIX
+from tests.conftest import REPO_ROOT
+
+SCENARIO = str(REPO_ROOT / "examples" / "conversation.json")
+
+
+def test_staged_files_replace_the_earlier_run_and_stale_owned_ones_go(tmp_path):
+    (tmp_path / "a.json").write_text("old")
+    (tmp_path / "extra_1.png").write_text("stale")
+    (tmp_path / "notes.txt").write_text("the user's")
+    with staged_output(tmp_path, ("extra_*.png",)) as staged:
+        (staged.path / "a.json").write_text("new")
+        assert (tmp_path / "a.json").read_text() == "old"  # nothing moves before the run ends
+        assert staged.final(staged.path / "a.json") == tmp_path / "a.json"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.json", "notes.txt"]
+    assert (tmp_path / "a.json").read_text() == "new"
+
+
+def test_a_failed_run_keeps_the_earlier_files_and_leaves_no_temporary_folder(tmp_path):
+    (tmp_path / "a.json").write_text("old")
+    with pytest.raises(KeyboardInterrupt), staged_output(tmp_path, ("a.json",)) as staged:
+        (staged.path / "a.json").write_text("half")
+        raise KeyboardInterrupt
+    assert [p.name for p in tmp_path.iterdir()] == ["a.json"] and (tmp_path / "a.json").read_text() == "old"
+
+
+def test_clear_owned_deletes_only_matching_files_and_leftover_temporaries(tmp_path):
+    for name in ("overlay_000001.png", "topview_000001.png", "overlay.txt", "mine.png", f"{TEMPORARY_PREFIX}x"):
+        (tmp_path / name).write_text("")
+    (tmp_path / f"{TEMPORARY_PREFIX}dir").mkdir()
+    removed = clear_owned(tmp_path, ("overlay_*.png", "topview_*.png"))
+    assert len(removed) == 4
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["mine.png", "overlay.txt"]
+
+
+def test_costmap_into_an_existing_folder_replaces_its_files_and_keeps_others(tmp_path, capsys):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "costmap.png").write_bytes(b"an earlier, broken picture")
+    (out / "notes.txt").write_text("keep")
+    (out / f"{TEMPORARY_PREFIX}killed").mkdir()  # a run killed with SIGKILL
+    assert main(["costmap", SCENARIO, "--out", str(out)]) == 0
+    names = sorted(p.name for p in out.iterdir())
+    assert names == ["costmap.mcap", "costmap.npz", "costmap.pgm", "costmap.png", "costmap.yaml", "notes.txt"]
+    assert cv2.imread(str(out / "costmap.png")) is not None
+    assert f"wrote {out / 'costmap.png'}" in capsys.readouterr().out
+
+
+def test_detect_rerun_clears_the_earlier_runs_pictures(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["detect", "--source", "synthetic:S1", "--frames", "3", "--out", str(out)]) == 0
+    (out / "mine.txt").write_text("keep")
+    assert main(["detect", "--source", "synthetic:S1", "--frames", "1", "--out", str(out)]) == 0
+    assert sorted(p.name for p in out.iterdir()) == [
+        "detections.jsonl",
+        "mine.txt",
+        "overlay_000000.png",
+        "topview_000000.png",
+    ]
+    assert "removed 7 file(s) of an earlier run" in capsys.readouterr().err
+
+
+def _detect_until_interrupted(out: Path, sig: signal.Signals) -> int:
+    """Start ``sid detect --out`` on a long synthetic sequence, send ``sig`` once two frames are written; the exit
+    code."""
+    code = "import sys; from sid.cli import main; sys.exit(main(sys.argv[1:]))"
+    argv = [sys.executable, "-c", code, "detect", "--source", "synthetic:S1", "--frames", "10000", "--out", str(out)]
+    process = subprocess.Popen(argv, cwd=REPO_ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    try:
+        deadline = time.monotonic() + 300  # a hang bound, not a speed check
+        while len(list(out.glob("topview_*.png"))) < 2 and time.monotonic() < deadline and process.poll() is None:
+            time.sleep(0.05)
+        process.send_signal(sig)
+        process.wait(timeout=300)
+    finally:
+        if process.poll() is None:
+            process.kill()
+    assert process.stderr is not None
+    err = process.stderr.read().decode()
+    assert "Traceback" not in err, err
+    return process.returncode
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("sig", "code"), [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
+def test_an_interrupted_detect_leaves_every_file_whole(tmp_path, sig, code):
+    out = tmp_path / "out"
+    assert _detect_until_interrupted(out, sig) == code
+    lines = (out / "detections.jsonl").read_text().splitlines()
+    frames = [json.loads(line)["frame"] for line in lines]  # every line whole
+    overlays, tops = sorted(out.glob("overlay_*.png")), sorted(out.glob("topview_*.png"))
+    assert [int(p.stem.split("_")[1]) for p in overlays] == frames  # each frame's line and both its pictures
+    assert [int(p.stem.split("_")[1]) for p in tops] == frames
+    assert all(cv2.imread(str(p)) is not None for p in overlays + tops)
+    assert not [p for p in out.iterdir() if p.name.startswith(TEMPORARY_PREFIX)]
+    assert os.path.getsize(out / "detections.jsonl") > 0
