@@ -50,6 +50,8 @@ from sid.perception.people import Person
 
 # |sin| of the angle between two rays below which they count as parallel (their crossing is rounding noise).
 _PARALLEL = 1e-9
+# Relative difference below which two removals' excess values tie (rounding, e.g. after moving the scene).
+_TIE = 1e-9
 # Hull area (m^2) below which the polygon of crossings is treated as degenerate (a point or a segment).
 _DEGENERATE_AREA = 1e-9
 
@@ -339,7 +341,7 @@ def _groups_in_cluster(ids: list[int], positions: np.ndarray, facing: np.ndarray
     remaining = np.ones(len(ids), dtype=bool)
     groups = []
     for mask in candidates:
-        found = _prune(mask & remaining, meetings, positions, params)
+        found = _prune(mask & remaining, meetings, positions, ids, params)
         if found is None:
             continue
         members, geometry = found
@@ -442,16 +444,19 @@ def _segment_ends(crossings: np.ndarray, centre: complex) -> np.ndarray:
 
 
 def _prune(
-    candidates: np.ndarray, meetings: _Meetings, positions: np.ndarray, params: GroupParams
+    candidates: np.ndarray, meetings: _Meetings, positions: np.ndarray, ids: list[int], params: GroupParams
 ) -> tuple[np.ndarray, _Geometry] | None:
-    """The group left after pruning ``candidates`` (bool mask), with its geometry, or None."""
+    """The group left after pruning ``candidates`` (bool mask), with its geometry, or None.
+
+    Removals whose excess ties (within rounding: moving the scene must not change the choice) go to the lowest
+    person id, so that neither the input order nor the scene's placement decides between them."""
     members = _with_meetings(candidates, meetings)
     if np.count_nonzero(members) < 2:
         return None
     geometry = _geometry(members, meetings, positions)
     excess = geometry.excess(params)
     while excess > 1.0:
-        best: tuple[float, np.ndarray, _Geometry] | None = None
+        best: tuple[float, np.ndarray, _Geometry, int] | None = None
         for i in np.flatnonzero(members):
             trial = members.copy()
             trial[i] = False
@@ -460,9 +465,11 @@ def _prune(
                 continue
             trial_geometry = _geometry(trial, meetings, positions)
             trial_excess = trial_geometry.excess(params)
-            if best is None or trial_excess < best[0]:
-                best = (trial_excess, trial, trial_geometry)
+            if best is None or trial_excess < best[0] - _TIE * max(1.0, best[0]):
+                best = (trial_excess, trial, trial_geometry, ids[i])
+            elif trial_excess <= best[0] + _TIE * max(1.0, best[0]) and ids[i] < best[3]:
+                best = (min(trial_excess, best[0]), trial, trial_geometry, ids[i])
         if best is None or best[0] >= excess:
             return None
-        excess, members, geometry = best
+        excess, members, geometry, _ = best
     return members, geometry
