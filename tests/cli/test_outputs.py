@@ -83,7 +83,15 @@ def _detect_until_interrupted(out: Path, sig: signal.Signals) -> int:
     code."""
     code = "import sys; from sid.cli import main; sys.exit(main(sys.argv[1:]))"
     argv = [sys.executable, "-c", code, "detect", "--source", "synthetic:S1", "--frames", "10000", "--out", str(out)]
-    process = subprocess.Popen(argv, cwd=REPO_ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    # A shell's background job starts with SIGINT ignored, and Python then keeps ignoring it (as a user's
+    # background `sid` should): give the command the default disposition, whatever ran this test.
+    process = subprocess.Popen(
+        argv,
+        cwd=REPO_ROOT,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
     try:
         deadline = time.monotonic() + 300  # a hang bound, not a speed check
         while len(list(out.glob("topview_*.png"))) < 2 and time.monotonic() < deadline and process.poll() is None:
