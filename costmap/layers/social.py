@@ -65,7 +65,7 @@ def _people_by_id(people: Sequence[Person] | Mapping[int, Person]) -> Mapping[in
     return people if isinstance(people, Mapping) else {p.id: p for p in people}
 
 
-def _zone_hull(group: Group, people: Sequence[Person] | Mapping[int, Person]) -> BaseGeometry:
+def zone_hull(group: Group, people: Sequence[Person] | Mapping[int, Person]) -> BaseGeometry:
     """Convex hull (Polygon, LineString or Point) of the group's o-space vertices and its members' positions."""
     by_id = _people_by_id(people)
     missing = [m for m in group.members if m not in by_id]
@@ -89,7 +89,7 @@ def group_zone_polygon(
     may be a list of persons or a mapping id -> person; every member must be there.
     """
     check_number("group zone", "margin", margin, low=0, unit="metres")
-    grown = _zone_hull(group, people).buffer(margin, quad_segs=16) if margin > 0 else _zone_hull(group, people)
+    grown = zone_hull(group, people).buffer(margin, quad_segs=16) if margin > 0 else zone_hull(group, people)
     if not isinstance(grown, Polygon) or grown.is_empty or grown.area == 0:
         raise ValueError(f"group {group.members}: the zone is degenerate (collinear points); use a margin > 0")
     return grown
@@ -187,7 +187,7 @@ def paint_person(costs: np.ndarray, spec: GridSpec, person: Person, params: Soci
 def paint_group(costs: np.ndarray, spec: GridSpec, hull: BaseGeometry, params: SocialParams) -> Window | None:
     """Max a group's zone cost and its fall-off into ``costs`` (in place); returns the window it reaches.
 
-    ``hull``: the group's ``_zone_hull``.
+    ``hull``: the group's ``zone_hull``.
 
     Distances within 1e-6 m of the zone edge count as inside, so rounding never drops a cell that lies in
     ``group_zone_polygon`` below ``group_cost``.
@@ -240,7 +240,7 @@ class SocialLayer(Layer):
     def update(self, inputs: LayerInputs, changed: Window | None) -> Window | None:
         """Repaint the layer for the people (world frame) and groups of ``inputs``."""
         by_id = _people_by_id(inputs.people)
-        hulls = [_zone_hull(group, by_id) for group in inputs.groups]  # raises on a bad group before any change
+        hulls = [zone_hull(group, by_id) for group in inputs.groups]  # raises on a bad group before any change
         previous = self._painted
         if previous is not None:
             self.costs[previous.slices] = FREE_SPACE

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field, replace
 from costmap.combine import CombinationMethod
 from costmap.grid import FREE_SPACE, GridSpec, Window, union
 from costmap.layer import Layer, LayerInputs
-from costmap.layers.social import SocialParams, _zone_hull, paint_body, paint_group, paint_person
+from costmap.layers.social import SocialParams, paint_body, paint_group, paint_person, zone_hull
 from sid.checks import check_number
 
 
@@ -57,7 +57,7 @@ class TrackedPeopleLayer(Layer):
         people = [] if tracks is None else [p.as_person() for p in tracks.people]
         by_id = {p.id: p for p in people}
         conversations = [] if tracks is None else [g.as_group() for g in tracks.groups if g.kind == "conversation"]
-        hulls = [_zone_hull(group, by_id) for group in conversations]  # raises on a bad group before any change
+        hulls = [zone_hull(group, by_id) for group in conversations]  # raises on a bad group before any change
         previous = self._painted
         if previous is not None:
             self.costs[previous.slices] = FREE_SPACE
