@@ -140,7 +140,9 @@ def test_node_publishes_the_group_zone_for_nav2(tmp_path: Path, monkeypatch: pyt
             when = stamp(time.time())
             publishers["odom"].publish(odometry(when))
             publishers["info"].publish(camera_info(frame, when))
-            bad = bool(grids) and bad_frames < 3  # once it answers, frames it cannot read: it must log them, go on
+            # Once it has answered a frame (so its image subscriptions are matched: the latched costmap can come
+            # sooner), frames it cannot read: it must log them and go on.
+            bad = bool(groups) and bad_frames < 3
             bad_frames += bad
             publishers["color"].publish(image(frame.color, "yuv422" if bad else "rgb8", when))
             publishers["depth"].publish(image(depth_mm, "16UC1", when))
