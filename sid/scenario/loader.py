@@ -13,7 +13,7 @@ from collections.abc import Callable
 from collections.abc import Set as AbstractSet
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -503,14 +503,23 @@ def scenario_from_dict(data: Any, base_dir: Path | None = None, default_name: st
     )
 
 
+_Built = TypeVar("_Built")
+
+
 def load_scenario(path: str | Path) -> Scenario:
     """Read a scenario file (.json, or YAML for any other suffix); errors name the file and the field."""
+    return read_scenario_file(path, scenario_from_dict)
+
+
+def read_scenario_file(path: str | Path, build: Callable[[Any, Path, str], _Built]) -> _Built:
+    """Parse a scenario-style file and ``build(data, base_dir, default_name)`` from it (a scenario, or a richer
+    record such as a simulation); a ``ScenarioError`` names the file and the field."""
     path = Path(path)
     try:
         data = load_document(path, "scenario file")
     except ValueError as exc:
         raise ScenarioError(str(exc)) from None
     try:
-        return scenario_from_dict(data, base_dir=path.parent, default_name=path.stem)
+        return build(data, path.parent, path.stem)
     except ScenarioError as exc:
         raise ScenarioError(f"{path}: {exc}") from exc

@@ -24,10 +24,10 @@ import numpy as np
 from shapely.geometry import LineString, Point, Polygon
 from shapely.ops import unary_union
 
-from sid.documents import is_number, load_document
+from sid.documents import is_number
 from sid.experiments.simulate.robot import DriveLimits
 from sid.perception.people import Person
-from sid.scenario.loader import Scenario, ScenarioError, scenario_from_dict
+from sid.scenario.loader import Scenario, ScenarioError, read_scenario_file, scenario_from_dict
 from sid.scenario.obstacles import BoxObstacle, CircleObstacle, Obstacle
 
 JITTER_XY_M = 0.05
@@ -114,15 +114,7 @@ def world_from_dict(data: Any, base_dir: Path | None = None, default_name: str =
 
 def load_world(path: str | Path) -> SimWorld:
     """Read a simulation (or plain scenario) file; errors name the file and the field."""
-    path = Path(path)
-    try:
-        data = load_document(path, "scenario file")
-    except ValueError as exc:
-        raise ScenarioError(str(exc)) from None
-    try:
-        return world_from_dict(data, base_dir=path.parent, default_name=path.stem)
-    except ScenarioError as exc:
-        raise ScenarioError(f"{path}: {exc}") from exc
+    return read_scenario_file(path, world_from_dict)
 
 
 # --- ground-truth geometry -------------------------------------------------------------------------------------
