@@ -44,6 +44,7 @@ ROBOT = (1.0, 2.0, 0.5)  # the robot's pose in the map (x, y, yaw), sent as odom
 FORMATION_DISTANCE = 1.9  # S4's formation centre, metres ahead of the camera
 RATE_HZ = 5.0
 WANTED = 25  # costmaps to collect once the group shows
+BAD_FRAME_LOGGED = "skipped, colour image encoding 'yuv422' is not supported"
 
 
 def render_scene():
@@ -133,17 +134,26 @@ def test_node_publishes_the_group_zone_for_nav2(tmp_path: Path, monkeypatch: pyt
     depth_mm = np.round(frame.depth * 1000).astype(np.uint16)
     try:
         deadline = time.monotonic() + 180
-        bad_frames = 0
+        sent = 0
+        skip_logged = False
+        answered_before_skip = 0  # group messages received before the node had logged a bad frame
         while time.monotonic() < deadline and node_process.poll() is None:
-            if sum(1 for g in groups if g["groups"]) >= WANTED:
+            if not skip_logged and BAD_FRAME_LOGGED in (tmp_path / "node.log").read_text():
+                skip_logged, answered_before_skip = True, len(groups)
+            if (
+                skip_logged
+                and sum(1 for g in groups if g["groups"]) >= WANTED
+                and len(groups) > answered_before_skip + 3
+            ):
                 break
             when = stamp(time.time())
             publishers["odom"].publish(odometry(when))
             publishers["info"].publish(camera_info(frame, when))
             # Once it has answered a frame (so its image subscriptions are matched: the latched costmap can come
-            # sooner), frames it cannot read: it must log them and go on.
-            bad = bool(groups) and bad_frames < 3
-            bad_frames += bad
+            # sooner), every third frame one it cannot read, until it has logged one (the camera topics are best
+            # effort, so on a loaded machine a single bad frame may never arrive): it must log it and go on.
+            sent += 1
+            bad = bool(groups) and not skip_logged and sent % 3 == 0
             publishers["color"].publish(image(frame.color, "yuv422" if bad else "rgb8", when))
             publishers["depth"].publish(image(depth_mm, "16UC1", when))
             next_frame = time.monotonic() + 1 / RATE_HZ
@@ -158,7 +168,8 @@ def test_node_publishes_the_group_zone_for_nav2(tmp_path: Path, monkeypatch: pyt
         rclpy.shutdown(context=context)
     log = (tmp_path / "node.log").read_text()
     assert sum(1 for g in groups if g["groups"]) >= WANTED, f"too few costmaps with a group; node log:\n{log[-3000:]}"
-    assert "skipped, colour image encoding 'yuv422' is not supported" in log
+    assert BAD_FRAME_LOGGED in log
+    assert len(groups) > answered_before_skip + 3, "the node stopped answering after a bad frame"
 
     # The group: four tracked people around one conversation, in the map frame (the odometry pose applied).
     last = groups[-1]
