@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import ctypes
 import os
 from collections.abc import Iterable
 from pathlib import Path
@@ -30,3 +31,31 @@ def physical_cores(cpus: Iterable[int] | None = None) -> int:
         except OSError:
             cores.add(f"cpu{cpu}")
     return max(1, len(cores))
+
+
+# glibc's mallopt parameters (malloc.h).
+_M_TRIM_THRESHOLD, _M_TOP_PAD, _M_MMAP_THRESHOLD = -1, -2, -3
+_MMAP_THRESHOLD_MAX = 32 * 2**20  # glibc's ceiling for M_MMAP_THRESHOLD on 64-bit systems
+
+
+def keep_freed_memory(keep_bytes: int = 256 * 2**20) -> bool:
+    """Make glibc's malloc keep freed memory for reuse (up to ``keep_bytes`` at the top of the heap) instead of
+    handing large blocks back to the kernel at every free; returns whether it applied (False off glibc).
+
+    numpy's temporaries of a few hundred kB to a few MB (image-sized arrays in the renderer, the costmap's grids)
+    are otherwise mapped and unmapped at every call, and each new mapping is paid again in page faults: on the
+    development VM that was 11 of 28 s of a ``sid simulate paper`` run, in the kernel (docs/benchmarks.md). The same
+    settings as the ``MALLOC_MMAP_THRESHOLD_`` / ``MALLOC_TRIM_THRESHOLD_`` / ``MALLOC_TOP_PAD_`` environment
+    variables, set from inside the process. Process-wide: call it once, from an entry point (the ``sid`` command,
+    a worker process), never from library code.
+    """
+    try:
+        libc = ctypes.CDLL(None)
+        mallopt = libc.mallopt
+    except (OSError, AttributeError):  # not glibc (musl, macOS, Windows): leave the allocator alone
+        return False
+    mallopt.argtypes, mallopt.restype = [ctypes.c_int, ctypes.c_int], ctypes.c_int
+    applied = mallopt(_M_MMAP_THRESHOLD, min(keep_bytes, _MMAP_THRESHOLD_MAX))
+    applied &= mallopt(_M_TRIM_THRESHOLD, keep_bytes)
+    applied &= mallopt(_M_TOP_PAD, min(keep_bytes, 64 * 2**20))
+    return bool(applied)

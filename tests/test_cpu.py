@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import platform
+
 import sid.cpu
-from sid.cpu import physical_cores, usable_cpus
+from sid.cpu import keep_freed_memory, physical_cores, usable_cpus
 
 
 def fake_topology(root, siblings: dict[int, str]) -> None:
@@ -28,3 +30,9 @@ def test_cpus_without_topology_count_as_cores(tmp_path, monkeypatch):
 
 def test_this_machine_has_at_least_one_core_per_usable_cpu_set():
     assert 1 <= physical_cores() <= len(usable_cpus())
+
+
+def test_keep_freed_memory_applies_on_glibc():
+    applied = keep_freed_memory()
+    assert applied == (platform.libc_ver()[0] == "glibc")
+    assert keep_freed_memory() == applied  # idempotent: every worker and every command may call it

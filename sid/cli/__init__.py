@@ -13,6 +13,7 @@ from typing import TextIO
 
 from sid.checks import limits
 from sid.cli.common import signals_as_interrupts
+from sid.cpu import keep_freed_memory
 from sid.documents import InputWarning
 
 # Each module provides ``add_parser(subparsers)``; the parser it adds sets ``func(args) -> int``.
@@ -68,6 +69,7 @@ def main(argv: list[str] | None = None) -> int:
         else:
             default_show(message, category, filename, lineno, file, line)
 
+    keep_freed_memory()  # numpy's image-sized temporaries reuse heap memory instead of new mappings (sid.cpu)
     with warnings.catch_warnings(), signals_as_interrupts():
         warnings.showwarning = show
         try:

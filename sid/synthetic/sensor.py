@@ -164,6 +164,12 @@ class _Views:
     color: RayCaster | None
     floor: _Floor | None
 
+    @property
+    def registered(self) -> bool:
+        """Whether depth is cast on the colour camera's rays (registered depth): then the shaded colour render
+        carries the depth and labels too, and the scene is cast once, not twice."""
+        return self.depth is self.color
+
 
 # Flat colours (RGB) of the first people; more people cycle through them.
 PERSON_COLORS = np.array(
@@ -330,14 +336,18 @@ class SyntheticCamera:
         views = self._cameras(scene.mount, wall)
         movers = [i for i, m in enumerate(moving) if m]
         still = self._still_layer(views, pose, tuple((i, p) for i, p in enumerate(people) if not moving[i]), bodies)
-        depth = views.depth.render([bodies[i] for i in movers], labels=movers, base=still.depth)
         color_intr = self.calibration.color
+        shaded = None
         if views.color is not None:
             assert still.color is not None and still.painted is not None  # made with the colour caster
             shaded = views.color.render([bodies[i] for i in movers], shading=True, labels=movers, base=still.color)
             color = _paint(shaded, still.painted[1], still.color)
         else:
             color = np.full((color_intr.height, color_intr.width, 3), 128, dtype=np.uint8)
+        if views.registered and shaded is not None:
+            depth = shaded
+        else:
+            depth = views.depth.render([bodies[i] for i in movers], labels=movers, base=still.depth)
         to_depth, to_color = views.depth.world_to_camera, self.world_to_color(scene.mount)
         keypoints_px, visible, self_occluded, boxes = [], [], [], []
         for i, kp in enumerate(keypoints_world):
@@ -365,7 +375,8 @@ class SyntheticCamera:
             labels = [i for i, _ in still]
             chosen = [bodies[i] for i in labels]
             color = None if views.color is None else views.color.render(chosen, shading=True, labels=labels)
-            self._still = _StillLayer(key, views.depth.render(chosen, labels=labels), color)
+            depth = color if views.registered and color is not None else views.depth.render(chosen, labels=labels)
+            self._still = _StillLayer(key, depth, color)
         layer = self._still
         if layer.color is not None and (layer.painted is None or layer.painted[0] != pose):
             assert views.floor is not None  # made with the colour caster
@@ -380,11 +391,13 @@ class SyntheticCamera:
             if len(self._views) >= _MAX_CACHED_VIEWS:
                 self._views.clear()
             background = Background(ground=True, wall_distance=wall_distance)
-            depth = RayCaster(self.depth_intrinsics, self.world_to_depth(mount), background)
             color, floor = None, None
             if self.shaded_color:
                 color = RayCaster(self.calibration.color, self.world_to_color(mount), background)
                 floor = _Floor.of(color.render([], shading=True), color.background_world)
+            registered = color is not None and self.calibration.depth is None
+            depth = color if registered else RayCaster(self.depth_intrinsics, self.world_to_depth(mount), background)
+            assert depth is not None
             self._views[key] = _Views(depth, color, floor)
         return self._views[key]
 

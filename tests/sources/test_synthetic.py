@@ -20,7 +20,7 @@ from sid.synthetic.noise import DepthNoise, KeypointNoise
 from sid.synthetic.pose import TruthPose
 from sid.synthetic.render import LABEL_NONE
 from sid.synthetic.scene import Scene, ScenePerson
-from sid.synthetic.sensor import FrameTruth, SyntheticCamera
+from sid.synthetic.sensor import D435I_COLOR, FrameTruth, SyntheticCamera
 from sid.synthetic.sequence import Sequence
 from tests.conftest import REPO_ROOT
 
@@ -202,3 +202,16 @@ def test_plain_colour_option_and_exact_data() -> None:
     exact = source.camera.exact_depth(source.scene)
     np.testing.assert_array_equal(frame.depth, exact.depth)
     assert not np.any(exact.label == LABEL_NONE)  # a wall at 5 m closes the view
+
+
+def test_registered_depth_is_cast_with_the_colour_image() -> None:
+    """With registered depth the shaded colour render carries depth and labels: they equal a plain depth render."""
+    calibration = Calibration(D435I_COLOR.scaled(640, 360))
+    shaded, plain = (
+        SyntheticSource("S4", frames=1, noise=DepthNoise.exact(), calibration=calibration, shaded_color=color)
+        for color in (True, False)
+    )
+    np.testing.assert_array_equal(shaded[0].depth, plain[0].depth)
+    np.testing.assert_array_equal(
+        shaded.camera.exact_depth(shaded.scene).label, plain.camera.exact_depth(plain.scene).label
+    )
