@@ -8,7 +8,8 @@ import sys
 
 from planner.facade import PLANNERS
 from planner.problem import DEFAULT_COST_WEIGHT
-from sid.cli.common import INPUT_ERRORS, check_output_folder, fail, print_written, staged_output
+from sid.cli.common import check_output_folder, fail, print_written, staged_output
+from sid.cli.planning import INPUT_ERRORS
 from sid.experiments.compare import BY_SCENARIO, format_summary, write_comparison
 from sid.experiments.harness import prepare, run_matrix, summarise
 from sid.experiments.progress import ProgressBar

@@ -6,14 +6,8 @@ import argparse
 
 from costmap.export import export_costmap
 from costmap.mapfile import MapFileError
-from sid.cli.common import (
-    OutputFolderError,
-    add_scenario_arguments,
-    check_output_folder,
-    fail,
-    print_written,
-    staged_output,
-)
+from sid.cli.common import OutputFolderError, check_output_folder, fail, print_written, staged_output
+from sid.cli.planning import add_scenario_arguments
 from sid.scenario.build import build_costmap
 from sid.scenario.loader import ScenarioError, load_scenario
 from sid.scenario.obstacles import outline

@@ -5,16 +5,8 @@ from __future__ import annotations
 
 import argparse
 
-from sid.cli.common import (
-    INPUT_ERRORS,
-    add_planner_option,
-    add_planning_options,
-    check_output_folder,
-    fail,
-    print_written,
-    staged_output,
-    warn_goal_zone,
-)
+from sid.cli.common import check_output_folder, fail, print_written, staged_output
+from sid.cli.planning import INPUT_ERRORS, add_planner_option, add_planning_options, warn_goal_zone
 from sid.experiments.demo import DEMO_ITERATIONS, DEMO_SEED, run_demo
 from sid.experiments.plan_pictures import format_table
 from sid.scenario.loader import load_scenario

@@ -5,15 +5,12 @@ from __future__ import annotations
 import argparse
 
 from planner.facade import resolve_planner
-from sid.cli.common import (
+from sid.cli.common import check_output_folder, fail, print_written, staged_output
+from sid.cli.planning import (
     INPUT_ERRORS,
     add_planner_option,
     add_planning_options,
     add_scenario_arguments,
-    check_output_folder,
-    fail,
-    print_written,
-    staged_output,
     warn_goal_zone,
 )
 from sid.experiments.scenario_plan import plan_scenario, write_plan

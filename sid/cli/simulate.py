@@ -10,14 +10,8 @@ import sys
 import time
 from pathlib import Path
 
-from sid.cli.common import (
-    INPUT_ERRORS,
-    add_planner_option,
-    check_output_folder,
-    fail,
-    print_written,
-    staged_output,
-)
+from sid.cli.common import check_output_folder, fail, print_written, staged_output
+from sid.cli.planning import INPUT_ERRORS, add_planner_option
 from sid.experiments.progress import ProgressBar
 from sid.experiments.simulate.loop import PERCEPTIONS, RunOptions
 from sid.experiments.simulate.scenes import SCENE_ORDER, load_scene, scene_list

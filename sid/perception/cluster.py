@@ -23,7 +23,6 @@ module then agrees with the KD-tree, i.e. with exact arithmetic.
 from __future__ import annotations
 
 import numpy as np
-from sklearn.cluster import DBSCAN
 
 from sid.checks import check_number
 
@@ -50,6 +49,8 @@ def dbscan_labels(points: np.ndarray, eps: float, min_samples: int) -> np.ndarra
     if n == 0:
         return np.empty(0, dtype=np.intp)
     if n > SMALL_N_MAX:
+        from sklearn.cluster import DBSCAN  # here, not at the top: scikit-learn takes seconds to import
+
         return DBSCAN(eps=eps, min_samples=int(min_samples)).fit_predict(points).astype(np.intp)
     return _dbscan_dense(points, float(eps), int(min_samples))
 
