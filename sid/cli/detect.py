@@ -118,7 +118,7 @@ def _pose(args: argparse.Namespace) -> PoseFn:
         from sid.synthetic.pose import TruthPose
 
         return TruthPose()
-    raise SourceError("detect: a real source needs a pose model: --model FILE.onnx (see docs/models.md)")
+    raise SourceError("a real source needs a pose model: --model FILE.onnx (see docs/models.md)")
 
 
 def _source_options(args: argparse.Namespace) -> dict:

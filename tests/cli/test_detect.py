@@ -96,7 +96,8 @@ def test_detect_takes_the_group_method(method, capsys):
 
 def test_detect_needs_a_model_for_real_sources(tmp_path, capsys):
     assert main(["detect", "--source", str(tmp_path)]) == 2
-    assert "--model" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "--model" in err and err.startswith("detect: a real source") and "detect: detect:" not in err
 
 
 def test_detect_reports_a_missing_model_file(tmp_path, capsys):

@@ -31,6 +31,18 @@ def test_a_command_imports_only_its_own_module(command: str) -> None:
     assert not {f"sid.cli.{other}" for other in COMMANDS if other != command} & set(loaded)
 
 
+HEAVY = ("ompl", "sklearn", "planner", "sid.experiments.harness")
+
+
+def test_detect_starts_without_the_planners_or_scikit_learn() -> None:
+    """``sid detect`` needs neither OMPL nor the harness (planner options live in ``sid.cli.planning``), and
+    scikit-learn only past 128 people in one call (``sid.perception.cluster``): together they were most of its start-up."""
+    probe = PROBE.replace('m.startswith("sid.cli.")', f"m.split('.')[0] in {HEAVY!r} or m in {HEAVY!r}")
+    done = subprocess.run([sys.executable, "-c", probe.format(command="detect")], cwd=REPO, capture_output=True,
+                          text=True, timeout=300, check=True)  # fmt: skip
+    assert eval(done.stdout.strip().splitlines()[-1]) == []
+
+
 def test_help_and_unknown_commands_still_list_every_command(capsys: pytest.CaptureFixture[str]) -> None:
     with pytest.raises(SystemExit):
         main(["--help"])

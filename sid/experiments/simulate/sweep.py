@@ -47,7 +47,7 @@ def sweep_jobs(scenes: Sequence[str], seeds: int, options: RunOptions | None = N
     """Every scene x seeds 1..``seeds`` x without / with the social layer (other options from ``options``)."""
     options = options or RunOptions()
     if isinstance(seeds, bool) or int(seeds) != seeds or seeds < 1:
-        raise ValueError(f"simulate: --seeds must be a whole number >= 1, got {seeds}")
+        raise ValueError(f"sweep: seeds must be a whole number >= 1, got {seeds}")
     for scene in scenes:
         load_scene(scene)  # a bad scene fails here, before any run
     return [
@@ -99,7 +99,7 @@ def _on_ray(jobs: Sequence[Job], address: str, progress: Progress | None) -> lis
     try:
         import ray
     except ImportError:
-        raise ValueError("simulate: --ray needs Ray: pip install 'sid[cluster]'") from None
+        raise ValueError("sweep: running on Ray needs Ray: pip install 'sid[cluster]'") from None
     root = str(Path(__file__).resolve().parents[3])  # where the sid, costmap and planner packages live
     paths = os.pathsep.join([root, *(p for p in sys.path if p)])
     started = not ray.is_initialized()
@@ -131,7 +131,7 @@ def run_sweep(
     """Run the jobs (in this process with ``workers`` 1, in ``workers`` processes, or on the Ray cluster at
     ``ray_address``: "local" starts one on this machine, "auto" joins a running head); records in job order."""
     if workers < 1:
-        raise ValueError(f"simulate: --workers must be >= 1, got {workers}")
+        raise ValueError(f"sweep: workers must be >= 1, got {workers}")
     if ray_address is not None:
         return _on_ray(jobs, ray_address, progress)
     if workers == 1:
