@@ -36,7 +36,7 @@ HEAVY = ("ompl", "sklearn", "planner", "sid.experiments.harness")
 
 def test_detect_starts_without_the_planners_or_scikit_learn() -> None:
     """``sid detect`` needs neither OMPL nor the harness (planner options live in ``sid.cli.planning``), and
-    scikit-learn only past 128 people in one call (``sid.perception.cluster``): together they were most of its start-up."""
+    scikit-learn only past 128 people in one call (``sid.perception.cluster``): most of its start-up, before."""
     probe = PROBE.replace('m.startswith("sid.cli.")', f"m.split('.')[0] in {HEAVY!r} or m in {HEAVY!r}")
     done = subprocess.run([sys.executable, "-c", probe.format(command="detect")], cwd=REPO, capture_output=True,
                           text=True, timeout=300, check=True)  # fmt: skip
