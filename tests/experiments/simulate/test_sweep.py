@@ -30,7 +30,7 @@ def test_jobs_cover_scenes_modes_and_seeds(scene):
         (s, social, seed) for s in (scene, "pair") for social in (False, True) for seed in (1, 2)
     }
     assert all(j.options.perception == "exact" for j in jobs)
-    with pytest.raises(ValueError, match="--seeds"):
+    with pytest.raises(ValueError, match="seeds must be"):
         sweep_jobs([scene], 0)
     with pytest.raises(ValueError, match="built-in scene"):
         sweep_jobs(["nowhere"], 1)
