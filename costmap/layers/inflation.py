@@ -22,7 +22,7 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
-from costmap.grid import FREE_SPACE, INSCRIBED, LETHAL, MAX_NON_OBSTACLE, GridSpec, Window
+from costmap.grid import FREE_SPACE, INSCRIBED, LETHAL, MAX_NON_OBSTACLE, GridSpec, Window, nonzero_cells
 from costmap.layer import Layer, LayerInputs
 from sid.checks import check_number
 
@@ -87,6 +87,8 @@ class InflationLayer(Layer):
         d2 = np.arange(self.cell_radius**2 + 2)
         self._cost_by_d2 = inflation_cost(np.sqrt(d2) * spec.resolution, inscribed_radius, params.cost_scaling_factor)
         self._cost_by_d2[-1] = FREE_SPACE
+        # The same as OpenCV's 256-entry lookup table, when the reach allows one (beyond it: never indexed).
+        self._lut = np.pad(self._cost_by_d2, (0, 256 - len(self._cost_by_d2))) if len(self._cost_by_d2) <= 256 else None
         # The lethal cells ``costs`` was computed from (none yet: all FREE is right for them).
         self._lethal = np.zeros(spec.shape, dtype=bool)
 
@@ -120,19 +122,20 @@ class InflationLayer(Layer):
     def _affected(self, changed: np.ndarray, source: Window) -> list[Window]:
         """Windows (inside ``source``) holding every cell within reach of the ``changed`` cells (bool over
         ``source``): the grid is cut into tiles of ``cell_radius`` cells, the tiles holding a change and their
-        neighbours are grouped into 8-connected clusters (scipy on the small tile grid) and each cluster's bounding
-        box is one window. A tile's neighbours reach at least ``cell_radius`` cells beyond it."""
+        neighbours are grouped into 8-connected clusters (OpenCV on the small tile grid: a few times faster than
+        scipy.ndimage's dilation and labelling there) and each cluster's bounding box is one window. A tile's
+        neighbours reach at least ``cell_radius`` cells beyond it."""
         t = max(self.cell_radius, 1)
-        rows, cols = np.nonzero(changed)
-        tiles = np.zeros((changed.shape[0] // t + 3, changed.shape[1] // t + 3), dtype=bool)
-        tiles[rows // t + 1, cols // t + 1] = True  # one empty tile of margin on every side
-        eight = np.ones((3, 3), dtype=bool)
-        labels, _ = ndimage.label(ndimage.binary_dilation(tiles, structure=eight), structure=eight)
+        rows, cols = nonzero_cells(changed)
+        tiles = np.zeros((changed.shape[0] // t + 3, changed.shape[1] // t + 3), dtype=np.uint8)
+        tiles[rows // t + 1, cols // t + 1] = 1  # one empty tile of margin on every side
+        grown = cv2.dilate(tiles, np.ones((3, 3), dtype=np.uint8))
+        _, _, boxes, _ = cv2.connectedComponentsWithStats(grown, connectivity=8)
         windows = []
-        for tile_rows, tile_cols in ndimage.find_objects(labels):
+        for tile_col, tile_row, tile_cols, tile_rows, _ in boxes[1:].tolist():  # label 0: the tiles of no cluster
             # Tile i (margin included) covers rows (i - 1) * t .. i * t - 1 of ``source``.
-            row0, row1 = source.row0 + (tile_rows.start - 1) * t, source.row0 + (tile_rows.stop - 1) * t
-            col0, col1 = source.col0 + (tile_cols.start - 1) * t, source.col0 + (tile_cols.stop - 1) * t
+            row0, row1 = source.row0 + (tile_row - 1) * t, source.row0 + (tile_row + tile_rows - 1) * t
+            col0, col1 = source.col0 + (tile_col - 1) * t, source.col0 + (tile_col + tile_cols - 1) * t
             windows.append(Window(max(row0, source.row0), min(row1, source.row1), max(col0, source.col0),
                                   min(col1, source.col1)))  # fmt: skip
         return windows
@@ -145,6 +148,6 @@ class InflationLayer(Layer):
         far = len(self._cost_by_d2) - 1  # index of the "beyond reach" entry
         np.minimum(distance, np.float32(np.sqrt(far)), out=distance)  # clip first: the squares stay small
         d2 = np.rint(np.square(distance, out=distance))
-        if far < 256:  # the usual case (reach <= 15 cells): OpenCV's table lookup is faster (docs/parameters.md)
-            return cv2.LUT(d2.astype(np.uint8), np.pad(self._cost_by_d2, (0, 255 - far)))
+        if self._lut is not None:  # the usual case (reach <= 15 cells): OpenCV's lookup is faster (docs/parameters.md)
+            return cv2.LUT(d2.astype(np.uint8), self._lut)
         return self._cost_by_d2[d2.astype(np.int32)]

@@ -8,17 +8,22 @@ beam's hit. Beams with no return (``inf``) clear out to ``raytrace_max_range`` w
 
 Lines are traced with a rounded DDA over integer cells (one cell per step along the major axis: the cells of
 Bresenham's algorithm up to tie-breaking), for all beams at once in numpy rather than cell by cell (line drawing
-in OpenCV or scikit-image draws one line per call, 720 Python calls per scan).
+in OpenCV or scikit-image draws one line per call, 720 Python calls per scan). The layer keeps each beam's cells
+and, while the sensor stays in its cell, traces again only the beams whose end cell moved (``_BeamCells``).
+
+Each update reports the window of the cells whose value changed, not the window the scan covers: a scan of a scene
+that did not change (people's marks aside, which are cleared) makes the costmap recombine nothing.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from costmap.combine import CombinationMethod
-from costmap.grid import FREE_SPACE, LETHAL, NO_INFORMATION, GridSpec, Window, union
+from costmap.grid import FREE_SPACE, LETHAL, NO_INFORMATION, GridSpec, Window, changed_window, nonzero_cells, union
 from costmap.layer import Layer, LayerInputs
 from costmap.scan import LaserScan
 from sid.checks import check_number, check_numbers
@@ -54,25 +59,79 @@ class ObstacleParams:
 
 
 def trace_cells(spec: GridSpec, origin: np.ndarray, ends: np.ndarray) -> np.ndarray:
-    """Flat indices of the cells on the lines origin -> ends (world, (M, 2), finite), end cells excluded, in the grid.
-
-    float32 arithmetic, for speed (docs/parameters.md): exact enough for cell indices below 2^20; it changes only
-    which cell a tie (exactly half-way) rounds to.
-    """
-    if len(ends) == 0:
-        return np.zeros(0, dtype=np.int64)
+    """Flat indices of the cells on the lines origin -> ends (world, (M, 2), finite), end cells excluded, in the grid
+    (``_trace_lines``)."""
     c0 = spec.world_to_cell(origin)[0]
-    delta = (spec.world_to_cell(ends) - c0).astype(np.float32)  # (M, 2) as (row, col)
-    steps = np.abs(delta).max(axis=1)
-    n = int(steps.max())
-    if n == 0:
-        return np.zeros(0, dtype=np.int64)
+    delta = spec.world_to_cell(ends) - c0
+    flat, keep = _trace_lines(spec, c0, delta, _longest(delta))
+    return flat[keep]
+
+
+def _longest(delta: np.ndarray) -> int:
+    """Steps of the longest line of ``delta`` (cells, (M, 2) as (row, col)): its length along its major axis."""
+    return int(np.abs(delta).max(initial=0))
+
+
+def _trace_lines(spec: GridSpec, c0: np.ndarray, delta: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The cells of the lines from cell ``c0`` (row, col) to cells ``c0 + delta`` ((M, 2)), end cells excluded, as
+    flat indices (M, n) and whether each is on its line and in the grid (M, n); ``n``: at least the longest line.
+
+    Step k of a line of ``steps`` cells (its length along its major axis) is c0 + rint(k / steps * delta), in float32
+    for speed (docs/parameters.md): exact enough for cell indices below 2^20; it changes only which cell a tie
+    (exactly half-way) rounds to.
+    """
+    delta = delta.astype(np.float32)
+    steps = np.abs(delta).max(axis=1, initial=0)
     k = np.arange(n, dtype=np.float32)[None, :]
     frac = k / np.maximum(steps, 1)[:, None]  # (M, n)
     rows = (c0[0] + np.rint(frac * delta[:, :1])).astype(np.int32)
     cols = (c0[1] + np.rint(frac * delta[:, 1:])).astype(np.int32)
     keep = (k < steps[:, None]) & (rows >= 0) & (rows < spec.height) & (cols >= 0) & (cols < spec.width)
-    return rows[keep].astype(np.int64) * spec.width + cols[keep]
+    return rows.astype(np.int64) * spec.width + cols, keep
+
+
+_PAIRS_PER_CHUNK = 2**20
+"""``clear_discs`` tests at most this many (mark, person) pairs at once (a few MB of float64)."""
+
+
+class _BeamCells:
+    """The cells the last scan's beams crossed, kept beam by beam, so that the next scan from the same cell traces
+    only the beams whose end cell moved (a line's cells depend only on its two end cells)."""
+
+    def __init__(self, spec: GridSpec) -> None:
+        self.spec = spec
+        self.origin = np.full(2, -1)  # the sensor's cell (row, col)
+        self.delta = np.zeros((0, 2), dtype=np.int64)  # (M, 2) end cell - sensor cell, by beam
+        self.flat = np.zeros((0, 0), dtype=np.int64)  # (M, n) as ``_trace_lines``
+        self.keep = np.zeros((0, 0), dtype=bool)
+
+    def cells(self, origin: np.ndarray, ends: np.ndarray) -> np.ndarray:
+        """Flat indices of the cells on the lines origin -> ends (world, (M, 2), finite), end cells excluded, in the
+        grid: ``trace_cells``'s cells, in the same order."""
+        c0 = self.spec.world_to_cell(origin)[0]
+        delta = self.spec.world_to_cell(ends) - c0
+        if np.array_equal(c0, self.origin) and delta.shape == self.delta.shape:
+            redo = np.flatnonzero((delta != self.delta).any(axis=1))
+        else:
+            redo = np.arange(len(delta))
+            self.flat = np.zeros((len(delta), 0), dtype=np.int64)
+            self.keep = np.zeros((len(delta), 0), dtype=bool)
+        n = _longest(delta[redo])
+        if n > self.flat.shape[1]:  # longer lines than any kept: widen (the new steps are off every line)
+            grow = ((0, 0), (0, n - self.flat.shape[1]))
+            self.flat, self.keep = np.pad(self.flat, grow), np.pad(self.keep, grow)
+        self.flat[redo], self.keep[redo] = _trace_lines(self.spec, c0, delta[redo], self.flat.shape[1])
+        self.origin, self.delta = c0, delta
+        return self.flat[self.keep]
+
+
+class _ScanMarks(NamedTuple):
+    """What one scan writes: the cells its beams clear (flat indices), the cells its hits mark LETHAL ((K, 2) as
+    (row, col)), and a window holding both."""
+
+    cleared: np.ndarray
+    hits: np.ndarray
+    window: Window
 
 
 class ObstacleLayer(Layer):
@@ -93,17 +152,37 @@ class ObstacleLayer(Layer):
         self.params = params or ObstacleParams()
         super().__init__(spec, self.params.default_value)
         self.people_clear_radius = float(people_clear_radius)
+        self._beams = _BeamCells(spec)
 
     def update(self, inputs: LayerInputs, changed: Window | None) -> Window | None:
-        """Apply the scan (if any), then clear the people's marks."""
-        scanned = None if inputs.scan is None else self.apply_scan(inputs.scan)
-        if self.people_clear_radius == 0:
-            return scanned
-        people = np.array([(p.x, p.y) for p in inputs.people], dtype=float)
-        return union(scanned, self.clear_discs(people, self.people_clear_radius))
+        """Apply the scan (if any), then clear the people's marks; returns the window of the cells whose value
+        changed (a new scan of an unchanged scene changes none: the costmap recombines nothing for it)."""
+        scan = None if inputs.scan is None else self._scan_marks(inputs.scan)
+        people = [(p.x, p.y) for p in inputs.people] if self.people_clear_radius > 0 else []
+        return self._apply(scan, np.array(people, dtype=float).reshape(-1, 2))
 
     def apply_scan(self, scan: LaserScan) -> Window | None:
-        """Clear along every beam, then mark every hit (Nav2's raytraceFreespace + marking); returns the window."""
+        """Clear along every beam, then mark every hit (Nav2's raytraceFreespace + marking); returns the window of
+        the cells whose value changed."""
+        return self._apply(self._scan_marks(scan), np.zeros((0, 2)))
+
+    def _apply(self, scan: _ScanMarks | None, people: np.ndarray) -> Window | None:
+        """Write a scan's marks (if any), then clear the marks within ``people_clear_radius`` of the people (world,
+        (N, 2)); returns the window of the cells whose value changed (compared with a copy of the cells written)."""
+        discs = self._discs_window(people, self.people_clear_radius)
+        touched = union(None if scan is None else scan.window, discs)
+        if touched is None:
+            return None
+        before = self.costs[touched.slices].copy()
+        if scan is not None:
+            self.costs.ravel()[scan.cleared] = FREE_SPACE
+            self.costs[scan.hits[:, 0], scan.hits[:, 1]] = LETHAL
+        if discs is not None:
+            self.clear_discs(people, self.people_clear_radius)
+        return changed_window(before, self.costs[touched.slices], touched)
+
+    def _scan_marks(self, scan: LaserScan) -> _ScanMarks:
+        """What a scan writes (nothing written yet)."""
         p = self.params
         origin = np.asarray(scan.pose[:2])
         if not self.spec.contains(origin[None])[0]:
@@ -114,28 +193,35 @@ class ObstacleLayer(Layer):
         clearing = np.isfinite(clear_to)
         clear_len = np.minimum(clear_to[clearing], p.raytrace_max_range)
         ends = origin + dirs[clearing] * clear_len[:, None]
-        self.costs.ravel()[trace_cells(self.spec, origin, ends)] = FREE_SPACE
-
         with np.errstate(invalid="ignore"):
             marking = np.isfinite(r) & (r >= p.obstacle_min_range) & (r <= p.obstacle_max_range)
         hit_xy = origin + dirs[marking] * r[marking, None]
         hits = self.spec.world_to_cell(hit_xy)
-        hits = hits[self.spec.in_bounds(hits)]
-        self.costs[hits[:, 0], hits[:, 1]] = LETHAL
-        return self.spec.window_around(np.vstack([origin[None], ends, hit_xy]))
+        window = self.spec.window_around(np.vstack([origin[None], ends, hit_xy]))
+        assert window is not None  # it holds the sensor, which is inside the grid
+        return _ScanMarks(self._beams.cells(origin, ends), hits[self.spec.in_bounds(hits)], window)
 
-    def clear_discs(self, centres: np.ndarray, radius: float) -> Window | None:
-        """Turn LETHAL marks whose cell centre lies within ``radius`` metres of any centre (N, 2) into FREE; returns
-        the window of the discs."""
+    def clear_discs(self, centres: np.ndarray, radius: float) -> None:
+        """Turn LETHAL marks whose cell centre lies within ``radius`` metres of any centre (N, 2) into FREE.
+
+        Only the marks are tested (against every centre at once): there are few, and discs are many small windows.
+        """
         centres = np.asarray(centres, dtype=float).reshape(-1, 2)
-        cleared = None
-        for cx, cy in centres:
-            window = self.spec.window((cx - radius, cy - radius), (cx + radius, cy + radius))
-            if window is None:
-                continue
-            xs, ys = self.spec.cell_axes(window)
-            view = self.costs[window.slices]
-            inside = ((xs - cx) ** 2 + (ys - cy) ** 2 <= radius**2) & (view == LETHAL)
-            view[inside] = FREE_SPACE
-            cleared = window.union(cleared)
-        return cleared
+        window = self._discs_window(centres, radius)
+        if window is None:
+            return
+        view = self.costs[window.slices]
+        rows, cols = nonzero_cells(view == LETHAL)
+        xs, ys = self.spec.cell_axes(window)
+        chunk = max(1, _PAIRS_PER_CHUNK // len(centres))  # (marks, centres) pairs at a time: memory stays bounded
+        for start in range(0, len(rows), chunk):
+            r, c = rows[start : start + chunk], cols[start : start + chunk]
+            dx, dy = xs[0, c, None] - centres[:, 0], ys[r, 0, None] - centres[:, 1]  # (marks, centres)
+            inside = (dx**2 + dy**2 <= radius**2).any(axis=1)
+            view[r[inside], c[inside]] = FREE_SPACE
+
+    def _discs_window(self, centres: np.ndarray, radius: float) -> Window | None:
+        """The cells of the bounding box of discs of ``radius`` metres around world centres (N, 2); None: none."""
+        if len(centres) == 0:
+            return None
+        return self.spec.window(tuple(centres.min(axis=0) - radius), tuple(centres.max(axis=0) + radius))

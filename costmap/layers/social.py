@@ -22,8 +22,11 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from functools import lru_cache
+from typing import cast
 
 import numpy as np
+import shapely
 from shapely.geometry import MultiPoint, Polygon
 from shapely.geometry.base import BaseGeometry
 
@@ -56,6 +59,7 @@ class SocialParams:
         check_numbers("social", self, ("group_margin", "people_clear_margin"), low=0, unit="metres")
 
 
+@lru_cache(maxsize=64)
 def _reach(amplitude: float, sigma: float) -> float:
     """Distance (m) at which amplitude * exp(-d^2 / 2 sigma^2) drops below 1 (the smallest non-zero cost)."""
     return sigma * float(np.sqrt(2 * np.log(amplitude))) if amplitude > 1 else 0.0
@@ -71,12 +75,11 @@ def zone_hull(group: Group, people: Sequence[Person] | Mapping[int, Person]) -> 
     missing = [m for m in group.members if m not in by_id]
     if missing:
         raise ValueError(f"group {group.members}: members {missing} are not among the people given")
-    points = [(by_id[m].x, by_id[m].y) for m in group.members]
-    zone = np.asarray(group.zone, dtype=float).reshape(-1, 2)
-    points += [tuple(v) for v in zone]
-    if not np.isfinite(np.asarray(points)).all():
+    members = np.array([(by_id[m].x, by_id[m].y) for m in group.members], dtype=float).reshape(-1, 2)
+    points = np.vstack([members, np.asarray(group.zone, dtype=float).reshape(-1, 2)])
+    if not np.isfinite(points).all():
         raise ValueError(f"group {group.members}: non-finite member position or zone vertex")
-    return MultiPoint(points).convex_hull
+    return cast(MultiPoint, shapely.multipoints(points)).convex_hull  # from the array: no point object per vertex
 
 
 def group_zone_polygon(
@@ -107,44 +110,55 @@ def _hull_ring(hull: BaseGeometry) -> tuple[np.ndarray, bool]:
 
 
 def _distance_to_hull(xs: np.ndarray, ys: np.ndarray, ring: np.ndarray, polygon: bool) -> np.ndarray:
-    """Exact distance (m) from points (xs, ys broadcast together) to a convex hull (0 inside).
+    """Exact distance (m) from points (xs (1, cols) and ys (rows, 1), broadcast together) to a convex hull (0 inside).
 
     ring, polygon: ``_hull_ring``'s vertices (a point, a polyline, or a closed counter-clockwise ring) and whether
     they bound a polygon.
 
     Written out in numpy rather than ``shapely.distance``, which needs a point object per cell, and one pass per
-    edge (keeping the running minimum) rather than all edges at once: both are faster (docs/parameters.md).
+    edge (keeping the running minimum) rather than all edges at once: both are faster (docs/parameters.md). The
+    per-edge arithmetic runs in preallocated buffers.
     """
     if len(ring) == 1:
         return np.hypot(xs - ring[0, 0], ys - ring[0, 1])
     shape = np.broadcast_shapes(np.shape(xs), np.shape(ys))
-    best = np.full(shape, np.inf, dtype=np.result_type(xs, ys))
-    inside = np.ones(shape, dtype=bool)
+    dtype = np.result_type(xs, ys)
+    best = np.full(shape, np.inf, dtype=dtype)
+    t, ox, oy = (np.empty(shape, dtype=dtype) for _ in range(3))
+    inside, side = np.ones(shape, dtype=bool), np.empty(shape, dtype=bool)
     # Python floats keep the arithmetic in the offsets' dtype (float32 from ``_local_axes``; numpy float64 scalars
     # would promote it): within 1 cost unit of float64, at 1-2 of 640,000 cells (docs/benchmarks.md).
     for (ax, ay), (bx, by) in zip(ring[:-1].tolist(), ring[1:].tolist(), strict=True):
         ex, ey = bx - ax, by - ay
         dx, dy = xs - ax, ys - ay
-        if polygon:
-            inside &= ex * dy - ey * dx >= 0  # on the inner side of this counter-clockwise edge
-        t = np.clip((dx * ex + dy * ey) / max(ex * ex + ey * ey, 1e-18), 0.0, 1.0)
-        np.minimum(best, (dx - t * ex) ** 2 + (dy - t * ey) ** 2, out=best)
-    distance = np.sqrt(best)
+        if polygon:  # on the inner side of this counter-clockwise edge: ex * dy - ey * dx >= 0 (comparing the two
+            inside &= np.greater_equal(ex * dy, ey * dx, out=side)  # products is that test, without the subtraction)
+        np.add(dx * ex, dy * ey, out=t)
+        t /= max(ex * ex + ey * ey, 1e-18)
+        np.clip(t, 0.0, 1.0, out=t)
+        np.subtract(dx, np.multiply(t, ex, out=ox), out=ox)
+        np.subtract(dy, np.multiply(t, ey, out=oy), out=oy)
+        ox *= ox
+        oy *= oy
+        ox += oy
+        np.minimum(best, ox, out=best)
+    distance = np.sqrt(best, out=best)
     if polygon:
         distance[inside] = 0.0
     return distance
 
 
-def _person_box(person: Person, params: SocialParams) -> tuple[tuple[float, float], tuple[float, float]]:
-    """World bounding box of the cells where the person's personal-space cost is at least 1."""
+def _person_box(
+    person: Person, params: SocialParams, sigma_front: float
+) -> tuple[tuple[float, float], tuple[float, float]]:
+    """World bounding box of the cells where the person's personal-space cost is at least 1 (``sigma_front``, m:
+    the spread ahead)."""
     if person.theta is None:
         r = _reach(params.amplitude, params.sigma_unknown)
         return (person.x - r, person.y - r), (person.x + r, person.y + r)
-    front, rear, side = (
-        _reach(params.amplitude, s) for s in (params.sigma_front, params.sigma_rear, params.sigma_side)
-    )
-    c, s = np.cos(person.theta), np.sin(person.theta)
-    # The rectangle's corners (u along the facing, v sideways), in scalars: a person's box is per-frame overhead.
+    front, rear, side = (_reach(params.amplitude, s) for s in (sigma_front, params.sigma_rear, params.sigma_side))
+    c, s = float(np.cos(person.theta)), float(np.sin(person.theta))
+    # The rectangle's corners (u along the facing, v sideways), in Python floats: a person's box is per-frame overhead.
     corners = [(u, v) for u in (front, -rear) for v in (side, -side)]
     xs = [person.x + c * u - s * v for u, v in corners]
     ys = [person.y + s * u + c * v for u, v in corners]
@@ -158,30 +172,40 @@ def _local_axes(spec: GridSpec, window: Window, x: float, y: float) -> tuple[np.
     return (xs - x).astype(np.float32), (ys - y).astype(np.float32)
 
 
-def paint_person(costs: np.ndarray, spec: GridSpec, person: Person, params: SocialParams) -> Window | None:
-    """Max the person's personal-space Gaussian into ``costs`` (in place; only the cells it reaches); returns them."""
-    window = spec.window(*_person_box(person, params))
+def paint_person(
+    costs: np.ndarray, spec: GridSpec, person: Person, params: SocialParams, sigma_front: float | None = None
+) -> Window | None:
+    """Max the person's personal-space Gaussian into ``costs`` (in place; only the cells it reaches); returns them.
+
+    ``sigma_front`` (m) replaces ``params.sigma_front`` (the tracked-people layer stretches walkers ahead). The
+    exponent is built with negative coefficients (-u^2 / 2 su^2 - v^2 / 2 sv^2): the same float32 numbers as negating
+    it afterwards, one pass fewer."""
+    front = params.sigma_front if sigma_front is None else sigma_front
+    window = spec.window(*_person_box(person, params, front))
     if window is None:
         return None
     dx, dy = _local_axes(spec, window, person.x, person.y)
     if person.theta is None:
         exponent = dx * dx + dy * dy
-        exponent *= np.float32(0.5 / params.sigma_unknown**2)
+        exponent *= np.float32(-0.5 / params.sigma_unknown**2)
     else:
         c, s = np.float32(np.cos(person.theta)), np.float32(np.sin(person.theta))
         u, v = c * dx + s * dy, c * dy - s * dx
-        ku = np.where(u >= 0, np.float32(0.5 / params.sigma_front**2), np.float32(0.5 / params.sigma_rear**2))
-        exponent = np.multiply(u, u, out=u)  # in place from here on: u^2 ku + v^2 / (2 sigma_side^2)
+        ku = np.where(u >= 0, np.float32(-0.5 / front**2), np.float32(-0.5 / params.sigma_rear**2))
+        exponent = np.multiply(u, u, out=u)  # in place from here on: -u^2 ku - v^2 / (2 sigma_side^2)
         exponent *= ku
         v *= v
-        v *= np.float32(0.5 / params.sigma_side**2)
+        v *= np.float32(-0.5 / params.sigma_side**2)
         exponent += v
-    np.negative(exponent, out=exponent)
     cost = np.exp(exponent, out=exponent)
     cost *= np.float32(params.amplitude)
-    view = costs[window.slices]
-    np.maximum(view, cost.astype(np.uint8), out=view)  # truncation = floor here
+    _max_into(costs[window.slices], cost)
     return window
+
+
+def _max_into(view: np.ndarray, cost: np.ndarray) -> None:
+    """view = max(view, cost) in place, for a uint8 ``view`` and float costs in [0, 253) (truncated: floor)."""
+    np.maximum(view, cost.astype(np.uint8), out=view)
 
 
 def paint_group(costs: np.ndarray, spec: GridSpec, hull: BaseGeometry, params: SocialParams) -> Window | None:
@@ -201,10 +225,14 @@ def paint_group(costs: np.ndarray, spec: GridSpec, hull: BaseGeometry, params: S
     dx, dy = _local_axes(spec, window, ox, oy)
     ring, polygon = _hull_ring(hull)
     ring = ring - (ox, oy)  # as the cell offsets: relative to the hull's centre
-    outside = np.maximum(_distance_to_hull(dx, dy, ring, polygon) - np.float32(params.group_margin + 1e-6), 0)
-    falloff = np.exp(-(outside * outside) * np.float32(0.5 / params.group_sigma**2))
-    view = costs[window.slices]
-    np.maximum(view, (np.float32(params.group_cost) * falloff).astype(np.uint8), out=view)
+    outside = _distance_to_hull(dx, dy, ring, polygon)
+    outside -= np.float32(params.group_margin + 1e-6)
+    np.maximum(outside, 0, out=outside)
+    outside *= outside  # then the exponent, with a negative coefficient (as ``paint_person``)
+    outside *= np.float32(-0.5 / params.group_sigma**2)
+    falloff = np.exp(outside, out=outside)
+    falloff *= np.float32(params.group_cost)
+    _max_into(costs[window.slices], falloff)
     return window
 
 

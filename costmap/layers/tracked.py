@@ -17,7 +17,7 @@ Costs never exceed 252 except the bodies (254), as in the social layer; combined
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 from costmap.combine import CombinationMethod
 from costmap.grid import FREE_SPACE, GridSpec, Window, union
@@ -64,12 +64,11 @@ class TrackedPeopleLayer(Layer):
         social = self.params.social
         painted = [paint_group(self.costs, self.spec, hull, social) for hull in hulls]
         for track in () if tracks is None else tracks.people:
-            person = by_id[track.id]
-            params = social
+            person, front = by_id[track.id], social.sigma_front
             if track.walking:
                 person.theta = math.atan2(track.vy, track.vx)
-                params = replace(social, sigma_front=social.sigma_front + self.params.lookahead * track.speed)
-            painted.append(paint_person(self.costs, self.spec, person, params))
+                front += self.params.lookahead * track.speed
+            painted.append(paint_person(self.costs, self.spec, person, social, front))
         painted += [paint_body(self.costs, self.spec, person, self.body_radius) for person in people]
         self._painted = union(*painted)
         return union(previous, self._painted)

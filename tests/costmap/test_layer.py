@@ -72,6 +72,7 @@ def test_windows_union_grow_and_clip():
     assert Window(-5, 2, 190, 300).clipped(SPEC) == Window(0, 2, 190, 200)
     assert Window(-5, 0, 0, 3).clipped(SPEC) is None
     assert SPEC.window((20.0, 0.0), (21.0, 1.0)) is None
+    assert SPEC.window((np.nan, 0.0), (1.0, 1.0)) is None and SPEC.window((0.0, 0.0), (np.inf, 1.0)) is None
     assert SPEC.window_around([[0.0, 0.0], [-0.96, 0.07]]) == Window(80, 82, 0, 21)
     assert SPEC.window_around(np.zeros((0, 2))) is None
     costs = np.zeros(SPEC.shape)
@@ -245,9 +246,11 @@ def test_the_lidar_layer_clears_people_marks_by_its_own_parameter():
         window = layer.update(LayerInputs(people, (), scan), None)
         assert ((layer.costs[near.slices] == LETHAL).any()) == marks
         assert (layer.costs == LETHAL).any() and window is not None
-        assert layer.update(LayerInputs(people), None) == (
-            None if radius == 0 else SPEC.window((3.7, -0.3), (4.3, 0.3))
-        )
+        assert layer.update(LayerInputs(people), None) is None  # no scan and nothing left to clear: no change
+        mark = SPEC.window((4.1, 0.05), (4.1, 0.05))
+        assert mark is not None
+        layer.costs[mark.slices] = LETHAL  # within 0.3 m of the person: theirs when the layer clears people's marks
+        assert layer.update(LayerInputs(people), None) == (None if radius == 0 else mark)  # the window of what changed
     with pytest.raises(ValueError, match="people_clear_radius"):
         ObstacleLayer(SPEC, people_clear_radius=-1.0)
 

@@ -216,6 +216,33 @@ def test_lidar_layer_respects_obstacle_and_raytrace_ranges():
     assert (row[10:69] == FREE_SPACE).all() and (row[75:] == NO_INFORMATION).all()
 
 
+def test_lidar_layer_retraces_only_moved_beams_and_gives_the_cells_of_a_fresh_trace():
+    from costmap.layers.obstacle import trace_cells
+
+    rng = np.random.default_rng(3)
+    layer = ObstacleLayer(SPEC)
+    origin = np.array([4.0, 0.0])
+    ends = origin + rng.normal(0.0, 4.0, (360, 2))
+    for _ in range(6):  # some beams move their end cell, one scan gets longer, then the sensor moves
+        ends[rng.random(len(ends)) < 0.2] += rng.normal(0.0, 0.3, 2)
+        np.testing.assert_array_equal(layer._beams.cells(origin, ends), trace_cells(SPEC, origin, ends))
+        ends[0] = origin + (20.0, 0.5)
+        origin = origin + (0.01, 0.0)
+
+
+def test_lidar_layer_reports_only_what_changed():
+    people = [Person(1, 4.0, 0.0, np.pi)]
+    layer = ObstacleLayer(SPEC, people_clear_radius=0.3)
+    scan = simulate_scan((0.0, 0.0, 0.0), [SegmentObstacle(((-1.0, 2.5), (9.0, 2.5)))], people, beams=720)
+    assert layer.update(LayerInputs(people, (), scan), None) is not None
+    assert layer.update(LayerInputs(people, (), scan), None) is None  # the same scene again: nothing changed
+    moved = [Person(1, 4.0, -1.0, np.pi)]
+    window = layer.update(LayerInputs(moved, (), simulate_scan((0.0, 0.0, 0.0), [], moved, beams=720)), None)
+    assert window is not None  # the wall is gone: its marks were cleared, only there
+    assert window.row0 <= SPEC.world_to_cell([[0.0, 2.5]])[0, 0] < window.row1
+    assert window.row0 >= SPEC.world_to_cell([[0.0, 2.0]])[0, 0]
+
+
 def test_lidar_layer_rejects_a_sensor_outside_the_map():
     layer = ObstacleLayer(SPEC)
     with pytest.raises(ValueError, match="outside the costmap"):
