@@ -36,7 +36,9 @@ Choices the paper leaves open, decided here:
 
 from __future__ import annotations
 
+import itertools
 import math
+import operator
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from functools import cached_property, lru_cache
@@ -54,6 +56,8 @@ _PARALLEL = 1e-9
 _TIE = 1e-9
 # Hull area (m^2) below which the polygon of crossings is treated as degenerate (a point or a segment).
 _DEGENERATE_AREA = 1e-9
+# Sort key of a point x + iy: (x, y).
+_BY_X_THEN_Y = operator.attrgetter("real", "imag")
 
 
 GROUP_METHODS = ("ospace", "rays", "paper")
@@ -225,30 +229,34 @@ def _ospace_groups(
     people: list[Person], ids: list[int], positions: np.ndarray, facing: np.ndarray, params: GroupParams
 ) -> list[Group]:
     """The o-space method's groups, each with the paper's zone geometry on its members' rays (see the module
-    docstring)."""
-    quality = np.clip([p.orientation_quality for p in people], 0.0, 1.0)
+    docstring). Per group the work is on Python numbers: a group has a handful of members."""
     floor = params.facing_weight_floor
-    found = find_ospaces(positions, facing, floor + (1.0 - floor) * quality, params.ospace_model)
-    label = np.full(len(people), -1)
-    for k, ospace in enumerate(found):
-        label[ospace.members] = k
+    weight = np.array([floor + (1.0 - floor) * min(max(p.orientation_quality, 0.0), 1.0) for p in people])
+    found = find_ospaces(positions, facing, weight, params.ospace_model)
+    members = [ospace.members.tolist() for ospace in found]
     # The rays of every two members of one group, computed in one call for all groups.
-    i, j = _pairs(len(people))
-    same = (label[i] == label[j]) & (label[i] >= 0)
-    meetings = _ray_meetings(positions, facing, params, (i[same], j[same]))
-    meeting_group = label[meetings.first]
+    pairs = [pair for group in members for pair in itertools.combinations(group, 2)]
+    first, second = np.array(pairs, dtype=int).reshape(-1, 2).T
+    meetings = _ray_meetings(positions, facing, params, (first, second))
+    label = [-1] * len(people)
+    for k, group in enumerate(members):
+        for i in group:
+            label[i] = k
+    crossings: list[list[complex]] = [[] for _ in found]
+    for i, point in zip(meetings.first.tolist(), meetings.points.tolist(), strict=True):
+        crossings[label[i]].append(point)
+    points = positions.tolist()
     groups = []
-    for k, ospace in enumerate(found):
-        members = ospace.members
-        crossings = meetings.points[meeting_group == k]
-        if len(crossings):
-            geometry = _zone(crossings, positions[members])
+    for ospace, group, meeting in zip(found, members, crossings, strict=True):
+        member_positions = [points[i] for i in group]
+        if meeting:
+            geometry = _zone(meeting, member_positions)
         else:  # no two members' rays meet: the fitted o-space centre
-            spread = float(np.abs(positions[members] - ospace.centre).mean())
-            geometry = _Geometry(0.0, ospace.centre, np.array([[ospace.centre.real, ospace.centre.imag]]), spread)
+            centre = ospace.centre
+            geometry = _Geometry(0.0, centre, np.array([[centre.real, centre.imag]]), _spread(member_positions, centre))
         groups.append(
             Group(
-                members=tuple(ids[i] for i in members),
+                members=tuple(ids[i] for i in group),
                 interest_point=(geometry.centre.real, geometry.centre.imag),
                 area=geometry.area,
                 zone=geometry.zone,
@@ -264,17 +272,19 @@ def _as_arrays(people: list[Person]) -> tuple[list[int], np.ndarray, np.ndarray]
     if len(set(ids)) != len(ids):
         duplicates = sorted({i for i in ids if ids.count(i) > 1})
         raise ValueError(f"groups: person ids must be unique, repeated: {duplicates}")
-    positions = np.empty(len(people), dtype=complex)
-    facing = np.full(len(people), np.nan, dtype=complex)
-    for k, person in enumerate(people):
+    positions = []
+    facing = []
+    for person in people:
         if not (math.isfinite(person.x) and math.isfinite(person.y)):
             raise ValueError(f"groups: person {person.id} has a non-finite position ({person.x}, {person.y})")
-        positions[k] = complex(person.x, person.y)
-        if person.theta is not None:
-            if not math.isfinite(person.theta):
-                raise ValueError(f"groups: person {person.id} has a non-finite theta {person.theta} (use None)")
-            facing[k] = complex(math.cos(person.theta), math.sin(person.theta))
-    return ids, positions, facing
+        positions.append(complex(person.x, person.y))
+        if person.theta is None:
+            facing.append(complex(math.nan, math.nan))
+        elif not math.isfinite(person.theta):
+            raise ValueError(f"groups: person {person.id} has a non-finite theta {person.theta} (use None)")
+        else:
+            facing.append(complex(math.cos(person.theta), math.sin(person.theta)))
+    return ids, np.array(positions, dtype=complex), np.array(facing, dtype=complex)
 
 
 @dataclass(frozen=True)
@@ -374,21 +384,26 @@ def _with_meetings(members: np.ndarray, meetings: _Meetings) -> np.ndarray:
 
 def _geometry(members: np.ndarray, meetings: _Meetings, positions: np.ndarray) -> _Geometry:
     """The zone of the crossings between ``members`` (bool mask)."""
-    return _zone(meetings.points[_active(members, meetings)], positions[members])
+    return _zone(meetings.points[_active(members, meetings)].tolist(), positions[members].tolist())
 
 
-def _zone(crossings: np.ndarray, member_positions: np.ndarray) -> _Geometry:
-    """Hull area, centre, zone polygon of ``crossings`` (complex, at least one) and the members' spread around it."""
-    hull = _convex_hull(crossings.tolist()) if len(crossings) >= 3 else []
+def _zone(crossings: list[complex], member_positions: list[complex]) -> _Geometry:
+    """Hull area, centre, zone polygon of ``crossings`` (at least one) and the members' spread around it (complex
+    x + iy, m)."""
+    hull = _convex_hull(crossings) if len(crossings) >= 3 else []
     area, centre = _shoelace(hull) if len(hull) >= 3 else (0.0, 0j)
     if area > _DEGENERATE_AREA:
         zone = np.array([(p.real, p.imag) for p in hull])
     else:
         area = 0.0
-        centre = complex(crossings.sum() / len(crossings))
-        zone = _segment_ends(crossings, centre)
-    spread = float(np.abs(member_positions - centre).sum() / len(member_positions))
-    return _Geometry(area, centre, zone, spread)
+        centre, zone = _degenerate_zone(crossings)
+    return _Geometry(area, centre, zone, _spread(member_positions, centre))
+
+
+def _spread(member_positions: list[complex], centre: complex) -> float:
+    """D (m): the mean distance of the members to ``centre``. In numpy, although the members are few: its complex
+    absolute value and sum round differently from Python's, and the ray methods' pruning compares these values."""
+    return float(np.abs(np.array(member_positions) - centre).sum() / len(member_positions))
 
 
 def _convex_hull(points: list[complex]) -> list[complex]:
@@ -397,7 +412,7 @@ def _convex_hull(points: list[complex]) -> list[complex]:
     Hand-written rather than shapely's: the pruning loop builds several hulls of a handful of points per call, where
     a shapely round trip costs several times more (docs/parameters.md).
     """
-    ordered = sorted(set(points), key=lambda p: (p.real, p.imag))
+    ordered = sorted(set(points), key=_BY_X_THEN_Y)
     if len(ordered) < 3:
         return ordered
 
@@ -431,16 +446,21 @@ def _shoelace(polygon: list[complex]) -> tuple[float, complex]:
     return 0.5 * twice_area, origin + moment / (3.0 * twice_area)
 
 
-def _segment_ends(crossings: np.ndarray, centre: complex) -> np.ndarray:
-    """(K, 2) zone of a degenerate hull: the centre when the crossings coincide, else the two extreme crossings."""
-    offsets = crossings - centre
+def _degenerate_zone(crossings: list[complex]) -> tuple[complex, np.ndarray]:
+    """Centre (the mean) and (K, 2) zone of crossings whose hull has no area: the centre when the crossings
+    coincide, else the two extreme crossings."""
+    if len(crossings) == 1:
+        return crossings[0], np.array([[crossings[0].real, crossings[0].imag]])
+    points = np.array(crossings)
+    centre = complex(points.sum() / len(points))
+    offsets = points - centre
     far = offsets[int(np.argmax(np.abs(offsets)))]
     if abs(far) < 1e-6:
         ends = np.array([centre])
     else:
         along = (offsets * far.conjugate()).real
-        ends = crossings[[int(np.argmin(along)), int(np.argmax(along))]]
-    return np.column_stack((ends.real, ends.imag))
+        ends = points[[int(np.argmin(along)), int(np.argmax(along))]]
+    return centre, np.column_stack((ends.real, ends.imag))
 
 
 def _prune(

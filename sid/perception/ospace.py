@@ -25,13 +25,16 @@ The first candidates are every known-facing person's proposals at several radii 
 later rounds use the refitted groups plus the first proposals of whoever is still alone. Only people with a known
 facing open an o-space and a group needs two of them; people with unknown facing may then join one.
 
-Arrays are candidate-major: row k lists the people within reach of candidate k's centre (all of them in a small
-scene, a KD-tree's answer in a crowd), so the work grows with the number of people near each candidate, not with
-N^2. Nothing depends on the input order except the breaking of exact ties (lowest index first).
+Two implementations of the same arithmetic, cross-checked by the tests: a crowd runs on numpy arrays,
+candidate-major (row k lists the people within reach of candidate k's centre, a KD-tree's answer), so the work grows
+with the number of people near each candidate, not with N^2; a small scene runs on Python numbers, where numpy's
+overhead per call would outweigh the work. Nothing depends on the input order except the breaking of exact ties
+(lowest index first).
 """
 
 from __future__ import annotations
 
+import cmath
 import math
 from dataclasses import dataclass
 from functools import cached_property
@@ -43,10 +46,10 @@ from sid.checks import check_number
 
 # Greedy assignment and refit rounds at most; the partition is stable after 2-4 on the benchmarks.
 _MAX_ROUNDS = 8
-# Up to this many people every person is listed for every candidate (a few numpy calls); above it a KD-tree finds
-# who is within reach: its set-up costs more than listing everyone in a small scene, but the exclusivity test grows
-# with the square of the people listed per candidate.
-_DENSE_PEOPLE_MAX = 12
+# Up to this many people the search runs on Python numbers (``_find_small``): a handful of people make a few dozen
+# candidates, and numpy's overhead per call outweighs the arithmetic. Above it, numpy arrays and a KD-tree finding
+# who is within reach of each candidate (the exclusivity test grows with the square of the people listed).
+_SMALL_PEOPLE_MAX = 16
 
 
 @dataclass(frozen=True)
@@ -75,6 +78,11 @@ class OSpaceModel:
         ``radius_max``."""
         return np.linspace(self.radius_min, self.radius_max, int(self.radius_steps))
 
+    @cached_property
+    def reach(self) -> float:
+        """Distance (m) from a centre beyond which nobody can join it: every cost term is at least (|p - c| - R)^2."""
+        return self.radius_max + math.sqrt(self.price)
+
 
 @dataclass(frozen=True)
 class OSpace:
@@ -88,6 +96,13 @@ class OSpace:
 def find_ospaces(positions: np.ndarray, facing: np.ndarray, weight: np.ndarray, model: OSpaceModel) -> list[OSpace]:
     """Groups of two or more among people at ``positions`` (complex x + iy, m) with unit ``facing`` (complex, NaN
     when unknown) and facing weights in (0, 1]; ordered by their lowest member index."""
+    if len(positions) <= _SMALL_PEOPLE_MAX:
+        return _find_small(positions.tolist(), facing.tolist(), weight.tolist(), model)
+    return _find_crowd(positions, facing, weight, model)
+
+
+def _find_crowd(positions: np.ndarray, facing: np.ndarray, weight: np.ndarray, model: OSpaceModel) -> list[OSpace]:
+    """``find_ospaces`` on numpy arrays, candidate-major, with a KD-tree listing the people within reach."""
     known = ~np.isnan(facing)
     owners = np.flatnonzero(known)
     if len(owners) < 2:
@@ -102,22 +117,15 @@ def find_ospaces(positions: np.ndarray, facing: np.ndarray, weight: np.ndarray, 
     table = np.array((positions.real, positions.imag, f.real, f.imag, w))
     moments = np.array((*table[:4], table[0] * table[2] + table[1] * table[3], np.ones(len(w)))) * w
     known_list = known.tolist()
-    # Every cost term is at least (|p - c| - R)^2, so nobody farther than this from a centre can join it.
-    reach = model.radius_max + math.sqrt(model.price)
-    tree = cKDTree(table[:2].T) if len(positions) > _DENSE_PEOPLE_MAX else None
-    if tree is None:  # everyone is listed for every candidate, in input order: one row broadcasts
-        values = table[:, None, :]
-        offsets = _offsets(values[0], values[1])
+    tree = cKDTree(table[:2].T)
     centres, rad = first_centres, first_radii
     labels: list[int] = []
     for _ in range(_MAX_ROUNDS):
-        near = _near(positions, tree, centres, reach)
-        if tree is not None:
-            values = table[:, near]
-            offsets = _offsets(values[0], values[1])
-        cost = _costs(values, offsets, centres, rad, near >= 0, model)
+        near = _near(tree, centres, model.reach)
+        values = table[:, near]
+        cost = _costs(values, centres, rad, near >= 0, model)
         previous = labels
-        labels, behind = _canonical(_assign(cost, near, known, model.price), known_list)
+        labels, behind = _canonical(_assign(cost, near, known, model.price).tolist(), known_list)
         label_array = np.array(labels)
         fitted_centres, fitted_radii = _refit(label_array, moments, rad[behind], model)
         if labels == previous:
@@ -136,12 +144,9 @@ def find_ospaces(positions: np.ndarray, facing: np.ndarray, weight: np.ndarray, 
     ]
 
 
-def _near(positions: np.ndarray, tree: cKDTree | None, centres: np.ndarray, reach: float) -> np.ndarray:
+def _near(tree: cKDTree, centres: np.ndarray, reach: float) -> np.ndarray:
     """(M, K) indices of the people within ``reach`` (m) of each centre, ascending, padded with -1; ``tree`` indexes
-    the positions (None: every person in input order, -1 where beyond reach)."""
-    if tree is None:
-        inside = np.abs(positions[None, :] - centres[:, None]) < reach
-        return np.where(inside, np.arange(len(positions)), -1)
+    the positions."""
     pairs = cKDTree(np.column_stack((centres.real, centres.imag))).sparse_distance_matrix(
         tree, reach, output_type="ndarray"
     )
@@ -154,23 +159,12 @@ def _near(positions: np.ndarray, tree: cKDTree | None, centres: np.ndarray, reac
     return near
 
 
-def _offsets(px: np.ndarray, py: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(., K, K) x and y (m) from person a to person b of each row of ``px``, ``py`` (., K)."""
-    return px[:, None, :] - px[:, :, None], py[:, None, :] - py[:, :, None]
-
-
 def _costs(
-    values: np.ndarray,
-    offsets: tuple[np.ndarray, np.ndarray],
-    centres: np.ndarray,
-    radii: np.ndarray,
-    listed: np.ndarray,
-    model: OSpaceModel,
+    values: np.ndarray, centres: np.ndarray, radii: np.ndarray, listed: np.ndarray, model: OSpaceModel
 ) -> np.ndarray:
     """(M, K) cost (m^2) of the person in column a of row k joining candidate k; inf where refused (not ``listed``,
-    blocked, or dearer than standing alone). ``values``: (5, ., K) x, y (m), facing x, y and weight of the listed
-    people, ``offsets`` their ``_offsets`` (a row of one broadcasts: everyone listed everywhere). Real arithmetic on x
-    and y: numpy's broadcast complex products are several times slower."""
+    blocked, or dearer than standing alone). ``values``: (5, M, K) x, y (m), facing x, y and weight of the listed
+    people. Real arithmetic on x and y: numpy's broadcast complex products are several times slower."""
     px, py, fx, fy, weight = values
     ox, oy = centres.real[:, None] - px, centres.imag[:, None] - py  # from the person to the centre
     r = radii[:, None]
@@ -178,26 +172,35 @@ def _costs(
     radial = (np.sqrt(ox**2 + oy**2) - r) ** 2 + model.unknown_cost**2
     cost = weight * proposal + (1.0 - weight) * radial
     keep = listed & (cost < model.price)
-    if model.body_radius > 0 and np.logical_or.reduce(keep, axis=None):
-        keep &= ~_blocked(offsets, ox, oy, listed, model.body_radius)
+    if model.body_radius > 0:
+        row, column = np.nonzero(keep)
+        blocked = _blocked(px, py, ox, oy, listed, row, column, model.body_radius)
+        keep[row[blocked], column[blocked]] = False
     return np.where(keep, cost, np.inf)
 
 
 def _blocked(
-    offsets: tuple[np.ndarray, np.ndarray], ox: np.ndarray, oy: np.ndarray, listed: np.ndarray, body_radius: float
+    px: np.ndarray,
+    py: np.ndarray,
+    ox: np.ndarray,
+    oy: np.ndarray,
+    listed: np.ndarray,
+    row: np.ndarray,
+    column: np.ndarray,
+    body_radius: float,
 ) -> np.ndarray:
-    """(M, K): whether the segment from person a of row k to candidate k's centre, (ox, oy)[k, a] away, passes
-    within ``body_radius`` of another listed person b of row k standing between them (projection strictly inside
-    the segment); ``offsets`` (., K, K) from a to b. Anyone between a person and a centre is nearer that centre, so
-    within reach, so listed in row k."""
-    rx, ry = offsets
-    sx, sy = ox[:, :, None], oy[:, :, None]
+    """(E,): for each entry e, whether the segment from person a = ``column[e]`` of row k = ``row[e]`` (at ``px``,
+    ``py`` [k, a], m) to candidate k's centre, (ox, oy)[k, a] away, passes within ``body_radius`` of another listed
+    person b of row k standing between them (projection strictly inside the segment). Anyone between a person and a
+    centre is nearer that centre, so within reach, so listed in row k."""
+    rx, ry = px[row] - px[row, column][:, None], py[row] - py[row, column][:, None]  # (E, K) from a to each b
+    sx, sy = ox[row, column][:, None], oy[row, column][:, None]
     length2 = sx**2 + sy**2
     dot = rx * sx + ry * sy
     cross = rx * sy - ry * sx
-    # A person is never between themselves and the centre: dot = 0 on the diagonal.
-    between = (dot > 0) & (dot < length2) & (cross**2 < body_radius**2 * length2) & listed[:, None, :]
-    return np.logical_or.reduce(between, axis=2)
+    # A person is never between themselves and the centre: dot = 0.
+    between = (dot > 0) & (dot < length2) & (cross**2 < body_radius**2 * length2) & listed[row]
+    return np.logical_or.reduce(between, axis=1)
 
 
 def _assign(cost: np.ndarray, near: np.ndarray, known: np.ndarray, price: float) -> np.ndarray:
@@ -242,11 +245,10 @@ def _first_per_person(person: np.ndarray, candidate: np.ndarray, key: np.ndarray
     return result
 
 
-def _canonical(chosen: np.ndarray, known: list[bool]) -> tuple[list[int], list[int]]:
+def _canonical(choices: list[int], known: list[bool]) -> tuple[list[int], list[int]]:
     """Group labels 0, 1, ... per person (-1 alone), numbered in order of each group's lowest member index, from the
     candidate each person chose; candidates chosen by fewer than two known facings dissolve. Also the candidate
     behind each group. Plain Python: a pass over N small integers, cheaper than numpy's calls for a frame."""
-    choices = chosen.tolist()
     counts: dict[int, int] = {}
     for c, k in zip(choices, known, strict=True):
         if k and c >= 0:
@@ -279,3 +281,196 @@ def _refit(
     fitted = np.divide(pull, spread, out=radii.copy(), where=spread > 1e-9 * total)
     fitted = np.minimum(np.maximum(fitted, model.radius_min), model.radius_max)
     return (p_sum + fitted * f_sum) / total, fitted
+
+
+# --- Small scenes: the same search on Python numbers, candidate by candidate -----------------------------------------
+
+
+# Per person: x, y (m), facing x, y (0 when unknown) and facing weight (0 when unknown).
+_Person = tuple[float, float, float, float, float]
+# Per person a, everyone else b: (squared distance m^2, x and y from a to b in m, b), nearest first.
+_Neighbours = list[list[tuple[float, float, float, int]]]
+# A candidate's row: (person, cost in m^2) of each person who may join it, ascending by person.
+_Row = list[tuple[int, float]]
+# Relative slack on the distance bound of the exclusivity test's shortcut, far above rounding (a few 1e-16).
+_SLACK = 1e-9
+
+
+def _find_small(
+    positions: list[complex], facing: list[complex], weight: list[float], model: OSpaceModel
+) -> list[OSpace]:
+    """``find_ospaces`` on Python numbers (positions and facings complex, NaN facing unknown): the crowd path's
+    rounds and arithmetic (``_costs``, ``_assign``, ``_refit``) with each candidate's row kept as a list of the
+    people who may join it. The first candidates' rows do not change between rounds: computed once."""
+    known = [not cmath.isnan(f) for f in facing]
+    owners = [j for j, k in enumerate(known) if k]
+    if len(owners) < 2:
+        return []
+    facing = [f if k else 0j for f, k in zip(facing, known, strict=True)]
+    people = [
+        (p.real, p.imag, f.real, f.imag, w if k else 0.0)
+        for p, f, w, k in zip(positions, facing, weight, known, strict=True)
+    ]
+    neighbours = _neighbours(people)
+    radii = model.radii.tolist()
+    first = [(positions[o] + r * facing[o], r) for o in owners for r in radii]
+    first_owner = [o for o in owners for _ in radii]
+    first_rows = _rows_small(first, people, neighbours, model)
+    candidates, rows = first, first_rows
+    labels: list[int] = []
+    for _ in range(_MAX_ROUNDS):
+        previous = labels
+        labels, behind = _canonical(_assign_small(rows, known, model.price), known)
+        fitted = _refit_small(labels, people, [candidates[k][1] for k in behind], model)
+        if labels == previous:
+            break
+        alone = [k for k, o in enumerate(first_owner) if labels[o] < 0]
+        candidates = fitted + [first[k] for k in alone]
+        rows = _rows_small(fitted, people, neighbours, model) + [first_rows[k] for k in alone]
+    return [
+        OSpace(np.array([j for j, label in enumerate(labels) if label == g]), centre, radius)
+        for g, (centre, radius) in enumerate(fitted)
+    ]
+
+
+def _neighbours(people: list[_Person]) -> _Neighbours:
+    """Everyone else as seen from each person, nearest first."""
+    return [
+        sorted(
+            ((bx - ax) * (bx - ax) + (by - ay) * (by - ay), bx - ax, by - ay, b)
+            for b, (bx, by, *_) in enumerate(people)
+            if b != a
+        )
+        for a, (ax, ay, *_) in enumerate(people)
+    ]
+
+
+def _rows_small(
+    candidates: list[tuple[complex, float]], people: list[_Person], neighbours: _Neighbours, model: OSpaceModel
+) -> list[_Row]:
+    """Per candidate o-space (centre complex, radius m), the people who may join it with their costs (m^2):
+    ``_costs`` row by row, the exclusivity test only for those under the price."""
+    reach, price, sqrt = model.reach, model.price, math.sqrt
+    unknown2, body2 = model.unknown_cost**2, model.body_radius**2
+    nearest = [others[0][0] if others else math.inf for others in neighbours]  # squared distance (m^2)
+    rows = []
+    for centre, radius in candidates:
+        cx, cy = centre.real, centre.imag
+        listed = [False] * len(people)
+        row, doubtful = [], []
+        for j, (px, py, fx, fy, w) in enumerate(people):
+            ox, oy = cx - px, cy - py  # from the person to the centre
+            length2 = ox * ox + oy * oy
+            distance = sqrt(length2)
+            if distance < reach:
+                listed[j] = True
+                dx, dy = radius * fx - ox, radius * fy - oy
+                radial = distance - radius
+                cost = w * (dx * dx + dy * dy) + (1.0 - w) * (radial * radial + unknown2)
+                if cost >= price:
+                    continue
+                # Only someone nearer than sqrt(length2 + body2) can be in the way: most have no such neighbour.
+                if (length2 + body2) * (1.0 + _SLACK) <= nearest[j]:
+                    row.append((j, cost))
+                else:
+                    doubtful.append((j, cost, ox, oy, length2))
+        if doubtful:  # tested once everyone within reach is listed
+            row.extend(
+                (j, cost)
+                for j, cost, ox, oy, length2 in doubtful
+                if not _blocked_small(ox, oy, length2, neighbours[j], listed, body2)
+            )
+            row.sort()
+        rows.append(row)
+    return rows
+
+
+def _blocked_small(
+    ox: float,
+    oy: float,
+    length2: float,
+    neighbours: list[tuple[float, float, float, int]],
+    listed: list[bool],
+    body2: float,
+) -> bool:
+    """``_blocked`` for one person and a centre (ox, oy) m away, length2 = ox^2 + oy^2: whether a ``listed`` person
+    among their ``neighbours`` stands between them within sqrt(``body2``) m of the segment. Such a person is nearer
+    than sqrt(length2 + body2): the search stops at the first one farther."""
+    bound = (length2 + body2) * (1.0 + _SLACK)
+    for distance2, rx, ry, b in neighbours:
+        if distance2 >= bound:
+            return False
+        dot = rx * ox + ry * oy
+        if listed[b] and 0 < dot < length2:
+            cross = rx * oy - ry * ox
+            if cross * cross < body2 * length2:
+                return True
+    return False
+
+
+def _assign_small(rows: list[_Row], known: list[bool], price: float) -> list[int]:
+    """``_assign`` on rows: the candidate each person joins (-1 alone), by the same greedy passes."""
+    current = [price] * len(known)
+    opened = [False] * len(rows)
+    openers = rows if all(known) else [[(j, c) for j, c in row if known[j]] for row in rows]
+    while True:
+        # (Gains added in order, not by the builtin ``sum``: it rounds differently from Python 3.12 on.)
+        savings = []
+        for row in openers:
+            total = 0.0
+            for j, c in row:
+                if c < current[j]:
+                    total += current[j] - c
+            savings.append(total - price)
+        if max(savings) <= 0:
+            break
+        # Each person's favourite: the candidate of highest saving among those that lower their cost, then lowest.
+        best, favourite = [-math.inf] * len(known), [-1] * len(known)
+        for k, row in enumerate(openers):
+            for j, c in row:
+                if c < current[j] and savings[k] > best[j]:
+                    best[j], favourite[j] = savings[k], k
+        accepted = [
+            k
+            for k, row in enumerate(openers)
+            if savings[k] > 0 and all(favourite[j] == k or c >= current[j] for j, c in row)
+        ]
+        for k in accepted:
+            opened[k] = True
+            for j, c in openers[k]:
+                current[j] = min(current[j], c)
+    return _cheapest_opened(rows, opened, len(known))
+
+
+def _cheapest_opened(rows: list[_Row], opened: list[bool], count: int) -> list[int]:
+    """For each of ``count`` people, the opened candidate of lowest cost in its row (ties: the lowest), -1 if none."""
+    chosen = [-1] * count
+    best = [math.inf] * count
+    for k, row in enumerate(rows):
+        if opened[k]:
+            for j, c in row:
+                if c < best[j]:
+                    best[j], chosen[j] = c, k
+    return chosen
+
+
+def _refit_small(
+    labels: list[int], people: list[_Person], radii: list[float], model: OSpaceModel
+) -> list[tuple[complex, float]]:
+    """``_refit`` on Python numbers: per group (labels 0..G-1), the centre (complex, m) and radius (m); ``radii``
+    (G) is kept where the facings do not fix R."""
+    sums = [[0.0] * 6 for _ in radii]  # per group: w x, w y, w fx, w fy, w <p, f>, w
+    for label, (x, y, fx, fy, w) in zip(labels, people, strict=True):
+        if label >= 0:
+            for i, value in enumerate((x * w, y * w, fx * w, fy * w, (x * fx + y * fy) * w, w)):
+                sums[label][i] += value
+    fitted = []
+    for (px, py, fx, fy, pf, total), kept in zip(sums, radii, strict=True):
+        f_norm = math.hypot(fx, fy)
+        spread = total - f_norm * f_norm / total
+        pull = -(pf - (px * fx + py * fy) / total)
+        radius = pull / spread if spread > 1e-9 * total else kept
+        radius = min(max(radius, model.radius_min), model.radius_max)
+        scale = 1.0 / total  # numpy divides a complex by a real as a product with the reciprocal
+        fitted.append((complex((px + radius * fx) * scale, (py + radius * fy) * scale), radius))
+    return fitted

@@ -1,4 +1,4 @@
-"""The o-space assignment on its own: the fitted centre and radius, the crowd path against the dense one, checks."""
+"""The o-space assignment on its own: the fitted centre and radius, the crowd path against the small one, checks."""
 
 from __future__ import annotations
 
@@ -41,7 +41,7 @@ def test_each_group_fits_its_own_radius():
     assert [g.centre for g in groups] == pytest.approx([0j, 5 + 0j], abs=1e-9)
 
 
-def test_the_crowd_path_gives_what_the_dense_path_gives(monkeypatch):
+def test_the_crowd_path_gives_what_the_small_scene_path_gives(monkeypatch):
     rng = np.random.default_rng(3)
     people = []
     for k in range(9):  # circles of 3 centres 2.4 m apart, noisy
@@ -51,11 +51,32 @@ def test_the_crowd_path_gives_what_the_dense_path_gives(monkeypatch):
             x, y = cx + 0.7 * math.cos(a) + rng.normal(0, 0.05), cy + 0.7 * math.sin(a) + rng.normal(0, 0.05)
             people.append((x, y, math.atan2(cy - y, cx - x) + rng.normal(0, 0.3)))
     crowd = find_ospaces(*arrays(people), MODEL)
-    monkeypatch.setattr(ospace, "_DENSE_PEOPLE_MAX", 1000)
-    dense = find_ospaces(*arrays(people), MODEL)
-    assert [g.members.tolist() for g in crowd] == [g.members.tolist() for g in dense]
-    assert [g.centre for g in crowd] == pytest.approx([g.centre for g in dense])
+    monkeypatch.setattr(ospace, "_SMALL_PEOPLE_MAX", 1000)
+    small = find_ospaces(*arrays(people), MODEL)
+    assert [g.members.tolist() for g in crowd] == [g.members.tolist() for g in small]
+    assert [g.centre for g in crowd] == pytest.approx([g.centre for g in small])
     assert len(crowd) >= 7
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_the_two_paths_agree_on_random_scenes(seed: int, monkeypatch) -> None:
+    scene = random_scene(seed)
+    monkeypatch.setattr(ospace, "_SMALL_PEOPLE_MAX", 0)
+    crowd = find_ospaces(*scene, MODEL)
+    monkeypatch.setattr(ospace, "_SMALL_PEOPLE_MAX", 1000)
+    small = find_ospaces(*scene, MODEL)
+    assert [g.members.tolist() for g in crowd] == [g.members.tolist() for g in small]
+    assert [g.centre for g in crowd] == pytest.approx([g.centre for g in small], abs=1e-9)
+    assert [g.radius for g in crowd] == pytest.approx([g.radius for g in small], abs=1e-9)
+
+
+@pytest.mark.parametrize("small", [False, True])
+def test_nobody_joins_across_someone_standing_in_the_way(small: bool, monkeypatch) -> None:
+    # Three in a row facing along it: the middle one stands on the line from each end to any centre between them.
+    monkeypatch.setattr(ospace, "_SMALL_PEOPLE_MAX", 1000 if small else 0)
+    people = [(0.0, 0.0, 0.0), (0.6, 0.0, math.pi), (1.2, 0.0, math.pi)]
+    assert [g.members.tolist() for g in find_ospaces(*arrays(people), MODEL)] == [[0, 1]]
+    assert find_ospaces(*arrays([people[0], people[2]]), MODEL)[0].members.tolist() == [0, 1]
 
 
 # The groups the detector gave before it was made faster (members per seed of ``random_scene``): any change to the
