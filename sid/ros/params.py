@@ -29,6 +29,9 @@ class NodeParams:
     sync_tolerance: float = 0.015
     camera_height: float = CameraMount.height
     camera_tilt: float = CameraMount.tilt
+    camera_x: float = CameraMount.x
+    camera_y: float = CameraMount.y
+    camera_yaw: float = CameraMount.yaw
     pose_source: str = "auto"
     odom_topic: str = "/odom"
     global_frame: str = MAP_FRAME
@@ -66,7 +69,8 @@ class NodeParams:
 
     @property
     def mount(self) -> CameraMount:
-        return CameraMount(self.camera_height, self.camera_tilt)
+        """The camera on ``base_frame``: height, tilt, position (x, y) and heading of its optical axis."""
+        return CameraMount(self.camera_height, self.camera_tilt, self.camera_x, self.camera_y, self.camera_yaw)
 
 
 DESCRIPTIONS: dict[str, str] = {
@@ -77,6 +81,9 @@ DESCRIPTIONS: dict[str, str] = {
     "sync_tolerance": "largest stamp difference (s) of a colour and a depth image taken as one frame",
     "camera_height": "camera optical centre above the ground (m)",
     "camera_tilt": "camera downward pitch (rad)",
+    "camera_x": "camera optical centre ahead of base_frame's origin (m)",
+    "camera_y": "camera optical centre left of base_frame's origin (m)",
+    "camera_yaw": "heading of the camera's optical axis from base_frame's x axis (rad, counter-clockwise)",
     "pose_source": "robot pose from 'tf' (tf2_ros), 'odom' (odom_topic), 'none' (robot fixed at the global "
     "frame's origin) or 'auto' (tf when tf2_ros is importable, else odom)",
     "odom_topic": "nav_msgs/Odometry topic giving base_frame's pose in global_frame (pose_source odom)",

@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import ast
 
+import pytest
 import yaml
 
 from sid.cli.ros import SHARE
+from sid.perception.mount import CameraMount
 from sid.ros.params import NODE_NAME, PARAMETERS, NodeParams
 
 
@@ -26,6 +28,13 @@ def test_parameters_yaml_lists_every_parameter_with_its_default() -> None:
     assert shipped == {name: default for name, default, _ in PARAMETERS}
     assert all(description for _, _, description in PARAMETERS)
     assert NodeParams().grid.shape == (400, 400)
+
+
+def test_the_camera_mount_parameters_place_the_camera_on_the_base() -> None:
+    mount = NodeParams(camera_x=0.25, camera_y=-0.05, camera_height=1.1, camera_tilt=0.2, camera_yaw=0.3).mount
+    assert mount == CameraMount(height=1.1, tilt=0.2, x=0.25, y=-0.05, yaw=0.3)
+    with pytest.raises(ValueError, match="yaw"):
+        NodeParams(camera_yaw=float("nan"))
 
 
 def test_nav2_example_puts_the_keepout_filter_in_both_costmaps() -> None:
