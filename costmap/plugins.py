@@ -29,6 +29,7 @@ class CostmapParams:
     obstacle: ObstacleParams = field(default_factory=ObstacleParams)
     inflation: InflationParams = field(default_factory=InflationParams)
     social: SocialParams = field(default_factory=SocialParams)
+    tracked_people: TrackedPeopleParams = field(default_factory=TrackedPeopleParams)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "plugins", tuple(self.plugins))
@@ -70,7 +71,7 @@ PLUGINS: dict[str, Factory] = {
     "static": _static,
     "lidar": lambda c: ObstacleLayer(c.spec, c.params.obstacle, c.people_clear_radius),
     "social": lambda c: SocialLayer(c.spec, c.params.social, c.body_radius),
-    "tracked_people": lambda c: TrackedPeopleLayer(c.spec, TrackedPeopleParams(c.params.social), c.body_radius),
+    "tracked_people": lambda c: TrackedPeopleLayer(c.spec, c.params.tracked_people, c.body_radius, c.params.social),
     "inflation": lambda c: InflationLayer(c.spec, c.params.inflation, c.robot_radius),
 }
 

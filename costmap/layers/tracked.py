@@ -17,7 +17,7 @@ Costs never exceed 252 except the bodies (254), as in the social layer; combined
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from costmap.combine import CombinationMethod
 from costmap.grid import FREE_SPACE, GridSpec, Window, union
@@ -28,10 +28,10 @@ from sid.checks import check_number
 
 @dataclass(frozen=True)
 class TrackedPeopleParams:
-    """The social layer's parameters (``social``) plus ``lookahead``: seconds of a walker's motion over which its
-    cost is stretched ahead (sigma ahead = sigma_front + lookahead * speed, m)."""
+    """``lookahead``: seconds of a walker's motion over which its cost is stretched ahead (sigma ahead =
+    sigma_front + lookahead * speed, m). The personal-space and zone costs are the social layer's (``SocialParams``).
+    """
 
-    social: SocialParams = field(default_factory=SocialParams)
     lookahead: float = 1.0
 
     def __post_init__(self) -> None:
@@ -39,15 +39,24 @@ class TrackedPeopleParams:
 
 
 class TrackedPeopleLayer(Layer):
-    """Rebuilt from the current tracks at every update (nothing stale is kept); no tracks given: an empty layer."""
+    """Rebuilt from the current tracks at every update (nothing stale is kept); no tracks given: an empty layer.
+
+    ``social``: the costs of people and zones (as the social layer's); ``params``: the walkers' stretch."""
 
     name = "tracked_people"
     combination: CombinationMethod = "max_nonzero"
 
-    def __init__(self, spec: GridSpec, params: TrackedPeopleParams | None = None, body_radius: float = 0.2) -> None:
+    def __init__(
+        self,
+        spec: GridSpec,
+        params: TrackedPeopleParams | None = None,
+        body_radius: float = 0.2,
+        social: SocialParams | None = None,
+    ) -> None:
         check_number("tracked people layer", "body_radius", body_radius, low=0, low_open=True, unit="metres")
         super().__init__(spec)
         self.params = params or TrackedPeopleParams()
+        self.social = social or SocialParams()
         self.body_radius = float(body_radius)
         self._painted: Window | None = None
 
@@ -61,7 +70,7 @@ class TrackedPeopleLayer(Layer):
         previous = self._painted
         if previous is not None:
             self.costs[previous.slices] = FREE_SPACE
-        social = self.params.social
+        social = self.social
         painted = [paint_group(self.costs, self.spec, hull, social) for hull in hulls]
         for track in () if tracks is None else tracks.people:
             person, front = by_id[track.id], social.sigma_front

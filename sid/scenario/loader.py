@@ -21,6 +21,7 @@ from costmap.grid import GridSpec
 from costmap.layers.inflation import InflationParams
 from costmap.layers.obstacle import ObstacleParams
 from costmap.layers.social import SocialParams
+from costmap.layers.tracked import TrackedPeopleParams
 from costmap.mapfile import MapFileError, read_map
 from costmap.occupancy import OccupancyGrid
 from costmap.plugins import PLUGINS, CostmapParams
@@ -478,6 +479,7 @@ def scenario_from_dict(data: Any, base_dir: Path | None = None, default_name: st
         "obstacle": lambda v, n: _params(v, n, ObstacleParams),
         "inflation": lambda v, n: _params(v, n, InflationParams),
         "social": lambda v, n: _params(v, n, SocialParams),
+        "tracked_people": lambda v, n: _params(v, n, TrackedPeopleParams),
     }
     layers_data = _mapping(data.get("layers", {}), "layers", set(layer_sections))
     sections = {k: layer_sections[k](v, f"layers.{k}") for k, v in layers_data.items()}

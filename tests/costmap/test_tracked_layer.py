@@ -9,7 +9,7 @@ import pytest
 
 from costmap.grid import FREE_SPACE, LETHAL, GridSpec
 from costmap.layer import LayerInputs
-from costmap.layers.social import SocialLayer
+from costmap.layers.social import SocialLayer, SocialParams
 from costmap.layers.tracked import TrackedPeopleLayer, TrackedPeopleParams
 from costmap.plugins import CostmapParams, layered_costmap
 from sid.perception.groups import Group
@@ -93,3 +93,12 @@ def test_the_plugin_builds_the_layer_and_clears_lidar_marks_around_people() -> N
     layered.update(LayerInputs([track.as_person()], tracks=Tracks([track])))
     (row, col) = SPEC.world_to_cell(np.array([4.0, 0.0]))[0]
     assert layered.master.costs[row, col] == LETHAL
+
+
+def test_the_costmap_parameters_reach_the_tracked_layer() -> None:
+    params = CostmapParams(
+        plugins=("tracked_people",), social=SocialParams(sigma_front=0.5), tracked_people=TrackedPeopleParams(2.0)
+    )
+    (layer,) = layered_costmap(SPEC, params).layers
+    assert isinstance(layer, TrackedPeopleLayer)
+    assert layer.params.lookahead == 2.0 and layer.social.sigma_front == 0.5

@@ -108,6 +108,7 @@ def test_yaml_files_load_too(tmp_path):
         ("groups", {"epsilon": 1}, r"groups\.epsilon: unknown field"),
         ("layers", {"inflation": {"inflation_radius": -1}}, r"layers\.inflation: inflation: inflation_radius"),
         ("layers", {"social": {"group_cost": 300}}, r"layers\.social: social: group_cost"),
+        ("layers", {"tracked_people": {"lookahead": -1}}, r"layers\.tracked_people: .*lookahead"),
         ("peple", [], r"scenario\.peple: unknown field"),
     ],
 )
