@@ -25,6 +25,10 @@ from costmap.layer import Layer, LayerInputs
 from costmap.layers.social import SocialParams, paint_body, paint_group, paint_person, zone_hull
 from sid.checks import check_number
 
+MAX_LOOKAHEAD = 10.0
+"""The longest ``lookahead`` (s): a walker's cost stretched 14 m ahead at 1.4 m/s; beyond it the windows would grow
+without bound and say nothing about where a person will be."""
+
 
 @dataclass(frozen=True)
 class TrackedPeopleParams:
@@ -35,7 +39,7 @@ class TrackedPeopleParams:
     lookahead: float = 1.0
 
     def __post_init__(self) -> None:
-        check_number("tracked people layer", "lookahead", self.lookahead, low=0, unit="seconds")
+        check_number("tracked people layer", "lookahead", self.lookahead, low=0, high=MAX_LOOKAHEAD, unit="seconds")
 
 
 class TrackedPeopleLayer(Layer):

@@ -109,6 +109,7 @@ def test_yaml_files_load_too(tmp_path):
         ("layers", {"inflation": {"inflation_radius": -1}}, r"layers\.inflation: inflation: inflation_radius"),
         ("layers", {"social": {"group_cost": 300}}, r"layers\.social: social: group_cost"),
         ("layers", {"tracked_people": {"lookahead": -1}}, r"layers\.tracked_people: .*lookahead"),
+        ("layers", {"tracked_people": {"lookahead": 1e308}}, r"lookahead must be .* in \[0, 10\]"),
         ("peple", [], r"scenario\.peple: unknown field"),
     ],
 )
