@@ -58,6 +58,8 @@ _TIE = 1e-9
 _DEGENERATE_AREA = 1e-9
 # Sort key of a point x + iy: (x, y).
 _BY_X_THEN_Y = operator.attrgetter("real", "imag")
+# The facing of a person whose theta is None.
+_UNKNOWN_FACING = complex(math.nan, math.nan)
 
 
 GROUP_METHODS = ("ospace", "rays", "paper")
@@ -208,65 +210,57 @@ def detect_groups(people: Sequence[Person], params: GroupParams = GroupParams())
     duplicate ids. Fewer than two people give no group.
     """
     people = list(people)
-    ids, positions, facing = _as_arrays(people)
+    ids, positions, facing = _validated(people)
     if len(people) < 2:
         return []
     if params.method == "ospace":
         return _ospace_groups(people, ids, positions, facing, params)
     if params.method == "paper" and not math.isinf(params.meeting_radius):
         params = replace(params, meeting_radius=math.inf)
-    labels = dbscan_labels(np.column_stack((positions.real, positions.imag)), params.eps, params.min_samples)
-    has_ray = ~np.isnan(facing)
+    position_array, facing_array = np.array(positions, dtype=complex), np.array(facing, dtype=complex)
+    labels = dbscan_labels(np.column_stack((position_array.real, position_array.imag)), params.eps, params.min_samples)
+    has_ray = ~np.isnan(facing_array)
     groups: list[Group] = []
     for label in range(int(labels.max()) + 1):
         cluster = np.flatnonzero((labels == label) & has_ray)
         if len(cluster) >= 2:
-            groups.extend(_groups_in_cluster([ids[i] for i in cluster], positions[cluster], facing[cluster], params))
+            groups.extend(
+                _groups_in_cluster([ids[i] for i in cluster], position_array[cluster], facing_array[cluster], params)
+            )
     return groups
 
 
 def _ospace_groups(
-    people: list[Person], ids: list[int], positions: np.ndarray, facing: np.ndarray, params: GroupParams
+    people: list[Person], ids: list[int], positions: list[complex], facing: list[complex], params: GroupParams
 ) -> list[Group]:
     """The o-space method's groups, each with the paper's zone geometry on its members' rays (see the module
-    docstring). Per group the work is on Python numbers: a group has a handful of members."""
+    docstring), or the fitted o-space centre when no two members' rays meet. On Python numbers but for the
+    products and distances whose rounding numpy decides (``_member_crossings``, ``_spreads``)."""
     floor = params.facing_weight_floor
-    weight = np.array([floor + (1.0 - floor) * min(max(p.orientation_quality, 0.0), 1.0) for p in people])
+    weight = [floor + (1.0 - floor) * min(max(p.orientation_quality, 0.0), 1.0) for p in people]
     found = find_ospaces(positions, facing, weight, params.ospace_model)
     members = [ospace.members.tolist() for ospace in found]
-    # The rays of every two members of one group, computed in one call for all groups.
-    pairs = [pair for group in members for pair in itertools.combinations(group, 2)]
-    first, second = np.array(pairs, dtype=int).reshape(-1, 2).T
-    meetings = _ray_meetings(positions, facing, params, (first, second))
-    label = [-1] * len(people)
-    for k, group in enumerate(members):
-        for i in group:
-            label[i] = k
-    crossings: list[list[complex]] = [[] for _ in found]
-    for i, point in zip(meetings.first.tolist(), meetings.points.tolist(), strict=True):
-        crossings[label[i]].append(point)
-    points = positions.tolist()
-    groups = []
-    for ospace, group, meeting in zip(found, members, crossings, strict=True):
-        member_positions = [points[i] for i in group]
-        if meeting:
-            geometry = _zone(meeting, member_positions)
+    zones = []
+    for ospace, crossings in zip(found, _member_crossings(positions, facing, members, params), strict=True):
+        if crossings:
+            zones.append(_zone(crossings))
         else:  # no two members' rays meet: the fitted o-space centre
             centre = ospace.centre
-            geometry = _Geometry(0.0, centre, np.array([[centre.real, centre.imag]]), _spread(member_positions, centre))
-        groups.append(
-            Group(
-                members=tuple(ids[i] for i in group),
-                interest_point=(geometry.centre.real, geometry.centre.imag),
-                area=geometry.area,
-                zone=geometry.zone,
-                spread=geometry.spread,
-            )
+            zones.append((0.0, centre, np.array([[centre.real, centre.imag]])))
+    spreads = _spreads(positions, members, [centre for _, centre, _ in zones])
+    return [
+        Group(
+            members=tuple(ids[i] for i in group),
+            interest_point=(centre.real, centre.imag),
+            area=area,
+            zone=zone,
+            spread=spread,
         )
-    return groups
+        for group, (area, centre, zone), spread in zip(members, zones, spreads, strict=True)
+    ]
 
 
-def _as_arrays(people: list[Person]) -> tuple[list[int], np.ndarray, np.ndarray]:
+def _validated(people: list[Person]) -> tuple[list[int], list[complex], list[complex]]:
     """Ids, positions and unit facing vectors as complex numbers x + iy (NaN facing = unknown), validated."""
     ids = [p.id for p in people]
     if len(set(ids)) != len(ids):
@@ -279,12 +273,12 @@ def _as_arrays(people: list[Person]) -> tuple[list[int], np.ndarray, np.ndarray]
             raise ValueError(f"groups: person {person.id} has a non-finite position ({person.x}, {person.y})")
         positions.append(complex(person.x, person.y))
         if person.theta is None:
-            facing.append(complex(math.nan, math.nan))
+            facing.append(_UNKNOWN_FACING)
         elif not math.isfinite(person.theta):
             raise ValueError(f"groups: person {person.id} has a non-finite theta {person.theta} (use None)")
         else:
             facing.append(complex(math.cos(person.theta), math.sin(person.theta)))
-    return ids, np.array(positions, dtype=complex), np.array(facing, dtype=complex)
+    return ids, positions, facing
 
 
 @dataclass(frozen=True)
@@ -329,6 +323,44 @@ def _ray_meetings(
     face_to_face = (along_i.real >= reach) & (-along_j.real >= reach) & (distance > 0) & (distance <= 4 * half)
     meet = crossing | face_to_face
     return _Meetings(i[meet], j[meet], points[meet])
+
+
+def _member_crossings(
+    positions: list[complex], facing: list[complex], groups: list[list[int]], params: GroupParams
+) -> list[list[complex]]:
+    """Per group (member indices into ``positions``), where its members' rays meet, pair by pair in the order of
+    ``itertools.combinations``: ``_ray_meetings`` on Python numbers, for the o-space method's few members.
+
+    The complex products and distances still go through numpy, one call for all groups: its SIMD loops fuse
+    multiply-adds, so Python's own products round differently in the last bit. The rest (divisions, comparisons,
+    points) rounds the same in both, and is cheaper here than numpy's overhead per call. A test checks that both
+    give the same points."""
+    pairs = [(k, i, j) for k, group in enumerate(groups) for i, j in itertools.combinations(group, 2)]
+    crossings: list[list[complex]] = [[] for _ in groups]
+    if not pairs:
+        return crossings
+    offsets = [(positions[j] - positions[i]).conjugate() for _, i, j in pairs]  # conj(p_j - p_i)
+    first, second = [facing[i] for _, i, _ in pairs], [facing[j] for _, _, j in pairs]
+    count = len(pairs)
+    # conj(d) f_i, conj(d) f_j and conj(f_i) f_j (see _ray_meetings), and |d|.
+    products = (
+        np.array(offsets + offsets + [f.conjugate() for f in first]) * np.array(first + second + second)
+    ).tolist()
+    distances = np.abs(np.array(offsets)).tolist()
+    half = 0.5 * params.ray_length
+    cos_tolerance = math.cos(params.facing_tolerance)
+    for n, (k, i, j) in enumerate(pairs):
+        along_i, along_j, denom = products[n], products[count + n], products[2 * count + n].imag
+        if abs(denom) > _PARALLEL:
+            s, t = along_j.imag / denom, along_i.imag / denom
+            if max(abs(s - half), abs(t - half)) <= half:
+                crossings[k].append(positions[i] + s * first[n])
+                continue
+        distance = distances[n]
+        reach = cos_tolerance * distance
+        if along_i.real >= reach and -along_j.real >= reach and 0 < distance <= 4 * half:
+            crossings[k].append(0.5 * (positions[i] + positions[j]))
+    return crossings
 
 
 def _groups_in_cluster(ids: list[int], positions: np.ndarray, facing: np.ndarray, params: GroupParams) -> list[Group]:
@@ -384,26 +416,37 @@ def _with_meetings(members: np.ndarray, meetings: _Meetings) -> np.ndarray:
 
 def _geometry(members: np.ndarray, meetings: _Meetings, positions: np.ndarray) -> _Geometry:
     """The zone of the crossings between ``members`` (bool mask)."""
-    return _zone(meetings.points[_active(members, meetings)].tolist(), positions[members].tolist())
+    area, centre, zone = _zone(meetings.points[_active(members, meetings)].tolist())
+    return _Geometry(area, centre, zone, _spread(positions[members].tolist(), centre))
 
 
-def _zone(crossings: list[complex], member_positions: list[complex]) -> _Geometry:
-    """Hull area, centre, zone polygon of ``crossings`` (at least one) and the members' spread around it (complex
-    x + iy, m)."""
+def _zone(crossings: list[complex]) -> tuple[float, complex, np.ndarray]:
+    """Hull area (m^2), centre (complex x + iy, m) and (K, 2) zone polygon of ``crossings`` (at least one)."""
     hull = _convex_hull(crossings) if len(crossings) >= 3 else []
     area, centre = _shoelace(hull) if len(hull) >= 3 else (0.0, 0j)
     if area > _DEGENERATE_AREA:
-        zone = np.array([(p.real, p.imag) for p in hull])
-    else:
-        area = 0.0
-        centre, zone = _degenerate_zone(crossings)
-    return _Geometry(area, centre, zone, _spread(member_positions, centre))
+        return area, centre, np.array([(p.real, p.imag) for p in hull])
+    centre, zone = _degenerate_zone(crossings)
+    return 0.0, centre, zone
 
 
 def _spread(member_positions: list[complex], centre: complex) -> float:
     """D (m): the mean distance of the members to ``centre``. In numpy, although the members are few: its complex
     absolute value and sum round differently from Python's, and the ray methods' pruning compares these values."""
     return float(np.abs(np.array(member_positions) - centre).sum() / len(member_positions))
+
+
+def _spreads(positions: list[complex], groups: list[list[int]], centres: list[complex]) -> list[float]:
+    """``_spread`` of each group (member indices into ``positions``) around its centre, the distances of all groups
+    in one numpy call (the same values and sums as ``_spread``'s)."""
+    offsets = [positions[i] - centre for group, centre in zip(groups, centres, strict=True) for i in group]
+    distances = np.abs(np.array(offsets, dtype=complex))
+    spreads = []
+    start = 0
+    for group in groups:
+        spreads.append(float(distances[start : start + len(group)].sum() / len(group)))
+        start += len(group)
+    return spreads
 
 
 def _convex_hull(points: list[complex]) -> list[complex]:

@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import cmath
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -83,6 +84,17 @@ class OSpaceModel:
         """Distance (m) from a centre beyond which nobody can join it: every cost term is at least (|p - c| - R)^2."""
         return self.radius_max + math.sqrt(self.price)
 
+    @cached_property
+    def reach_squared(self) -> float:
+        """The smallest squared distance (m^2) whose rounded square root is ``reach`` or more: d2 < reach_squared
+        exactly when sqrt(d2) < reach (the root is monotonic), without taking the root."""
+        bound = self.reach * self.reach
+        while math.sqrt(bound) >= self.reach:
+            bound = math.nextafter(bound, 0.0)
+        while math.sqrt(bound) < self.reach:
+            bound = math.nextafter(bound, math.inf)
+        return bound
+
 
 @dataclass(frozen=True)
 class OSpace:
@@ -93,12 +105,16 @@ class OSpace:
     radius: float
 
 
-def find_ospaces(positions: np.ndarray, facing: np.ndarray, weight: np.ndarray, model: OSpaceModel) -> list[OSpace]:
+def find_ospaces(
+    positions: Sequence[complex], facing: Sequence[complex], weight: Sequence[float], model: OSpaceModel
+) -> list[OSpace]:
     """Groups of two or more among people at ``positions`` (complex x + iy, m) with unit ``facing`` (complex, NaN
     when unknown) and facing weights in (0, 1]; ordered by their lowest member index."""
     if len(positions) <= _SMALL_PEOPLE_MAX:
-        return _find_small(positions.tolist(), facing.tolist(), weight.tolist(), model)
-    return _find_crowd(positions, facing, weight, model)
+        return _find_small(list(positions), list(facing), list(weight), model)
+    return _find_crowd(
+        np.array(positions, dtype=complex), np.array(facing, dtype=complex), np.array(weight, dtype=float), model
+    )
 
 
 def _find_crowd(positions: np.ndarray, facing: np.ndarray, weight: np.ndarray, model: OSpaceModel) -> list[OSpace]:
@@ -288,12 +304,14 @@ def _refit(
 
 # Per person: x, y (m), facing x, y (0 when unknown) and facing weight (0 when unknown).
 _Person = tuple[float, float, float, float, float]
-# Per person a, everyone else b: (squared distance m^2, x and y from a to b in m, b), nearest first.
-_Neighbours = list[list[tuple[float, float, float, int]]]
-# A candidate's row: (person, cost in m^2) of each person who may join it, ascending by person.
-_Row = list[tuple[int, float]]
 # Relative slack on the distance bound of the exclusivity test's shortcut, far above rounding (a few 1e-16).
 _SLACK = 1e-9
+
+
+# A candidate o-space's row: (person, cost in m^2) of each person who may join it, ascending by person, and the
+# saving (m^2) of opening it while everyone is alone, the first pass of every ``_assign_small`` call (a candidate's
+# row does not change between rounds, so neither does this).
+_Row = tuple[list[tuple[int, float]], float]
 
 
 def _find_small(
@@ -311,11 +329,11 @@ def _find_small(
         (p.real, p.imag, f.real, f.imag, w if k else 0.0)
         for p, f, w, k in zip(positions, facing, weight, known, strict=True)
     ]
-    neighbours = _neighbours(people)
+    scene = _SmallScene(people, known, model)
     radii = model.radii.tolist()
     first = [(positions[o] + r * facing[o], r) for o in owners for r in radii]
     first_owner = [o for o in owners for _ in radii]
-    first_rows = _rows_small(first, people, neighbours, model)
+    first_rows = scene.rows(first)
     candidates, rows = first, first_rows
     labels: list[int] = []
     for _ in range(_MAX_ROUNDS):
@@ -326,123 +344,153 @@ def _find_small(
             break
         alone = [k for k, o in enumerate(first_owner) if labels[o] < 0]
         candidates = fitted + [first[k] for k in alone]
-        rows = _rows_small(fitted, people, neighbours, model) + [first_rows[k] for k in alone]
+        rows = scene.rows(fitted) + [first_rows[k] for k in alone]
     return [
         OSpace(np.array([j for j, label in enumerate(labels) if label == g]), centre, radius)
         for g, (centre, radius) in enumerate(fitted)
     ]
 
 
-def _neighbours(people: list[_Person]) -> _Neighbours:
-    """Everyone else as seen from each person, nearest first."""
-    return [
-        sorted(
-            ((bx - ax) * (bx - ax) + (by - ay) * (by - ay), bx - ax, by - ay, b)
-            for b, (bx, by, *_) in enumerate(people)
-            if b != a
-        )
-        for a, (ax, ay, *_) in enumerate(people)
-    ]
+class _SmallScene:
+    """The people of a small scene (``_Person`` tuples, and which facings are known) and what the rows of their
+    candidate o-spaces need: ``_costs`` and ``_blocked`` row by row, on Python numbers."""
 
+    def __init__(self, people: list[_Person], known: list[bool], model: OSpaceModel) -> None:
+        self.people, self.model = people, model
+        # Per person, the squared distance (m^2) to the nearest other person (inf when alone).
+        nearest = [math.inf] * len(people)
+        for a, (ax, ay, *_) in enumerate(people):
+            for b in range(a + 1, len(people)):
+                bx, by = people[b][0], people[b][1]
+                distance2 = (bx - ax) * (bx - ax) + (by - ay) * (by - ay)
+                if distance2 < nearest[a]:
+                    nearest[a] = distance2
+                if distance2 < nearest[b]:
+                    nearest[b] = distance2
+        # Per person: index, x, y, facing x, y, weight, squared distance to the nearest other, facing known.
+        self._table = [(j, *person, nearest[j], known[j]) for j, person in enumerate(people)]
+        self._neighbours: dict[int, list[tuple[float, float, float, int]]] = {}
 
-def _rows_small(
-    candidates: list[tuple[complex, float]], people: list[_Person], neighbours: _Neighbours, model: OSpaceModel
-) -> list[_Row]:
-    """Per candidate o-space (centre complex, radius m), the people who may join it with their costs (m^2):
-    ``_costs`` row by row, the exclusivity test only for those under the price."""
-    reach, price, sqrt = model.reach, model.price, math.sqrt
-    unknown2, body2 = model.unknown_cost**2, model.body_radius**2
-    nearest = [others[0][0] if others else math.inf for others in neighbours]  # squared distance (m^2)
-    rows = []
-    for centre, radius in candidates:
-        cx, cy = centre.real, centre.imag
-        listed = [False] * len(people)
-        row, doubtful = [], []
-        for j, (px, py, fx, fy, w) in enumerate(people):
-            ox, oy = cx - px, cy - py  # from the person to the centre
-            length2 = ox * ox + oy * oy
-            distance = sqrt(length2)
-            if distance < reach:
-                listed[j] = True
-                dx, dy = radius * fx - ox, radius * fy - oy
-                radial = distance - radius
-                cost = w * (dx * dx + dy * dy) + (1.0 - w) * (radial * radial + unknown2)
-                if cost >= price:
+    def rows(self, candidates: list[tuple[complex, float]]) -> list[_Row]:
+        """Per candidate o-space (centre complex, radius m), its row (``_Row``): the people who may join it with their
+        costs (m^2), the exclusivity test only for those whose nearest neighbour could be in the way.
+
+        A clear facing (weight 1) costs the proposal's squared distance alone: the general formula adds
+        0 x (radial term) = 0 to it, exactly (the term is finite unless ``unknown_cost`` exceeds 1e154 m, where its
+        square overflows). Whether someone is within ``reach`` is decided on the squared distance
+        (``OSpaceModel.reach_squared``), as the rounded root would decide it."""
+        model = self.model
+        reach2, price, sqrt = model.reach_squared, model.price, math.sqrt
+        unknown2, body2 = model.unknown_cost**2, model.body_radius**2
+        slack = 1.0 + _SLACK
+        rows = []
+        for centre, radius in candidates:
+            cx, cy = centre.real, centre.imag
+            entries = []
+            saving = 0.0
+            for j, px, py, fx, fy, w, nearest, known in self._table:
+                ox, oy = cx - px, cy - py  # from the person to the centre
+                length2 = ox * ox + oy * oy
+                if length2 >= reach2:
                     continue
-                # Only someone nearer than sqrt(length2 + body2) can be in the way: most have no such neighbour.
-                if (length2 + body2) * (1.0 + _SLACK) <= nearest[j]:
-                    row.append((j, cost))
+                dx, dy = radius * fx - ox, radius * fy - oy
+                if w == 1.0:
+                    cost = dx * dx + dy * dy
                 else:
-                    doubtful.append((j, cost, ox, oy, length2))
-        if doubtful:  # tested once everyone within reach is listed
-            row.extend(
-                (j, cost)
-                for j, cost, ox, oy, length2 in doubtful
-                if not _blocked_small(ox, oy, length2, neighbours[j], listed, body2)
+                    radial = sqrt(length2) - radius
+                    cost = w * (dx * dx + dy * dy) + (1.0 - w) * (radial * radial + unknown2)
+                # Only someone nearer than sqrt(length2 + body2) can be in the way: most have no such neighbour.
+                if cost < price and ((length2 + body2) * slack <= nearest or not self._blocked(j, cx, cy)):
+                    entries.append((j, cost))
+                    if known:
+                        saving += price - cost
+            rows.append((entries, saving - price))
+        return rows
+
+    def _blocked(self, j: int, cx: float, cy: float) -> bool:
+        """``_blocked`` for person j and the centre (cx, cy) (m): whether someone within the centre's reach stands
+        between them, within ``body_radius`` of the segment. Such a person is nearer j than sqrt(length2 + body2),
+        length2 the segment's squared length: the search, nearest first, stops at the first one farther."""
+        px, py = self.people[j][0], self.people[j][1]
+        ox, oy = cx - px, cy - py
+        length2 = ox * ox + oy * oy
+        body2 = self.model.body_radius**2
+        bound = (length2 + body2) * (1.0 + _SLACK)
+        for distance2, rx, ry, b in self._neighbours_of(j):
+            if distance2 >= bound:
+                return False
+            dot = rx * ox + ry * oy
+            if 0 < dot < length2 and self._within_reach(b, cx, cy):
+                cross = rx * oy - ry * ox
+                if cross * cross < body2 * length2:
+                    return True
+        return False
+
+    def _within_reach(self, b: int, cx: float, cy: float) -> bool:
+        """Whether person b is within reach of the centre (cx, cy) (m), as ``rows`` decides it."""
+        ox, oy = cx - self.people[b][0], cy - self.people[b][1]
+        return ox * ox + oy * oy < self.model.reach_squared
+
+    def _neighbours_of(self, a: int) -> list[tuple[float, float, float, int]]:
+        """Everyone else as seen from person a, nearest first: (squared distance m^2, x and y from a to b in m, b).
+        Built on first use: most people never need it."""
+        if a not in self._neighbours:
+            ax, ay = self.people[a][0], self.people[a][1]
+            self._neighbours[a] = sorted(
+                ((bx - ax) * (bx - ax) + (by - ay) * (by - ay), bx - ax, by - ay, b)
+                for b, (bx, by, *_) in enumerate(self.people)
+                if b != a
             )
-            row.sort()
-        rows.append(row)
-    return rows
-
-
-def _blocked_small(
-    ox: float,
-    oy: float,
-    length2: float,
-    neighbours: list[tuple[float, float, float, int]],
-    listed: list[bool],
-    body2: float,
-) -> bool:
-    """``_blocked`` for one person and a centre (ox, oy) m away, length2 = ox^2 + oy^2: whether a ``listed`` person
-    among their ``neighbours`` stands between them within sqrt(``body2``) m of the segment. Such a person is nearer
-    than sqrt(length2 + body2): the search stops at the first one farther."""
-    bound = (length2 + body2) * (1.0 + _SLACK)
-    for distance2, rx, ry, b in neighbours:
-        if distance2 >= bound:
-            return False
-        dot = rx * ox + ry * oy
-        if listed[b] and 0 < dot < length2:
-            cross = rx * oy - ry * ox
-            if cross * cross < body2 * length2:
-                return True
-    return False
+        return self._neighbours[a]
 
 
 def _assign_small(rows: list[_Row], known: list[bool], price: float) -> list[int]:
-    """``_assign`` on rows: the candidate each person joins (-1 alone), by the same greedy passes."""
-    current = [price] * len(known)
+    """``_assign`` on rows: the candidate each person joins (-1 alone), by the same greedy passes.
+
+    Only candidates with a positive saving are followed from pass to pass: a saving never grows (the people's costs
+    only fall, and a sum of smaller or fewer non-negative gains rounds no larger), and a candidate without a positive
+    saving is never opened, nor the favourite of anyone whom a candidate with a positive saving serves."""
+    count = len(known)
+    current = [price] * count
     opened = [False] * len(rows)
-    openers = rows if all(known) else [[(j, c) for j, c in row if known[j]] for row in rows]
-    while True:
-        # (Gains added in order, not by the builtin ``sum``: it rounds differently from Python 3.12 on.)
-        savings = []
-        for row in openers:
+    openers = [entries for entries, _ in rows]
+    if not all(known):
+        openers = [[(j, c) for j, c in entries if known[j]] for entries in openers]
+    savings = [saving for _, saving in rows]
+    active = [k for k, saving in enumerate(savings) if saving > 0]
+    while active:
+        # Each person's favourite: the candidate of highest saving among those that lower their cost, then lowest.
+        # A candidate opens when it is the favourite of everyone it serves.
+        best, favourite, serves = [-math.inf] * count, [-1] * count, {}
+        for k in active:
+            saving, served = savings[k], 0
+            for j, c in openers[k]:
+                if c < current[j]:
+                    served += 1
+                    if saving > best[j]:
+                        best[j], favourite[j] = saving, k
+            serves[k] = served
+        for k in favourite:
+            if k >= 0:
+                serves[k] -= 1
+        for k in active:
+            if serves[k] == 0:
+                opened[k] = True
+                for j, c in openers[k]:
+                    if c < current[j]:
+                        current[j] = c
+        for k in active:
+            # (Gains added in order, not by the builtin ``sum``: it rounds differently from Python 3.12 on.)
             total = 0.0
-            for j, c in row:
+            for j, c in openers[k]:
                 if c < current[j]:
                     total += current[j] - c
-            savings.append(total - price)
-        if max(savings) <= 0:
-            break
-        # Each person's favourite: the candidate of highest saving among those that lower their cost, then lowest.
-        best, favourite = [-math.inf] * len(known), [-1] * len(known)
-        for k, row in enumerate(openers):
-            for j, c in row:
-                if c < current[j] and savings[k] > best[j]:
-                    best[j], favourite[j] = savings[k], k
-        accepted = [
-            k
-            for k, row in enumerate(openers)
-            if savings[k] > 0 and all(favourite[j] == k or c >= current[j] for j, c in row)
-        ]
-        for k in accepted:
-            opened[k] = True
-            for j, c in openers[k]:
-                current[j] = min(current[j], c)
-    return _cheapest_opened(rows, opened, len(known))
+            savings[k] = total - price
+        active = [k for k in active if savings[k] > 0]
+    return _cheapest_opened([entries for entries, _ in rows], opened, count)
 
 
-def _cheapest_opened(rows: list[_Row], opened: list[bool], count: int) -> list[int]:
+def _cheapest_opened(rows: list[list[tuple[int, float]]], opened: list[bool], count: int) -> list[int]:
     """For each of ``count`` people, the opened candidate of lowest cost in its row (ties: the lowest), -1 if none."""
     chosen = [-1] * count
     best = [math.inf] * count
@@ -462,8 +510,13 @@ def _refit_small(
     sums = [[0.0] * 6 for _ in radii]  # per group: w x, w y, w fx, w fy, w <p, f>, w
     for label, (x, y, fx, fy, w) in zip(labels, people, strict=True):
         if label >= 0:
-            for i, value in enumerate((x * w, y * w, fx * w, fy * w, (x * fx + y * fy) * w, w)):
-                sums[label][i] += value
+            group = sums[label]
+            group[0] += x * w
+            group[1] += y * w
+            group[2] += fx * w
+            group[3] += fy * w
+            group[4] += (x * fx + y * fy) * w
+            group[5] += w
     fitted = []
     for (px, py, fx, fy, pf, total), kept in zip(sums, radii, strict=True):
         f_norm = math.hypot(fx, fy)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import replace
 
@@ -11,7 +12,18 @@ import shapely
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from sid.perception.groups import GROUP_METHODS, Group, GroupParams, _convex_hull, _shoelace, detect_groups
+from sid.perception.groups import (
+    GROUP_METHODS,
+    Group,
+    GroupParams,
+    _convex_hull,
+    _member_crossings,
+    _ray_meetings,
+    _shoelace,
+    _spread,
+    _spreads,
+    detect_groups,
+)
 from sid.perception.people import Person
 
 RAYS = GroupParams(method="rays")
@@ -262,6 +274,40 @@ def test_a_hundred_people_in_one_crowd_are_grouped_circle_by_circle():
         people += circle(4, 0.8, centre=(2.4 * (k % 5), 2.4 * (k // 5)), start_deg=20, first_id=4 * k)
     groups = detect_groups(people)
     assert sorted(g.members for g in groups) == [tuple(range(4 * k, 4 * k + 4)) for k in range(25)]
+
+
+@pytest.mark.parametrize("seed", range(30))
+def test_the_ospace_zone_arithmetic_on_python_numbers_matches_the_numpy_one(seed):
+    # Groups of 2-8 members, random or on a grid with ties (face to face, parallel, crossing at a ray's end), some
+    # facings unknown: the same crossings, in the same order, to the last bit; the same spreads.
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(2, 20))
+    if seed % 2:
+        positions = (rng.uniform(0, 3, n) + 1j * rng.uniform(0, 3, n)).tolist()
+        angles = rng.uniform(-math.pi, math.pi, n)
+    else:
+        cells = rng.choice(16, n, replace=n > 16)
+        positions = [complex(0.75 * (c % 4), 0.75 * (c // 4)) for c in cells]
+        angles = rng.integers(0, 8, n) * math.pi / 4
+    facing = [complex(math.cos(a), math.sin(a)) if rng.random() > 0.15 else complex(math.nan, math.nan) for a in angles]
+    order = rng.permutation(n).tolist()
+    groups = []
+    while order:
+        size = int(rng.integers(2, 9))
+        groups.append(sorted(order[:size]))
+        order = order[size:]
+    crossings = _member_crossings(positions, facing, groups, RAYS)
+    for group, found in zip(groups, crossings, strict=True):
+        pairs = tuple(np.array(side, dtype=int) for side in zip(*itertools.combinations(group, 2), strict=True))
+        if not pairs:  # a single member
+            assert found == []
+            continue
+        meetings = _ray_meetings(np.array(positions), np.array(facing), RAYS, pairs)
+        assert found == meetings.points.tolist()
+    centres = [complex(*rng.uniform(0, 3, 2)) for _ in groups]
+    assert _spreads(positions, groups, centres) == [
+        _spread([positions[i] for i in group], centre) for group, centre in zip(groups, centres, strict=True)
+    ]
 
 
 # --- bad input --------------------------------------------------------------------------------------------------

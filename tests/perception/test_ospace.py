@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import cmath
 import math
 
 import numpy as np
@@ -14,16 +15,14 @@ from sid.perception.ospace import OSpaceModel, find_ospaces
 MODEL = GroupParams().ospace_model
 
 
-def arrays(people: list[tuple[float, float, float | None]]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    positions = np.array([complex(x, y) for x, y, _ in people])
-    facing = np.array(
-        [complex(math.cos(t), math.sin(t)) if t is not None else complex(np.nan, np.nan) for *_, t in people]
-    )
-    return positions, facing, np.ones(len(people))
+def inputs(people: list[tuple[float, float, float | None]]) -> tuple[list[complex], list[complex], list[float]]:
+    positions = [complex(x, y) for x, y, _ in people]
+    facing = [complex(math.cos(t), math.sin(t)) if t is not None else complex(np.nan, np.nan) for *_, t in people]
+    return positions, facing, [1.0] * len(people)
 
 
 def test_a_face_to_face_pair_gets_its_midpoint_and_half_its_distance():
-    [group] = find_ospaces(*arrays([(1.0, 2.0, 0.0), (2.2, 2.0, math.pi)]), MODEL)
+    [group] = find_ospaces(*inputs([(1.0, 2.0, 0.0), (2.2, 2.0, math.pi)]), MODEL)
     assert group.members.tolist() == [0, 1]
     assert group.centre == pytest.approx(complex(1.6, 2.0)) and group.radius == pytest.approx(0.6)
 
@@ -35,7 +34,7 @@ def test_each_group_fits_its_own_radius():
         for k in range(4):
             a = math.pi / 2 * k + 0.2
             people.append((centre + radius * math.cos(a), radius * math.sin(a), a + math.pi))
-    groups = find_ospaces(*arrays(people), MODEL)
+    groups = find_ospaces(*inputs(people), MODEL)
     assert [g.members.tolist() for g in groups] == [[0, 1, 2, 3], [4, 5, 6, 7]]
     assert [g.radius for g in groups] == pytest.approx([0.4, 0.75])
     assert [g.centre for g in groups] == pytest.approx([0j, 5 + 0j], abs=1e-9)
@@ -50,9 +49,9 @@ def test_the_crowd_path_gives_what_the_small_scene_path_gives(monkeypatch):
             a = 2 * math.pi * j / 3 + rng.normal(0, 0.2)
             x, y = cx + 0.7 * math.cos(a) + rng.normal(0, 0.05), cy + 0.7 * math.sin(a) + rng.normal(0, 0.05)
             people.append((x, y, math.atan2(cy - y, cx - x) + rng.normal(0, 0.3)))
-    crowd = find_ospaces(*arrays(people), MODEL)
+    crowd = find_ospaces(*inputs(people), MODEL)
     monkeypatch.setattr(ospace, "_SMALL_PEOPLE_MAX", 1000)
-    small = find_ospaces(*arrays(people), MODEL)
+    small = find_ospaces(*inputs(people), MODEL)
     assert [g.members.tolist() for g in crowd] == [g.members.tolist() for g in small]
     assert [g.centre for g in crowd] == pytest.approx([g.centre for g in small])
     assert len(crowd) >= 7
@@ -75,8 +74,8 @@ def test_nobody_joins_across_someone_standing_in_the_way(small: bool, monkeypatc
     # Three in a row facing along it: the middle one stands on the line from each end to any centre between them.
     monkeypatch.setattr(ospace, "_SMALL_PEOPLE_MAX", 1000 if small else 0)
     people = [(0.0, 0.0, 0.0), (0.6, 0.0, math.pi), (1.2, 0.0, math.pi)]
-    assert [g.members.tolist() for g in find_ospaces(*arrays(people), MODEL)] == [[0, 1]]
-    assert find_ospaces(*arrays([people[0], people[2]]), MODEL)[0].members.tolist() == [0, 1]
+    assert [g.members.tolist() for g in find_ospaces(*inputs(people), MODEL)] == [[0, 1]]
+    assert find_ospaces(*inputs([people[0], people[2]]), MODEL)[0].members.tolist() == [0, 1]
 
 
 # The groups the detector gave before it was made faster (members per seed of ``random_scene``): any change to the
@@ -109,7 +108,7 @@ EXPECTED_MEMBERS = [
 ]
 
 
-def random_scene(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def random_scene(seed: int) -> tuple[list[complex], list[complex], list[float]]:
     """2-30 people about 1.2 m apart, random facings (15 % unknown), half of them with a doubtful facing."""
     rng = np.random.default_rng(seed)
     n = int(rng.integers(2, 31))
@@ -118,7 +117,7 @@ def random_scene(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     facing = np.exp(1j * rng.uniform(-math.pi, math.pi, n))
     facing[rng.random(n) < 0.15] = complex(np.nan, np.nan)
     weight = np.where(rng.random(n) < 0.5, 1.0, 0.5 + 0.5 * rng.random(n))
-    return positions, facing, weight
+    return positions.tolist(), facing.tolist(), weight.tolist()
 
 
 @pytest.mark.parametrize("seed", range(len(EXPECTED_MEMBERS)))
@@ -127,7 +126,7 @@ def test_random_scenes_give_the_recorded_groups(seed: int) -> None:
 
 
 def test_two_people_without_facing_form_nothing():
-    assert find_ospaces(*arrays([(0.0, 0.0, None), (0.8, 0.0, None), (0.4, 0.5, -math.pi / 2)]), MODEL) == []
+    assert find_ospaces(*inputs([(0.0, 0.0, None), (0.8, 0.0, None), (0.4, 0.5, -math.pi / 2)]), MODEL) == []
 
 
 @pytest.mark.parametrize(
@@ -138,3 +137,119 @@ def test_bad_constants_are_refused_by_name(field, value):
     values = {"radius_min": 0.3, "radius_max": 0.8, "radius_steps": 4, "price": 0.65, "unknown_cost": 0.5}
     with pytest.raises(ValueError, match=f"ospace: {field}"):
         OSpaceModel(**(values | {"body_radius": 0.1, field: value}))
+
+
+def test_reach_squared_is_the_exact_threshold_of_the_rounded_root():
+    for model in (MODEL, GroupParams(radius_max=0.9, group_price=0.7).ospace_model):
+        bound = model.reach_squared
+        assert math.sqrt(bound) >= model.reach > math.sqrt(math.nextafter(bound, 0.0))
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_the_small_path_matches_a_direct_transcription_of_the_crowd_rules(seed: int) -> None:
+    # Rows and greedy passes written out plainly (no shortcuts: every row in every pass, every neighbour tested),
+    # on scenes small enough for the small path, with ties from a coarse grid in half of them.
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(2, 17))
+    if seed % 2:  # a 0.6 m grid, facings in steps of 45 degrees
+        cells = rng.choice(25, n, replace=False)
+        positions = [complex(0.6 * (c % 5), 0.6 * (c // 5)) for c in cells]
+        angles = rng.integers(0, 8, n) * math.pi / 4
+    else:
+        positions = (rng.uniform(0, 1.2 * math.sqrt(n), n) + 1j * rng.uniform(0, 1.2 * math.sqrt(n), n)).tolist()
+        angles = rng.uniform(-math.pi, math.pi, n)
+    facing = [complex(math.cos(a), math.sin(a)) if rng.random() > 0.15 else complex(math.nan, math.nan) for a in angles]
+    weight = rng.choice([1.0, 0.5, 0.75], n).tolist()
+    found = find_ospaces(positions, facing, weight, MODEL)
+    expected = plain_search(positions, facing, weight, MODEL)
+    assert [(g.members.tolist(), g.centre, g.radius) for g in found] == expected
+
+
+def plain_search(positions, facing, weight, model) -> list[tuple[list[int], complex, float]]:
+    """The small path's rounds with the rows and passes computed without any shortcut."""
+    known = [not cmath.isnan(f) for f in facing]
+    owners = [j for j, k in enumerate(known) if k]
+    if len(owners) < 2:
+        return []
+    facing = [f if k else 0j for f, k in zip(facing, known, strict=True)]
+    people = [
+        (p.real, p.imag, f.real, f.imag, w if k else 0.0)
+        for p, f, w, k in zip(positions, facing, weight, known, strict=True)
+    ]
+    radii = model.radii.tolist()
+    first = [(positions[o] + r * facing[o], r) for o in owners for r in radii]
+    first_owner = [o for o in owners for _ in radii]
+    candidates, labels = first, []
+    for _ in range(8):
+        previous = labels
+        rows = [plain_row(centre, radius, people, model) for centre, radius in candidates]
+        labels, behind = ospace._canonical(plain_assign(rows, known, model.price), known)
+        fitted = ospace._refit_small(labels, people, [candidates[k][1] for k in behind], model)
+        if labels == previous:
+            break
+        candidates = fitted + [first[k] for k, o in enumerate(first_owner) if labels[o] < 0]
+    return [
+        ([j for j, label in enumerate(labels) if label == g], centre, radius)
+        for g, (centre, radius) in enumerate(fitted)
+    ]
+
+
+def plain_row(centre, radius, people, model) -> list[tuple[int, float]]:
+    """(person, cost) of everyone who may join the candidate (centre, radius): within reach by the rounded root,
+    under the price by the general cost formula, and nobody listed in the way (every other person tested)."""
+    offsets = [(centre.real - x, centre.imag - y) for x, y, *_ in people]
+    listed = [math.sqrt(ox * ox + oy * oy) < model.reach for ox, oy in offsets]
+    row = []
+    for j, (px, py, fx, fy, w) in enumerate(people):
+        ox, oy = centre.real - px, centre.imag - py
+        length2 = ox * ox + oy * oy
+        if not listed[j]:
+            continue
+        dx, dy = radius * fx - ox, radius * fy - oy
+        radial = math.sqrt(length2) - radius
+        cost = w * (dx * dx + dy * dy) + (1.0 - w) * (radial * radial + model.unknown_cost**2)
+        blocked = False
+        for b, (bx, by, *_) in enumerate(people):
+            rx, ry = bx - px, by - py
+            dot, cross = rx * ox + ry * oy, rx * oy - ry * ox
+            if b != j and listed[b] and 0 < dot < length2 and cross * cross < model.body_radius**2 * length2:
+                blocked = True
+        if cost < model.price and not blocked:
+            row.append((j, cost))
+    return row
+
+
+def plain_assign(rows, known, price) -> list[int]:
+    """The greedy passes as the small path first wrote them: every row's saving and favourites in every pass."""
+    current, opened = [price] * len(known), [False] * len(rows)
+    openers = [[(j, c) for j, c in row if known[j]] for row in rows]
+    while True:
+        savings = []
+        for row in openers:
+            total = 0.0
+            for j, c in row:
+                if c < current[j]:
+                    total += current[j] - c
+            savings.append(total - price)
+        if max(savings) <= 0:
+            break
+        best, favourite = [-math.inf] * len(known), [-1] * len(known)
+        for k, row in enumerate(openers):
+            for j, c in row:
+                if c < current[j] and savings[k] > best[j]:
+                    best[j], favourite[j] = savings[k], k
+        accepted = [
+            k
+            for k, row in enumerate(openers)
+            if savings[k] > 0 and all(favourite[j] == k or c >= current[j] for j, c in row)
+        ]
+        for k in accepted:
+            opened[k] = True
+            for j, c in openers[k]:
+                current[j] = min(current[j], c)
+    chosen, cheapest = [-1] * len(known), [math.inf] * len(known)
+    for k, row in enumerate(rows):
+        for j, c in row if opened[k] else ():
+            if c < cheapest[j]:
+                cheapest[j], chosen[j] = c, k
+    return chosen
