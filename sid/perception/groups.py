@@ -234,30 +234,31 @@ def _ospace_groups(
     people: list[Person], ids: list[int], positions: list[complex], facing: list[complex], params: GroupParams
 ) -> list[Group]:
     """The o-space method's groups, each with the paper's zone geometry on its members' rays (see the module
-    docstring), or the fitted o-space centre when no two members' rays meet. On Python numbers but for the
-    products and distances whose rounding numpy decides (``_member_crossings``, ``_spreads``)."""
+    docstring), or the fitted o-space centre when no two members' rays meet. On Python numbers: a frame's groups
+    have a handful of members, for which numpy's overhead per call outweighs the work."""
     floor = params.facing_weight_floor
     weight = [floor + (1.0 - floor) * min(max(p.orientation_quality, 0.0), 1.0) for p in people]
     found = find_ospaces(positions, facing, weight, params.ospace_model)
     members = [ospace.members.tolist() for ospace in found]
-    zones = []
-    for ospace, crossings in zip(found, _member_crossings(positions, facing, members, params), strict=True):
+    groups = []
+    for ospace, group, crossings in zip(
+        found, members, _member_crossings(positions, facing, members, params), strict=True
+    ):
         if crossings:
-            zones.append(_zone(crossings))
+            area, centre, zone = _zone(crossings)
         else:  # no two members' rays meet: the fitted o-space centre
-            centre = ospace.centre
-            zones.append((0.0, centre, np.array([[centre.real, centre.imag]])))
-    spreads = _spreads(positions, members, [centre for _, centre, _ in zones])
-    return [
-        Group(
-            members=tuple(ids[i] for i in group),
-            interest_point=(centre.real, centre.imag),
-            area=area,
-            zone=zone,
-            spread=spread,
+            area, centre = 0.0, ospace.centre
+            zone = np.array([[centre.real, centre.imag]])
+        groups.append(
+            Group(
+                members=tuple(ids[i] for i in group),
+                interest_point=(centre.real, centre.imag),
+                area=area,
+                zone=zone,
+                spread=_spread([positions[i] for i in group], centre),
+            )
         )
-        for group, (area, centre, zone), spread in zip(members, zones, spreads, strict=True)
-    ]
+    return groups
 
 
 def _validated(people: list[Person]) -> tuple[list[int], list[complex], list[complex]]:
@@ -301,26 +302,30 @@ def _ray_meetings(
     params: GroupParams,
     pairs: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> _Meetings:
-    """Where the rays of each pair (all pairs unless given, i < j) meet (see the module docstring). 2D vectors are
-    complex numbers, so that conj(a) * b = dot(a, b) + i cross(a, b)."""
+    """Where the rays of each pair (all pairs unless given, i < j) meet (see the module docstring); positions and
+    facings are complex numbers x + iy. Dot and cross products are written out on the real parts: numpy's complex
+    products fuse multiply-adds on some CPUs, which would make the last bits depend on the machine and differ from
+    ``_member_crossings``' Python arithmetic."""
     i, j = _pairs(len(positions)) if pairs is None else pairs
     pi, pj, fi, fj = positions[i], positions[j], facing[i], facing[j]
-    d_conj = (pj - pi).conjugate()
+    d = pj - pi
+    dx, dy, fix, fiy, fjx, fjy = d.real, d.imag, fi.real, fi.imag, fj.real, fj.imag
     # Rays p_i + s f_i and p_j + t f_j meet where s f_i - t f_j = d = p_j - p_i: s = cross(d, f_j) / cross(f_i, f_j)
     # and t = cross(d, f_i) / cross(f_i, f_j); the segments meet when both lie in [0, ray_length].
-    denom = (fi.conjugate() * fj).imag
-    along_i = d_conj * fi
-    along_j = d_conj * fj
+    denom = fix * fjy - fiy * fjx
     half = 0.5 * params.ray_length
-    distance = np.abs(d_conj)
+    distance = np.abs(d)
     # Face to face: each looks at the other within the tolerance (dot(f, d) >= cos(tol) |d|).
     reach = math.cos(params.facing_tolerance) * distance
     with np.errstate(divide="ignore", invalid="ignore"):
-        s = along_j.imag / denom
-        t = along_i.imag / denom
+        s = (dx * fjy - dy * fjx) / denom
+        t = (dx * fiy - dy * fix) / denom
         crossing = (np.abs(denom) > _PARALLEL) & (np.maximum(np.abs(s - half), np.abs(t - half)) <= half)
-        points = np.where(crossing, pi + s * fi, 0.5 * (pi + pj))  # a face-to-face pair meets at its midpoint
-    face_to_face = (along_i.real >= reach) & (-along_j.real >= reach) & (distance > 0) & (distance <= 4 * half)
+        # A face-to-face pair meets at its midpoint.
+        points = np.where(crossing, pi + s * fi, 0.5 * (pi + pj))
+    facing_j = dx * fix + dy * fiy >= reach
+    facing_i = -(dx * fjx + dy * fjy) >= reach
+    face_to_face = facing_j & facing_i & (distance > 0) & (distance <= 4 * half)
     meet = crossing | face_to_face
     return _Meetings(i[meet], j[meet], points[meet])
 
@@ -329,37 +334,29 @@ def _member_crossings(
     positions: list[complex], facing: list[complex], groups: list[list[int]], params: GroupParams
 ) -> list[list[complex]]:
     """Per group (member indices into ``positions``), where its members' rays meet, pair by pair in the order of
-    ``itertools.combinations``: ``_ray_meetings`` on Python numbers, for the o-space method's few members.
-
-    The complex products and distances still go through numpy, one call for all groups: its SIMD loops fuse
-    multiply-adds, so Python's own products round differently in the last bit. The rest (divisions, comparisons,
-    points) rounds the same in both, and is cheaper here than numpy's overhead per call. A test checks that both
-    give the same points."""
-    pairs = [(k, i, j) for k, group in enumerate(groups) for i, j in itertools.combinations(group, 2)]
-    crossings: list[list[complex]] = [[] for _ in groups]
-    if not pairs:
-        return crossings
-    offsets = [(positions[j] - positions[i]).conjugate() for _, i, j in pairs]  # conj(p_j - p_i)
-    first, second = [facing[i] for _, i, _ in pairs], [facing[j] for _, _, j in pairs]
-    count = len(pairs)
-    # conj(d) f_i, conj(d) f_j and conj(f_i) f_j (see _ray_meetings), and |d|.
-    products = (
-        np.array(offsets + offsets + [f.conjugate() for f in first]) * np.array(first + second + second)
-    ).tolist()
-    distances = np.abs(np.array(offsets)).tolist()
+    ``itertools.combinations``: ``_ray_meetings`` on Python numbers, for the o-space method's few members (numpy's
+    overhead per call outweighs the work). The same operations in the same order, so the same bits; a test checks
+    it."""
     half = 0.5 * params.ray_length
     cos_tolerance = math.cos(params.facing_tolerance)
-    for n, (k, i, j) in enumerate(pairs):
-        along_i, along_j, denom = products[n], products[count + n], products[2 * count + n].imag
-        if abs(denom) > _PARALLEL:
-            s, t = along_j.imag / denom, along_i.imag / denom
-            if max(abs(s - half), abs(t - half)) <= half:
-                crossings[k].append(positions[i] + s * first[n])
-                continue
-        distance = distances[n]
-        reach = cos_tolerance * distance
-        if along_i.real >= reach and -along_j.real >= reach and 0 < distance <= 4 * half:
-            crossings[k].append(0.5 * (positions[i] + positions[j]))
+    crossings: list[list[complex]] = []
+    for group in groups:
+        found: list[complex] = []
+        for i, j in itertools.combinations(group, 2):
+            pi, fi, fj = positions[i], facing[i], facing[j]
+            d = positions[j] - pi
+            dx, dy, fix, fiy, fjx, fjy = d.real, d.imag, fi.real, fi.imag, fj.real, fj.imag
+            denom = fix * fjy - fiy * fjx
+            if abs(denom) > _PARALLEL:
+                s, t = (dx * fjy - dy * fjx) / denom, (dx * fiy - dy * fix) / denom
+                if max(abs(s - half), abs(t - half)) <= half:
+                    found.append(pi + s * fi)
+                    continue
+            distance = abs(d)
+            reach = cos_tolerance * distance
+            if dx * fix + dy * fiy >= reach and -(dx * fjx + dy * fjy) >= reach and 0 < distance <= 4 * half:
+                found.append(0.5 * (pi + positions[j]))
+        crossings.append(found)
     return crossings
 
 
@@ -431,22 +428,9 @@ def _zone(crossings: list[complex]) -> tuple[float, complex, np.ndarray]:
 
 
 def _spread(member_positions: list[complex], centre: complex) -> float:
-    """D (m): the mean distance of the members to ``centre``. In numpy, although the members are few: its complex
-    absolute value and sum round differently from Python's, and the ray methods' pruning compares these values."""
-    return float(np.abs(np.array(member_positions) - centre).sum() / len(member_positions))
-
-
-def _spreads(positions: list[complex], groups: list[list[int]], centres: list[complex]) -> list[float]:
-    """``_spread`` of each group (member indices into ``positions``) around its centre, the distances of all groups
-    in one numpy call (the same values and sums as ``_spread``'s)."""
-    offsets = [positions[i] - centre for group, centre in zip(groups, centres, strict=True) for i in group]
-    distances = np.abs(np.array(offsets, dtype=complex))
-    spreads = []
-    start = 0
-    for group in groups:
-        spreads.append(float(distances[start : start + len(group)].sum() / len(group)))
-        start += len(group)
-    return spreads
+    """D (m): the mean distance of the members to ``centre``, the distances summed exactly (``math.fsum``), so
+    that the value depends neither on the members' order nor on the machine."""
+    return math.fsum([abs(p - centre) for p in member_positions]) / len(member_positions)
 
 
 def _convex_hull(points: list[complex]) -> list[complex]:

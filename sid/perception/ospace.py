@@ -34,7 +34,6 @@ overhead per call would outweigh the work. Nothing depends on the input order ex
 
 from __future__ import annotations
 
-import cmath
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -78,6 +77,11 @@ class OSpaceModel:
         """The radii (m) of each person's first proposals, ``radius_steps`` evenly from ``radius_min`` to
         ``radius_max``."""
         return np.linspace(self.radius_min, self.radius_max, int(self.radius_steps))
+
+    @cached_property
+    def radius_list(self) -> list[float]:
+        """``radii`` as Python numbers."""
+        return self.radii.tolist()
 
     @cached_property
     def reach(self) -> float:
@@ -320,19 +324,23 @@ def _find_small(
     """``find_ospaces`` on Python numbers (positions and facings complex, NaN facing unknown): the crowd path's
     rounds and arithmetic (``_costs``, ``_assign``, ``_refit``) with each candidate's row kept as a list of the
     people who may join it. The first candidates' rows do not change between rounds: computed once."""
-    known = [not cmath.isnan(f) for f in facing]
-    owners = [j for j, k in enumerate(known) if k]
-    if len(owners) < 2:
+    known: list[bool] = []
+    people: list[_Person] = []
+    first: list[tuple[complex, float]] = []  # (centre, radius) of each known facing's first proposals
+    first_owner: list[int] = []
+    radii = model.radius_list
+    for j, (p, f, w) in enumerate(zip(positions, facing, weight, strict=True)):
+        if f == f:  # a known facing: a complex NaN is unequal to itself
+            known.append(True)
+            people.append((p.real, p.imag, f.real, f.imag, w))
+            first += [(p + r * f, r) for r in radii]
+            first_owner += [j] * len(radii)
+        else:
+            known.append(False)
+            people.append((p.real, p.imag, 0.0, 0.0, 0.0))
+    if len(first) < 2 * len(radii):
         return []
-    facing = [f if k else 0j for f, k in zip(facing, known, strict=True)]
-    people = [
-        (p.real, p.imag, f.real, f.imag, w if k else 0.0)
-        for p, f, w, k in zip(positions, facing, weight, known, strict=True)
-    ]
     scene = _SmallScene(people, known, model)
-    radii = model.radii.tolist()
-    first = [(positions[o] + r * facing[o], r) for o in owners for r in radii]
-    first_owner = [o for o in owners for _ in radii]
     first_rows = scene.rows(first)
     candidates, rows = first, first_rows
     labels: list[int] = []
