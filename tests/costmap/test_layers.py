@@ -12,7 +12,14 @@ from costmap.layer import LayerInputs
 from costmap.layered import LayeredCostmap
 from costmap.layers.inflation import InflationLayer, InflationParams, distance_to_lethal_cells
 from costmap.layers.obstacle import ObstacleLayer, ObstacleParams
-from costmap.layers.social import SocialLayer, SocialParams, group_zone_polygon
+from costmap.layers.social import (
+    SocialLayer,
+    SocialParams,
+    group_zone_polygon,
+    paint_group,
+    paint_person,
+    zone_hull,
+)
 from costmap.plugins import CostmapParams, layered_costmap
 from costmap.scan import LaserScan
 from sid.perception.groups import Group
@@ -305,6 +312,46 @@ def test_personal_space_is_larger_in_front_and_circular_without_orientation():
     assert left == right
     around = costmap.cost_at([[6.6, 0.0], [5.4, 0.0], [6.0, 0.6], [6.0, -0.6]])
     assert len(set(around.tolist())) == 1 and around[0] > 0
+
+
+@pytest.mark.parametrize("theta", [None, 0.0, 0.7, -2.9, np.pi / 2])
+def test_personal_space_is_the_float64_gaussian_to_one_cost_unit(theta):
+    # float32 and OpenCV's exp: never more than 1 unit from floor(amplitude exp(-(u^2 / 2 su^2 + v^2 / 2 sv^2)))
+    # in float64, and equal at all but a handful of cells.
+    params = SocialParams()
+    person = Person(1, 3.013, 0.487, theta)
+    costs = np.zeros(SPEC.shape, dtype=np.uint8)
+    window = paint_person(costs, SPEC, person, params)
+    assert window is not None
+    xs, ys = SPEC.cell_axes(window)
+    dx, dy = xs - person.x, ys - person.y
+    if theta is None:
+        exponent = -(dx**2 + dy**2) / (2 * params.sigma_unknown**2)
+    else:
+        u, v = np.cos(theta) * dx + np.sin(theta) * dy, np.cos(theta) * dy - np.sin(theta) * dx
+        sigma_u = np.where(u >= 0, params.sigma_front, params.sigma_rear)
+        exponent = -(u**2 / (2 * sigma_u**2) + v**2 / (2 * params.sigma_side**2))
+    expected = np.floor(params.amplitude * np.exp(exponent))
+    difference = np.abs(costs[window.slices].astype(int) - expected)
+    assert difference.max() <= 1 and np.count_nonzero(difference) <= 3
+    outside = np.ones(SPEC.shape, dtype=bool)
+    outside[window.slices] = False
+    assert not costs[outside].any() and expected[0].max() <= 1 and expected[:, 0].max() <= 1  # the window holds it
+
+
+def test_the_group_fall_off_is_the_float64_gaussian_of_the_distance_to_the_zone_to_one_cost_unit():
+    people, group = triad()
+    params = SocialParams()
+    hull = zone_hull(group, people)
+    costs = np.zeros(SPEC.shape, dtype=np.uint8)
+    window = paint_group(costs, SPEC, hull, params)
+    assert window is not None
+    xs, ys = SPEC.cell_axes(window)
+    distance = shapely.distance(hull, shapely.points(*np.broadcast_arrays(xs, ys)))
+    beyond = np.maximum(distance - params.group_margin, 0.0)
+    expected = np.floor(params.group_cost * np.exp(-(beyond**2) / (2 * params.group_sigma**2)))
+    difference = np.abs(costs[window.slices].astype(int) - expected)
+    assert difference.max() <= 1 and np.count_nonzero(difference) <= 3
 
 
 def test_social_layer_clips_people_outside_the_map():
