@@ -121,35 +121,37 @@ def _distance_to_hull(xs: np.ndarray, ys: np.ndarray, ring: np.ndarray, polygon:
     they bound a polygon.
 
     Written out in numpy rather than ``shapely.distance``, which needs a point object per cell, and one pass per
-    edge (keeping the running minimum) rather than all edges at once: both are faster (docs/parameters.md). The
-    per-edge arithmetic runs in preallocated buffers.
+    edge (keeping the running minimum) rather than all edges at once: both are faster (docs/parameters.md). Per
+    edge, in its own frame: t along it from its start, n across it (positive on the left, the inside of a
+    counter-clockwise ring); the squared distance to the segment is n^2 + (t - clip(t, 0, length))^2, and a point
+    is inside the polygon when n >= 0 for every edge. The arithmetic runs in preallocated buffers, in the offsets'
+    dtype (float32 from ``_local_axes``: Python floats do not promote it), within 1 cost unit of float64.
     """
     if len(ring) == 1:
         return np.hypot(xs - ring[0, 0], ys - ring[0, 1])
     shape = np.broadcast_shapes(np.shape(xs), np.shape(ys))
     dtype = np.result_type(xs, ys)
     best = np.full(shape, np.inf, dtype=dtype)
-    t, ox, oy = (np.empty(shape, dtype=dtype) for _ in range(3))
-    inside, side = np.ones(shape, dtype=bool), np.empty(shape, dtype=bool)
-    # Python floats keep the arithmetic in the offsets' dtype (float32 from ``_local_axes``; numpy float64 scalars
-    # would promote it): within 1 cost unit of float64, at 1-2 of 640,000 cells (docs/benchmarks.md).
+    least_across = np.full(shape, np.inf, dtype=dtype)
+    along, across, beyond = (np.empty(shape, dtype=dtype) for _ in range(3))
     for (ax, ay), (bx, by) in zip(ring[:-1].tolist(), ring[1:].tolist(), strict=True):
-        ex, ey = bx - ax, by - ay
+        length = math.hypot(bx - ax, by - ay)
+        if length < 1e-12:  # a repeated vertex (shapely's hulls have none): nothing to divide by
+            continue
+        ux, uy = (bx - ax) / length, (by - ay) / length
         dx, dy = xs - ax, ys - ay
-        if polygon:  # on the inner side of this counter-clockwise edge: ex * dy - ey * dx >= 0 (comparing the two
-            inside &= np.greater_equal(ex * dy, ey * dx, out=side)  # products is that test, without the subtraction)
-        np.add(dx * ex, dy * ey, out=t)
-        t /= max(ex * ex + ey * ey, 1e-18)
-        np.clip(t, 0.0, 1.0, out=t)
-        np.subtract(dx, np.multiply(t, ex, out=ox), out=ox)
-        np.subtract(dy, np.multiply(t, ey, out=oy), out=oy)
-        ox *= ox
-        oy *= oy
-        ox += oy
-        np.minimum(best, ox, out=best)
+        np.add(dx * ux, dy * uy, out=along)
+        np.subtract(dy * ux, dx * uy, out=across)
+        if polygon:
+            np.minimum(least_across, across, out=least_across)
+        np.clip(along, 0.0, length, out=beyond)
+        np.subtract(along, beyond, out=beyond)
+        np.square(across, out=across)
+        across += np.square(beyond, out=beyond)
+        np.minimum(best, across, out=best)
     distance = np.sqrt(best, out=best)
     if polygon:
-        distance[inside] = 0.0
+        distance[least_across >= 0] = 0.0
     return distance
 
 
