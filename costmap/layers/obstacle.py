@@ -9,7 +9,10 @@ beam's hit. Beams with no return (``inf``) clear out to ``raytrace_max_range`` w
 Lines are traced with a rounded DDA over integer cells (one cell per step along the major axis: the cells of
 Bresenham's algorithm up to tie-breaking), for all beams at once in numpy rather than cell by cell (line drawing
 in OpenCV or scikit-image draws one line per call, 720 Python calls per scan). The layer keeps each beam's cells
-and, while the sensor stays in its cell, traces again only the beams whose end cell moved (``_BeamCells``).
+and how many beams cross each cell and, while the sensor stays in its cell, traces again only the beams whose end
+cell moved (``_BeamCells``). It writes only what clearing every beam would change: the cells of those beams, and the
+last scan's hits that some beam now crosses (every other beam cell was cleared by the last scan already); a test
+checks the grid against clearing every beam.
 
 Each update reports the window of the cells whose value changed, not the window the scan covers: a scan of a scene
 that did not change (people's marks aside, which are cleared) makes the costmap recombine nothing.
@@ -23,7 +26,7 @@ from typing import NamedTuple
 import numpy as np
 
 from costmap.combine import CombinationMethod
-from costmap.grid import FREE_SPACE, LETHAL, NO_INFORMATION, GridSpec, Window, changed_window, nonzero_cells, union
+from costmap.grid import FREE_SPACE, LETHAL, NO_INFORMATION, GridSpec, Window, nonzero_cells
 from costmap.layer import Layer, LayerInputs
 from costmap.scan import LaserScan
 from sid.checks import check_number, check_numbers
@@ -94,9 +97,15 @@ _PAIRS_PER_CHUNK = 2**20
 """``clear_discs`` tests at most this many (mark, person) pairs at once (a few MB of float64)."""
 
 
+_ONE = np.int32(1)
+"""The coverage counts' step: a numpy scalar of their dtype keeps ``np.add.at`` on its fast path (a Python int is
+~30x slower)."""
+
+
 class _BeamCells:
-    """The cells the last scan's beams crossed, kept beam by beam, so that the next scan from the same cell traces
-    only the beams whose end cell moved (a line's cells depend only on its two end cells)."""
+    """The cells the current scan's beams cross, kept beam by beam, and how many beams cross each cell. A new scan
+    from the same sensor cell traces again only the beams whose end cell moved (a line's cells depend only on its
+    two end cells)."""
 
     def __init__(self, spec: GridSpec) -> None:
         self.spec = spec
@@ -104,34 +113,39 @@ class _BeamCells:
         self.delta = np.zeros((0, 2), dtype=np.int64)  # (M, 2) end cell - sensor cell, by beam
         self.flat = np.zeros((0, 0), dtype=np.int64)  # (M, n) as ``_trace_lines``
         self.keep = np.zeros((0, 0), dtype=bool)
+        self.coverage = np.zeros(spec.width * spec.height, dtype=np.int32)  # beams crossing each cell (flat index)
 
-    def cells(self, origin: np.ndarray, ends: np.ndarray) -> np.ndarray:
-        """Flat indices of the cells on the lines origin -> ends (world, (M, 2), finite), end cells excluded, in the
-        grid: ``trace_cells``'s cells, in the same order."""
+    def update(self, origin: np.ndarray, ends: np.ndarray) -> np.ndarray:
+        """Take the lines origin -> ends (world, (M, 2), finite) as the current beams; returns the flat indices of
+        the cells of the beams traced again (``trace_cells``' cells of those beams, end cells excluded)."""
         c0 = self.spec.world_to_cell(origin)[0]
         delta = self.spec.world_to_cell(ends) - c0
         if np.array_equal(c0, self.origin) and delta.shape == self.delta.shape:
             redo = np.flatnonzero((delta != self.delta).any(axis=1))
+            np.subtract.at(self.coverage, self.flat[redo][self.keep[redo]], _ONE)
         else:
             redo = np.arange(len(delta))
+            self.coverage[:] = 0
             self.flat = np.zeros((len(delta), 0), dtype=np.int64)
             self.keep = np.zeros((len(delta), 0), dtype=bool)
         n = _longest(delta[redo])
         if n > self.flat.shape[1]:  # longer lines than any kept: widen (the new steps are off every line)
             grow = ((0, 0), (0, n - self.flat.shape[1]))
             self.flat, self.keep = np.pad(self.flat, grow), np.pad(self.keep, grow)
-        self.flat[redo], self.keep[redo] = _trace_lines(self.spec, c0, delta[redo], self.flat.shape[1])
+        flat, keep = _trace_lines(self.spec, c0, delta[redo], self.flat.shape[1])
+        self.flat[redo], self.keep[redo] = flat, keep
         self.origin, self.delta = c0, delta
-        return self.flat[self.keep]
+        traced = flat[keep]
+        np.add.at(self.coverage, traced, _ONE)
+        return traced
 
 
 class _ScanMarks(NamedTuple):
-    """What one scan writes: the cells its beams clear (flat indices), the cells its hits mark LETHAL ((K, 2) as
-    (row, col)), and a window holding both."""
+    """What one scan writes (flat cell indices): the cells to clear (those of the beams traced again, and the last
+    scan's hits that a beam now crosses) and the cells its hits mark LETHAL."""
 
     cleared: np.ndarray
     hits: np.ndarray
-    window: Window
 
 
 class ObstacleLayer(Layer):
@@ -153,6 +167,8 @@ class ObstacleLayer(Layer):
         super().__init__(spec, self.params.default_value)
         self.people_clear_radius = float(people_clear_radius)
         self._beams = _BeamCells(spec)
+        self._hits = np.zeros(0, dtype=np.int64)  # the last scan's hit cells (flat indices)
+        self._written = np.zeros(spec.width * spec.height, dtype=bool)  # scratch: the cells a scan wrote
 
     def update(self, inputs: LayerInputs, changed: Window | None) -> Window | None:
         """Apply the scan (if any), then clear the people's marks; returns the window of the cells whose value
@@ -168,21 +184,29 @@ class ObstacleLayer(Layer):
 
     def _apply(self, scan: _ScanMarks | None, people: np.ndarray) -> Window | None:
         """Write a scan's marks (if any), then clear the marks within ``people_clear_radius`` of the people (world,
-        (N, 2)); returns the window of the cells whose value changed (compared with a copy of the cells written)."""
-        discs = self._discs_window(people, self.people_clear_radius)
-        touched = union(None if scan is None else scan.window, discs)
-        if touched is None:
-            return None
-        before = self.costs[touched.slices].copy()
+        (N, 2)); returns the window of the cells whose value changed (their values before and after compared)."""
+        flat = self.costs.ravel()
+        written = np.zeros(0, dtype=np.int64)
         if scan is not None:
-            self.costs.ravel()[scan.cleared] = FREE_SPACE
-            self.costs[scan.hits[:, 0], scan.hits[:, 1]] = LETHAL
-        if discs is not None:
-            self.clear_discs(people, self.people_clear_radius)
-        return changed_window(before, self.costs[touched.slices], touched)
+            written = np.concatenate((scan.cleared, scan.hits))
+            before = flat[written]
+            flat[scan.cleared] = FREE_SPACE
+            flat[scan.hits] = LETHAL
+            self._hits = scan.hits
+        freed = self.clear_discs(people, self.people_clear_radius) if len(people) else written[:0]
+        if scan is not None:  # freed cells the scan wrote: compared with their value before it, as the others
+            self._written[written] = True
+            freed = freed[~self._written[freed]]
+            self._written[written] = False
+            written = written[flat[written] != before]
+        return _cells_window(np.concatenate((written, freed)), self.spec.width)
 
     def _scan_marks(self, scan: LaserScan) -> _ScanMarks:
-        """What a scan writes (nothing written yet)."""
+        """What a scan writes (nothing written yet; the beams' cells are taken as the current ones).
+
+        Clearing every beam's cells and then marking the hits, as Nav2 does, leaves the cells of a beam that did not
+        move FREE already (the last scan cleared them) but for the last scan's hits that such a beam crosses: only
+        those, and the cells of the beams traced again, are written."""
         p = self.params
         origin = np.asarray(scan.pose[:2])
         if not self.spec.contains(origin[None])[0]:
@@ -195,33 +219,45 @@ class ObstacleLayer(Layer):
         ends = origin + dirs[clearing] * clear_len[:, None]
         with np.errstate(invalid="ignore"):
             marking = np.isfinite(r) & (r >= p.obstacle_min_range) & (r <= p.obstacle_max_range)
-        hit_xy = origin + dirs[marking] * r[marking, None]
-        hits = self.spec.world_to_cell(hit_xy)
-        window = self.spec.window_around(np.vstack([origin[None], ends, hit_xy]))
-        assert window is not None  # it holds the sensor, which is inside the grid
-        return _ScanMarks(self._beams.cells(origin, ends), hits[self.spec.in_bounds(hits)], window)
+        hits = self.spec.world_to_cell(origin + dirs[marking] * r[marking, None])
+        hits = hits[self.spec.in_bounds(hits)]
+        traced = self._beams.update(origin, ends)
+        crossed = self._hits[self._beams.coverage[self._hits] > 0]
+        return _ScanMarks(np.concatenate((traced, crossed)), hits[:, 0] * self.spec.width + hits[:, 1])
 
-    def clear_discs(self, centres: np.ndarray, radius: float) -> None:
-        """Turn LETHAL marks whose cell centre lies within ``radius`` metres of any centre (N, 2) into FREE.
+    def clear_discs(self, centres: np.ndarray, radius: float) -> np.ndarray:
+        """Turn LETHAL marks whose cell centre lies within ``radius`` metres of any centre (N, 2) into FREE; returns
+        their flat indices.
 
         Only the marks are tested (against every centre at once): there are few, and discs are many small windows.
         """
         centres = np.asarray(centres, dtype=float).reshape(-1, 2)
         window = self._discs_window(centres, radius)
         if window is None:
-            return
+            return np.zeros(0, dtype=np.int64)
         view = self.costs[window.slices]
         rows, cols = nonzero_cells(view == LETHAL)
         xs, ys = self.spec.cell_axes(window)
         chunk = max(1, _PAIRS_PER_CHUNK // len(centres))  # (marks, centres) pairs at a time: memory stays bounded
+        freed = []
         for start in range(0, len(rows), chunk):
             r, c = rows[start : start + chunk], cols[start : start + chunk]
             dx, dy = xs[0, c, None] - centres[:, 0], ys[r, 0, None] - centres[:, 1]  # (marks, centres)
             inside = (dx**2 + dy**2 <= radius**2).any(axis=1)
             view[r[inside], c[inside]] = FREE_SPACE
+            freed.append((r[inside] + window.row0) * self.spec.width + c[inside] + window.col0)
+        return np.concatenate(freed) if freed else np.zeros(0, dtype=np.int64)
 
     def _discs_window(self, centres: np.ndarray, radius: float) -> Window | None:
         """The cells of the bounding box of discs of ``radius`` metres around world centres (N, 2); None: none."""
         if len(centres) == 0:
             return None
         return self.spec.window(tuple(centres.min(axis=0) - radius), tuple(centres.max(axis=0) + radius))
+
+
+def _cells_window(cells: np.ndarray, width: int) -> Window | None:
+    """The smallest window holding the cells of flat indices ``cells`` (a grid ``width`` cells wide); None: none."""
+    if len(cells) == 0:
+        return None
+    rows, cols = np.divmod(cells, width)
+    return Window(int(rows.min()), int(rows.max()) + 1, int(cols.min()), int(cols.max()) + 1)

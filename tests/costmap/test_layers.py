@@ -223,18 +223,66 @@ def test_lidar_layer_respects_obstacle_and_raytrace_ranges():
     assert (row[10:69] == FREE_SPACE).all() and (row[75:] == NO_INFORMATION).all()
 
 
-def test_lidar_layer_retraces_only_moved_beams_and_gives_the_cells_of_a_fresh_trace():
+def test_lidar_layer_retraces_only_moved_beams_and_counts_the_beams_of_a_fresh_trace():
     from costmap.layers.obstacle import trace_cells
 
     rng = np.random.default_rng(3)
     layer = ObstacleLayer(SPEC)
     origin = np.array([4.0, 0.0])
     ends = origin + rng.normal(0.0, 4.0, (360, 2))
-    for _ in range(6):  # some beams move their end cell, one scan gets longer, then the sensor moves
-        ends[rng.random(len(ends)) < 0.2] += rng.normal(0.0, 0.3, 2)
-        np.testing.assert_array_equal(layer._beams.cells(origin, ends), trace_cells(SPEC, origin, ends))
+    for step in range(6):  # some beams move their end cell, one scan gets longer, then the sensor moves
+        moved = rng.random(len(ends)) < 0.2
+        ends[moved] += rng.normal(0.0, 0.3, 2)
+        traced = layer._beams.update(origin, ends)
+        fresh = trace_cells(SPEC, origin, ends)
+        counts = np.bincount(fresh, minlength=SPEC.width * SPEC.height)
+        np.testing.assert_array_equal(layer._beams.coverage, counts)
+        assert np.isin(traced, fresh).all() and (step == 0 or len(traced) < len(fresh))
         ends[0] = origin + (20.0, 0.5)
         origin = origin + (0.01, 0.0)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_lidar_layer_writes_what_clearing_every_beam_then_marking_would(seed):
+    # Nav2's order written out plainly (every beam cleared, then every hit marked, then the people's marks cleared)
+    # against the layer's incremental writes, over scans where people walk and the sensor sometimes moves.
+    from costmap.layers.obstacle import trace_cells
+
+    rng = np.random.default_rng(seed)
+    walls = [SegmentObstacle(((-1.0, 2.5), (9.0, 2.5))), SegmentObstacle(((8.0, -3.5), (8.0, 3.5)))]
+    layer = ObstacleLayer(SPEC, ObstacleParams(track_unknown_space=bool(seed % 2)), people_clear_radius=0.3)
+    expected = np.full(SPEC.shape, layer.costs[0, 0])
+    people = [Person(k, x, y, 0.0) for k, (x, y) in enumerate(rng.uniform((1.0, -2.0), (7.0, 2.0), (4, 2)))]
+    pose = (0.0, 0.0, 0.0)
+    for step in range(12):
+        if step % 5 == 4:
+            pose = (pose[0] + 0.3, pose[1] + 0.1, pose[2])
+        people = [Person(p.id, p.x + rng.normal(0, 0.05), p.y + rng.normal(0, 0.05), 0.0) for p in people]
+        scan = simulate_scan(pose, walls, people, beams=360, range_max=10.0)
+        before = layer.costs.copy()
+        window = layer.update(LayerInputs(people, (), scan), None)
+        r = scan.valid_ranges()  # no return (inf): cleared to the 10 m raytrace range, not marked
+        origin = np.array(pose[:2])
+        clear_to = np.where(np.isinf(r), 10.0, r)
+        ends = origin + scan.directions * clear_to[:, None]
+        hits = SPEC.world_to_cell(ends[np.isfinite(r)])
+        hits = hits[SPEC.in_bounds(hits)]
+        expected.ravel()[trace_cells(SPEC, origin, ends)] = FREE_SPACE
+        expected[hits[:, 0], hits[:, 1]] = LETHAL
+        xs, ys = SPEC.cell_centres()
+        near = np.zeros(SPEC.shape, dtype=bool)
+        for p in people:
+            near |= np.hypot(xs - p.x, ys - p.y) <= 0.3
+        expected[near & (expected == LETHAL)] = FREE_SPACE
+        np.testing.assert_array_equal(layer.costs, expected)
+        changed = np.argwhere(before != layer.costs)
+        if window is None:
+            assert len(changed) == 0
+        else:  # the smallest window holding every changed cell
+            assert (changed.min(axis=0).tolist(), (changed.max(axis=0) + 1).tolist()) == (
+                [window.row0, window.col0],
+                [window.row1, window.col1],
+            )
 
 
 def test_lidar_layer_reports_only_what_changed():
