@@ -8,8 +8,10 @@ continuous *edge* coordinates of their input (0 = the left edge of the first pix
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cached_property, lru_cache
 from typing import Protocol, runtime_checkable
 
 import cv2
@@ -68,8 +70,8 @@ class Letterbox:
         """A square crop centred on ``box`` (u_min, v_min, u_max, v_max; pixels), its side ``expand`` times the
         box's longer side, scaled to fill the input. Parts of the crop outside the image are padding."""
         in_h, in_w = _size(input_hw, "input")
-        u0, v0, u1, v1 = (float(x) for x in np.asarray(box, dtype=float).reshape(4))
-        if not np.all(np.isfinite([u0, v0, u1, v1])) or u1 <= u0 or v1 <= v0:
+        u0, v0, u1, v1 = np.asarray(box, dtype=float).reshape(4).tolist()
+        if not all(map(math.isfinite, (u0, v0, u1, v1))) or u1 <= u0 or v1 <= v0:
             raise ValueError(f"letterbox: box must be finite with u_max > u_min and v_max > v_min, got {box}")
         if not expand > 0:
             raise ValueError(f"letterbox: expand must be positive, got {expand}")
@@ -91,9 +93,25 @@ class Letterbox:
 
     def normalised_to_image(self, xy: np.ndarray) -> np.ndarray:
         """Model outputs normalised to the input, (..., 2) as (x, y) in [0, 1] -> image pixels (u, v)."""
+        return self.normalised_to_image_in_place(np.array(xy, dtype=float))
+
+    def normalised_to_image_in_place(self, xy: np.ndarray) -> np.ndarray:
+        """``normalised_to_image`` of a float64 array (..., 2), overwriting it; returns it.
+
+        The same four operations, without temporaries: a decoder's arrays are small, so the call count is its cost.
+        """
+        size, pad = self._input_terms
+        xy *= size
+        xy -= pad
+        xy /= self.scale
+        xy -= 0.5
+        return xy
+
+    @cached_property
+    def _input_terms(self) -> tuple[np.ndarray, np.ndarray]:
+        """Input (width, height) and (pad_x, pad_y) in model-input pixels, as arrays built once per letterbox."""
         in_h, in_w = self.input_size
-        xy = np.asarray(xy, dtype=float)
-        return (xy * np.array([in_w, in_h]) - np.array([self.pad_x, self.pad_y])) / self.scale - 0.5
+        return np.array([in_w, in_h], dtype=float), np.array([self.pad_x, self.pad_y])
 
     def matrix(self) -> np.ndarray:
         """2x3 affine matrix of ``to_input`` (pixel-centre convention), as ``cv2.warpAffine`` takes it."""
@@ -110,27 +128,57 @@ class Letterbox:
         shrinks to fill whole pixels of the input exactly (640x480 into 256x256: 256x192 at scale 0.4, 32-pixel bands),
         ``cv2.resize`` samples at the same positions and is 2-3x faster (0.14 against 0.41 ms here, busy machine);
         its fixed-point weights round differently, by at most one grey level (6 % of the pixels of the real
-        five-people frame), and then ``cv2.copyMakeBorder`` pads.
+        five-people frame). It then resizes straight into the new input array, of which only the bands are filled.
         """
         in_h, in_w = self.input_size
-        h, w = color.shape[:2]
-        size = (self.scale * w, self.scale * h)
-        # Shrinking only: upscaling samples beyond the edge pixels' centres, where warpAffine blends ``fill`` in.
-        exact_fit = all(float(v).is_integer() for v in (*size, self.pad_x, self.pad_y)) and self.scale <= 1
-        inside = min(self.pad_x, self.pad_y) >= 0 and self.pad_x + size[0] <= in_w and self.pad_y + size[1] <= in_h
-        if exact_fit and inside:
-            resized = cv2.resize(color, (int(size[0]), int(size[1])), interpolation=cv2.INTER_LINEAR)
-            top, left = int(self.pad_y), int(self.pad_x)
-            bottom, right = in_h - top - int(size[1]), in_w - left - int(size[0])
-            return cv2.copyMakeBorder(resized, top, bottom, left, right, cv2.BORDER_CONSTANT, value=(fill, fill, fill))
-        return cv2.warpAffine(
-            color,
-            self.matrix(),
-            (in_w, in_h),
-            flags=cv2.INTER_LINEAR,
-            borderMode=cv2.BORDER_CONSTANT,
-            borderValue=(fill, fill, fill),
-        )
+        resize = _resize_plan(self, *color.shape[:2])
+        if resize is None:
+            return cv2.warpAffine(
+                color,
+                self.matrix(),
+                (in_w, in_h),
+                flags=cv2.INTER_LINEAR,
+                borderMode=cv2.BORDER_CONSTANT,
+                borderValue=(fill, fill, fill),
+            )
+        width, height = resize
+        top, left = int(self.pad_y), int(self.pad_x)
+        bottom, right = top + height, left + width
+        # Cheaper than a resize into its own array and then cv2.copyMakeBorder: one pass, one allocation.
+        out = np.empty((in_h, in_w, *color.shape[2:]), np.uint8)
+        if top > 0:
+            out[:top] = fill
+        if bottom < in_h:
+            out[bottom:] = fill
+        if left > 0:
+            out[top:bottom, :left] = fill
+        if right < in_w:
+            out[top:bottom, right:] = fill
+        inner = out[top:bottom, left:right]
+        written = cv2.resize(color, (width, height), dst=inner, interpolation=cv2.INTER_LINEAR)
+        if written is not inner:  # OpenCV's binding wrote a copy instead (never seen with these strides)
+            inner[...] = written
+        return out
+
+
+@lru_cache(maxsize=64)
+def _resize_plan(letterbox: Letterbox, h: int, w: int) -> tuple[int, int] | None:
+    """The resized (width, height) when an image of ``h`` x ``w`` pixels shrinks onto whole input pixels inside
+    the input (``Letterbox.warp`` may then resize and pad), else None (it needs ``cv2.warpAffine``). Cached: the
+    same letterbox serves every frame of a camera."""
+    in_h, in_w = letterbox.input_size
+    scale, pad_x, pad_y = letterbox.scale, letterbox.pad_x, letterbox.pad_y
+    width, height = scale * w, scale * h
+    # Shrinking only: upscaling samples beyond the edge pixels' centres, where warpAffine blends ``fill`` in.
+    exact_fit = all(float(v).is_integer() for v in (width, height, pad_x, pad_y)) and scale <= 1
+    inside = min(pad_x, pad_y) >= 0 and pad_x + width <= in_w and pad_y + height <= in_h
+    return (int(width), int(height)) if exact_fit and inside else None
+
+
+@lru_cache(maxsize=64)
+def fit_letterbox(image_hw: tuple[int, ...], input_hw: tuple[int, ...]) -> Letterbox:
+    """``Letterbox.fit``, built once per (image size, input size) pair: a camera's frames all share one."""
+    return Letterbox.fit(image_hw, input_hw)
 
 
 def check_color_image(color_rgb: np.ndarray) -> np.ndarray:
@@ -160,13 +208,12 @@ def check_boxes(boxes: np.ndarray | Sequence[Sequence[float]]) -> np.ndarray:
     return boxes
 
 
-def clip_boxes(boxes: np.ndarray, image_hw: Sequence[int]) -> np.ndarray:
-    """Clip (N, 4) boxes to the image's outer edge, -0.5 .. size - 0.5 (pixel-centre convention)."""
+def clip_corners(corners: np.ndarray, image_hw: Sequence[int]) -> None:
+    """Clip box corners (..., 2) as (u, v), in place, to the image's outer edge: -0.5 .. size - 0.5 (pixel-centre
+    convention)."""
     h, w = image_hw
-    out = boxes.copy()
-    out[:, [0, 2]] = np.clip(out[:, [0, 2]], -0.5, w - 0.5)
-    out[:, [1, 3]] = np.clip(out[:, [1, 3]], -0.5, h - 0.5)
-    return out
+    np.maximum(corners, -0.5, out=corners)  # np.clip's Python wrapper costs more than these two ufunc calls
+    np.minimum(corners, (w - 0.5, h - 0.5), out=corners)
 
 
 def _size(hw: Sequence[int], what: str) -> tuple[int, int]:

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from sid.perception.keypoints import NUM_KEYPOINTS, PoseDetection
-from sid.perception.pose.base import Letterbox, check_boxes, check_color_image, clip_boxes
+from sid.perception.pose.base import Letterbox, check_boxes, check_color_image, clip_corners, fit_letterbox
 from sid.perception.pose.contracts import MOVENET_MULTIPOSE, MOVENET_SINGLEPOSE, fixed_hw
 from sid.perception.pose.session import OnnxModel
 
@@ -58,21 +58,26 @@ def multipose_input_size(image_hw: Sequence[int], size: MultiPoseSize = MULTIPOS
 
 
 def _keep_only_box(image: np.ndarray, letterbox: Letterbox, box: Sequence[float], margin: float) -> np.ndarray:
-    """Set to the pad value every model-input pixel outside ``box`` grown by ``margin`` x its size on each side."""
-    u0, v0, u1, v1 = np.asarray(box, dtype=float)
-    grow = margin * np.array([u1 - u0, v1 - v0])
-    (c0, r0), (c1, r1) = letterbox.to_input(np.array([[u0, v0] - grow, [u1, v1] + grow]))
+    """Set to the pad value, in place, every model-input pixel outside ``box`` grown by ``margin`` x its size on
+    each side; returns ``image``."""
+    u0, v0, u1, v1 = (float(x) for x in box)
+    grow_u, grow_v = margin * (u1 - u0), margin * (v1 - v0)
+    # letterbox.to_input of the grown corners, on Python floats (the same operations, no small arrays)
+    c0, c1 = ((u + 0.5) * letterbox.scale + letterbox.pad_x - 0.5 for u in (u0 - grow_u, u1 + grow_u))
+    r0, r1 = ((v + 0.5) * letterbox.scale + letterbox.pad_y - 0.5 for v in (v0 - grow_v, v1 + grow_v))
     in_h, in_w = image.shape[:2]
-    c0, r0 = (int(np.clip(np.ceil(x), 0, n)) for x, n in ((c0, in_w), (r0, in_h)))
-    c1, r1 = (int(np.clip(np.floor(x) + 1, 0, n)) for x, n in ((c1, in_w), (r1, in_h)))
-    out = np.full_like(image, PAD_VALUE)
-    out[r0:r1, c0:c1] = image[r0:r1, c0:c1]
-    return out
+    c0, r0 = (min(max(math.ceil(x), 0), n) for x, n in ((c0, in_w), (r0, in_h)))
+    c1, r1 = (min(max(math.floor(x) + 1, 0), n) for x, n in ((c1, in_w), (r1, in_h)))
+    image[:r0] = PAD_VALUE
+    image[r1:] = PAD_VALUE
+    image[r0:r1, :c0] = PAD_VALUE
+    image[r0:r1, c1:] = PAD_VALUE
+    return image
 
 
-def _keypoints_yx(yx_score: np.ndarray, letterbox: Letterbox) -> tuple[np.ndarray, np.ndarray]:
-    """(..., 17, 3) normalised (y, x, score) -> keypoints (..., 17, 2) as image (u, v), scores (..., 17)."""
-    return letterbox.normalised_to_image(yx_score[..., 1::-1]), yx_score[..., 2]
+def _corners_yx(rows: np.ndarray) -> np.ndarray:
+    """MoveNet's box (ymin, xmin, ymax, xmax) per row (..., 4) -> its two corners (..., 2, 2) as (x, y)."""
+    return rows.reshape(*rows.shape[:-1], 2, 2)[..., ::-1]
 
 
 class MoveNetMultiPose:
@@ -109,7 +114,7 @@ class MoveNetMultiPose:
     def preprocess(self, color_rgb: np.ndarray) -> tuple[np.ndarray, Letterbox]:
         """RGB uint8 image -> int32 [1, H, W, 3] input tensor and the letterbox that made it."""
         color_rgb = check_color_image(color_rgb)
-        letterbox = Letterbox.fit(color_rgb.shape[:2], self.input_size_for(color_rgb.shape[:2]))
+        letterbox = fit_letterbox(color_rgb.shape[:2], self.input_size_for(color_rgb.shape[:2]))
         return letterbox.warp(color_rgb, PAD_VALUE)[None].astype(np.int32), letterbox
 
     def infer(self, tensor: np.ndarray) -> np.ndarray:
@@ -120,11 +125,17 @@ class MoveNetMultiPose:
         rows = output.reshape(-1, 56)
         rows = rows[rows[:, 55] >= self.score_threshold]
         rows = rows[np.argsort(-rows[:, 55], kind="stable")]
-        keypoints, scores = _keypoints_yx(rows[:, :51].reshape(-1, NUM_KEYPOINTS, 3), letterbox)
-        # Box (ymin, xmin, ymax, xmax) normalised -> two corners (x, y) -> image pixels.
-        corners = letterbox.normalised_to_image(rows[:, [52, 51, 54, 53]].reshape(-1, 2, 2)).reshape(-1, 4)
-        boxes = clip_boxes(corners, image_hw)
-        return [PoseDetection(k, s, b, r) for k, s, b, r in zip(keypoints, scores, boxes, rows[:, 55], strict=True)]
+        # Each person's 17 keypoints and two box corners go through one map to image pixels, all people at once.
+        points = np.empty((len(rows), NUM_KEYPOINTS + 2, 2))
+        points[:, :NUM_KEYPOINTS] = rows[:, :51].reshape(-1, NUM_KEYPOINTS, 3)[..., 1::-1]
+        points[:, NUM_KEYPOINTS:] = _corners_yx(rows[:, 51:55])
+        letterbox.normalised_to_image_in_place(points)
+        clip_corners(points[:, NUM_KEYPOINTS:], image_hw)
+        scores = rows[:, 2:51:3].astype(float)
+        return [
+            PoseDetection(p[:NUM_KEYPOINTS], s, p[NUM_KEYPOINTS:], r)
+            for p, s, r in zip(points, scores, rows[:, 55].tolist(), strict=True)
+        ]
 
     def __call__(self, color_rgb: np.ndarray) -> list[PoseDetection]:
         tensor, letterbox = self.preprocess(color_rgb)
@@ -177,7 +188,7 @@ class MoveNetSinglePose:
         """Whole image (``box`` None) or a square crop around ``box`` -> [1, H, W, 3] input tensor and its map."""
         color_rgb = check_color_image(color_rgb)
         if box is None:
-            letterbox = Letterbox.fit(color_rgb.shape[:2], self._size)
+            letterbox = fit_letterbox(color_rgb.shape[:2], self._size)
             image = letterbox.warp(color_rgb, PAD_VALUE)
         else:
             letterbox = Letterbox.crop(box, self._size, self.crop_expand)
@@ -190,11 +201,18 @@ class MoveNetSinglePose:
     def decode(self, output: np.ndarray, letterbox: Letterbox, image_hw: Sequence[int]) -> PoseDetection:
         """[1, 1, 17, 3] output -> one detection; its box spans the keypoints scoring at least the threshold
         (all keypoints if none does), its box_score is the mean keypoint score."""
-        keypoints, scores = _keypoints_yx(output.reshape(NUM_KEYPOINTS, 3), letterbox)
-        confident = scores >= self.score_threshold
-        pts = keypoints[confident] if confident.any() else keypoints
-        box = clip_boxes(np.concatenate([pts.min(axis=0), pts.max(axis=0)])[None], image_hw)[0]
-        return PoseDetection(keypoints, scores, box, float(scores.mean()))
+        yx_score = output.reshape(NUM_KEYPOINTS, 3)
+        keypoints, scores = letterbox.normalised_to_image(yx_score[:, 1::-1]), yx_score[:, 2]
+        pts = keypoints[scores >= self.score_threshold]
+        if len(pts) == 0:
+            pts = keypoints
+        box = np.empty(4)
+        np.minimum.reduce(pts, axis=0, out=box[:2])  # ufunc reductions skip the Python wrappers of min and max
+        np.maximum.reduce(pts, axis=0, out=box[2:])
+        clip_corners(box.reshape(2, 2), image_hw)
+        # The float32 sum / 17 equals scores.mean() bit for bit (correctly rounded either way), without np.mean's
+        # Python-level wrapper.
+        return PoseDetection(keypoints, scores, box, float(scores.sum() / NUM_KEYPOINTS))
 
     def __call__(self, color_rgb: np.ndarray) -> list[PoseDetection]:
         """The one person MoveNet sees in the whole image, or [] when its mean keypoint score is too low."""

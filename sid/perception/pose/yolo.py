@@ -17,7 +17,7 @@ import cv2
 import numpy as np
 
 from sid.perception.keypoints import NUM_KEYPOINTS, PoseDetection
-from sid.perception.pose.base import Letterbox, check_color_image, clip_boxes
+from sid.perception.pose.base import Letterbox, check_color_image, clip_corners, fit_letterbox
 from sid.perception.pose.contracts import YOLO_POSE, fixed_hw, yolo_layout
 from sid.perception.pose.session import OnnxModel
 
@@ -59,6 +59,7 @@ class YoloPose:
                 raise ValueError(f"yolo: input height and width must be multiples of 32, got {h}x{w}")
             self._size = (h, w)
         self._dtype = spec.dtype
+        self._pixel_unit = 1.0 / np.array(self._size[::-1], dtype=float)  # input px -> [0, 1], for pixel exports
         self.normalised = self._outputs_normalised() if normalised is None else bool(normalised)
 
     @property
@@ -78,7 +79,7 @@ class YoloPose:
     def preprocess(self, color_rgb: np.ndarray) -> tuple[np.ndarray, Letterbox]:
         """RGB uint8 image -> float [1, H, W, 3] or [1, 3, H, W] input in 0..1, and the letterbox that made it."""
         color_rgb = check_color_image(color_rgb)
-        letterbox = Letterbox.fit(color_rgb.shape[:2], self._size)
+        letterbox = fit_letterbox(color_rgb.shape[:2], self._size)
         image = letterbox.warp(color_rgb, PAD_VALUE)
         if self.layout == "nchw":
             image = image.transpose(2, 0, 1)
@@ -90,28 +91,32 @@ class YoloPose:
 
     def decode(self, output: np.ndarray, letterbox: Letterbox, image_hw: Sequence[int]) -> list[PoseDetection]:
         """[1, 56, N] candidates -> people above the score threshold after NMS, best first, in image pixels."""
-        output = output.reshape(56, -1)
-        candidates = output[:, output[4] >= self.score_threshold].T  # the few above the threshold, then transposed
-        if len(candidates) == 0:
+        rows = output.reshape(56, -1)
+        above = (rows[4] >= self.score_threshold).nonzero()[0]
+        if len(above) == 0:
             return []
-        xy = candidates[:, [0, 1]]
-        half = candidates[:, [2, 3]] / 2
-        corners = np.concatenate([xy - half, xy + half], axis=1)  # x0, y0, x1, y1 (edge coordinates)
-        keep = cv2.dnn.NMSBoxes(
-            np.concatenate([corners[:, :2], 2 * half], axis=1).tolist(),
-            candidates[:, 4].tolist(),
-            self.score_threshold,
-            self.iou_threshold,
-        )
-        kept = np.asarray(keep, dtype=int).reshape(-1)
-        candidates, corners = candidates[kept], corners[kept]
-        kpts = candidates[:, 5:].reshape(-1, NUM_KEYPOINTS, 3)
-        unit = 1.0 if self.normalised else 1.0 / np.array(self._size[::-1], dtype=float)  # input px -> [0, 1]
-        keypoints = letterbox.normalised_to_image(kpts[..., :2] * unit)
-        boxes = clip_boxes(letterbox.normalised_to_image(corners.reshape(-1, 2, 2) * unit).reshape(-1, 4), image_hw)
+        rects = rows[:5].take(above, axis=1)  # the few candidates above the threshold: centre x, y, w, h, score
+        rects[:2] -= rects[2:4] / 2  # centre -> top-left corner (edge coordinates), in float32 like the model
+        keep = cv2.dnn.NMSBoxes(rects[:4].T.tolist(), rects[4].tolist(), self.score_threshold, self.iou_threshold)
+        kept = rows.take(above[np.asarray(keep, dtype=np.intp).reshape(-1)], axis=1).T  # (people, 56), best first
+        return self._detections(kept, letterbox, image_hw)
+
+    def _detections(self, kept: np.ndarray, letterbox: Letterbox, image_hw: Sequence[int]) -> list[PoseDetection]:
+        """Kept candidates (people, 56) -> detections in image pixels, boxes clipped to the image."""
+        # Each person's 17 keypoints and two box corners go through one map to image pixels, all people at once.
+        points = np.empty((len(kept), NUM_KEYPOINTS + 2, 2))
+        points[:, :NUM_KEYPOINTS] = kept[:, 5:].reshape(-1, NUM_KEYPOINTS, 3)[..., :2]
+        centre, half = kept[:, 0:2], kept[:, 2:4] / 2  # float32, as the model gives them
+        points[:, NUM_KEYPOINTS] = centre - half
+        points[:, NUM_KEYPOINTS + 1] = centre + half
+        if not self.normalised:
+            points *= self._pixel_unit
+        letterbox.normalised_to_image_in_place(points)
+        clip_corners(points[:, NUM_KEYPOINTS:], image_hw)
+        scores = kept[:, 7::3].astype(float)
         return [
-            PoseDetection(k, s, b, c)
-            for k, s, b, c in zip(keypoints, kpts[..., 2], boxes, candidates[:, 4], strict=True)
+            PoseDetection(p[:NUM_KEYPOINTS], s, p[NUM_KEYPOINTS:], c)
+            for p, s, c in zip(points, scores, kept[:, 4].tolist(), strict=True)
         ]
 
     def __call__(self, color_rgb: np.ndarray) -> list[PoseDetection]:

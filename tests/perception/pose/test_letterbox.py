@@ -9,7 +9,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from sid.perception.pose import multipose_input_size
-from sid.perception.pose.base import Letterbox
+from sid.perception.pose.base import Letterbox, clip_corners, fit_letterbox
 
 sizes = st.tuples(st.integers(1, 2000), st.integers(1, 2000))
 
@@ -104,6 +104,39 @@ def test_whole_pixel_letterbox_resizes_within_one_grey_level_of_warp_affine(imag
     assert np.abs(fast.astype(int) - reference.astype(int)).max() <= 1
     top, left = int(letterbox.pad_y), int(letterbox.pad_x)
     assert np.all(fast[:top] == 114) and np.all(fast[:, :left] == 114)
+
+
+@pytest.mark.parametrize(
+    ("image_hw", "input_hw"), [((480, 640), (256, 256)), ((640, 480), (256, 256)), ((480, 640), (192, 320))]
+)
+def test_whole_pixel_warp_is_resize_then_border_bit_for_bit(image_hw, input_hw):
+    """Resizing straight into the input and filling the bands (rows or columns) gives the pixels of a resize
+    into its own array padded by ``cv2.copyMakeBorder``."""
+    letterbox = Letterbox.fit(image_hw, input_hw)
+    image = np.random.default_rng(1).integers(0, 256, (*image_hw, 3), dtype=np.uint8)
+    (in_h, in_w), top, left = input_hw, int(letterbox.pad_y), int(letterbox.pad_x)
+    width, height = round(image_hw[1] * letterbox.scale), round(image_hw[0] * letterbox.scale)
+    resized = cv2.resize(image, (width, height), interpolation=cv2.INTER_LINEAR)
+    expected = cv2.copyMakeBorder(resized, top, in_h - top - height, left, in_w - left - width,
+                                  cv2.BORDER_CONSTANT, value=(7, 7, 7))  # fmt: skip
+    np.testing.assert_array_equal(letterbox.warp(image, 7), expected)
+
+
+def test_fit_letterbox_is_built_once_per_size_pair():
+    first = fit_letterbox((480, 640), (256, 256))
+    assert first is fit_letterbox((480, 640), (256, 256)) and first == Letterbox.fit((480, 640), (256, 256))
+    assert fit_letterbox((720, 1280), (256, 256)) != first
+
+
+def test_in_place_map_is_the_copying_map_and_corners_clip_to_the_outer_edge():
+    letterbox = Letterbox.crop((100.0, 200.0, 140.0, 300.0), (192, 192))
+    xy = np.random.default_rng(2).uniform(-0.5, 1.5, (3, 19, 2))
+    expected = letterbox.normalised_to_image(xy)
+    assert letterbox.normalised_to_image_in_place(xy) is xy
+    np.testing.assert_array_equal(xy, expected)
+    corners = np.array([[[-3.0, 5.0], [700.0, 500.0]], [[10.0, -1.0], [20.0, 479.0]]])
+    clip_corners(corners, (480, 640))
+    np.testing.assert_array_equal(corners, [[[-0.5, 5.0], [639.5, 479.5]], [[10.0, -0.5], [20.0, 479.0]]])
 
 
 def test_bad_letterbox_arguments_are_named():

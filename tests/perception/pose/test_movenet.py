@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from sid.perception.keypoints import NUM_KEYPOINTS
-from sid.perception.pose import MoveNetMultiPose, MoveNetSinglePose, load_pose_estimator
+from sid.perception.pose import Letterbox, MoveNetMultiPose, MoveNetSinglePose, load_pose_estimator
 from tests.pose_models import build_multipose_model, build_singlepose_model
 
 
@@ -132,6 +132,21 @@ def test_singlepose_whole_image_mode_thresholds_the_mean_keypoint_score(tmp_path
     np.testing.assert_allclose(found.box, [319.5, 239.5, 319.5, 239.5], atol=1e-4)  # the confident keypoints
     assert estimator(np.zeros((480, 640, 3), np.uint8)) and found.box_score == pytest.approx((16 * 0.3 + 0.1) / 17)
     assert load_pose_estimator(tmp_path / "s.onnx", score_threshold=0.5)(np.zeros((480, 640, 3), np.uint8)) == []
+
+
+def test_singlepose_decode_box_spans_the_confident_keypoints_and_scores_their_exact_mean(tmp_path):
+    estimator = load_pose_estimator(build_singlepose_model(tmp_path / "s.onnx"))
+    letterbox = Letterbox.fit((480, 640), (192, 192))
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        output = rng.uniform(-0.2, 1.2, (1, 1, NUM_KEYPOINTS, 3)).astype(np.float32)
+        found = estimator.decode(output, letterbox, (480, 640))
+        scores = output.reshape(NUM_KEYPOINTS, 3)[:, 2]
+        confident = found.keypoints[scores >= estimator.score_threshold]
+        pts = confident if len(confident) else found.keypoints
+        box = np.concatenate([pts.min(axis=0), pts.max(axis=0)])
+        np.testing.assert_array_equal(found.box, np.clip(box, -0.5, [639.5, 479.5, 639.5, 479.5]))
+        assert found.box_score == float(scores.mean())  # bit for bit
 
 
 @pytest.mark.parametrize(
