@@ -38,7 +38,9 @@ less for the near-identity rotation of a factory-calibrated D435i.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Literal
 
 import cv2
@@ -77,7 +79,7 @@ def _validate_depth(depth_m: np.ndarray, intr: Intrinsics, what: str) -> np.ndar
             f"{what}: depth image is {depth_m.shape[1]}x{depth_m.shape[0]} but the calibration says "
             f"{intr.width}x{intr.height}"
         )
-    if not np.issubdtype(depth_m.dtype, np.floating):
+    if depth_m.dtype.kind != "f":  # floating (np.issubdtype costs more than the lookups it guards)
         raise ValueError(f"{what}: depth must be float metres, got dtype {depth_m.dtype} (multiply by depth_scale)")
     return depth_m
 
@@ -90,38 +92,34 @@ def _reduce_patches(values: np.ndarray, method: PatchMethod, min_support: int = 
     ``"min"``: the smallest reading (what the paper's authors did over a 5x5 patch). ``"median"``: plain median.
     """
     n, p = values.shape
-    result = np.full(n, np.nan)
     if n == 0 or p == 0:
-        return result
+        return np.full(n, np.nan)
     ordered = np.sort(values, axis=1)  # NaN sorts last
-    count = np.count_nonzero(np.isfinite(ordered), axis=1)
-    has = count > 0
+    # The readings of a row are its first ``count`` sorted values (the callers drop readings <= 0, so no -inf).
+    finite = np.isfinite(ordered)
+    count = finite.sum(axis=1)
     rows = np.arange(n)
     if method == "min":
-        result[has] = ordered[has, 0]
-        return result
+        return np.where(count > 0, ordered[:, 0], np.nan)
     if method == "median":
         lo, hi = (count - 1) // 2, count // 2
         mid = 0.5 * (ordered[rows, np.maximum(lo, 0)] + ordered[rows, np.maximum(hi, 0)])
-        result[has] = mid[has]
-        return result
+        return np.where(count > 0, mid, np.nan)
     if method != "nearest":
         raise ValueError(f"unknown patch method {method!r}; use 'nearest', 'min' or 'median'")
     with np.errstate(invalid="ignore"):
-        breaks = np.diff(ordered, axis=1) > np.maximum(_GAP_ABS, _GAP_REL * ordered[:, :-1])
+        breaks = ordered[:, 1:] - ordered[:, :-1] > np.maximum(_GAP_ABS, _GAP_REL * ordered[:, :-1])
     surface = np.zeros((n, p), dtype=np.int64)
     np.cumsum(breaks, axis=1, out=surface[:, 1:])
-    valid = np.arange(p)[None, :] < count[:, None]
-    sizes = np.bincount((rows[:, None] * p + surface)[valid], minlength=n * p).reshape(n, p)
+    sizes = np.bincount((rows[:, None] * p + surface)[finite], minlength=n * p).reshape(n, p)
     support = np.minimum(min_support, sizes.max(axis=1))
     chosen = np.argmax(sizes >= support[:, None], axis=1)
     start = np.argmax(surface == chosen[:, None], axis=1)
     size = sizes[rows, chosen]
-    lo = np.minimum(start + np.maximum(size - 1, 0) // 2, p - 1)
-    hi = np.minimum(start + size // 2, p - 1)
-    mid = 0.5 * (ordered[rows, lo] + ordered[rows, hi])
-    result[has] = mid[has]
-    return result
+    # The chosen surface's middle readings (it starts at ``start`` and holds ``size``, so both lie in the row; a
+    # row without readings has size 0 and reads cell -1, which the last line replaces).
+    mid = 0.5 * (ordered[rows, start + (size - 1) // 2] + ordered[rows, start + size // 2])
+    return np.where(count > 0, mid, np.nan)
 
 
 def _patch_offsets(patch: int) -> tuple[np.ndarray, np.ndarray]:
@@ -431,10 +429,12 @@ def depth_at_color_pixels(
     colour-pixel-to-depth search of librealsense's ``rs2_project_color_pixel_to_depth_pixel``, done for a whole
     patch at once and with the same splat as the dense alignment.
 
-    ``search="window"`` (what ``sid.perception.lifting`` uses per frame; ~3x faster here) skips the search: from the
+    ``search="window"`` (what ``sid.perception.lifting`` uses per frame; ~4x faster here) skips the search: from the
     colour pixel's ray, ``_WINDOW_STEPS`` fixed-point steps (the first at infinite depth, then at the depth found)
     find the depth pixel the ray meets, and the readings of the depth window about as wide as the colour patch
     around it (3x3 for a 5x5 patch and D435i intrinsics), as colour-frame z (``value``), are reduced as above.
+    What depends only on the calibration (each depth pixel's colour-frame z per metre of reading: ~5 ms to build at
+    848x480) is kept for the last few calibrations.
     It reads the depth image's own pixels instead of the splatted patch, so it is not identical: on the synthetic
     D435i frames of ``sid bench`` it is 8 mm from the exact search at the median, 30 mm at the 90th percentile
     (docs/benchmarks.md; tests/perception/test_align.py bounds it against the dense alignment). ``mode`` only
@@ -449,7 +449,7 @@ def depth_at_color_pixels(
             return np.zeros(0)
         return _reduce_patches(_registered_patches(depth_m, pixels, patch), method)
     depth_m = _validate_depth(depth_m, calib.depth, "depth_at_color_pixels")
-    if not (0 < depth_min < depth_max and np.isfinite(depth_max)):
+    if not (0 < depth_min < depth_max and math.isfinite(depth_max)):
         raise ValueError(f"need 0 < depth_min < depth_max < inf, got {depth_min}, {depth_max}")
     if len(pixels) == 0:
         return np.zeros(0)
@@ -458,6 +458,61 @@ def depth_at_color_pixels(
     return _reduce_patches(
         _unregistered_patches(depth_m, pixels, calib, patch, mode, value, depth_min, depth_max), method
     )
+
+
+@dataclass(frozen=True)
+class _WindowGeometry:
+    """What ``search="window"`` needs of one calibration and patch size, computed once (``_window_geometry``).
+
+    half: the window's half width (depth pixels); du, dv: (C,) its cells' offsets from the centre pixel and offsets:
+    (C,) the same as flat indices into the depth image; support: the nearest surface's support scaled to C cells;
+    ray_z: (H_d * W_d,) per depth pixel (u, v) the colour-frame z of R K_d^-1 [u, v, 1], i.e. per metre of reading;
+    focal, principal: (2, 1) the depth intrinsics' (fx, fy) and (cx, cy); interior_end: (2, 1) the first centre
+    column and row whose window leaves the image.
+    """
+
+    half: int
+    du: np.ndarray
+    dv: np.ndarray
+    offsets: np.ndarray
+    support: int
+    ray_z: np.ndarray
+    focal: np.ndarray
+    principal: np.ndarray
+    interior_end: np.ndarray
+
+
+def _window_geometry(calib: Calibration, patch: int) -> _WindowGeometry:
+    """The ``_WindowGeometry`` of a calibration with depth intrinsics, kept for the last few calibrations by the
+    values it depends on, not by object: a stream's frames may each carry their own copy of one calibration."""
+    kd, kc, rotation = calib.depth, calib.color, calib.depth_to_color.rotation
+    assert kd is not None
+    depth = (kd.width, kd.height, kd.fx, kd.fy, kd.cx, kd.cy)
+    return _cached_window_geometry(depth, (kc.fx, kc.fy), tuple(rotation[2].tolist()), patch)
+
+
+@lru_cache(maxsize=4)  # a few MB each at 848x480; ``ray_z`` takes ~5 ms to build
+def _cached_window_geometry(
+    depth: tuple[int, int, float, float, float, float],
+    color_focal: tuple[float, float],
+    rotation_z: tuple[float, ...],
+    patch: int,
+) -> _WindowGeometry:
+    """``_window_geometry`` from the depth intrinsics (width, height, fx, fy, cx, cy), the colour focal lengths
+    (fx, fy) and the depth-to-colour rotation's last row."""
+    width, height, fx, fy, cx, cy = depth
+    # The colour patch spans about patch * fd / fc depth pixels: an odd window at least that wide (at least 1).
+    half = max(0, int(np.ceil((patch * max(fx / color_focal[0], fy / color_focal[1]) - 1) / 2)))
+    dv, du = (a.ravel() for a in np.mgrid[-half : half + 1, -half : half + 1])
+    rows, cols = np.mgrid[0:height, 0:width]
+    ray_z = rotation_z[0] * (cols - cx) / fx + rotation_z[1] * (rows - cy) / fy + rotation_z[2]
+    support = int(np.ceil(_MIN_SUPPORT * len(du) / patch**2))
+    arrays = (du, dv, dv * width + du, ray_z.ravel(), np.array([[fx], [fy]]), np.array([[cx], [cy]]))
+    for array in arrays:  # shared by every call with this calibration
+        array.flags.writeable = False
+    interior_end = np.array([[width - half], [height - half]])
+    interior_end.flags.writeable = False
+    return _WindowGeometry(half, *arrays[:3], support, *arrays[3:], interior_end)
 
 
 def _window_depth(
@@ -476,37 +531,51 @@ def _window_depth(
     assert calib.depth is not None
     kd, kc = calib.depth, calib.color
     rotation, translation = calib.depth_to_color.rotation, calib.depth_to_color.translation
-    height, width = depth_m.shape
-    # The colour patch spans about patch * fd / fc depth pixels: an odd window at least that wide (at least 1).
-    half = max(0, int(np.ceil((patch * max(kd.fx / kc.fx, kd.fy / kc.fy) - 1) / 2)))
-    dv, du = (a.ravel() for a in np.mgrid[-half : half + 1, -half : half + 1])
-    finite = np.all(np.isfinite(pixels), axis=1)
-    px = np.where(finite[:, None], pixels, 0.0)
-    # Colour ray (x, y, 1) per pixel in the depth frame: a point at colour depth z is z * ray - R^T t.
-    ray = rotation.T @ np.stack([(px[:, 0] - kc.cx) / kc.fx, (px[:, 1] - kc.cy) / kc.fy, np.ones(len(px))])
-    shift = rotation.T @ translation
-    # Support for the nearest surface scaled from the colour patch's to the window's number of cells.
-    support = int(np.ceil(_MIN_SUPPORT * len(du) / patch**2))
-    z = np.full(len(px), np.inf)  # colour-frame depth of each pixel's surface; the first step looks from infinity
-    for step in range(_WINDOW_STEPS):
-        known = np.isfinite(z)
-        point = np.where(known, z, 1.0) * ray - known * shift[:, None]  # (3, N) in the depth frame (a direction)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            u = np.floor(point[0] / point[2] * kd.fx + kd.cx + 0.5)[:, None] + du
-            v = np.floor(point[1] / point[2] * kd.fy + kd.cy + 0.5)[:, None] + dv
-            inside = (u >= 0) & (u < width) & (v >= 0) & (v < height) & (finite & (point[2] > 0))[:, None]
-        cols, rows = np.where(inside, u, 0).astype(np.intp), np.where(inside, v, 0).astype(np.intp)
-        reading = depth_m[rows, cols].astype(float)
-        with np.errstate(invalid="ignore"):
-            reading[~(inside & (reading >= depth_min) & (reading <= depth_max))] = np.nan
-        # Colour-frame z of each reading's point: (R d K_d^-1 [u, v, 1] + t)_z.
-        ray_z = rotation[2, 0] * (cols - kd.cx) / kd.fx + rotation[2, 1] * (rows - kd.cy) / kd.fy + rotation[2, 2]
-        colour_z = reading * ray_z + translation[2]
-        if step == _WINDOW_STEPS - 1:
-            return _reduce_patches(colour_z if value == "z" else reading, method, support)
-        nearest = np.fmin.reduce(colour_z, axis=1)  # the steps only move the window: the nearest reading will do
-        z = np.where(np.isfinite(nearest), nearest, z)
-    raise AssertionError("unreachable: the last step returns")
+    geometry = _window_geometry(calib, patch)
+    flat = np.ascontiguousarray(depth_m).reshape(-1)
+    finite = np.isfinite(pixels).all(axis=1)
+    shift = (rotation.T @ translation)[:, None]
+    z = np.full(len(pixels), np.inf)  # colour-frame depth of each pixel's surface; the first step looks from infinity
+    low, high = np.float64(depth_min), np.float64(depth_max)
+    colour_ray = np.ones((3, len(pixels)))
+    with np.errstate(divide="ignore", invalid="ignore"):  # NaN pixels, rays that miss the depth camera
+        # Colour ray (x, y, 1) per pixel (NaN for a NaN pixel, never seen), in the depth frame: a point at colour
+        # depth z is z * ray - R^T t; at infinity, the ray's direction.
+        colour_ray[:2] = ((pixels - (kc.cx, kc.cy)) / (kc.fx, kc.fy)).T
+        point = ray = rotation.T @ colour_ray
+        for step in range(_WINDOW_STEPS):
+            index, inside = _window_cells(point, finite, geometry, kd)
+            reading = flat.take(index)  # the image's dtype: float64 scalars below compare and multiply in float64
+            valid = (reading >= low) & (reading <= high)
+            if inside is not None:
+                valid &= inside
+            if step == _WINDOW_STEPS - 1:
+                break
+            # Colour-frame z of each reading's point, (R d K_d^-1 [u, v, 1] + t)_z; the steps only move the window,
+            # so the nearest reading will do.
+            nearest = np.fmin.reduce(
+                np.where(valid, reading * geometry.ray_z.take(index) + translation[2], np.nan), axis=1
+            )
+            z = np.where(np.isfinite(nearest), nearest, z)
+            known = np.isfinite(z)
+            point = np.where(known, z, 1.0) * ray - known * shift  # (3, N) in the depth frame (a direction if unknown)
+        stored = reading * geometry.ray_z.take(index) + translation[2] if value == "z" else reading.astype(float)
+        return _reduce_patches(np.where(valid, stored, np.nan), method, geometry.support)
+
+
+def _window_cells(
+    point: np.ndarray, finite: np.ndarray, geometry: _WindowGeometry, kd: Intrinsics
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """Flat depth-image indices (N, C) of the window around the depth pixel each point (3, N, depth frame) projects
+    to, and which cells lie in the image (None: all of them; cells outside index pixel 0)."""
+    centre = np.floor(point[:2] / point[2] * geometry.focal + geometry.principal + 0.5)  # (2, N) pixel (u, v)
+    seen = finite & (point[2] > 0)
+    # Usually every window lies inside the image: one add gives all indices, no per-cell test.
+    if seen.all() and ((centre >= geometry.half) & (centre < geometry.interior_end)).all():
+        return (centre[1] * kd.width + centre[0]).astype(np.intp)[:, None] + geometry.offsets, None
+    u, v = centre[0][:, None] + geometry.du, centre[1][:, None] + geometry.dv
+    inside = (u >= 0) & (u < kd.width) & (v >= 0) & (v < kd.height) & seen[:, None]
+    return np.where(inside, v * kd.width + u, 0).astype(np.intp), inside
 
 
 def _unregistered_patches(

@@ -6,7 +6,7 @@ robust to holes and silhouette edges), is deprojected with the colour intrinsics
 to the world frame with the camera mount. Keypoints without a valid depth are dropped, never placed at the camera,
 and so are keypoints whose depth is far from their person's (``depth_gate``) or belongs to a person standing in front
 (``occluder_gap``). Position = mean of the lifted keypoints' world x, y; facing =
-``sid.perception.orientation.estimate_orientation``.
+``sid.perception.orientation.estimate_orientation`` (``estimate_orientations``: everyone at once).
 
 A depth camera sees the body's surface, not its joints. Two corrections, both along each keypoint's viewing ray
 (its pixel is kept), turn surface readings into points inside the body:
@@ -47,14 +47,15 @@ from sid.perception.align import Search, depth_at_color_pixels
 from sid.perception.camera import Calibration
 from sid.perception.keypoints import COCO_KEYPOINTS, KP, NUM_KEYPOINTS, PoseDetection
 from sid.perception.mount import CameraMount
-from sid.perception.orientation import EAR_SEPARATION, HIP_SEPARATION, SHOULDER_SEPARATION, estimate_orientation
+from sid.perception.orientation import EAR_SEPARATION, HIP_SEPARATION, SHOULDER_SEPARATION, estimate_orientations
 from sid.perception.people import Person
 
 # Far-side completion. Root keypoints, each with its partner a fixed separation away: shoulders, hips, ears
 # (``widths`` order), left then right.
 _FAR = np.array([KP[f"{side}_{part}"] for side in ("left", "right") for part in ("shoulder", "hip", "ear")])
-# The other side's keypoint of each keypoint (left <-> right; the nose is its own).
+# The other side's keypoint of each keypoint (left <-> right; the nose is its own), and of each root.
 _MIRROR = np.array([KP[n.replace("left", "@").replace("right", "left").replace("@", "right")] for n in COCO_KEYPOINTS])
+_FAR_PARTNER = _MIRROR[_FAR]
 # Followers of each root keypoint (-1: none): the arm hangs from the shoulder, the leg from the hip.
 _FOLLOWERS = np.full((NUM_KEYPOINTS, 2), -1)
 for _side in ("left", "right"):
@@ -74,7 +75,7 @@ class LiftParams:
     patch: side (pixels, odd) of the depth window read around each keypoint. 5, as the paper's authors did.
     depth_search: how keypoint depth is found in unregistered depth (``sid.perception.align.depth_at_color_pixels``'s
       ``search``). "window" (default): fixed-point steps to the depth pixel each keypoint sees and the depth window
-      around it, ~3x faster than "exact" here (0.48 against 1.5 ms for 4 x 17 keypoints, busy machine) and within
+      around it, ~4x faster than "exact" here (0.64 against 2.6 ms median for 4 x 17 keypoints, busy machine) and within
       8 mm (median; 30 mm at the 90th percentile) of it on sid bench's synthetic frames; the far outliers (a window
       that reads the wall beside a silhouette) are what ``depth_gate`` drops. "exact": the splat search, equal to
       aligning the whole frame. Measured in docs/benchmarks.md (issue 14).
@@ -163,8 +164,9 @@ def lift_people(
         raise ValueError(f"lift: {len(ids)} ids for {len(detections)} detections")
     if not detections:
         return []
-    keypoints = np.stack([d.keypoints for d in detections])  # (P, 17, 2) colour pixels
-    scores = np.stack([d.scores for d in detections])  # (P, 17)
+    # np.array of a list of equal-shape arrays stacks them, with less overhead than np.stack.
+    keypoints = np.array([d.keypoints for d in detections])  # (P, 17, 2) colour pixels
+    scores = np.array([d.scores for d in detections])  # (P, 17)
     confident = (scores >= params.min_score) & np.isfinite(keypoints).all(axis=2)  # (comparisons with NaN: False)
     depth = np.full(scores.shape, np.nan)
     depth[confident] = depth_at_color_pixels(
@@ -174,14 +176,14 @@ def lift_people(
     # Median depth per person over its usable keypoints (unusable ones sort last as +inf; np.nanmedian is ~30x
     # slower on arrays this small).
     ordered = np.sort(np.where(usable, depth, np.inf), axis=1)
-    count = np.count_nonzero(usable, axis=1)
+    count = usable.sum(axis=1)
     rows = np.arange(len(detections))
     median = 0.5 * (
         ordered[rows, np.maximum(count - 1, 0) // 2] + ordered[rows, np.minimum(count // 2, ordered.shape[1] - 1)]
     )
     usable &= np.abs(depth - median[:, None]) <= params.depth_gate
     if len(detections) > 1 and math.isfinite(params.occluder_gap):
-        boxes = np.stack([d.box for d in detections])
+        boxes = np.array([d.box for d in detections])
         usable &= ~_reads_someone_in_front(keypoints, depth, median, boxes, params.occluder_gap)
 
     # Each keypoint's viewing ray (camera frame, through K_c^-1 [u v 1] = (ray_x, ray_y, 1)) and its range along it
@@ -197,17 +199,14 @@ def lift_people(
         _complete_far_side(ray_x, ray_y, norm, ranges, scores, inferred, widths, params)
 
     world = np.full((*scores.shape, 3), np.nan)
-    if usable.any():
-        z = ranges[usable] / norm[usable]
-        camera = np.stack([ray_x[usable] * z, ray_y[usable] * z, z], axis=1)
-        world[usable] = mount.camera_to_world(camera)
-    counts = np.count_nonzero(usable, axis=1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        positions = np.where(usable[..., None], world[..., :2], 0.0).sum(axis=1) / counts[:, None]
+    z = ranges[usable] / norm[usable]
+    world[usable] = mount.camera_to_world(np.stack([ray_x[usable] * z, ray_y[usable] * z, z], axis=1))
+    counts = usable.sum(axis=1)
+    placed = np.flatnonzero(counts >= params.min_keypoints)
+    positions = np.where(usable[placed, :, None], world[placed, :, :2], 0.0).sum(axis=1) / counts[placed, None]
+    facings = estimate_orientations(world[placed], inferred[placed])
     people = []
-    for k in np.flatnonzero(counts >= params.min_keypoints).tolist():
-        theta, quality = estimate_orientation(world[k], inferred[k])
-        x, y = positions[k].tolist()
+    for k, (x, y), (theta, quality) in zip(placed.tolist(), positions.tolist(), facings, strict=True):
         people.append(Person(int(ids[k]) if ids is not None else k, x, y, theta, quality, world[k]))
     return people
 
@@ -220,11 +219,13 @@ def _reads_someone_in_front(
     keypoints: (P, 17, 2) colour pixels; depth: (P, 17) m (NaN: none); median: (P,) each person's median keypoint
     depth (m); boxes: (P, 4) (u_min, v_min, u_max, v_max). Pairs (i, j) below: keypoints of i, person j.
     """
+    in_front = median[None, :] < median[:, None] - gap  # (P, P)
+    if not in_front.any():
+        return np.zeros(depth.shape, dtype=bool)
     u, v = keypoints[:, None, :, 0], keypoints[:, None, :, 1]  # (P, 1, 17)
     box = boxes[None, :, :, None]  # (1, P, 4, 1)
     inside = (u >= box[:, :, 0]) & (u <= box[:, :, 2]) & (v >= box[:, :, 1]) & (v <= box[:, :, 3])  # (P, P, 17)
     # Closer to j's median than to i's, j in front: nearer than the midpoint of the two medians (-inf: j not in front).
-    in_front = median[None, :] < median[:, None] - gap  # (P, P)
     limit = np.where(in_front, 0.5 * (median[:, None] + median[None, :]), -np.inf)
     return np.asarray((inside & (depth[:, None, :] < limit[:, :, None])).any(axis=1))
 
@@ -247,11 +248,11 @@ def _complete_far_side(
     """
     gap = params.far_side_score_gap
     # Candidates: a root keypoint scoring clearly lower than its partner (the hidden one, if the pair collapsed).
-    people, k = np.nonzero(scores[:, _FAR] <= scores[:, _MIRROR[_FAR]] - gap)
+    people, k = np.nonzero(scores[:, _FAR] <= scores[:, _FAR_PARTNER] - gap)
     if len(people) == 0:
         return
     base = people * NUM_KEYPOINTS
-    far, near = base + _FAR[k], base + _MIRROR[_FAR[k]]
+    far, near = base + _FAR[k], base + _FAR_PARTNER[k]
     r, x, y, n = ranges.reshape(-1), ray_x.reshape(-1), ray_y.reshape(-1), norm.reshape(-1)  # views
     far_range, near_range = r[far], r[near]
     foot = (x[far] * x[near] + y[far] * y[near] + 1.0) / (n[far] * n[near]) * near_range  # u . P, u the far unit ray

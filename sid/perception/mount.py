@@ -10,6 +10,7 @@ directly below the camera and, with no tilt: x = z_cam, y = -x_cam, z = height -
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -51,10 +52,19 @@ class CameraMount:
         """(3,) the optical centre in ``base_footprint`` (m)."""
         return np.array([self.x, self.y, self.height])
 
+    @cached_property
+    def _pose(self) -> tuple[np.ndarray, np.ndarray]:
+        """(rotation, position), built once per mount (read-only): the transforms run per frame."""
+        rotation, position = self.rotation, self.position
+        rotation.flags.writeable = position.flags.writeable = False
+        return rotation, position
+
     def camera_to_world(self, points: np.ndarray) -> np.ndarray:
         """(N, 3) camera-frame points -> (N, 3) ``base_footprint`` points."""
-        return np.asarray(points, dtype=float).reshape(-1, 3) @ self.rotation.T + self.position
+        rotation, position = self._pose
+        return np.asarray(points, dtype=float).reshape(-1, 3) @ rotation.T + position
 
     def world_to_camera(self, points: np.ndarray) -> np.ndarray:
         """(N, 3) ``base_footprint`` points -> (N, 3) camera-frame points."""
-        return (np.asarray(points, dtype=float).reshape(-1, 3) - self.position) @ self.rotation
+        rotation, position = self._pose
+        return (np.asarray(points, dtype=float).reshape(-1, 3) - position) @ rotation

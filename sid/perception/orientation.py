@@ -93,27 +93,83 @@ def estimate_orientation(keypoints_world: np.ndarray, inferred: np.ndarray | Non
         if inferred.shape != (NUM_KEYPOINTS,):
             raise ValueError(f"orientation: inferred must be a ({NUM_KEYPOINTS},) mask, got shape {inferred.shape}")
     usable = np.isfinite(points).all(axis=1)
+    both = (usable[_LEFT] & usable[_RIGHT]).tolist()
     present = points[usable]
-    if len(present) < 3:
+    # Without 3 keypoints or a left/right pair: no facing, whatever the plane.
+    if len(present) < 3 or not any(both):
         return None, 0.0
     centred = present - present.sum(axis=0) / len(present)
     eigenvalues, eigenvectors = np.linalg.eigh(centred.T @ centred)  # ascending
-    l3, l2, l1 = eigenvalues.tolist()
+    flags = inferred.tolist() if inferred is not None else None
+    return _facing(eigenvalues.tolist(), eigenvectors[:, 0].tolist(), points[:, :2].tolist(), both, flags)
+
+
+def estimate_orientations(
+    keypoints_world: np.ndarray, inferred: np.ndarray | None = None
+) -> list[tuple[float | None, float]]:
+    """``estimate_orientation`` for P people at once: (P, 17, 3) world keypoints, optional (P, 17) inferred mask.
+
+    Returns one (yaw, quality) per person, the same as ``estimate_orientation`` of each person alone, for little
+    more than the cost of one (``sid.perception.lifting`` calls it once per frame).
+    """
+    points = np.asarray(keypoints_world, dtype=float)
+    if points.ndim != 3 or points.shape[1:] != (NUM_KEYPOINTS, 3):
+        raise ValueError(f"orientation: keypoints must be a (P, {NUM_KEYPOINTS}, 3) array, got shape {points.shape}")
+    if inferred is not None:
+        inferred = np.asarray(inferred, dtype=bool)
+        if inferred.shape != points.shape[:2]:
+            raise ValueError(f"orientation: inferred must be a {points.shape[:2]} mask, got shape {inferred.shape}")
+    return _orientations(points, inferred)
+
+
+def _orientations(points: np.ndarray, inferred: np.ndarray | None) -> list[tuple[float | None, float]]:
+    """``estimate_orientations`` of checked (P, 17, 3) float points and (P, 17) bool ``inferred`` (or None)."""
+    usable = np.isfinite(points).all(axis=2)
+    counts = usable.sum(axis=1)
+    both = usable[:, _LEFT] & usable[:, _RIGHT]
+    # Everyone's scatter matrix at once, with a missing keypoint's row zero: it adds nothing to the sums (x + 0.0 is
+    # x), so each person's matrix is the one ``estimate_orientation`` computes from their usable keypoints alone.
+    rows = usable[..., None]
+    with np.errstate(invalid="ignore", divide="ignore"):  # people without keypoints: 0 / 0, zeroed below
+        masked = np.where(rows, points, 0.0)
+        centred = np.where(rows, masked - masked.sum(axis=1, keepdims=True) / counts[:, None, None], 0.0)
+    eigenvalues, eigenvectors = np.linalg.eigh(centred.transpose(0, 2, 1) @ centred)  # ascending, per person
+    flags = inferred.tolist() if inferred is not None else [None] * len(points)
+    return [
+        # Without 3 keypoints or a left/right pair: no facing, whatever the plane.
+        _facing(values, normal, xy, pairs, person_flags) if count >= 3 and any(pairs) else (None, 0.0)
+        for count, pairs, values, normal, xy, person_flags in zip(
+            counts.tolist(),
+            both.tolist(),
+            eigenvalues.tolist(),
+            eigenvectors[:, :, 0].tolist(),
+            points[:, :, :2].tolist(),
+            flags,
+            strict=True,
+        )
+    ]
+
+
+def _facing(
+    eigenvalues: list[float],
+    normal: list[float],
+    xy: list[list[float]],
+    both: list[bool],
+    flags: list[bool] | None,
+) -> tuple[float | None, float]:
+    """(yaw, quality) of one person (``estimate_orientation``) from the keypoints' covariance eigenvalues (ascending)
+    and smallest-eigenvalue eigenvector ``normal``, their world (x, y) ``xy`` (17 rows), which ``SIGN_PAIRS`` have
+    both keypoints (``both``) and the inferred flags (plain floats: six pairs are cheaper in Python than in numpy)."""
+    l3, l2, l1 = eigenvalues
     if l2 <= _COLLINEAR_RATIO * l1:
         return None, 0.0
-    nx, ny, _ = eigenvectors[:, 0].tolist()
+    nx, ny, _ = normal
     horizontal = math.hypot(nx, ny)
     if horizontal < _MIN_HORIZONTAL_NORMAL:
         return None, 0.0
     fx, fy = nx / horizontal, ny / horizontal
 
-    # Left-right extent across the facing axis, summed over the pairs with both keypoints present (plain floats:
-    # six pairs are cheaper in Python than in numpy calls).
-    both = (usable[_LEFT] & usable[_RIGHT]).tolist()
-    if not any(both):
-        return None, 0.0
-    xy = points[:, :2].tolist()
-    flags = inferred.tolist() if inferred is not None else None
+    # Left-right extent across the facing axis, summed over the pairs with both keypoints present.
     lx = ly = typical = 0.0
     for (left, right, separation), present in zip(SIGN_PAIRS, both, strict=True):
         if present:

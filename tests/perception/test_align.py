@@ -235,6 +235,41 @@ def test_window_search_stays_close_to_the_full_alignment_on_a_d435i_pair() -> No
     np.testing.assert_allclose(depth_at_color_pixels(depth, two, calib, search="window"), dense_two, atol=0.01)
 
 
+def test_window_search_reads_each_pixel_alone_whatever_the_others_and_the_calibrations_before() -> None:
+    """The window search has a fast path (every window inside the depth image) and keeps per-calibration tables; a
+    pixel's depth must not depend on either: the same with pixels near the border in the call or alone, and right
+    (near the full alignment, as above) for each of more calibrations than it keeps, one after the other."""
+    depth = scene(seed=4)
+    rng = np.random.default_rng(6)
+    inner = np.column_stack([rng.uniform(25, 55, 40), rng.uniform(20, 40, 40)])
+    border = np.array([[0.0, 0.0], [79.4, 30.0], [40.0, 59.6], [-2.0, 10.0], [np.nan, 5.0]])
+    for patch in (1, 3, 5):
+        alone = depth_at_color_pixels(depth, inner, CALIB, patch, search="window")
+        mixed = depth_at_color_pixels(depth, np.concatenate([inner, border]), CALIB, patch, search="window")
+        np.testing.assert_array_equal(mixed[: len(inner)], alone)
+        assert np.isfinite(alone).sum() > 35 and np.isnan(mixed[-1])
+    first = depth_at_color_pixels(depth, inner, CALIB, search="window")
+    pixels = np.column_stack([rng.uniform(0, COLOR.width, 300), rng.uniform(0, COLOR.height, 300)])
+    for k in range(1, 7):  # a table left from another calibration is off by 3-10 cm here
+        turned = Rotation.from_euler("xyz", [1.5 + 2 * k, -2.0 - 2 * k, 1.0], degrees=True).as_matrix()
+        calib = Calibration(COLOR, DEPTH, Extrinsics(turned, [0.04, -0.01, 0.005]))
+        dense = depth_at_color_pixels(align_depth_to_color(depth, calib), pixels, Calibration(COLOR))
+        window = depth_at_color_pixels(depth, pixels, calib, search="window")
+        assert np.nanmedian(np.abs(window - dense)) < 0.015
+    again = Calibration(COLOR, DEPTH, Extrinsics(ROTATION, [0.04, -0.01, 0.005]))
+    np.testing.assert_array_equal(depth_at_color_pixels(depth, inner, again, search="window"), first)
+
+
+def test_window_search_compares_float32_readings_with_the_range_in_float64() -> None:
+    """A float32 reading is compared with depth_min and depth_max as it is (float32(0.3) is above 0.3), not with
+    the range rounded to float32."""
+    depth = np.full((DEPTH.height, DEPTH.width), np.float32(0.3))
+    pixel = np.array([[40.0, 30.0]])
+    assert np.isnan(depth_at_color_pixels(depth, pixel, CALIB, depth_min=0.1, depth_max=0.3, search="window"))[0]
+    inside = depth_at_color_pixels(depth, pixel, CALIB, depth_min=0.1, depth_max=0.31, search="window")
+    assert inside[0] == pytest.approx(0.3, abs=0.01)
+
+
 def test_window_search_is_checked_by_name() -> None:
     with pytest.raises(ValueError, match="unknown depth search 'fast'"):
         depth_at_color_pixels(scene(seed=1), np.zeros((1, 2)), CALIB, search="fast")  # type: ignore[arg-type]

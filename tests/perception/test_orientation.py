@@ -23,7 +23,7 @@ import numpy as np
 import pytest
 
 from sid.perception.keypoints import COCO_KEYPOINTS, KP, NUM_KEYPOINTS
-from sid.perception.orientation import SIGN_PAIRS, estimate_orientation
+from sid.perception.orientation import SIGN_PAIRS, estimate_orientation, estimate_orientations
 from sid.perception.skeleton import skeleton_world
 
 YAWS_DEG = list(range(-180, 180, 15))
@@ -204,11 +204,35 @@ def test_inferred_keypoints_count_less_as_left_right_evidence_but_keep_the_yaw()
     assert inferred_quality == pytest.approx(measured_quality * 0.5 * extent / typical)
 
 
+def test_everyone_at_once_equals_each_person_alone():
+    """``estimate_orientations`` (the lift's per-frame call) fits all people in one go; each answer must be
+    ``estimate_orientation``'s, with keypoints missing, inferred flags, too few keypoints and no left/right pair. The
+    sums are the same, so the answers are bit for bit (with numpy's OpenBLAS here; a BLAS kernel that splits a sum
+    differently may move a last bit, which the tolerance allows)."""
+    rng = np.random.default_rng(5)
+    for trial in range(200):
+        people = int(rng.integers(1, 7))
+        yaws = rng.uniform(-np.pi, np.pi, people)
+        keypoints = np.stack([observe(rng.uniform(1.5, 4), rng.uniform(-1, 1), yaw, rng) for yaw in yaws])
+        keypoints[rng.random((people, NUM_KEYPOINTS)) < rng.uniform(0, 0.8)] = np.nan
+        keypoints[0, [KP["left_shoulder"], KP["left_hip"], KP["left_ear"], KP["left_knee"]]] = np.nan
+        inferred = rng.random((people, NUM_KEYPOINTS)) < 0.3 if trial % 2 else None
+        together = estimate_orientations(keypoints, inferred)
+        alone = [estimate_orientation(k, None if inferred is None else inferred[i]) for i, k in enumerate(keypoints)]
+        assert [yaw is None for yaw, _ in together] == [yaw is None for yaw, _ in alone]
+        assert together == pytest.approx(alone, rel=1e-12, abs=1e-12)
+    assert estimate_orientations(np.zeros((0, NUM_KEYPOINTS, 3))) == []
+
+
 def test_wrong_shape_is_rejected():
     with pytest.raises(ValueError, match=r"\(17, 3\)"):
         estimate_orientation(np.zeros((17, 2)))
     with pytest.raises(ValueError, match="inferred"):
         estimate_orientation(np.zeros((17, 3)), np.zeros(16, dtype=bool))
+    with pytest.raises(ValueError, match=r"\(P, 17, 3\)"):
+        estimate_orientations(np.zeros((17, 3)))
+    with pytest.raises(ValueError, match="inferred"):
+        estimate_orientations(np.zeros((2, 17, 3)), np.zeros((2, 16), dtype=bool))
 
 
 if __name__ == "__main__":  # the failure table quoted in the module docstring
