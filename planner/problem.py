@@ -162,32 +162,61 @@ class CostField:
         """J (M,) of straight segments p[i] -> q[i] (each (M, 2)) and whether each is plannable over its length.
 
         Same midpoint rule as ``segment_cost``; plannability is checked at the midpoints and the piece ends
-        (spacing at most half a cell). The smoother's inner loop: one flat pass over all samples, in cell units
-        (as ``segment_cost``: offsets times 1 / resolution, floored).
+        (spacing at most half a cell). Ends that are not finite numbers give a NaN or infinite J (the segment's
+        length) and a segment that is not plannable.
         """
         p = np.asarray(p, dtype=float).reshape(-1, 2)
         q = np.asarray(q, dtype=float).reshape(-1, 2)
         if len(p) == 0:
             return np.zeros(0), np.zeros(0, bool)
+        return self.segments_xy(np.ascontiguousarray(p.T), np.ascontiguousarray(q.T))
+
+    def segments_xy(self, p: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``segments`` with the ends given coordinate-major: p, q (2, M), M >= 1 (world frame, metres). The
+        smoother's inner loop, which builds its candidates that way.
+
+        Sample k of a segment of n pieces (k = 0 .. 2n: even k piece ends, odd k the midpoints the cost uses) sits in
+        row k of (K, M) arrays (samples past a segment's end repeat its end), in cell units (offsets times
+        1 / resolution, floored, as ``segment_cost``); each segment's cost sums its midpoints in order of k, and
+        numpy's inner loops run over segments, not over two coordinates.
+        """
         d = q - p
-        length = np.hypot(d[:, 0], d[:, 1])
-        n = np.maximum(1, np.ceil(length * self._inv_res - 1e-9)).astype(np.int64)
-        # Samples at t = k / (2n), k = 0..2n: even k are piece ends, odd k are the midpoints used for the cost.
-        counts = 2 * n + 1
-        starts = np.cumsum(counts) - counts
-        seg = np.repeat(np.arange(len(p)), counts)
-        k = np.arange(len(seg)) - starts[seg]
+        length = np.hypot(d[0], d[1])
+        finite = np.isfinite(length)
+        if not finite.all():  # NaN or infinite ends: J is the length (NaN or inf), not plannable
+            cost, ok = length.copy(), np.zeros(len(length), dtype=bool)
+            if finite.any():
+                cost[finite], ok[finite] = self.segments_xy(p[:, finite], q[:, finite])
+            return cost, ok
         inv = self._inv_res
-        step = d * (inv / (2.0 * n))[:, None]  # cells per sample
-        x = ((p[:, 0] - self._ox) * inv)[seg] + k * step[seg, 0]
-        y = ((p[:, 1] - self._oy) * inv)[seg] + k * step[seg, 1]
-        col, row = np.floor(x).astype(np.int64), np.floor(y).astype(np.int64)
-        inside = (row >= 0) & (row < self._h) & (col >= 0) & (col < self._w)
-        flat = np.clip(row, 0, self._h - 1) * self._w + np.clip(col, 0, self._w - 1)  # clipped, as ``cells``
-        ok = self.plannable.ravel()[flat] & inside
-        weights = self.weight.ravel()[flat] * (k % 2)  # midpoints only
-        cost = length * (1.0 + np.add.reduceat(weights, starts) / n)
-        return cost, np.logical_and.reduceat(ok, starts)
+        pieces = np.ceil(length * inv - 1e-9)
+        np.maximum(pieces, 1.0, out=pieces)
+        last = 2.0 * pieces  # each segment's end sample
+        width = int(last.max()) + 2  # one spare sample: each segment's slice of samples ends inside its row
+        k = np.minimum(np.arange(width, dtype=float)[:, None], last)  # (K, M)
+        start = (p - np.array([[self._ox], [self._oy]])) * inv
+        xy = start[:, None, :] + k * (d * (inv / last))[:, None, :]  # (2, K, M) cells
+        size = np.array([[[self._w]], [[self._h]]])
+        # The samples run monotonically from one end (row 0) to the other (row K - 1): both inside, all inside.
+        ends = xy[:, :: width - 1]
+        if np.count_nonzero((ends >= 0.0) & (ends < size)) == ends.size:
+            cells = xy.astype(np.intp)  # truncation is floor for offsets >= 0
+            inside = None
+        else:  # outside samples read the nearest border cell and are not plannable
+            cells = np.floor(xy).astype(np.intp)
+            inside = ((cells >= 0) & (cells < size)).all(axis=0)
+            np.clip(cells, 0, size - 1, out=cells)
+        flat = cells[1] * self._w + cells[0]
+        plannable = self.plannable.ravel().take(flat)
+        ok = (plannable if inside is None else plannable & inside).all(axis=0)
+        weights = self.weight.ravel().take(flat.T)  # (M, K): one row per segment
+        weights[:, 0::2] = 0.0  # midpoints only
+        # Per segment the slice [row start, row start + last + 1) of the flat array; the slices between are dropped.
+        bounds = np.empty((len(length), 2), dtype=np.intp)
+        bounds[:, 0] = np.arange(0, len(length) * width, width)
+        bounds[:, 1] = bounds[:, 0] + (last + 1.0).astype(np.intp)
+        cost = length * (1.0 + np.add.reduceat(weights.ravel(), bounds.ravel())[0::2] / pieces)
+        return cost, ok
 
     def path_cost(self, path: np.ndarray) -> float:
         """J of a polyline (N, 2)."""

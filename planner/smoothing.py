@@ -11,6 +11,8 @@ a Python callback. Here every candidate move of a pass is evaluated at once with
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from planner.problem import CostField
@@ -18,6 +20,8 @@ from planner.validity import interpolate
 
 _DIRECTIONS = np.array([[1, 0], [0, 1], [-1, 0], [0, -1], [1, 1], [-1, 1], [-1, -1], [1, -1]], float)
 _DIRECTIONS[4:] /= np.sqrt(2.0)
+_NEIGHBOURS = np.array([-1, 0, 1])
+_WINDOW = 64  # greedy_shortcut's default window (vertices)
 REFINE_SWEEPS = 2
 REFINE_MIN_STEP = 0.25
 """``smooth``'s refinement: at most this many sweeps per step size, down to this step (in cells). Over the navigation
@@ -28,18 +32,22 @@ DP_REACH = 12
 already bent the path, so longer shortcuts rarely pay, and all pairs cost O(N^2) segments."""
 
 
-def greedy_shortcut(field: CostField, path: np.ndarray, window: int = 64) -> np.ndarray:
+def greedy_shortcut(field: CostField, path: np.ndarray, window: int = _WINDOW) -> np.ndarray:
     """Any-angle pass: from each kept vertex jump to the farthest of the next ``window`` vertices that a straight,
     plannable segment reaches at no more cost than the path between them. O(len(path)) numpy calls."""
     path = np.asarray(path, dtype=float).reshape(-1, 2)
     if len(path) <= 2:
         return path.copy()
-    step_cost = field.segments(path[:-1], path[1:])[0]
+    return _greedy(field, path, field.segments(path[:-1], path[1:])[0], window)
+
+
+def _greedy(field: CostField, path: np.ndarray, step_cost: np.ndarray, window: int) -> np.ndarray:
+    """``greedy_shortcut`` of a path (N > 2, 2) whose segments cost ``step_cost`` (N - 1,)."""
     prefix = np.concatenate([[0.0], np.cumsum(step_cost)])
     kept, a = [0], 0
     while a < len(path) - 1:
         js = np.arange(a + 1, min(a + window, len(path) - 1) + 1)
-        cost, ok = field.segments(np.repeat(path[a : a + 1], len(js), axis=0), path[js])
+        cost, ok = field.segments(np.broadcast_to(path[a], (len(js), 2)), path[js])
         good = ok & (cost <= prefix[js] - prefix[a] + 1e-9)
         good[0] = True  # the path's own next step is always kept available
         a = int(js[np.flatnonzero(good)[-1]])
@@ -52,9 +60,14 @@ def dp_shortcut(field: CostField, path: np.ndarray, reach: int | None = None) ->
     ``reach`` vertices apart; None: all pairs). The path's own segments are always allowed, so the result never costs
     more. O(N * reach) segments (O(N^2) without a reach)."""
     path = np.asarray(path, dtype=float).reshape(-1, 2)
-    n = len(path)
-    if n <= 2:
+    if len(path) <= 2:
         return path.copy()
+    return path[_cheapest_subsequence(field, path, reach)[0]]
+
+
+def _cheapest_subsequence(field: CostField, path: np.ndarray, reach: int | None) -> tuple[list[int], np.ndarray]:
+    """``dp_shortcut``'s vertex indices for a path (N > 2, 2), and the costs J of the result's segments."""
+    n = len(path)
     i, j = np.triu_indices(n, 1)
     if reach is not None:
         i, j = i[j - i <= reach], j[j - i <= reach]
@@ -62,67 +75,94 @@ def dp_shortcut(field: CostField, path: np.ndarray, reach: int | None = None) ->
     ok |= j == i + 1
     matrix = np.full((n, n), np.inf)
     matrix[i[ok], j[ok]] = cost[ok]
-    best = np.full(n, np.inf)
-    best[0] = 0.0
-    previous = np.zeros(n, dtype=np.int64)
+    # The recurrence on Python floats: one numpy call per vertex would cost more than these few additions.
+    columns = matrix.T.tolist()
+    best, previous = [0.0] * n, [0] * n
     for k in range(1, n):
-        total = best[:k] + matrix[:k, k]
-        previous[k] = int(np.argmin(total))
-        best[k] = total[previous[k]]
+        column, best_k = columns[k], math.inf
+        for m in range(0 if reach is None else max(0, k - reach), k):
+            total = best[m] + column[m]
+            if total < best_k:  # strict: the first of equal totals, as np.argmin
+                best_k, previous[k] = total, m
+        best[k] = best_k
     order = [n - 1]
     while order[-1] != 0:
-        order.append(int(previous[order[-1]]))
-    return path[order[::-1]]
+        order.append(previous[order[-1]])
+    order.reverse()
+    return order, matrix[order[:-1], order[1:]]
 
 
 def refine(field: CostField, path: np.ndarray, max_step: float, min_step: float, sweeps: int = 4) -> np.ndarray:
     """Move interior vertices downhill in J: at step sizes from ``max_step`` halving to ``min_step`` (metres), try
     the eight compass moves for every other vertex at once (alternate vertices share no segment) and move each vertex
     to the move that lowers the cost of its two segments most while keeping them plannable (steepest descent). All
-    16 segments of every candidate move of a pass are priced in one ``CostField.segments`` call.
+    16 segments of every candidate move of a pass that may win are priced in one numpy pass (``_descend``).
 
     Within a step size only vertices that may move are priced again: one that moved, or whose neighbour moved. A
     vertex that did not move while its neighbours stayed would get the same answer, so the result is the same as
     pricing every vertex in every pass."""
     path = np.asarray(path, dtype=float).reshape(-1, 2).copy()
-    n = len(path)
-    if n <= 2:
+    if len(path) <= 2:
         return path
     seg_cost = field.segments(path[:-1], path[1:])[0]
-    moves = len(_DIRECTIONS)
-    parity = np.arange(n) % 2
     step = max_step
     while step >= min_step:
-        active = np.zeros(n, dtype=bool)
-        active[1:-1] = True  # a new step size: every interior vertex may move again
+        active = np.ones(len(path), dtype=bool)
+        active[[0, -1]] = False  # a new step size: every interior vertex may move again; the ends never move
         for _ in range(sweeps):
             moved = False
             for first in (1, 0):
-                idx = np.flatnonzero(active & (parity == first))
-                k = len(idx)
-                if k == 0:
-                    continue
-                candidate = (path[idx][None, :, :] + (_DIRECTIONS * step)[:, None, :]).reshape(-1, 2)  # (8k, 2)
-                before, after = np.tile(path[idx - 1], (moves, 1)), np.tile(path[idx + 1], (moves, 1))
-                cost, ok = field.segments(np.concatenate([before, candidate]), np.concatenate([candidate, after]))
-                c_in, c_out = cost[: moves * k].reshape(moves, k), cost[moves * k :].reshape(moves, k)
-                total = np.where((ok[: moves * k] & ok[moves * k :]).reshape(moves, k), c_in + c_out, np.inf)
-                best = np.argmin(total, axis=0)
-                cols = np.arange(k)
-                better = total[best, cols] < seg_cost[idx - 1] + seg_cost[idx] - 1e-9
-                active[idx[~better]] = False
-                if better.any():
-                    moved = True
-                    chosen, pick = idx[better], best[better]
-                    path[chosen] = candidate.reshape(moves, k, 2)[pick, cols[better]]
-                    seg_cost[chosen - 1] = c_in[pick, cols[better]]
-                    seg_cost[chosen] = c_out[pick, cols[better]]
-                    active[chosen - 1] = active[chosen + 1] = True
-                    active[0] = active[-1] = False  # the ends never move
+                idx = np.flatnonzero(active[first::2]) * 2 + first
+                if len(idx):
+                    moved |= _descend(field, path, seg_cost, idx, _DIRECTIONS * step, active)
             if not moved:
                 break
         step /= 2
     return path
+
+
+def _descend(
+    field: CostField, path: np.ndarray, seg_cost: np.ndarray, idx: np.ndarray, moves: np.ndarray, active: np.ndarray
+) -> bool:
+    """One pass of ``refine`` over the vertices ``idx`` (no two adjacent, none an end) with the offsets ``moves``
+    (8, 2) in metres: move each to its best plannable candidate when that lowers the cost of its two segments, in
+    place in ``path``, ``seg_cost`` (J of each segment) and ``active`` (vertices that may move). Whether any moved.
+
+    A segment costs at least its length, so a move whose two new segments are together at least as long as the
+    cost to beat cannot win, nor be the best of the moves that do: only the others are priced (on the navigation
+    study's paths about a quarter of the moves). Arrays are coordinate-major, vertices last: numpy's inner loops
+    then run over vertices rather than over two coordinates."""
+    k = len(idx)
+    before, vertex, after = path[idx[:, None] + _NEIGHBOURS].transpose(1, 2, 0)  # each (2, k): x/y, vertex
+    candidate = vertex[:, None, :] + moves.T[:, :, None]  # (2, 8, k): x/y, move, vertex
+    ends = np.empty((2, 2, 2, 8, k))  # segment start/end, x/y, in/out segment, move, vertex
+    ends[0, :, 0], ends[0, :, 1] = before[:, None, :], candidate
+    ends[1, :, 0], ends[1, :, 1] = candidate, after[:, None, :]
+    d = ends[1] - ends[0]
+    length = np.hypot(d[0], d[1])  # (2, 8, k), as ``CostField.segments_xy`` computes it
+    threshold = seg_cost[idx - 1] + seg_cost[idx] - 1e-9
+    hopeful = np.flatnonzero(length[0] + length[1] < threshold)  # flat (move, vertex) indices
+    cost = np.empty((2, 8, k))
+    cost.fill(np.inf)
+    if len(hopeful):
+        p, q = ends.reshape(2, 2, 2, -1).take(hopeful, axis=3).reshape(2, 2, -1)
+        priced, ok = field.segments_xy(p, q)
+        priced[~ok] = np.inf
+        cost.reshape(2, -1)[:, hopeful] = priced.reshape(2, -1)  # a view: writes into cost
+    total = cost[0] + cost[1]  # inf unless both segments are priced and plannable
+    best = total.argmin(axis=0)
+    rows = np.arange(k)
+    better = total[best, rows] < threshold
+    active[idx[~better]] = False
+    moving = np.flatnonzero(better)
+    if not len(moving):
+        return False
+    chosen, pick = idx[moving], best[moving]
+    path[chosen] = candidate[:, pick, moving].T
+    seg_cost[chosen - 1], seg_cost[chosen] = cost[:, pick, moving]
+    active[chosen - 1] = active[chosen + 1] = True
+    active[0] = active[-1] = False
+    return True
 
 
 def smooth(field: CostField, path: np.ndarray) -> np.ndarray:
@@ -132,7 +172,14 @@ def smooth(field: CostField, path: np.ndarray) -> np.ndarray:
     if len(path) < 2:
         return path.copy()
     res = field.resolution
-    short = dp_shortcut(field, greedy_shortcut(field, path))
+    step_cost = field.segments(path[:-1], path[1:])[0]
+    short = path if len(path) == 2 else _greedy(field, path, step_cost, _WINDOW)
+    short = dp_shortcut(field, short)
     refined = refine(field, interpolate(short, 6 * res), 4 * res, REFINE_MIN_STEP * res, sweeps=REFINE_SWEEPS)
-    result = dp_shortcut(field, refined, reach=DP_REACH)
-    return result if field.path_cost(result) <= field.path_cost(path) else path.copy()
+    if len(refined) <= 2:
+        result, result_cost = refined, field.segments(refined[:-1], refined[1:])[0]
+    else:
+        order, result_cost = _cheapest_subsequence(field, refined, DP_REACH)
+        result = refined[order]
+    # The same sums as ``field.path_cost`` of both paths, from segment costs already known.
+    return result if float(result_cost.sum()) <= float(step_cost.sum()) else path.copy()

@@ -18,7 +18,7 @@ from planner import ompl_planners
 from planner.facade import PLANNERS, plan, resolve_planner
 from planner.ompl_planners import OMPL_PLANNERS
 from planner.problem import CostField, PlanningError, PlanningProblem
-from planner.smoothing import dp_shortcut, refine, smooth
+from planner.smoothing import _DIRECTIONS, dp_shortcut, refine, smooth
 from planner.validity import check_path, interpolate
 
 RADIUS = 0.25
@@ -178,6 +178,96 @@ def test_refine_and_a_short_reach_shortcut_never_raise_cost_and_keep_vertices(wa
     # A longer reach can only find a cheaper (or equal) subsequence.
     costs = [field.path_cost(dp_shortcut(field, refined, reach=r)) for r in (2, 12, None)]
     assert costs[0] >= costs[1] - 1e-9 >= costs[2] - 2e-9
+
+
+def plain_segments(field: CostField, p: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``CostField.segments`` written plainly, segment by segment: the midpoints of ceil(L / resolution) pieces for
+    the cost (even samples weigh 0), midpoints and piece ends for plannability, outside samples clamped to the
+    border and not plannable;
+    ends that are not finite give J = the length and not plannable."""
+    inv = 1.0 / field.resolution
+    costs, oks = [], []
+    for (x0, y0), (x1, y1) in zip(p.tolist(), q.tolist(), strict=True):
+        dx, dy = x1 - x0, y1 - y0
+        length = float(np.hypot(dx, dy))
+        if not np.isfinite(length):
+            costs.append(length)
+            oks.append(False)
+            continue
+        n = max(1.0, float(np.ceil(length * inv - 1e-9)))
+        weights, ok = [], True
+        for k in range(int(2 * n) + 1):
+            x = (x0 - field.spec.origin_x) * inv + k * (dx * (inv / (2 * n)))
+            y = (y0 - field.spec.origin_y) * inv + k * (dy * (inv / (2 * n)))
+            col, row = int(np.floor(x)), int(np.floor(y))
+            inside = 0 <= row < field.spec.height and 0 <= col < field.spec.width
+            row, col = min(max(row, 0), field.spec.height - 1), min(max(col, 0), field.spec.width - 1)
+            ok &= inside and bool(field.plannable[row, col])
+            weights.append(float(field.weight[row, col]) if k % 2 else 0.0)
+        # numpy's sum of the samples in order (pairwise beyond 8 terms, as any numpy sum of a row)
+        costs.append(length * (1.0 + float(np.add.reduce(np.array(weights))) / n))
+        oks.append(ok)
+    return np.array(costs), np.array(oks)
+
+
+def test_segments_equal_a_plain_segment_by_segment_pricing_to_the_last_bit():
+    # Also on cell boundaries, for zero-length segments, for segments leaving the map (clamped lookups) and for ends
+    # that are not finite numbers.
+    field = CostField(PlanningProblem(walled_map(blob_cost=200), (1.0, 2.0), (9.0, 6.0), RADIUS))
+    rng = np.random.default_rng(3)
+    for trial in range(120):
+        m = int(rng.integers(1, 60))
+        p = rng.uniform((-0.3, -0.3), (10.3, 8.3), (m, 2)) if trial % 4 == 0 else rng.uniform((0, 0), (10, 8), (m, 2))
+        q = p + rng.normal(0, rng.choice([0.02, 0.3, 3.0]), (m, 2))
+        if trial % 4:
+            q = np.clip(q, 0.0, (10 - 1e-9, 8 - 1e-9))
+        if trial % 3 == 0:
+            p, q = np.round(p / 0.05) * 0.05, np.round(q / 0.025) * 0.025  # on cell edges and centres
+        q[: m // 5] = p[: m // 5]
+        if trial % 20 == 0:
+            p[-1, trial % 2] = (np.nan, np.inf)[trial // 20 % 2]
+        expected, got = plain_segments(field, p, q), field.segments(p, q)
+        assert np.array_equal(got[0], expected[0], equal_nan=True) and np.array_equal(got[1], expected[1])
+        assert [field.segments(p[i : i + 1], q[i : i + 1])[0][0] for i in range(0, m, 7)] == pytest.approx(
+            got[0][::7].tolist(), nan_ok=True, rel=0, abs=0
+        )
+
+
+def refine_every_move(field: CostField, path: np.ndarray, max_step: float, min_step: float, sweeps: int) -> np.ndarray:
+    """``refine`` written plainly: every interior vertex of a parity, every move, priced by ``CostField.segments``."""
+    path = path.copy()
+    seg_cost = field.segments(path[:-1], path[1:])[0]
+    step = max_step
+    while step >= min_step:
+        for _ in range(sweeps):
+            moved = False
+            for first in (1, 0):
+                for i in range(first or 2, len(path) - 1, 2):
+                    candidates = path[i] + _DIRECTIONS * step
+                    c_in, ok_in = field.segments(np.repeat(path[i - 1 : i], 8, axis=0), candidates)
+                    c_out, ok_out = field.segments(candidates, np.repeat(path[i + 1 : i + 2], 8, axis=0))
+                    total = np.where(ok_in & ok_out, c_in + c_out, np.inf)
+                    best = int(np.argmin(total))
+                    if total[best] < seg_cost[i - 1] + seg_cost[i] - 1e-9:
+                        path[i], seg_cost[i - 1], seg_cost[i], moved = candidates[best], c_in[best], c_out[best], True
+            if not moved:
+                break
+        step /= 2
+    return path
+
+
+def test_refine_equals_pricing_every_move(walls):
+    # refine prices only vertices that may move and only moves that may win; the result must not change.
+    field = CostField(PlanningProblem(walled_map(blob_cost=250), (1.0, 2.0), (9.0, 6.0), RADIUS))
+    rng = np.random.default_rng(1)
+    for seed in (1, 2):
+        dense = interpolate(plan(walls, "rrtconnect", seed=seed, simplify=False).path, 0.3)
+        jittered = dense.copy()
+        jittered[1:-1] += rng.normal(0, 0.02, jittered[1:-1].shape)
+        for path in (dense, jittered):
+            for sweeps in (1, 2):
+                expected = refine_every_move(field, path, 0.2, 0.0125, sweeps)
+                assert np.array_equal(refine(field, path, 0.2, 0.0125, sweeps), expected)
 
 
 def test_bitstar_stops_once_its_cost_settles_and_other_planners_use_their_budget(walls):
