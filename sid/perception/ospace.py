@@ -38,9 +38,12 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.spatial import cKDTree
+
+if TYPE_CHECKING:  # imported where a crowd needs it: scipy.spatial is ~0.3 s of a command's start-up
+    from scipy.spatial import cKDTree
 
 from sid.checks import check_number
 
@@ -123,6 +126,8 @@ def find_ospaces(
 
 def _find_crowd(positions: np.ndarray, facing: np.ndarray, weight: np.ndarray, model: OSpaceModel) -> list[OSpace]:
     """``find_ospaces`` on numpy arrays, candidate-major, with a KD-tree listing the people within reach."""
+    from scipy.spatial import cKDTree
+
     known = ~np.isnan(facing)
     owners = np.flatnonzero(known)
     if len(owners) < 2:
@@ -167,6 +172,8 @@ def _find_crowd(positions: np.ndarray, facing: np.ndarray, weight: np.ndarray, m
 def _near(tree: cKDTree, centres: np.ndarray, reach: float) -> np.ndarray:
     """(M, K) indices of the people within ``reach`` (m) of each centre, ascending, padded with -1; ``tree`` indexes
     the positions."""
+    from scipy.spatial import cKDTree
+
     pairs = cKDTree(np.column_stack((centres.real, centres.imag))).sparse_distance_matrix(
         tree, reach, output_type="ndarray"
     )
