@@ -131,9 +131,13 @@ def _source_options(args: argparse.Namespace) -> dict:
 
 def _skip_reason(frame: Frame) -> str | None:
     depth = frame.depth
-    if depth is None or depth.size == 0 or not np.any(np.isfinite(depth) & (depth > 0)):
+    if depth is None or depth.size == 0:
         return "no depth"
-    return None
+    # One pixel in 256 settles a usual frame (~0.5 ms less than the whole image); the whole one only when it has none.
+    for view in (depth[::16, ::16], depth):
+        if np.any(np.isfinite(view) & (view > 0)):
+            return None
+    return "no depth"
 
 
 def camera_view(calibration: Calibration, mount: CameraMount) -> CameraView:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import shutil
+from dataclasses import replace
 
 import cv2
 import numpy as np
@@ -248,3 +249,15 @@ def test_summary_counts_every_skipped_frame(tmp_path, capsys):
     captured = capsys.readouterr()
     assert len(_lines(captured.out)) == 1
     assert "1 frames with people, 3 skipped" in captured.err
+
+
+def test_a_frame_is_skipped_for_depth_only_when_no_pixel_has_any():
+    from sid.cli.detect import _skip_reason
+
+    frame = next(iter(SyntheticSource("S1", frames=1)))
+    sparse = np.zeros_like(frame.depth)
+    sparse[5, 7] = 2.0  # one reading, off the coarse sample grid
+    nan_and_inf = np.where(np.arange(frame.depth.size).reshape(frame.depth.shape) % 2, np.nan, np.inf)
+    cases = {"whole": frame.depth, "one pixel": sparse, "none": np.zeros_like(frame.depth), "nan/inf": nan_and_inf}
+    reasons = {name: _skip_reason(replace(frame, depth=depth)) for name, depth in cases.items()}
+    assert reasons == {"whole": None, "one pixel": None, "none": "no depth", "nan/inf": "no depth"}
