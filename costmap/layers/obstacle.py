@@ -9,10 +9,11 @@ beam's hit. Beams with no return (``inf``) clear out to ``raytrace_max_range`` w
 Lines are traced with a rounded DDA over integer cells (one cell per step along the major axis: the cells of
 Bresenham's algorithm up to tie-breaking), for all beams at once in numpy rather than cell by cell (line drawing
 in OpenCV or scikit-image draws one line per call, 720 Python calls per scan). The layer keeps each beam's cells
-and how many beams cross each cell and, while the sensor stays in its cell, traces again only the beams whose end
-cell moved (``_BeamCells``). It writes only what clearing every beam would change: the cells of those beams, and the
-last scan's hits that some beam now crosses (every other beam cell was cleared by the last scan already); a test
-checks the grid against clearing every beam.
+and, while the sensor stays in its cell, traces again only the beams whose end cell moved (``_BeamCells``). While
+few beams move (a standing robot, people walking) it also counts the beams crossing each cell and writes only what
+clearing every beam would change: the cells of the beams traced again, and the last scan's hits that some beam now
+crosses (every other beam cell was cleared by the last scan already); a test checks the grid against clearing every
+beam, with the sensor standing, turning and moving.
 
 Each update reports the window of the cells whose value changed, not the window the scan covers: a scan of a scene
 that did not change (people's marks aside, which are cleared) makes the costmap recombine nothing.
@@ -26,7 +27,7 @@ from typing import NamedTuple
 import numpy as np
 
 from costmap.combine import CombinationMethod
-from costmap.grid import FREE_SPACE, LETHAL, NO_INFORMATION, GridSpec, Window, nonzero_cells
+from costmap.grid import FREE_SPACE, LETHAL, NO_INFORMATION, GridSpec, Window, changed_window, nonzero_cells, union
 from costmap.layer import Layer, LayerInputs
 from costmap.scan import LaserScan
 from sid.checks import check_number, check_numbers
@@ -97,15 +98,20 @@ _PAIRS_PER_CHUNK = 2**20
 """``clear_discs`` tests at most this many (mark, person) pairs at once (a few MB of float64)."""
 
 
+_INCREMENTAL_SHARE = 0.5
+"""A scan whose beams' end cells moved for at most this share of the beams (the sensor in the same cell) is written
+incrementally (``_BeamCells``); otherwise whole."""
+
 _ONE = np.int32(1)
 """The coverage counts' step: a numpy scalar of their dtype keeps ``np.add.at`` on its fast path (a Python int is
 ~30x slower)."""
 
 
 class _BeamCells:
-    """The cells the current scan's beams cross, kept beam by beam, and how many beams cross each cell. A new scan
-    from the same sensor cell traces again only the beams whose end cell moved (a line's cells depend only on its
-    two end cells)."""
+    """The cells the current scan's beams cross, kept beam by beam. A new scan from the same sensor cell traces again
+    only the beams whose end cell moved (a line's cells depend only on its two end cells); while the sensor stays in
+    its cell, the number of beams crossing each cell is kept too (built when first needed: a moving sensor traces
+    every beam again anyway)."""
 
     def __init__(self, spec: GridSpec) -> None:
         self.spec = spec
@@ -113,21 +119,31 @@ class _BeamCells:
         self.delta = np.zeros((0, 2), dtype=np.int64)  # (M, 2) end cell - sensor cell, by beam
         self.flat = np.zeros((0, 0), dtype=np.int64)  # (M, n) as ``_trace_lines``
         self.keep = np.zeros((0, 0), dtype=bool)
-        self.coverage = np.zeros(spec.width * spec.height, dtype=np.int32)  # beams crossing each cell (flat index)
+        self._coverage: np.ndarray | None = None  # beams crossing each cell (flat index, int32); None: not built
 
-    def update(self, origin: np.ndarray, ends: np.ndarray) -> np.ndarray:
-        """Take the lines origin -> ends (world, (M, 2), finite) as the current beams; returns the flat indices of
-        the cells of the beams traced again (``trace_cells``' cells of those beams, end cells excluded)."""
+    def update(self, origin: np.ndarray, ends: np.ndarray) -> tuple[np.ndarray, Window | None, bool]:
+        """Take the lines origin -> ends (world, (M, 2), finite) as the current beams. Returns the flat indices of
+        the cells of the beams traced again (``trace_cells``' cells of those beams, end cells excluded), a window
+        holding them (None when there are none) and whether every beam was traced again (the sensor moved to
+        another cell, the number of beams changed, or more than ``_INCREMENTAL_SHARE`` of the beams moved)."""
         c0 = self.spec.world_to_cell(origin)[0]
         delta = self.spec.world_to_cell(ends) - c0
-        if np.array_equal(c0, self.origin) and delta.shape == self.delta.shape:
-            redo = np.flatnonzero((delta != self.delta).any(axis=1))
+        same_sensor = np.array_equal(c0, self.origin) and delta.shape == self.delta.shape
+        redo = np.flatnonzero((delta != self.delta).any(axis=1)) if same_sensor else np.arange(0)
+        # Counting beams pays while few of them move (a standing robot, people walking); when most move (the robot
+        # moves within its cell) the scan is written whole, as after a move to another cell.
+        if same_sensor and len(redo) <= _INCREMENTAL_SHARE * len(delta):
             np.subtract.at(self.coverage, self.flat[redo][self.keep[redo]], _ONE)
+            # A line's cells lie in the box of its two end cells.
+            corners = np.vstack((c0[None], c0 + delta[redo]))
+            window = Window(*_box(corners)).clipped(self.spec) if len(redo) else None
+            everything = False
         else:
             redo = np.arange(len(delta))
-            self.coverage[:] = 0
+            self._coverage = None
             self.flat = np.zeros((len(delta), 0), dtype=np.int64)
             self.keep = np.zeros((len(delta), 0), dtype=bool)
+            window, everything = None, True
         n = _longest(delta[redo])
         if n > self.flat.shape[1]:  # longer lines than any kept: widen (the new steps are off every line)
             grow = ((0, 0), (0, n - self.flat.shape[1]))
@@ -136,16 +152,33 @@ class _BeamCells:
         self.flat[redo], self.keep[redo] = flat, keep
         self.origin, self.delta = c0, delta
         traced = flat[keep]
-        np.add.at(self.coverage, traced, _ONE)
-        return traced
+        if self._coverage is not None:
+            np.add.at(self._coverage, traced, _ONE)
+        return traced, window, everything
+
+    @property
+    def coverage(self) -> np.ndarray:
+        """How many current beams cross each cell (flat index), built from the kept cells when first asked for."""
+        if self._coverage is None:
+            cells = self.flat[self.keep]
+            self._coverage = np.bincount(cells, minlength=self.spec.width * self.spec.height).astype(np.int32)
+        return self._coverage
+
+
+def _box(cells: np.ndarray) -> tuple[int, int, int, int]:
+    """(row0, row1, col0, col1) of the smallest window holding cells (K >= 1, 2) as (row, col)."""
+    low, high = cells.min(axis=0), cells.max(axis=0) + 1
+    return int(low[0]), int(high[0]), int(low[1]), int(high[1])
 
 
 class _ScanMarks(NamedTuple):
-    """What one scan writes (flat cell indices): the cells to clear (those of the beams traced again, and the last
-    scan's hits that a beam now crosses) and the cells its hits mark LETHAL."""
+    """What one scan writes: the cells to clear (flat indices: those of the beams traced again, and the last scan's
+    hits that a beam now crosses), the cells its hits mark LETHAL ((K, 2) as (row, col)) and a window holding both
+    (None: nothing to write)."""
 
     cleared: np.ndarray
     hits: np.ndarray
+    window: Window | None
 
 
 class ObstacleLayer(Layer):
@@ -168,7 +201,6 @@ class ObstacleLayer(Layer):
         self.people_clear_radius = float(people_clear_radius)
         self._beams = _BeamCells(spec)
         self._hits = np.zeros(0, dtype=np.int64)  # the last scan's hit cells (flat indices)
-        self._written = np.zeros(spec.width * spec.height, dtype=bool)  # scratch: the cells a scan wrote
 
     def update(self, inputs: LayerInputs, changed: Window | None) -> Window | None:
         """Apply the scan (if any), then clear the people's marks; returns the window of the cells whose value
@@ -184,22 +216,19 @@ class ObstacleLayer(Layer):
 
     def _apply(self, scan: _ScanMarks | None, people: np.ndarray) -> Window | None:
         """Write a scan's marks (if any), then clear the marks within ``people_clear_radius`` of the people (world,
-        (N, 2)); returns the window of the cells whose value changed (their values before and after compared)."""
-        flat = self.costs.ravel()
-        written = np.zeros(0, dtype=np.int64)
+        (N, 2)); returns the window of the cells whose value changed (compared with a copy of the cells written)."""
+        discs = self._discs_window(people, self.people_clear_radius)
+        touched = union(None if scan is None else scan.window, discs)
+        if touched is None:
+            return None
+        before = self.costs[touched.slices].copy()
         if scan is not None:
-            written = np.concatenate((scan.cleared, scan.hits))
-            before = flat[written]
-            flat[scan.cleared] = FREE_SPACE
-            flat[scan.hits] = LETHAL
-            self._hits = scan.hits
-        freed = self.clear_discs(people, self.people_clear_radius) if len(people) else written[:0]
-        if scan is not None:  # freed cells the scan wrote: compared with their value before it, as the others
-            self._written[written] = True
-            freed = freed[~self._written[freed]]
-            self._written[written] = False
-            written = written[flat[written] != before]
-        return _cells_window(np.concatenate((written, freed)), self.spec.width)
+            self.costs.ravel()[scan.cleared] = FREE_SPACE
+            self.costs[scan.hits[:, 0], scan.hits[:, 1]] = LETHAL
+            self._hits = scan.hits[:, 0] * self.spec.width + scan.hits[:, 1]
+        if discs is not None:
+            self.clear_discs(people, self.people_clear_radius)
+        return changed_window(before, self.costs[touched.slices], touched)
 
     def _scan_marks(self, scan: LaserScan) -> _ScanMarks:
         """What a scan writes (nothing written yet; the beams' cells are taken as the current ones).
@@ -219,45 +248,40 @@ class ObstacleLayer(Layer):
         ends = origin + dirs[clearing] * clear_len[:, None]
         with np.errstate(invalid="ignore"):
             marking = np.isfinite(r) & (r >= p.obstacle_min_range) & (r <= p.obstacle_max_range)
-        hits = self.spec.world_to_cell(origin + dirs[marking] * r[marking, None])
+        hit_xy = origin + dirs[marking] * r[marking, None]
+        hits = self.spec.world_to_cell(hit_xy)
         hits = hits[self.spec.in_bounds(hits)]
-        traced = self._beams.update(origin, ends)
+        traced, traced_window, everything = self._beams.update(origin, ends)
+        if everything:  # every beam's cells, in the whole scan's box
+            window = self.spec.window_around(np.vstack([origin[None], ends, hit_xy]))
+            assert window is not None  # it holds the sensor, which is inside the grid
+            return _ScanMarks(traced, hits, window)
         crossed = self._hits[self._beams.coverage[self._hits] > 0]
-        return _ScanMarks(np.concatenate((traced, crossed)), hits[:, 0] * self.spec.width + hits[:, 1])
+        marked = np.vstack((hits, np.column_stack(np.divmod(crossed, self.spec.width))))
+        window = union(traced_window, Window(*_box(marked)) if len(marked) else None)
+        return _ScanMarks(np.concatenate((traced, crossed)), hits, window)
 
-    def clear_discs(self, centres: np.ndarray, radius: float) -> np.ndarray:
-        """Turn LETHAL marks whose cell centre lies within ``radius`` metres of any centre (N, 2) into FREE; returns
-        their flat indices.
+    def clear_discs(self, centres: np.ndarray, radius: float) -> None:
+        """Turn LETHAL marks whose cell centre lies within ``radius`` metres of any centre (N, 2) into FREE.
 
         Only the marks are tested (against every centre at once): there are few, and discs are many small windows.
         """
         centres = np.asarray(centres, dtype=float).reshape(-1, 2)
         window = self._discs_window(centres, radius)
         if window is None:
-            return np.zeros(0, dtype=np.int64)
+            return
         view = self.costs[window.slices]
         rows, cols = nonzero_cells(view == LETHAL)
         xs, ys = self.spec.cell_axes(window)
         chunk = max(1, _PAIRS_PER_CHUNK // len(centres))  # (marks, centres) pairs at a time: memory stays bounded
-        freed = []
         for start in range(0, len(rows), chunk):
             r, c = rows[start : start + chunk], cols[start : start + chunk]
             dx, dy = xs[0, c, None] - centres[:, 0], ys[r, 0, None] - centres[:, 1]  # (marks, centres)
             inside = (dx**2 + dy**2 <= radius**2).any(axis=1)
             view[r[inside], c[inside]] = FREE_SPACE
-            freed.append((r[inside] + window.row0) * self.spec.width + c[inside] + window.col0)
-        return np.concatenate(freed) if freed else np.zeros(0, dtype=np.int64)
 
     def _discs_window(self, centres: np.ndarray, radius: float) -> Window | None:
         """The cells of the bounding box of discs of ``radius`` metres around world centres (N, 2); None: none."""
         if len(centres) == 0:
             return None
         return self.spec.window(tuple(centres.min(axis=0) - radius), tuple(centres.max(axis=0) + radius))
-
-
-def _cells_window(cells: np.ndarray, width: int) -> Window | None:
-    """The smallest window holding the cells of flat indices ``cells`` (a grid ``width`` cells wide); None: none."""
-    if len(cells) == 0:
-        return None
-    rows, cols = np.divmod(cells, width)
-    return Window(int(rows.min()), int(rows.max()) + 1, int(cols.min()), int(cols.max()) + 1)

@@ -230,16 +230,23 @@ def test_lidar_layer_retraces_only_moved_beams_and_counts_the_beams_of_a_fresh_t
     layer = ObstacleLayer(SPEC)
     origin = np.array([4.0, 0.0])
     ends = origin + rng.normal(0.0, 4.0, (360, 2))
-    for step in range(6):  # some beams move their end cell, one scan gets longer, then the sensor moves
+    previous = None
+    for _ in range(8):  # some beams move their end cell, one scan gets longer, then the sensor moves (1 cm a step)
         moved = rng.random(len(ends)) < 0.2
         ends[moved] += rng.normal(0.0, 0.3, 2)
-        traced = layer._beams.update(origin, ends)
+        traced, window, everything = layer._beams.update(origin, ends)
+        cell = SPEC.world_to_cell(origin[None])[0].tolist()
         fresh = trace_cells(SPEC, origin, ends)
         counts = np.bincount(fresh, minlength=SPEC.width * SPEC.height)
         np.testing.assert_array_equal(layer._beams.coverage, counts)
-        assert np.isin(traced, fresh).all() and (step == 0 or len(traced) < len(fresh))
+        assert everything == (cell != previous)  # all beams again when the sensor's cell changed
+        assert np.isin(traced, fresh).all() and (everything or len(traced) < len(fresh))
+        if window is not None:  # the traced cells lie in it
+            rows, cols = np.divmod(traced, SPEC.width)
+            assert window.row0 <= rows.min() and rows.max() < window.row1
+            assert window.col0 <= cols.min() and cols.max() < window.col1
         ends[0] = origin + (20.0, 0.5)
-        origin = origin + (0.01, 0.0)
+        origin, previous = origin + (0.01, 0.0), cell
 
 
 @pytest.mark.parametrize("seed", range(4))
@@ -255,8 +262,10 @@ def test_lidar_layer_writes_what_clearing_every_beam_then_marking_would(seed):
     people = [Person(k, x, y, 0.0) for k, (x, y) in enumerate(rng.uniform((1.0, -2.0), (7.0, 2.0), (4, 2)))]
     pose = (0.0, 0.0, 0.0)
     for step in range(12):
-        if step % 5 == 4:
+        if step % 5 == 4:  # the sensor moves to another cell
             pose = (pose[0] + 0.3, pose[1] + 0.1, pose[2])
+        elif step % 5 == 2:  # it turns in its cell: most beams' end cells move
+            pose = (pose[0], pose[1], pose[2] + 0.01)
         people = [Person(p.id, p.x + rng.normal(0, 0.05), p.y + rng.normal(0, 0.05), 0.0) for p in people]
         scan = simulate_scan(pose, walls, people, beams=360, range_max=10.0)
         before = layer.costs.copy()
