@@ -34,6 +34,9 @@ from costmap.grid import INSCRIBED, LETHAL, MAX_NON_OBSTACLE, NO_INFORMATION, Co
 from sid.checks import check_number
 
 _LOOP_MAX = 20  # segment_cost sums this many samples or fewer in a Python loop, more with numpy (docs/parameters.md)
+SAMPLES_PER_CALL = 2**20
+"""``CostField.segments`` prices at most about this many samples at once (a few arrays of 8 MB): a batch of long and
+short segments (all pairs of a long path) is cut into chunks of similar length."""
 
 DEFAULT_COST_WEIGHT = 4.0
 """w in J = integral of (1 + w c / 252) ds; see the module docstring. 4: on the demo scenario the smallest weight
@@ -193,6 +196,8 @@ class CostField:
         np.maximum(pieces, 1.0, out=pieces)
         last = 2.0 * pieces  # each segment's end sample
         width = int(last.max()) + 2  # one spare sample: each segment's slice of samples ends inside its row
+        if width * len(last) > SAMPLES_PER_CALL and len(last) > 1:
+            return self._segments_in_chunks(p, q, last)
         k = np.minimum(np.arange(width, dtype=float)[:, None], last)  # (K, M)
         start = (p - np.array([[self._ox], [self._oy]])) * inv
         xy = start[:, None, :] + k * (d * (inv / last))[:, None, :]  # (2, K, M) cells
@@ -216,6 +221,22 @@ class CostField:
         bounds[:, 0] = np.arange(0, len(length) * width, width)
         bounds[:, 1] = bounds[:, 0] + (last + 1.0).astype(np.intp)
         cost = length * (1.0 + np.add.reduceat(weights.ravel(), bounds.ravel())[0::2] / pieces)
+        return cost, ok
+
+    def _segments_in_chunks(self, p: np.ndarray, q: np.ndarray, last: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``segments_xy`` of many segments of unequal length (``last``: 2 x their pieces) in chunks of similar
+        length, each within ``SAMPLES_PER_CALL`` samples: memory stays bounded and short segments do not pay for the
+        longest one's row. The same values (each segment's samples and sum do not depend on the others)."""
+        order = np.argsort(last, kind="stable")
+        width = last[order] + 2.0  # a chunk's row width is that of its last (longest) segment
+        cost, ok = np.empty(len(last)), np.empty(len(last), dtype=bool)
+        start = 0
+        while start < len(order):
+            fits = width[start:] * np.arange(1, len(order) - start + 1) <= SAMPLES_PER_CALL  # True..., then False...
+            stop = start + (len(fits) if fits.all() else max(1, int(np.argmin(fits))))
+            chunk = order[start:stop]
+            cost[chunk], ok[chunk] = self.segments_xy(p[:, chunk], q[:, chunk])
+            start = stop
         return cost, ok
 
     def path_cost(self, path: np.ndarray) -> float:

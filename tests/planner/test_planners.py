@@ -233,6 +233,20 @@ def test_segments_equal_a_plain_segment_by_segment_pricing_to_the_last_bit():
         )
 
 
+def test_segments_of_unequal_length_are_priced_in_chunks_with_the_same_values(monkeypatch):
+    # All pairs of a path's vertices: short and long segments together; cut into small chunks they price the same.
+    import planner.problem
+
+    field = CostField(PlanningProblem(walled_map(blob_cost=200), (1.0, 2.0), (9.0, 6.0), RADIUS))
+    rng = np.random.default_rng(5)
+    vertices = rng.uniform((0.2, 0.2), (9.8, 7.8), (40, 2))
+    i, j = np.triu_indices(len(vertices), 1)
+    whole = field.segments(vertices[i], vertices[j])
+    monkeypatch.setattr(planner.problem, "SAMPLES_PER_CALL", 500)  # a few segments a chunk, some alone
+    chunked = field.segments(vertices[i], vertices[j])
+    assert np.array_equal(whole[0], chunked[0]) and np.array_equal(whole[1], chunked[1])
+
+
 def refine_every_move(field: CostField, path: np.ndarray, max_step: float, min_step: float, sweeps: int) -> np.ndarray:
     """``refine`` written plainly: every interior vertex of a parity, every move, priced by ``CostField.segments``."""
     path = path.copy()
