@@ -61,9 +61,6 @@ class SocialParams:
         check_numbers("social", self, ("group_margin", "people_clear_margin"), low=0, unit="metres")
 
 
-_SQRT_HALF = math.sqrt(0.5)
-
-
 @lru_cache(maxsize=64)
 def _reach(amplitude: float, sigma: float) -> float:
     """Distance (m) at which amplitude * exp(-d^2 / 2 sigma^2) drops below 1 (the smallest non-zero cost)."""
@@ -103,80 +100,121 @@ def group_zone_polygon(
     return grown
 
 
-def _hull_ring(hull: BaseGeometry) -> tuple[np.ndarray, bool]:
-    """The vertices of a convex hull (Point, LineString or Polygon) as an (K, 2) array, a polygon's ring closed
-    and counter-clockwise (as shapely's ``orient(hull, 1.0)``), and whether it is a polygon."""
+def _hull_ring(hull: BaseGeometry) -> tuple[list[list[float]], bool]:
+    """The vertices [x, y] (world frame, m) of a convex hull (Point, LineString or Polygon), a polygon's ring closed
+    and counter-clockwise (as shapely's ``orient(hull, 1.0)``), and whether it is a polygon. Python floats, read in
+    one call (``shapely.get_coordinates``): a handful of vertices, per group and frame."""
+    ring = shapely.get_coordinates(hull).tolist()
     if not isinstance(hull, Polygon):
-        return np.asarray(hull.coords, dtype=float).reshape(-1, 2), False
-    ring = np.asarray(hull.exterior.coords, dtype=float)
-    x, y = ring[:, 0], ring[:, 1]
-    clockwise = float(np.dot(x[:-1], y[1:]) - np.dot(x[1:], y[:-1])) < 0  # shoelace: twice the signed area
-    return (ring[::-1] if clockwise else ring), True
+        return ring, False
+    twice_area = sum(ax * by - bx * ay for (ax, ay), (bx, by) in zip(ring[:-1], ring[1:], strict=True))  # shoelace
+    return (ring[::-1] if twice_area < 0 else ring), True
 
 
-def _distance_to_hull(xs: np.ndarray, ys: np.ndarray, ring: np.ndarray, polygon: bool) -> np.ndarray:
-    """Exact distance (m) from points (xs (1, cols) and ys (rows, 1), broadcast together) to a convex hull (0 inside).
+def _bounds(points: list[list[float]]) -> tuple[tuple[float, float], tuple[float, float]]:
+    """The bounding box (x min, y min), (x max, y max) of points [x, y]."""
+    xs, ys = [x for x, _ in points], [y for _, y in points]
+    return (min(xs), min(ys)), (max(xs), max(ys))
 
-    ring, polygon: ``_hull_ring``'s vertices (a point, a polyline, or a closed counter-clockwise ring) and whether
-    they bound a polygon.
 
-    Written out in numpy rather than ``shapely.distance``, which needs a point object per cell, and one pass per
-    edge (keeping the running minimum) rather than all edges at once: both are faster (docs/parameters.md). Per
-    edge, in its own frame: t along it from its start, n across it (positive on the left, the inside of a
-    counter-clockwise ring); the squared distance to the segment is n^2 + (t - clip(t, 0, length))^2, and a point
-    is inside the polygon when n >= 0 for every edge. The arithmetic runs in preallocated buffers, in the offsets'
-    dtype (float32 from ``_local_axes``: Python floats do not promote it), within 1 cost unit of float64.
+def _polynomials(spec: GridSpec, window: Window, x: float, y: float, coefficients: Sequence[float]) -> np.ndarray:
+    """Polynomials of degree <= 2 in the offsets (dx, dy) (m, world frame) of the window's cell centres from (x, y),
+    float32 (k, rows, cols). ``coefficients``: 9 per polynomial, those of 1, dx, dx^2, dy, dy dx, dy dx^2, dy^2, ...
+
+    Two matrix products (the x powers first, then the y powers): one BLAS call writes every cell of every polynomial,
+    ~2x faster here than a broadcast add of a row and a column vector per polynomial. In float32, on offsets from a
+    point near the cells, so the terms stay small: within 1 cost unit of float64 (the tests check it).
     """
+    xs, ys = spec.cell_axes(window)
+    cols = xs.shape[1]
+    powers = np.empty((3, cols + len(ys)), dtype=np.float32)  # 1, d, d^2 of the x offsets, then of the y offsets
+    powers[0] = 1.0
+    powers[1, :cols] = xs[0] - x
+    powers[1, cols:] = ys[:, 0] - y
+    np.square(powers[1], out=powers[2])
+    by_y_power = np.array(coefficients, dtype=np.float32).reshape(-1, 3, 3)
+    per_x = np.matmul(by_y_power, powers[:, :cols])  # (k, 3, cols): the sums over the x powers
+    return np.matmul(powers[:, cols:].T, per_x)
+
+
+def _line(x0: float, y0: float, ux: float, uy: float) -> list[float]:
+    """``_polynomials`` coefficients of the linear function (dx - x0) ux + (dy - y0) uy."""
+    return [-(x0 * ux + y0 * uy), ux, 0.0, uy, 0.0, 0.0, 0.0, 0.0, 0.0]
+
+
+def _distance_to_hull(spec: GridSpec, window: Window, ring: list[list[float]], polygon: bool) -> np.ndarray:
+    """Exact distance (m) from the window's cell centres to a convex hull (0 inside), float32 (rows, cols).
+
+    ring, polygon: ``_hull_ring``'s vertices (a point, a polyline, or a closed counter-clockwise ring; world frame) and
+    whether they bound a polygon.
+
+    Written out in numpy rather than ``shapely.distance``, which needs a point object per cell (docs/parameters.md).
+    Per edge, in its own frame: t along it from its middle, n across it (positive on the left, the inside of a
+    counter-clockwise ring); the distance to the segment is hypot(n, max(|t| - length / 2, 0)), and a point is inside
+    the polygon when n >= 0 for every edge. Every edge's t and n come from one ``_polynomials`` call, on offsets from
+    the first vertex, and each step then runs on all edges at once; the per-edge setup is in Python floats (a handful
+    of edges: numpy's call overhead would dominate).
+    """
+    ox, oy = ring[0]
     if len(ring) == 1:
-        return np.hypot(xs - ring[0, 0], ys - ring[0, 1])
-    shape = np.broadcast_shapes(np.shape(xs), np.shape(ys))
-    dtype = np.result_type(xs, ys)
-    best = np.full(shape, np.inf, dtype=dtype)
-    least_across = np.full(shape, np.inf, dtype=dtype)
-    along, across, beyond = (np.empty(shape, dtype=dtype) for _ in range(3))
-    for (ax, ay), (bx, by) in zip(ring[:-1].tolist(), ring[1:].tolist(), strict=True):
+        dx, dy = _polynomials(spec, window, ox, oy, _line(0.0, 0.0, 1.0, 0.0) + _line(0.0, 0.0, 0.0, 1.0))
+        return cast(np.ndarray, cv2.magnitude(dx, dy))
+    along: list[float] = []  # the coefficients of every edge's t, then (across) of every edge's n
+    across: list[float] = []
+    halves = []
+    for (ax, ay), (bx, by) in zip(ring[:-1], ring[1:], strict=True):
         length = math.hypot(bx - ax, by - ay)
-        if length < 1e-12:  # a repeated vertex (shapely's hulls have none): nothing to divide by
+        if length < 1e-12:  # a repeated vertex (shapely's hulls have none): no direction
             continue
         ux, uy = (bx - ax) / length, (by - ay) / length
-        dx, dy = xs - ax, ys - ay
-        np.add(dx * ux, dy * uy, out=along)
-        np.subtract(dy * ux, dx * uy, out=across)
-        if polygon:
-            np.minimum(least_across, across, out=least_across)
-        np.clip(along, 0.0, length, out=beyond)
-        np.subtract(along, beyond, out=beyond)
-        np.square(across, out=across)
-        across += np.square(beyond, out=beyond)
-        np.minimum(best, across, out=best)
-    distance = np.sqrt(best, out=best)
-    if polygon:
-        distance[least_across >= 0] = 0.0
-    return distance
+        mx, my = (ax + bx) / 2 - ox, (ay + by) / 2 - oy
+        along += _line(mx, my, ux, uy)
+        across += _line(mx, my, -uy, ux)
+        halves.append(length / 2)
+    fields = _polynomials(spec, window, ox, oy, along + across)
+    edges, cols = len(halves), fields.shape[2]
+    # Every edge in each call (as one (edges x rows, cols) array for OpenCV): 5 calls whatever the number of edges.
+    beyond, normal = fields[:edges], fields[edges:]
+    np.abs(beyond, out=beyond)
+    beyond -= np.array(halves, dtype=np.float32)[:, None, None]
+    flat = beyond.reshape(-1, cols)
+    cv2.threshold(flat, 0.0, 0.0, cv2.THRESH_TOZERO, dst=flat)  # max(beyond, 0), ~2x numpy's here
+    cv2.magnitude(flat, normal.reshape(-1, cols), magnitude=flat)
+    best = beyond.min(axis=0)
+    if polygon:  # inside: n >= 0 for every edge
+        best *= normal.min(axis=0) < 0
+    return best
 
 
 def _person_box(
     person: Person, params: SocialParams, sigma_front: float
 ) -> tuple[tuple[float, float], tuple[float, float]]:
     """World bounding box of the cells where the person's personal-space cost is at least 1 (``sigma_front``, m:
-    the spread ahead)."""
+    the spread ahead), in Python floats (a person's box is per-frame overhead).
+
+    Those cells form two half-ellipses, ahead and behind, sharing the side semi-axis. An ellipse with semi-axes a
+    (along the facing theta) and b reaches hypot(a cos theta, b sin theta) along x: a is the front reach on the side
+    the person faces and the rear reach on the other (likewise along y). At 45 degrees, about half the area of the
+    rotated rectangle's box."""
     if person.theta is None:
         r = _reach(params.amplitude, params.sigma_unknown)
         return (person.x - r, person.y - r), (person.x + r, person.y + r)
     front, rear, side = (_reach(params.amplitude, s) for s in (sigma_front, params.sigma_rear, params.sigma_side))
     c, s = math.cos(person.theta), math.sin(person.theta)
-    # The rectangle's corners (u along the facing, v sideways), in Python floats: a person's box is per-frame overhead.
-    corners = [(u, v) for u in (front, -rear) for v in (side, -side)]
-    xs = [person.x + c * u - s * v for u, v in corners]
-    ys = [person.y + s * u + c * v for u, v in corners]
-    return (min(xs), min(ys)), (max(xs), max(ys))
+    ahead_x, behind_x = (front, rear) if c >= 0 else (rear, front)
+    ahead_y, behind_y = (front, rear) if s >= 0 else (rear, front)
+    return (
+        (person.x - math.hypot(behind_x * c, side * s), person.y - math.hypot(behind_y * s, side * c)),
+        (person.x + math.hypot(ahead_x * c, side * s), person.y + math.hypot(ahead_y * s, side * c)),
+    )
 
 
-def _local_axes(spec: GridSpec, window: Window, x: float, y: float) -> tuple[np.ndarray, np.ndarray]:
-    """Cell-centre offsets from (x, y) in a window as float32 (1, cols) and (rows, 1): float32 for the speed of the
-    per-cell arithmetic (docs/parameters.md), exact to ~1e-6 m over a few metres."""
-    xs, ys = spec.cell_axes(window)
-    return (xs - x).astype(np.float32), (ys - y).astype(np.float32)
+def _gaussian_exponent(sigma_along: float, sigma_side: float, c: float, s: float, log_scale: float) -> list[float]:
+    """``_polynomials`` coefficients of log_scale - (u^2 / 2 sigma_along^2 + v^2 / 2 sigma_side^2), with
+    u = c dx + s dy along the facing and v = c dy - s dx sideways (m)."""
+    a, b = 0.5 / sigma_along**2, 0.5 / sigma_side**2
+    dx2, dy_dx, dy2 = -(a * c * c + b * s * s), -2 * (a - b) * c * s, -(a * s * s + b * c * c)
+    return [log_scale, 0.0, dx2, 0.0, dy_dx, 0.0, dy2, 0.0, 0.0]
 
 
 def paint_person(
@@ -184,43 +222,47 @@ def paint_person(
 ) -> Window | None:
     """Max the person's personal-space Gaussian into ``costs`` (in place; only the cells it reaches); returns them.
 
-    ``sigma_front`` (m) replaces ``params.sigma_front`` (the tracked-people layer stretches walkers ahead). In float32
-    (``_local_axes``), with the offsets scaled by sqrt(1/2) / sigma first (u along the facing, by the front sigma,
-    then the cells behind by front / rear), so that the exponent is -(u^2 + v^2): within 1 cost unit of the float64
-    formula, which it matches at all but a few cells in a million (a test checks both)."""
+    ``sigma_front`` (m) replaces ``params.sigma_front`` (the tracked-people layer stretches walkers ahead). The
+    exponent, log(amplitude) - (u^2 / 2 su^2 + v^2 / 2 sv^2), is a quadratic in the cell offsets: that of the wider
+    half's Gaussian, W, and of the narrower half's, N, are evaluated together (``_polynomials``, float32) with
+    P = W + lam u' (u' the distance into the wider half), lam large enough that P <= N on the narrower half; then
+    min(W, max(N, P)) is W on the wider half and N on the other, in two passes and without a mask. Within 1 cost
+    unit of the float64 formula, which it matches at all but a few cells in a million (a test checks both)."""
     front = params.sigma_front if sigma_front is None else sigma_front
-    window = spec.window(*_person_box(person, params, front))
-    if window is None:
-        return None
-    dx, dy = _local_axes(spec, window, person.x, person.y)
+    (x0, y0), (x1, y1) = _person_box(person, params, front)
+    window = spec.window((x0, y0), (x1, y1))
+    if window is None or params.amplitude == 0:  # a zero amplitude paints nothing (and has no log)
+        return window
+    log_amplitude = math.log(params.amplitude)  # exp(log(amplitude) - ...): the scaling rides on the exponent
     if person.theta is None:
-        k = _SQRT_HALF / params.sigma_unknown
-        u, v = dx * k, dy * k  # (1, cols) and (rows, 1)
-        exponent = np.add(np.square(u, out=u), np.square(v, out=v))
+        sigma = params.sigma_unknown
+        exponent = _polynomials(
+            spec, window, person.x, person.y, _gaussian_exponent(sigma, sigma, 1.0, 0.0, log_amplitude)
+        )[0]
     else:
         c, s = math.cos(person.theta), math.sin(person.theta)
-        kf, ks = _SQRT_HALF / front, _SQRT_HALF / params.sigma_side
-        u = (c * kf) * dx + (s * kf) * dy
-        np.multiply(u, front / params.sigma_rear, out=u, where=u < 0)  # behind the person: the rear sigma
-        v = (c * ks) * dy - (s * ks) * dx
-        exponent = np.square(u, out=u)
-        exponent += np.square(v, out=v)
-    np.negative(exponent, out=exponent)
-    _max_into(costs[window.slices], _exp(exponent), params.amplitude)
+        wide, narrow, sign = (
+            (front, params.sigma_rear, 1.0) if front >= params.sigma_rear else (params.sigma_rear, front, -1.0)
+        )
+        wider = _gaussian_exponent(wide, params.sigma_side, c, s, log_amplitude)
+        narrower = _gaussian_exponent(narrow, params.sigma_side, c, s, log_amplitude)
+        # N - W = -(1 / 2 narrow^2 - 1 / 2 wide^2) u^2 <= -|lam u| wherever |u| <= far: the window's cell centres
+        # lie within half a cell of the box, so within far of the person
+        far = max(person.x - x0, x1 - person.x) + max(person.y - y0, y1 - person.y) + spec.resolution
+        lam = sign * ((0.5 / narrow**2 - 0.5 / wide**2) * far + 1e-3)
+        penalised = [*wider]
+        penalised[1] += lam * c
+        penalised[3] += lam * s
+        wider_e, narrower_e, exponent = _polynomials(spec, window, person.x, person.y, wider + narrower + penalised)
+        np.maximum(narrower_e, exponent, out=exponent)
+        np.minimum(wider_e, exponent, out=exponent)
+    _max_into(costs[window.slices], cv2.exp(exponent, dst=exponent))
     return window
 
 
-def _exp(values: np.ndarray) -> np.ndarray:
-    """exp of a float32 array, in place: OpenCV's vectorised exp, ~4x numpy's here for float32, within a few ulp of
-    it (docs/benchmarks.md)."""
-    return cv2.exp(values, dst=values)
-
-
-def _max_into(view: np.ndarray, unit: np.ndarray, scale: float) -> None:
-    """view = max(view, floor(scale x unit)) in place, for a uint8 ``view`` and float ``unit`` with scale x unit in
-    [0, 253): the product is truncated to uint8 as it is written (no float temporary)."""
-    scaled = np.multiply(unit, scale, out=np.empty(unit.shape, dtype=np.uint8), casting="unsafe")
-    np.maximum(view, scaled, out=view)
+def _max_into(view: np.ndarray, scaled: np.ndarray) -> None:
+    """view = max(view, floor(scaled)) in place, for a uint8 ``view`` and a float ``scaled`` in [0, 253)."""
+    cv2.max(view, scaled.astype(np.uint8), dst=view)  # the cast truncates: floor for non-negative values
 
 
 def paint_group(costs: np.ndarray, spec: GridSpec, hull: BaseGeometry, params: SocialParams) -> Window | None:
@@ -232,20 +274,18 @@ def paint_group(costs: np.ndarray, spec: GridSpec, hull: BaseGeometry, params: S
     ``group_zone_polygon`` below ``group_cost``.
     """
     reach = params.group_margin + _reach(params.group_cost, params.group_sigma)
-    x0, y0, x1, y1 = hull.bounds
+    ring, polygon = _hull_ring(hull)
+    (x0, y0), (x1, y1) = _bounds(ring)
     window = spec.window((x0 - reach, y0 - reach), (x1 + reach, y1 + reach))
     if window is None:
         return None
-    ox, oy = (x0 + x1) / 2, (y0 + y1) / 2
-    dx, dy = _local_axes(spec, window, ox, oy)
-    ring, polygon = _hull_ring(hull)
-    ring = ring - (ox, oy)  # as the cell offsets: relative to the hull's centre
-    outside = _distance_to_hull(dx, dy, ring, polygon)
+    outside = _distance_to_hull(spec, window, ring, polygon)
     outside -= np.float32(params.group_margin + 1e-6)
-    np.maximum(outside, 0, out=outside)
-    outside *= outside  # then the exponent, with a negative coefficient
-    outside *= np.float32(-0.5 / params.group_sigma**2)
-    _max_into(costs[window.slices], _exp(outside), params.group_cost)
+    cv2.threshold(outside, 0.0, 0.0, cv2.THRESH_TOZERO, dst=outside)  # max(outside, 0)
+    cv2.multiply(outside, outside, dst=outside, scale=-0.5 / params.group_sigma**2)  # the exponent, in one pass
+    unit = cv2.exp(outside, dst=outside)
+    # group_cost x exp(0) is exactly group_cost (not so exp(log(group_cost)), which may round below it)
+    _max_into(costs[window.slices], np.multiply(unit, np.float32(params.group_cost), out=unit))
     return window
 
 

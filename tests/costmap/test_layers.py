@@ -396,6 +396,46 @@ def test_personal_space_is_the_float64_gaussian_to_one_cost_unit(theta):
     assert not costs[outside].any() and expected[0].max() <= 1 and expected[:, 0].max() <= 1  # the window holds it
 
 
+@pytest.mark.parametrize(
+    ("theta", "sigma_front", "sigma_rear"),
+    [(0.7, 0.8, 0.4), (2.4, 2.2, 0.4), (-1.1, 0.5, 0.9), (np.pi / 4, 0.8, 0.8), (-3.0, 3.5, 0.3)],
+)
+def test_personal_space_holds_the_float64_gaussian_for_any_spread_ahead_or_behind(theta, sigma_front, sigma_rear):
+    # A walker's stretched front (the tracked layer's sigma_front), a rear wider than the front, equal halves: the
+    # whole grid within 1 cost unit of the float64 formula, nothing painted outside the window it returns.
+    params = SocialParams(sigma_rear=sigma_rear)
+    person = Person(1, 4.21, -0.37, theta)
+    costs = np.zeros(SPEC.shape, dtype=np.uint8)
+    window = paint_person(costs, SPEC, person, params, sigma_front)
+    assert window is not None
+    xs, ys = SPEC.cell_centres()
+    dx, dy = xs - person.x, ys - person.y
+    u, v = np.cos(theta) * dx + np.sin(theta) * dy, np.cos(theta) * dy - np.sin(theta) * dx
+    sigma_u = np.where(u >= 0, sigma_front, sigma_rear)
+    expected = np.floor(params.amplitude * np.exp(-(u**2 / (2 * sigma_u**2) + v**2 / (2 * params.sigma_side**2))))
+    difference = np.abs(costs.astype(int) - expected)
+    assert difference.max() <= 1 and np.count_nonzero(difference) <= 3
+    outside = np.ones(SPEC.shape, dtype=bool)
+    outside[window.slices] = False
+    assert not costs[outside].any()
+
+
+@pytest.mark.parametrize(
+    "hull", [shapely.Point(3.02, 0.41), shapely.LineString([(2.0, -1.0), (3.3, 0.7)]), shapely.box(5.0, -1.0, 5.8, 1.5)]
+)
+def test_the_group_fall_off_of_a_point_a_segment_or_a_box_is_the_float64_gaussian(hull):
+    params = SocialParams()
+    costs = np.zeros(SPEC.shape, dtype=np.uint8)
+    window = paint_group(costs, SPEC, hull, params)
+    assert window is not None
+    xs, ys = SPEC.cell_axes(window)
+    distance = shapely.distance(hull, shapely.points(*np.broadcast_arrays(xs, ys)))
+    beyond = np.maximum(distance - params.group_margin, 0.0)
+    expected = np.floor(params.group_cost * np.exp(-(beyond**2) / (2 * params.group_sigma**2)))
+    difference = np.abs(costs[window.slices].astype(int) - expected)
+    assert difference.max() <= 1 and np.count_nonzero(difference) <= 3
+
+
 def test_the_group_fall_off_is_the_float64_gaussian_of_the_distance_to_the_zone_to_one_cost_unit():
     people, group = triad()
     params = SocialParams()
