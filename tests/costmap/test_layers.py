@@ -421,25 +421,17 @@ def test_personal_space_holds_the_float64_gaussian_for_any_spread_ahead_or_behin
 
 
 @pytest.mark.parametrize(
-    "hull", [shapely.Point(3.02, 0.41), shapely.LineString([(2.0, -1.0), (3.3, 0.7)]), shapely.box(5.0, -1.0, 5.8, 1.5)]
+    "hull",
+    [
+        zone_hull(triad()[1], triad()[0]),  # a group's zone
+        shapely.Point(3.02, 0.41),
+        shapely.LineString([(2.0, -1.0), (3.3, 0.7)]),
+        shapely.box(5.0, -1.0, 5.8, 1.5),
+    ],
+    ids=["zone", "point", "segment", "box"],
 )
-def test_the_group_fall_off_of_a_point_a_segment_or_a_box_is_the_float64_gaussian(hull):
+def test_the_group_fall_off_is_the_float64_gaussian_of_the_distance_to_the_hull_to_one_cost_unit(hull):
     params = SocialParams()
-    costs = np.zeros(SPEC.shape, dtype=np.uint8)
-    window = paint_group(costs, SPEC, hull, params)
-    assert window is not None
-    xs, ys = SPEC.cell_axes(window)
-    distance = shapely.distance(hull, shapely.points(*np.broadcast_arrays(xs, ys)))
-    beyond = np.maximum(distance - params.group_margin, 0.0)
-    expected = np.floor(params.group_cost * np.exp(-(beyond**2) / (2 * params.group_sigma**2)))
-    difference = np.abs(costs[window.slices].astype(int) - expected)
-    assert difference.max() <= 1 and np.count_nonzero(difference) <= 3
-
-
-def test_the_group_fall_off_is_the_float64_gaussian_of_the_distance_to_the_zone_to_one_cost_unit():
-    people, group = triad()
-    params = SocialParams()
-    hull = zone_hull(group, people)
     costs = np.zeros(SPEC.shape, dtype=np.uint8)
     window = paint_group(costs, SPEC, hull, params)
     assert window is not None
