@@ -92,16 +92,7 @@ def estimate_orientation(keypoints_world: np.ndarray, inferred: np.ndarray | Non
         inferred = np.asarray(inferred, dtype=bool)
         if inferred.shape != (NUM_KEYPOINTS,):
             raise ValueError(f"orientation: inferred must be a ({NUM_KEYPOINTS},) mask, got shape {inferred.shape}")
-    usable = np.isfinite(points).all(axis=1)
-    both = (usable[_LEFT] & usable[_RIGHT]).tolist()
-    present = points[usable]
-    # Without 3 keypoints or a left/right pair: no facing, whatever the plane.
-    if len(present) < 3 or not any(both):
-        return None, 0.0
-    centred = present - present.sum(axis=0) / len(present)
-    eigenvalues, eigenvectors = np.linalg.eigh(centred.T @ centred)  # ascending
-    flags = inferred.tolist() if inferred is not None else None
-    return _facing(eigenvalues.tolist(), eigenvectors[:, 0].tolist(), points[:, :2].tolist(), both, flags)
+    return _orientations(points[None], None if inferred is None else inferred[None])[0]
 
 
 def estimate_orientations(
@@ -109,8 +100,8 @@ def estimate_orientations(
 ) -> list[tuple[float | None, float]]:
     """``estimate_orientation`` for P people at once: (P, 17, 3) world keypoints, optional (P, 17) inferred mask.
 
-    Returns one (yaw, quality) per person, the same as ``estimate_orientation`` of each person alone, for little
-    more than the cost of one (``sid.perception.lifting`` calls it once per frame).
+    Returns one (yaw, quality) per person, as ``estimate_orientation`` of each alone would, for little more than the
+    cost of one (``sid.perception.lifting`` calls it once per frame).
     """
     points = np.asarray(keypoints_world, dtype=float)
     if points.ndim != 3 or points.shape[1:] != (NUM_KEYPOINTS, 3):
@@ -128,7 +119,7 @@ def _orientations(points: np.ndarray, inferred: np.ndarray | None) -> list[tuple
     counts = usable.sum(axis=1)
     both = usable[:, _LEFT] & usable[:, _RIGHT]
     # Everyone's scatter matrix at once, with a missing keypoint's row zero: it adds nothing to the sums (x + 0.0 is
-    # x), so each person's matrix is the one ``estimate_orientation`` computes from their usable keypoints alone.
+    # x), so each person's matrix is the one of their usable keypoints alone.
     rows = usable[..., None]
     with np.errstate(invalid="ignore", divide="ignore"):  # people without keypoints: 0 / 0, zeroed below
         masked = np.where(rows, points, 0.0)

@@ -352,11 +352,11 @@ def _bench_lift(ctx: Context) -> Records:
 
 
 def _bench_pca(ctx: Context) -> Records:
-    from sid.perception.orientation import estimate_orientation
+    from sid.perception.orientation import estimate_orientations
 
     frame = _frames(ctx, 4)[0]
-    keypoints = [p.keypoints_world for p in frame.truth.people]
-    stats = measure(lambda: [estimate_orientation(k) for k in keypoints], ctx.settings)
+    keypoints = np.array([p.keypoints_world for p in frame.truth.people])  # (4, 17, 3)
+    stats = measure(lambda: estimate_orientations(keypoints), ctx.settings)
     return {"pca/4": record(stats, people=len(keypoints))}
 
 
@@ -775,7 +775,7 @@ def benchmarks(ctx: Context) -> list[Benchmark]:
             needs=("align/sparse_4x17",),
         ),  # fmt: skip
         Benchmark("lift/4", "lift_people (keypoint depth, 3D, position, PCA facing), 4 people", _bench_lift),
-        Benchmark("pca/4", "estimate_orientation, 4 people", _bench_pca),
+        Benchmark("pca/4", "estimate_orientations (PCA facing), 4 people at once", _bench_pca),
     ]
     items += [Benchmark(f"pose/{p.stem}", f"pose model {p.name}", _bench_pose(p)) for p in models]
     items += [Benchmark(f"frame/{n}", f"Pipeline per frame, {n} people", _bench_frame(n)) for n in FRAME_SIZES]
