@@ -62,9 +62,8 @@ def _keep_only_box(image: np.ndarray, letterbox: Letterbox, box: Sequence[float]
     each side; returns ``image``."""
     u0, v0, u1, v1 = (float(x) for x in box)
     grow_u, grow_v = margin * (u1 - u0), margin * (v1 - v0)
-    # letterbox.to_input of the grown corners, on Python floats (the same operations, no small arrays)
-    c0, c1 = ((u + 0.5) * letterbox.scale + letterbox.pad_x - 0.5 for u in (u0 - grow_u, u1 + grow_u))
-    r0, r1 = ((v + 0.5) * letterbox.scale + letterbox.pad_y - 0.5 for v in (v0 - grow_v, v1 + grow_v))
+    corners = np.array([[u0 - grow_u, v0 - grow_v], [u1 + grow_u, v1 + grow_v]])
+    (c0, r0), (c1, r1) = letterbox.to_input(corners).tolist()
     in_h, in_w = image.shape[:2]
     c0, r0 = (min(max(math.ceil(x), 0), n) for x, n in ((c0, in_w), (r0, in_h)))
     c1, r1 = (min(max(math.floor(x) + 1, 0), n) for x, n in ((c1, in_w), (r1, in_h)))
