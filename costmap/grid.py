@@ -7,6 +7,7 @@ and y in [origin_y + row*res, ...): row 0 is the lowest y (as in nav_msgs/Occupa
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -65,11 +66,45 @@ class Window:
 
 def union(*windows: Window | None) -> Window | None:
     """The smallest window holding every given window; None when none is given."""
-    out = None
+    given = [window for window in windows if window is not None]
+    if not given:
+        return None
+    return Window(
+        min(w.row0 for w in given), max(w.row1 for w in given), min(w.col0 for w in given), max(w.col1 for w in given)
+    )
+
+
+SEPARATE_WINDOW_CELLS = 50_000
+"""``disjoint`` keeps two windows apart only when that spares more than this many cells: every window costs each layer
+of a costmap a write and inflation a search for changes, about what this many more cells cost in one window
+(measured on sid bench's scene with its groups 1-3x as far apart, docs/benchmarks.md)."""
+
+
+def disjoint(windows: Iterable[Window | None], slack: int = SEPARATE_WINDOW_CELLS) -> list[Window]:
+    """Windows that cover every cell of ``windows`` and share no cell: given windows that overlap, or whose union box
+    holds at most ``slack`` cells more than the two, are merged into that box until no two are left so. Changes far
+    apart stay apart, where ``union``'s one box (Nav2's update bounds) would span the cells between them.
+
+    On (row0, row1, col0, col1) tuples of Python ints: a frame has tens of windows, and a ``Window`` per step of the
+    merging would cost more than the merging."""
+    out: list[tuple[int, int, int, int]] = []
     for window in windows:
-        if window is not None:
-            out = window.union(out)
-    return out
+        if window is None:
+            continue
+        r0, r1, c0, c1 = window.row0, window.row1, window.col0, window.col1
+        merged = True
+        while merged:  # the merged box may reach others
+            merged = False
+            for i, (b0, b1, d0, d1) in enumerate(out):
+                u0, u1, v0, v1 = min(r0, b0), max(r1, b1), min(c0, d0), max(c1, d1)
+                overlap = r0 < b1 and b0 < r1 and c0 < d1 and d0 < c1
+                if overlap or (u1 - u0) * (v1 - v0) - (r1 - r0) * (c1 - c0) - (b1 - b0) * (d1 - d0) <= slack:
+                    del out[i]
+                    merged = (u0, u1, v0, v1) != (b0, b1, d0, d1)  # a box that grew may now reach others
+                    r0, r1, c0, c1 = u0, u1, v0, v1
+                    break
+        out.append((r0, r1, c0, c1))
+    return [Window(*box) for box in out]
 
 
 def nonzero_cells(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -77,18 +112,6 @@ def nonzero_cells(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     indices: numpy's 2-D ``nonzero`` is ~20x slower on a sparse mask."""
     rows, cols = np.divmod(np.flatnonzero(mask), mask.shape[1])
     return rows, cols
-
-
-def changed_window(before: np.ndarray, after: np.ndarray, within: Window) -> Window | None:
-    """The smallest window holding every cell where ``after`` differs from ``before`` (both the cells of ``within``);
-    None when none does."""
-    differs = before != after
-    rows = np.flatnonzero(differs.any(axis=1))
-    if len(rows) == 0:
-        return None
-    cols = np.flatnonzero(differs.any(axis=0))
-    row0, col0 = within.row0, within.col0
-    return Window(row0 + int(rows[0]), row0 + int(rows[-1]) + 1, col0 + int(cols[0]), col0 + int(cols[-1]) + 1)
 
 
 @dataclass(frozen=True)

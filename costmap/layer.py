@@ -1,9 +1,11 @@
 """The costmap layer interface, in the spirit of Nav2's costmap_2d plugins.
 
 Every frame, ``LayeredCostmap.update`` hands each layer, in order, the same ``LayerInputs``; the layer updates its own
-uint8 grid and reports the window of cells it changed (Nav2's ``updateBounds``). The master grid is then reset over
-the union of those windows and every layer, in order, writes its grid there with its combination method (Nav2's
-``updateCosts``; methods in ``costmap.combine``). A layer may read the master in ``write`` (inflation does).
+uint8 grid and reports the window of cells it changed (Nav2's ``updateBounds``), or several (``update_windows``: a
+layer whose changes lie far apart, as people in distant groups, spares the costmap the cells between them). The
+master grid is then reset over those windows (``costmap.grid.disjoint``) and every layer, in order, writes its grid
+there with its combination method (Nav2's ``updateCosts``; methods in ``costmap.combine``). A layer may read the
+master in ``write`` (inflation does).
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from costmap.combine import CombinationMethod, check_method, combine
-from costmap.grid import FREE_SPACE, GridSpec, Window
+from costmap.grid import FREE_SPACE, GridSpec, Window, union
 from costmap.scan import LaserScan
 from sid.checks import check_numbers
 from sid.perception.groups import Group
@@ -68,6 +70,13 @@ class Layer(ABC):
         ``changed``: the union of the windows the layers before this one changed (and any not yet written).
         Raise ValueError before changing anything when the inputs cannot be used.
         """
+
+    def update_windows(self, inputs: LayerInputs, changed: Sequence[Window]) -> list[Window]:
+        """``update``, with the changed cells reported as windows (they may overlap; none: nothing changed) and the
+        windows the layers before this one changed given as such. By default ``update``'s one window; a layer
+        whose changes can lie far apart overrides it (``update`` then returns the union of these windows)."""
+        window = self.update(inputs, union(*changed))
+        return [] if window is None else [window]
 
     def write(self, master: np.ndarray, window: Window) -> None:
         """Combine this layer's costs into ``master`` (the combined grid) over ``window``."""

@@ -7,16 +7,17 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from costmap.grid import FREE_SPACE, Costmap2D, GridSpec, Window, union
+from costmap.grid import FREE_SPACE, Costmap2D, GridSpec, Window, disjoint, union
 from costmap.layer import Layer, LayerInputs
 
 
 class LayeredCostmap:
     """A master grid and an ordered list of layers over the same grid.
 
-    ``update`` hands every layer, in order, the frame's inputs and collects the windows they changed; the master is
-    then reset to ``default_value`` (FREE, or NO_INFORMATION when unknown space is tracked) over their union and every
-    layer, in order, writes its costs there. Windows of an update that raised are written at the next one.
+    ``update`` hands every layer, in order, the frame's inputs and collects the windows they changed
+    (``Layer.update_windows``), merged where they overlap or lie close (``disjoint``); the master is then reset to
+    ``default_value`` (FREE, or NO_INFORMATION when unknown space is tracked) over those windows (``windows``) and
+    every layer, in order, writes its costs there. Windows of an update that raised are written at the next one.
     """
 
     def __init__(self, spec: GridSpec, layers: Sequence[Layer], default_value: int = FREE_SPACE) -> None:
@@ -31,7 +32,8 @@ class LayeredCostmap:
         self.default_value = int(default_value)
         self.master = Costmap2D.filled(spec, self.default_value)
         self.inputs = LayerInputs()  # the inputs last applied
-        self._pending: Window | None = None  # changed but not yet written into the master
+        self.windows: list[Window] = []  # the disjoint windows the last update wrote
+        self._pending: list[Window] = []  # changed but not yet written into the master
 
     def layer(self, name: str) -> Layer | None:
         """The layer called ``name``, or None."""
@@ -43,14 +45,17 @@ class LayeredCostmap:
         return {layer.name: layer.costs for layer in self.layers}
 
     def update(self, inputs: LayerInputs) -> Window | None:
-        """Bring every layer to ``inputs``, then recombine the master where anything changed; returns that window."""
+        """Bring every layer to ``inputs``, then recombine the master where anything changed (``windows``); returns
+        the smallest window holding those (Nav2's update bounds), None when nothing changed."""
         for layer in self.layers:
-            self._pending = union(self._pending, layer.update(inputs, self._pending))
+            changed = layer.update_windows(inputs, self._pending)
+            self._pending = disjoint([*self._pending, *changed])
         self.inputs = inputs
-        window, self._pending = self._pending, None
-        if window is not None:
-            master = self.master.costs
+        self.windows, self._pending = self._pending, []
+        master = self.master.costs
+        for window in self.windows:
             master[window.slices] = self.default_value
-            for layer in self.layers:
+        for layer in self.layers:  # each layer over every window before the next: inflation reads the lethal cells
+            for window in self.windows:  # within reach of its window, which may lie in another
                 layer.write(master, window)
-        return window
+        return union(*self.windows)

@@ -15,6 +15,7 @@ cell gets exactly Nav2's value.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Literal
 
@@ -96,14 +97,20 @@ class InflationLayer(Layer):
         """Costs change within reach of whatever the layers before this one changed."""
         return None if changed is None else changed.grown(self.cell_radius, self.spec)
 
+    def update_windows(self, inputs: LayerInputs, changed: Sequence[Window]) -> list[Window]:
+        """Costs change within reach of each window the layers before this one changed."""
+        return [window.grown(self.cell_radius, self.spec) for window in changed]
+
     def write(self, master: np.ndarray, window: Window) -> None:
         """Bring the inflation costs up to date with the lethal cells of ``master`` and combine them over ``window``.
 
         A cell's cost depends only on the lethal cells within ``cell_radius`` of it, so only the cells within reach of
         a lethal cell that appeared or disappeared since the last write are recomputed (from the lethal cells within
-        reach of them): the cost of an update grows with the area that changed, not with the map, and every cell
-        gets the value a recomputation of the whole map would give (tests compare the two). Lethal cells change only
-        inside update windows, and each write compares the window grown by the reach, so none is missed.
+        reach of them, wherever those lie: a change near the edge of this window may be within reach of another
+        window written later, which will see it as known): the cost of an update grows with the area that changed,
+        not with the map, and every cell gets the value a recomputation of the whole map would give (tests compare
+        the two). Lethal cells change only inside update windows, and each write compares the window grown by the
+        reach, so none is missed.
         """
         source = window.grown(self.cell_radius, self.spec)
         lethal = master[source.slices] == LETHAL
@@ -120,8 +127,8 @@ class InflationLayer(Layer):
         super().write(master, window)
 
     def _affected(self, changed: np.ndarray, source: Window) -> list[Window]:
-        """Windows (inside ``source``) holding every cell within reach of the ``changed`` cells (bool over
-        ``source``): the grid is cut into tiles of ``cell_radius`` cells, the tiles holding a change and their
+        """Windows holding every cell within reach of the ``changed`` cells (bool over ``source``), clipped to the
+        grid: the grid is cut into tiles of ``cell_radius`` cells, the tiles holding a change and their
         neighbours are grouped into 8-connected clusters (OpenCV on the small tile grid: a few times faster than
         scipy.ndimage's dilation and labelling there) and each cluster's bounding box is one window. A tile's
         neighbours reach at least ``cell_radius`` cells beyond it."""
@@ -136,8 +143,7 @@ class InflationLayer(Layer):
             # Tile i (margin included) covers rows (i - 1) * t .. i * t - 1 of ``source``.
             row0, row1 = source.row0 + (tile_row - 1) * t, source.row0 + (tile_row + tile_rows - 1) * t
             col0, col1 = source.col0 + (tile_col - 1) * t, source.col0 + (tile_col + tile_cols - 1) * t
-            windows.append(Window(max(row0, source.row0), min(row1, source.row1), max(col0, source.col0),
-                                  min(col1, source.col1)))  # fmt: skip
+            windows.append(Window(row0, row1, col0, col1).grown(0, self.spec))  # clipped
         return windows
 
     def _inflate(self, lethal: np.ndarray) -> np.ndarray:

@@ -27,7 +27,7 @@ from typing import NamedTuple
 import numpy as np
 
 from costmap.combine import CombinationMethod
-from costmap.grid import FREE_SPACE, LETHAL, NO_INFORMATION, GridSpec, Window, changed_window, nonzero_cells, union
+from costmap.grid import FREE_SPACE, LETHAL, NO_INFORMATION, GridSpec, Window, nonzero_cells
 from costmap.layer import Layer, LayerInputs
 from costmap.scan import LaserScan
 from sid.checks import check_number, check_numbers
@@ -88,9 +88,10 @@ def _trace_lines(spec: GridSpec, c0: np.ndarray, delta: np.ndarray, n: int) -> t
     steps = np.abs(delta).max(axis=1, initial=0)
     k = np.arange(n, dtype=np.float32)[None, :]
     frac = k / np.maximum(steps, 1)[:, None]  # (M, n)
-    rows = (c0[0] + np.rint(frac * delta[:, :1])).astype(np.int32)
-    cols = (c0[1] + np.rint(frac * delta[:, 1:])).astype(np.int32)
-    keep = (k < steps[:, None]) & (rows >= 0) & (rows < spec.height) & (cols >= 0) & (cols < spec.width)
+    rows = np.rint(frac * delta[:, :1]).astype(np.int32) + np.int32(c0[0])  # integer adds: no float64 pass
+    cols = np.rint(frac * delta[:, 1:]).astype(np.int32) + np.int32(c0[1])
+    # in the grid: 0 <= index < size in one comparison each (a negative index reads as a huge unsigned one)
+    keep = (k < steps[:, None]) & (rows.view(np.uint32) < spec.height) & (cols.view(np.uint32) < spec.width)
     return rows.astype(np.int64) * spec.width + cols, keep
 
 
@@ -121,11 +122,11 @@ class _BeamCells:
         self.keep = np.zeros((0, 0), dtype=bool)
         self._coverage: np.ndarray | None = None  # beams crossing each cell (flat index, int32); None: not built
 
-    def update(self, origin: np.ndarray, ends: np.ndarray) -> tuple[np.ndarray, Window | None, bool]:
+    def update(self, origin: np.ndarray, ends: np.ndarray) -> tuple[np.ndarray, bool]:
         """Take the lines origin -> ends (world, (M, 2), finite) as the current beams. Returns the flat indices of
-        the cells of the beams traced again (``trace_cells``' cells of those beams, end cells excluded), a window
-        holding them (None when there are none) and whether every beam was traced again (the sensor moved to
-        another cell, the number of beams changed, or more than ``_INCREMENTAL_SHARE`` of the beams moved)."""
+        the cells of the beams traced again (``trace_cells``' cells of those beams, end cells excluded) and whether
+        every beam was traced again (the sensor moved to another cell, the number of beams changed, or more than
+        ``_INCREMENTAL_SHARE`` of the beams moved)."""
         c0 = self.spec.world_to_cell(origin)[0]
         delta = self.spec.world_to_cell(ends) - c0
         same_sensor = np.array_equal(c0, self.origin) and delta.shape == self.delta.shape
@@ -134,16 +135,13 @@ class _BeamCells:
         # moves within its cell) the scan is written whole, as after a move to another cell.
         if same_sensor and len(redo) <= _INCREMENTAL_SHARE * len(delta):
             np.subtract.at(self.coverage, self.flat[redo][self.keep[redo]], _ONE)
-            # A line's cells lie in the box of its two end cells.
-            corners = np.vstack((c0[None], c0 + delta[redo]))
-            window = Window(*_box(corners)).clipped(self.spec) if len(redo) else None
             everything = False
         else:
             redo = np.arange(len(delta))
             self._coverage = None
             self.flat = np.zeros((len(delta), 0), dtype=np.int64)
             self.keep = np.zeros((len(delta), 0), dtype=bool)
-            window, everything = None, True
+            everything = True
         n = _longest(delta[redo])
         if n > self.flat.shape[1]:  # longer lines than any kept: widen (the new steps are off every line)
             grow = ((0, 0), (0, n - self.flat.shape[1]))
@@ -154,7 +152,7 @@ class _BeamCells:
         traced = flat[keep]
         if self._coverage is not None:
             np.add.at(self._coverage, traced, _ONE)
-        return traced, window, everything
+        return traced, everything
 
     @property
     def coverage(self) -> np.ndarray:
@@ -165,20 +163,12 @@ class _BeamCells:
         return self._coverage
 
 
-def _box(cells: np.ndarray) -> tuple[int, int, int, int]:
-    """(row0, row1, col0, col1) of the smallest window holding cells (K >= 1, 2) as (row, col)."""
-    low, high = cells.min(axis=0), cells.max(axis=0) + 1
-    return int(low[0]), int(high[0]), int(low[1]), int(high[1])
-
-
 class _ScanMarks(NamedTuple):
     """What one scan writes: the cells to clear (flat indices: those of the beams traced again, and the last scan's
-    hits that a beam now crosses), the cells its hits mark LETHAL ((K, 2) as (row, col)) and a window holding both
-    (None: nothing to write)."""
+    hits that a beam now crosses) and the cells its hits mark LETHAL ((K, 2) as (row, col))."""
 
     cleared: np.ndarray
     hits: np.ndarray
-    window: Window | None
 
 
 class ObstacleLayer(Layer):
@@ -216,19 +206,24 @@ class ObstacleLayer(Layer):
 
     def _apply(self, scan: _ScanMarks | None, people: np.ndarray) -> Window | None:
         """Write a scan's marks (if any), then clear the marks within ``people_clear_radius`` of the people (world,
-        (N, 2)); returns the window of the cells whose value changed (compared with a copy of the cells written)."""
-        discs = self._discs_window(people, self.people_clear_radius)
-        touched = union(None if scan is None else scan.window, discs)
-        if touched is None:
-            return None
-        before = self.costs[touched.slices].copy()
+        (N, 2)); returns the window of the cells whose value changed.
+
+        Only the cells written are compared, before and after (an index may repeat): the scan's cells, and the marks
+        near the people, looked for before the scan is written among the LETHAL cells and the scan's hits."""
+        hits = np.zeros(0, dtype=np.int64) if scan is None else scan.hits[:, 0] * self.spec.width + scan.hits[:, 1]
+        near = self._marks_near(people, self.people_clear_radius, hits)
+        written = near if scan is None else np.concatenate((scan.cleared, hits, near))
+        costs = self.costs.ravel()
+        before = costs[written]
         if scan is not None:
-            self.costs.ravel()[scan.cleared] = FREE_SPACE
-            self.costs[scan.hits[:, 0], scan.hits[:, 1]] = LETHAL
-            self._hits = scan.hits[:, 0] * self.spec.width + scan.hits[:, 1]
-        if discs is not None:
-            self.clear_discs(people, self.people_clear_radius)
-        return changed_window(before, self.costs[touched.slices], touched)
+            costs[scan.cleared] = FREE_SPACE
+            costs[hits] = LETHAL
+            self._hits = hits
+        costs[near[costs[near] == LETHAL]] = FREE_SPACE
+        rows, cols = np.divmod(written[costs[written] != before], self.spec.width)
+        if len(rows) == 0:
+            return None
+        return Window(int(rows.min()), int(rows.max()) + 1, int(cols.min()), int(cols.max()) + 1)
 
     def _scan_marks(self, scan: LaserScan) -> _ScanMarks:
         """What a scan writes (nothing written yet; the beams' cells are taken as the current ones).
@@ -238,7 +233,7 @@ class ObstacleLayer(Layer):
         those, and the cells of the beams traced again, are written."""
         p = self.params
         origin = np.asarray(scan.pose[:2])
-        if not self.spec.contains(origin[None])[0]:
+        if self.spec.window(scan.pose[:2], scan.pose[:2]) is None:  # its cell is outside (scalar: cheaper here)
             raise ValueError(f"scan: sensor at ({origin[0]:.2f}, {origin[1]:.2f}) is outside the costmap")
         r = scan.valid_ranges()
         dirs = scan.directions
@@ -251,34 +246,37 @@ class ObstacleLayer(Layer):
         hit_xy = origin + dirs[marking] * r[marking, None]
         hits = self.spec.world_to_cell(hit_xy)
         hits = hits[self.spec.in_bounds(hits)]
-        traced, traced_window, everything = self._beams.update(origin, ends)
-        if everything:  # every beam's cells, in the whole scan's box
-            window = self.spec.window_around(np.vstack([origin[None], ends, hit_xy]))
-            assert window is not None  # it holds the sensor, which is inside the grid
-            return _ScanMarks(traced, hits, window)
+        traced, everything = self._beams.update(origin, ends)
+        if everything:  # every beam's cells
+            return _ScanMarks(traced, hits)
         crossed = self._hits[self._beams.coverage[self._hits] > 0]
-        marked = np.vstack((hits, np.column_stack(np.divmod(crossed, self.spec.width))))
-        window = union(traced_window, Window(*_box(marked)) if len(marked) else None)
-        return _ScanMarks(np.concatenate((traced, crossed)), hits, window)
+        return _ScanMarks(np.concatenate((traced, crossed)), hits)
 
     def clear_discs(self, centres: np.ndarray, radius: float) -> None:
-        """Turn LETHAL marks whose cell centre lies within ``radius`` metres of any centre (N, 2) into FREE.
+        """Turn LETHAL marks whose cell centre lies within ``radius`` metres of any centre (N, 2) into FREE."""
+        near = self._marks_near(np.asarray(centres, dtype=float).reshape(-1, 2), radius, np.zeros(0, dtype=np.int64))
+        self.costs.ravel()[near] = FREE_SPACE
 
-        Only the marks are tested (against every centre at once): there are few, and discs are many small windows.
+    def _marks_near(self, centres: np.ndarray, radius: float, also: np.ndarray) -> np.ndarray:
+        """Flat indices of the cells, among the LETHAL ones and those of ``also`` (flat indices), whose centre lies
+        within ``radius`` metres of any centre (N, 2); they may repeat.
+
+        Only those cells are tested (against every centre at once): there are few, and discs are many small windows.
         """
-        centres = np.asarray(centres, dtype=float).reshape(-1, 2)
         window = self._discs_window(centres, radius)
         if window is None:
-            return
-        view = self.costs[window.slices]
-        rows, cols = nonzero_cells(view == LETHAL)
-        xs, ys = self.spec.cell_axes(window)
-        chunk = max(1, _PAIRS_PER_CHUNK // len(centres))  # (marks, centres) pairs at a time: memory stays bounded
-        for start in range(0, len(rows), chunk):
+            return np.zeros(0, dtype=np.int64)
+        rows, cols = nonzero_cells(self.costs[window.slices] == LETHAL)
+        cells = np.concatenate(((rows + window.row0) * self.spec.width + cols + window.col0, also))
+        rows, cols = np.divmod(cells, self.spec.width)
+        xs, ys = self.spec.cell_axes()
+        inside = np.zeros(len(cells), dtype=bool)
+        chunk = max(1, _PAIRS_PER_CHUNK // len(centres))  # (cells, centres) pairs at a time: memory stays bounded
+        for start in range(0, len(cells), chunk):
             r, c = rows[start : start + chunk], cols[start : start + chunk]
-            dx, dy = xs[0, c, None] - centres[:, 0], ys[r, 0, None] - centres[:, 1]  # (marks, centres)
-            inside = (dx**2 + dy**2 <= radius**2).any(axis=1)
-            view[r[inside], c[inside]] = FREE_SPACE
+            dx, dy = xs[0, c, None] - centres[:, 0], ys[r, 0, None] - centres[:, 1]  # (cells, centres)
+            inside[start : start + chunk] = (dx**2 + dy**2 <= radius**2).any(axis=1)
+        return cells[inside]
 
     def _discs_window(self, centres: np.ndarray, radius: float) -> Window | None:
         """The cells of the bounding box of discs of ``radius`` metres around world centres (N, 2); None: none."""

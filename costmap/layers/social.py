@@ -33,7 +33,7 @@ from shapely.geometry import MultiPoint, Polygon
 from shapely.geometry.base import BaseGeometry
 
 from costmap.combine import CombinationMethod
-from costmap.grid import FREE_SPACE, LETHAL, MAX_NON_OBSTACLE, GridSpec, Window, union
+from costmap.grid import FREE_SPACE, LETHAL, MAX_NON_OBSTACLE, GridSpec, Window, disjoint, union
 from costmap.layer import Layer, LayerInputs
 from sid.checks import check_number, check_numbers
 from sid.perception.groups import Group
@@ -316,17 +316,23 @@ class SocialLayer(Layer):
         super().__init__(spec)
         self.params = params or SocialParams()
         self.body_radius = float(body_radius)
-        self._painted: Window | None = None  # the cells the last update may have painted
+        self._painted: list[Window] = []  # windows holding the cells the last update may have painted
 
     def update(self, inputs: LayerInputs, changed: Window | None) -> Window | None:
-        """Repaint the layer for the people (world frame) and groups of ``inputs``."""
+        """Repaint the layer for the people (world frame) and groups of ``inputs``; returns the union of
+        ``update_windows``' windows."""
+        return union(*self.update_windows(inputs, [] if changed is None else [changed]))
+
+    def update_windows(self, inputs: LayerInputs, changed: Sequence[Window]) -> list[Window]:
+        """Repaint the layer for the people (world frame) and groups of ``inputs``; returns the windows of the last
+        update's paint (now cleared) and of this one's."""
         by_id = _people_by_id(inputs.people)
         hulls = [zone_hull(group, by_id) for group in inputs.groups]  # raises on a bad group before any change
         previous = self._painted
-        if previous is not None:
-            self.costs[previous.slices] = FREE_SPACE
+        for window in previous:
+            self.costs[window.slices] = FREE_SPACE
         painted = [paint_group(self.costs, self.spec, hull, self.params) for hull in hulls]
         painted += [paint_person(self.costs, self.spec, person, self.params) for person in inputs.people]
         painted += [paint_body(self.costs, self.spec, person, self.body_radius) for person in inputs.people]
-        self._painted = union(*painted)
-        return union(previous, self._painted)
+        self._painted = disjoint(painted)
+        return [*previous, *self._painted]

@@ -17,10 +17,11 @@ Costs never exceed 252 except the bodies (254), as in the social layer; combined
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 from costmap.combine import CombinationMethod
-from costmap.grid import FREE_SPACE, GridSpec, Window, union
+from costmap.grid import FREE_SPACE, GridSpec, Window, disjoint, union
 from costmap.layer import Layer, LayerInputs
 from costmap.layers.social import SocialParams, paint_body, paint_group, paint_person, zone_hull
 from sid.checks import check_number
@@ -62,18 +63,24 @@ class TrackedPeopleLayer(Layer):
         self.params = params or TrackedPeopleParams()
         self.social = social or SocialParams()
         self.body_radius = float(body_radius)
-        self._painted: Window | None = None
+        self._painted: list[Window] = []  # windows holding the cells the last update may have painted
 
     def update(self, inputs: LayerInputs, changed: Window | None) -> Window | None:
-        """Repaint the layer for the tracked people and groups of ``inputs.tracks``."""
+        """Repaint the layer for the tracked people and groups of ``inputs.tracks``; returns the union of
+        ``update_windows``' windows."""
+        return union(*self.update_windows(inputs, [] if changed is None else [changed]))
+
+    def update_windows(self, inputs: LayerInputs, changed: Sequence[Window]) -> list[Window]:
+        """Repaint the layer for the tracked people and groups of ``inputs.tracks``; returns the windows of the last
+        update's paint (now cleared) and of this one's."""
         tracks = inputs.tracks
         people = [] if tracks is None else [p.as_person() for p in tracks.people]
         by_id = {p.id: p for p in people}
         conversations = [] if tracks is None else [g.as_group() for g in tracks.groups if g.kind == "conversation"]
         hulls = [zone_hull(group, by_id) for group in conversations]  # raises on a bad group before any change
         previous = self._painted
-        if previous is not None:
-            self.costs[previous.slices] = FREE_SPACE
+        for window in previous:
+            self.costs[window.slices] = FREE_SPACE
         social = self.social
         painted = [paint_group(self.costs, self.spec, hull, social) for hull in hulls]
         for track in () if tracks is None else tracks.people:
@@ -83,5 +90,5 @@ class TrackedPeopleLayer(Layer):
                 front += self.params.lookahead * track.speed
             painted.append(paint_person(self.costs, self.spec, person, social, front))
         painted += [paint_body(self.costs, self.spec, person, self.body_radius) for person in people]
-        self._painted = union(*painted)
-        return union(previous, self._painted)
+        self._painted = disjoint(painted)
+        return [*previous, *self._painted]

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from costmap.grid import LETHAL, NO_INFORMATION, Costmap2D, GridSpec
+from costmap.grid import LETHAL, NO_INFORMATION, Costmap2D, GridSpec, Window, disjoint, union
 
 SPEC = GridSpec.from_size(0.05, (-1.0, -4.0), (10.0, 8.0))
 
@@ -50,3 +52,36 @@ def test_cost_at_reads_unknown_outside():
 def test_costmap_rejects_wrong_dtype():
     with pytest.raises(ValueError, match="uint8"):
         Costmap2D(SPEC, np.zeros(SPEC.shape, dtype=np.int16))
+
+
+@given(
+    st.lists(st.tuples(st.integers(0, 90), st.integers(1, 30), st.integers(0, 90), st.integers(1, 30)), max_size=20),
+    st.sampled_from([0, 10, 200, 5000]),
+)
+def test_disjoint_windows_cover_the_given_ones_share_no_cell_and_merge_only_when_close(boxes, slack):
+    given_windows = [Window(r, r + h, c, c + w) for r, h, c, w in boxes]
+    out = disjoint([*given_windows, None], slack)
+    covered = np.zeros((120, 120), dtype=int)
+    for window in out:
+        covered[window.slices] += 1
+    assert covered.max(initial=0) <= 1  # no cell twice
+
+    def inside(a: Window, b: Window) -> bool:
+        return b.row0 <= a.row0 and a.row1 <= b.row1 and b.col0 <= a.col0 and a.col1 <= b.col1
+
+    for window in given_windows:
+        assert sum(inside(window, part) for part in out) == 1
+    for part in out:  # each is the box of the given windows it holds
+        assert union(*(w for w in given_windows if inside(w, part))) == part
+    cells = [(w.row1 - w.row0) * (w.col1 - w.col0) for w in out]
+    for (i, a), (j, b) in itertools.combinations(enumerate(out), 2):  # none left that should merge
+        u = union(a, b)
+        assert (u.row1 - u.row0) * (u.col1 - u.col0) - cells[i] - cells[j] > slack
+
+
+def test_disjoint_keeps_far_changes_apart_and_merges_near_ones():
+    a, b = Window(0, 10, 0, 10), Window(0, 10, 300, 310)
+    assert disjoint([a, b], slack=2899) == [a, b]  # their box would add 2,900 cells
+    assert disjoint([a, b], slack=2900) == [union(a, b)]
+    assert disjoint([a, Window(5, 20, 5, 20), None]) == [Window(0, 20, 0, 20)]  # overlapping: always merged
+    assert disjoint([]) == [] and disjoint([None]) == []

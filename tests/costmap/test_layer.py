@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -80,34 +82,37 @@ def test_windows_union_grow_and_clip():
     assert costs.sum() == 6
 
 
-def test_every_layer_changes_only_cells_inside_the_window_it_reports():
+def test_every_layer_changes_only_cells_inside_the_windows_it_reports():
     layered = layered_costmap(SPEC)
-    reported: dict[str, Window | None] = {}
+    reported: dict[str, list[Window]] = {}
     for layer in layered.layers:  # record what each layer reports
-        update = layer.update
+        update = layer.update_windows
 
         def spy(inputs, changed, update=update, name=layer.name):
             reported[name] = update(inputs, changed)
             return reported[name]
 
-        layer.update = spy
+        layer.update_windows = spy
     for inputs in frames():
         before = {name: grid.copy() for name, grid in layered.grids.items()}
         master_before = layered.master.costs.copy()
         window = layered.update(inputs)
-        assert window == union(*reported.values())
+        assert window == union(*(w for windows in reported.values() for w in windows))
+        assert window == union(*layered.windows)
+        for a, b in itertools.combinations(layered.windows, 2):
+            assert not a.overlaps(b)
         for name, grid in layered.grids.items():
             changed = grid != before[name]
-            if reported[name] is None:
-                assert not changed.any(), name
-            else:
-                changed[reported[name].slices] = False
-                assert not changed.any(), name
+            for part in reported[name]:
+                changed[part.slices] = False
+            assert not changed.any(), name
         outside = layered.master.costs != master_before
-        if window is not None:
-            outside[window.slices] = False
+        for part in layered.windows:
+            outside[part.slices] = False
         assert not outside.any()
-    assert reported["inflation"] == reported["social"].union(reported["lidar"]).grown(11, SPEC)
+    social_and_lidar = union(*reported["social"], *reported["lidar"])
+    assert social_and_lidar is not None
+    assert union(*reported["inflation"]) == social_and_lidar.grown(11, SPEC)
 
 
 def test_a_windowed_update_gives_the_master_a_full_recombination_gives():
@@ -124,6 +129,64 @@ def test_a_windowed_update_gives_the_master_a_full_recombination_gives():
             assert windows[2] is not None and windows[2] != SPEC.whole
         else:  # people are plain LiDAR marks: without a scan nothing changes
             assert windows[2] is None
+
+
+def far_apart_frames() -> list[LayerInputs]:
+    """Three groups 20-37 m apart on a 40 m map (so their windows are written apart), walking; one leaves, and a
+    scan from a sensor that moves comes every other frame."""
+    centres = [(-13.0, -13.0), (13.0, 13.0), (6.0, -6.0)]
+    walls = [SegmentObstacle(((-19.0, -19.0), (19.0, -19.0), (19.0, 19.0))), CircleObstacle((0.0, 3.0), 0.5)]
+    out = []
+    for step in range(6):
+        people = []
+        for k, (cx, cy) in enumerate(centres[: 3 - step // 4]):
+            for j, angle in enumerate(np.linspace(0.0, 2 * np.pi, 3, endpoint=False) + 0.3):
+                x, y = cx + 0.7 * np.cos(angle) + 0.05 * step, cy + 0.7 * np.sin(angle)
+                people.append(Person(10 * k + j, x, y, float(angle + np.pi)))
+        pose = (0.02 * step + (0.3 if step == 3 else 0.0), 0.0, 0.0)
+        scan = simulate_scan(pose, walls, people, beams=360, range_max=25.0) if step % 2 == 0 else None
+        out.append(LayerInputs(people, detect_groups(people), scan))
+    return out
+
+
+def test_windows_far_apart_are_written_apart_with_the_master_one_box_gives(monkeypatch):
+    import costmap.layered
+
+    spec = GridSpec.from_size(0.05, (-20.0, -20.0), (40.0, 40.0))
+    params = CostmapParams(obstacle=ObstacleParams(raytrace_max_range=25.0, obstacle_max_range=25.0))
+    apart, one_box = layered_costmap(spec, params), layered_costmap(spec, params)
+    counts = []
+    for inputs in far_apart_frames():
+        window = apart.update(inputs)
+        with monkeypatch.context() as patch:  # Nav2's one box: every window merged
+            patch.setattr(costmap.layered, "disjoint", lambda windows: [w for w in [union(*windows)] if w])
+            assert one_box.update(inputs) == window  # the same bounds reported
+        counts.append(len(apart.windows))
+        np.testing.assert_array_equal(apart.master.costs, one_box.master.costs)
+        for name, grid in apart.grids.items():
+            np.testing.assert_array_equal(grid, one_box.grids[name], err_msg=name)
+        full = np.full(spec.shape, apart.default_value, dtype=np.uint8)
+        for layer in apart.layers:
+            layer.write(full, spec.whole)
+        np.testing.assert_array_equal(apart.master.costs, full)
+    assert counts[1::2] == [3, 3, 2]  # frames without a scan: a window per group (a scan's spans them)
+
+
+def test_inflation_written_window_by_window_reaches_across_their_edges():
+    # A lethal cell that changes near the edge of one window is found by the first window whose reach holds it; the
+    # cells within reach of it in the next window must be recomputed then, though that window finds no change.
+    master = np.zeros(SPEC.shape, dtype=np.uint8)
+    master[60:64, 100:103] = LETHAL
+    first, second = Window(40, 80, 60, 96), Window(40, 80, 96, 140)  # the lethal cells lie in the second
+    for order in ((first, second), (second, first)):
+        layer = InflationLayer(SPEC, InflationParams(), inscribed_radius=0.25)
+        full = master.copy()
+        InflationLayer(SPEC, InflationParams(), inscribed_radius=0.25).write(full, SPEC.whole)
+        part = master.copy()
+        for window in order:
+            layer.write(part, window)
+        for window in order:
+            np.testing.assert_array_equal(part[window.slices], full[window.slices])
 
 
 def test_inflation_over_a_window_reads_the_lethal_cells_within_reach_of_it():

@@ -171,6 +171,28 @@ def test_max_can_skip_a_layer_value_that_carries_no_opinion():
     assert master.tolist() == [255, 40, 10, 40]  # a zero social cell does not turn unknown into free
 
 
+@pytest.mark.parametrize("method", ["max", "max_nonzero", "max_keep_unknown"])
+def test_max_combinations_equal_nav2_rules_written_out_on_every_pair_of_values(method):
+    # every (master, layer) pair of uint8 values, then windows of it with no unknown master or layer cell (the
+    # plain-max path) and with some, an empty one, and a strided one (numpy's path)
+    values = np.arange(256, dtype=np.uint8)
+    master, layer = np.meshgrid(values, values)
+    larger = np.maximum(master, layer)
+    unknown = master == NO_INFORMATION
+    if method == "max_keep_unknown":
+        expected = np.where(unknown & (layer >= INSCRIBED), layer, larger)
+    else:
+        no_opinion = NO_INFORMATION if method == "max" else FREE_SPACE
+        expected = np.where(layer == no_opinion, master, np.where(unknown, layer, larger))
+    windows = [(slice(None), slice(None)), (slice(0, 255), slice(0, 255)), (slice(3, 90), slice(7, 255))]
+    for rows, cols in [*windows, (slice(0, 0), slice(None)), (slice(None, None, 3), slice(None, None, -2))]:
+        out = master.copy()
+        combine(out[rows, cols], layer[rows, cols], method)
+        np.testing.assert_array_equal(out[rows, cols], expected[rows, cols])
+        out[rows, cols] = master[rows, cols]
+        np.testing.assert_array_equal(out, master)  # nothing outside the window
+
+
 # --- simulated scan and the LiDAR layer ---------------------------------------------------------------------
 
 
@@ -234,17 +256,13 @@ def test_lidar_layer_retraces_only_moved_beams_and_counts_the_beams_of_a_fresh_t
     for _ in range(8):  # some beams move their end cell, one scan gets longer, then the sensor moves (1 cm a step)
         moved = rng.random(len(ends)) < 0.2
         ends[moved] += rng.normal(0.0, 0.3, 2)
-        traced, window, everything = layer._beams.update(origin, ends)
+        traced, everything = layer._beams.update(origin, ends)
         cell = SPEC.world_to_cell(origin[None])[0].tolist()
         fresh = trace_cells(SPEC, origin, ends)
         counts = np.bincount(fresh, minlength=SPEC.width * SPEC.height)
         np.testing.assert_array_equal(layer._beams.coverage, counts)
         assert everything == (cell != previous)  # all beams again when the sensor's cell changed
         assert np.isin(traced, fresh).all() and (everything or len(traced) < len(fresh))
-        if window is not None:  # the traced cells lie in it
-            rows, cols = np.divmod(traced, SPEC.width)
-            assert window.row0 <= rows.min() and rows.max() < window.row1
-            assert window.col0 <= cols.min() and cols.max() < window.col1
         ends[0] = origin + (20.0, 0.5)
         origin, previous = origin + (0.01, 0.0), cell
 
