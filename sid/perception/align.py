@@ -64,6 +64,8 @@ _GAP_REL = 0.05
 _MIN_SUPPORT = 3
 # Anything beyond this (metres) is an empty z-buffer cell.
 _FAR = 1.0e6
+# ``_reduce_patches``: a row of c sorted readings has its middle ones at (c - 1) // 2 and c // 2.
+_LOW_HIGH = np.array([[1], [0]])
 # Every n-th depth pixel is enough to find the most common rectangle size.
 _CLASS_SAMPLE = 16
 # ``search="window"``: fixed-point steps from a colour pixel to the depth pixel it sees (the first from infinity).
@@ -95,31 +97,51 @@ def _reduce_patches(values: np.ndarray, method: PatchMethod, min_support: int = 
     if n == 0 or p == 0:
         return np.full(n, np.nan)
     ordered = np.sort(values, axis=1)  # NaN sorts last
-    # The readings of a row are its first ``count`` sorted values (the callers drop readings <= 0, so no -inf).
-    finite = np.isfinite(ordered)
-    count = finite.sum(axis=1)
-    rows = np.arange(n)
+    # The readings of a row are its first ``count`` sorted values (the callers keep only finite readings > 0).
+    count = np.isfinite(ordered).sum(axis=1)
     if method == "min":
         return np.where(count > 0, ordered[:, 0], np.nan)
-    if method == "median":
-        lo, hi = (count - 1) // 2, count // 2
-        mid = 0.5 * (ordered[rows, np.maximum(lo, 0)] + ordered[rows, np.maximum(hi, 0)])
-        return np.where(count > 0, mid, np.nan)
-    if method != "nearest":
+    if method not in ("nearest", "median"):
         raise ValueError(f"unknown patch method {method!r}; use 'nearest', 'min' or 'median'")
-    with np.errstate(invalid="ignore"):
-        breaks = ordered[:, 1:] - ordered[:, :-1] > np.maximum(_GAP_ABS, _GAP_REL * ordered[:, :-1])
-    surface = np.zeros((n, p), dtype=np.int64)
-    np.cumsum(breaks, axis=1, out=surface[:, 1:])
-    sizes = np.bincount((rows[:, None] * p + surface)[finite], minlength=n * p).reshape(n, p)
-    support = np.minimum(min_support, sizes.max(axis=1))
-    chosen = np.argmax(sizes >= support[:, None], axis=1)
-    start = np.argmax(surface == chosen[:, None], axis=1)
-    size = sizes[rows, chosen]
-    # The chosen surface's middle readings (it starts at ``start`` and holds ``size``, so both lie in the row; a
-    # row without readings has size 0 and reads cell -1, which the last line replaces).
-    mid = 0.5 * (ordered[rows, start + (size - 1) // 2] + ordered[rows, start + size // 2])
-    return np.where(count > 0, mid, np.nan)
+    # The indices of the two middle readings of each row, (2, N) (a row without readings reads cell -1, which the
+    # last line replaces).
+    middle = (count - _LOW_HIGH) // 2
+    if method == "nearest":
+        # Depth jumps between consecutive sorted readings, found in one pass over the flat array (a pair that spans
+        # two rows is no jump: skipped below). A row without a jump is one surface. Rows with jumps (silhouette
+        # edges, a few per frame) choose their surface in Python, from the jump positions, and read its middle.
+        flat = ordered.reshape(-1)
+        jumps = np.flatnonzero(flat[1:] - flat[:-1] > np.maximum(_GAP_ABS, _GAP_REL * flat[:-1]))
+        if len(jumps):
+            chosen = _nearest_surfaces(jumps.tolist(), p, count.tolist(), min_support)
+            middle[:, list(chosen)] = [
+                [start + (size - 1) // 2 for start, size in chosen.values()],
+                [start + size // 2 for start, size in chosen.values()],
+            ]
+    return np.where(count > 0, 0.5 * ordered[np.arange(n), middle].sum(axis=0), np.nan)
+
+
+def _nearest_surfaces(jumps: list[int], p: int, count: list[int], min_support: int) -> dict[int, tuple[int, int]]:
+    """(start, size) of the surface ``_reduce_patches`` chooses in each sorted row (of ``p`` readings) with depth
+    jumps, by row.
+
+    jumps: flat positions row * p + j of the jumps between sorted readings j and j + 1, in order (j = p - 1, a pair
+    across two rows, is ignored); count: readings per row. A row's surfaces run between its jumps; the chosen one
+    is the nearest holding at least ``min_support`` readings, or the nearest of the largest when none does.
+    """
+    bounds: dict[int, list[int]] = {}
+    for position in jumps:
+        row, j = divmod(position, p)
+        if j < p - 1:
+            bounds.setdefault(row, [0]).append(j + 1)
+    chosen = {}
+    for row, starts in bounds.items():
+        ends = [*starts[1:], count[row]]
+        sizes = [end - first for first, end in zip(starts, ends, strict=True)]
+        support = min(min_support, max(sizes))
+        k = next(k for k, length in enumerate(sizes) if length >= support)
+        chosen[row] = starts[k], sizes[k]
+    return chosen
 
 
 def _patch_offsets(patch: int) -> tuple[np.ndarray, np.ndarray]:
@@ -140,7 +162,8 @@ def _check_pixels(pixels: np.ndarray, patch: int) -> np.ndarray:
 
 
 def _registered_patches(depth_m: np.ndarray, pixels: np.ndarray, patch: int) -> np.ndarray:
-    """(N, patch*patch) depths around each (rounded) pixel; NaN outside the image, at 0/NaN readings, at NaN pixels."""
+    """(N, patch*patch) depths around each (rounded) pixel; NaN outside the image, at 0/NaN/inf readings, at NaN
+    pixels (an infinite reading is no reading, as in ``_reduce_patches``)."""
     h, w = depth_m.shape
     finite = np.all(np.isfinite(pixels), axis=1)
     centre = np.floor(np.where(finite[:, None], pixels, -(10**6)) + 0.5).astype(np.int64)
@@ -150,7 +173,7 @@ def _registered_patches(depth_m: np.ndarray, pixels: np.ndarray, patch: int) -> 
     inside = (u >= 0) & (u < w) & (v >= 0) & (v < h)
     values = depth_m[np.clip(v, 0, h - 1), np.clip(u, 0, w - 1)].astype(float)
     with np.errstate(invalid="ignore"):
-        values[~inside | ~(values > 0)] = np.nan
+        values[~inside | ~(values > 0) | (values == np.inf)] = np.nan
     return values
 
 
@@ -464,14 +487,14 @@ def depth_at_color_pixels(
 class _WindowGeometry:
     """What ``search="window"`` needs of one calibration and patch size, computed once (``_window_geometry``).
 
-    half: the window's half width (depth pixels); du, dv: (C,) its cells' offsets from the centre pixel and offsets:
-    (C,) the same as flat indices into the depth image; support: the nearest surface's support scaled to C cells;
-    ray_z: (H_d * W_d,) per depth pixel (u, v) the colour-frame z of R K_d^-1 [u, v, 1], i.e. per metre of reading;
-    focal, principal: (2, 1) the depth intrinsics' (fx, fy) and (cx, cy); interior_end: (2, 1) the first centre
-    column and row whose window leaves the image.
+    du, dv: (C,) the window's cells' offsets from the centre pixel and offsets: (C,) the same as flat indices into
+    the depth image; support: the nearest surface's support scaled to C cells; ray_z: (H_d * W_d,) per depth pixel
+    (u, v) the colour-frame z of R K_d^-1 [u, v, 1], i.e. per metre of reading; focal, principal: (2, 1) the depth
+    intrinsics' (fx, fy) and (cx, cy); interior_start, interior_end: (2, 1) the first centre column and row whose
+    window lies inside the image and the first whose window leaves it (as floats: they are compared with float
+    pixel coordinates, which is cheaper than with integers).
     """
 
-    half: int
     du: np.ndarray
     dv: np.ndarray
     offsets: np.ndarray
@@ -479,6 +502,7 @@ class _WindowGeometry:
     ray_z: np.ndarray
     focal: np.ndarray
     principal: np.ndarray
+    interior_start: np.ndarray
     interior_end: np.ndarray
 
 
@@ -507,12 +531,11 @@ def _cached_window_geometry(
     rows, cols = np.mgrid[0:height, 0:width]
     ray_z = rotation_z[0] * (cols - cx) / fx + rotation_z[1] * (rows - cy) / fy + rotation_z[2]
     support = int(np.ceil(_MIN_SUPPORT * len(du) / patch**2))
-    arrays = (du, dv, dv * width + du, ray_z.ravel(), np.array([[fx], [fy]]), np.array([[cx], [cy]]))
+    interior = np.array([[half], [half]], dtype=float), np.array([[width - half], [height - half]], dtype=float)
+    arrays = (du, dv, dv * width + du, ray_z.ravel(), np.array([[fx], [fy]]), np.array([[cx], [cy]]), *interior)
     for array in arrays:  # shared by every call with this calibration
         array.flags.writeable = False
-    interior_end = np.array([[width - half], [height - half]])
-    interior_end.flags.writeable = False
-    return _WindowGeometry(half, *arrays[:3], support, *arrays[3:], interior_end)
+    return _WindowGeometry(*arrays[:3], support, *arrays[3:])
 
 
 def _window_depth(
@@ -532,50 +555,52 @@ def _window_depth(
     kd, kc = calib.depth, calib.color
     rotation, translation = calib.depth_to_color.rotation, calib.depth_to_color.translation
     geometry = _window_geometry(calib, patch)
-    flat = np.ascontiguousarray(depth_m).reshape(-1)
-    finite = np.isfinite(pixels).all(axis=1)
+    flat = depth_m.reshape(-1)  # a copy only when the image is not contiguous
     shift = (rotation.T @ translation)[:, None]
-    z = np.full(len(pixels), np.inf)  # colour-frame depth of each pixel's surface; the first step looks from infinity
     low, high = np.float64(depth_min), np.float64(depth_max)
     colour_ray = np.ones((3, len(pixels)))
+    z = None  # colour-frame depth of each pixel's surface (NaN: none found yet); the first step looks from infinity
     with np.errstate(divide="ignore", invalid="ignore"):  # NaN pixels, rays that miss the depth camera
         # Colour ray (x, y, 1) per pixel (NaN for a NaN pixel, never seen), in the depth frame: a point at colour
-        # depth z is z * ray - R^T t; at infinity, the ray's direction.
+        # depth z is z * ray - R^T t; while z is unknown, the ray's direction.
         colour_ray[:2] = ((pixels - (kc.cx, kc.cy)) / (kc.fx, kc.fy)).T
         point = ray = rotation.T @ colour_ray
         for step in range(_WINDOW_STEPS):
-            index, inside = _window_cells(point, finite, geometry, kd)
-            reading = flat.take(index)  # the image's dtype: float64 scalars below compare and multiply in float64
+            index, inside = _window_cells(point, geometry, kd.width, kd.height)
+            # In float64 (the image may be float32): comparisons and products with float64 would cast it anyway.
+            reading = flat.take(index).astype(np.float64, copy=False)
             valid = (reading >= low) & (reading <= high)
             if inside is not None:
                 valid &= inside
             if step == _WINDOW_STEPS - 1:
                 break
             # Colour-frame z of each reading's point, (R d K_d^-1 [u, v, 1] + t)_z; the steps only move the window,
-            # so the nearest reading will do.
+            # so the nearest reading will do (NaN: none, the previous z stays).
             nearest = np.fmin.reduce(
                 np.where(valid, reading * geometry.ray_z.take(index) + translation[2], np.nan), axis=1
             )
-            z = np.where(np.isfinite(nearest), nearest, z)
-            known = np.isfinite(z)
-            point = np.where(known, z, 1.0) * ray - known * shift  # (3, N) in the depth frame (a direction if unknown)
-        stored = reading * geometry.ray_z.take(index) + translation[2] if value == "z" else reading.astype(float)
+            z = nearest if z is None else np.where(np.isnan(nearest), z, nearest)
+            point = np.where(np.isnan(z), ray, z * ray - shift)  # (3, N) in the depth frame
+        stored = reading * geometry.ray_z.take(index) + translation[2] if value == "z" else reading
         return _reduce_patches(np.where(valid, stored, np.nan), method, geometry.support)
 
 
 def _window_cells(
-    point: np.ndarray, finite: np.ndarray, geometry: _WindowGeometry, kd: Intrinsics
+    point: np.ndarray, geometry: _WindowGeometry, width: int, height: int
 ) -> tuple[np.ndarray, np.ndarray | None]:
     """Flat depth-image indices (N, C) of the window around the depth pixel each point (3, N, depth frame) projects
-    to, and which cells lie in the image (None: all of them; cells outside index pixel 0)."""
-    centre = np.floor(point[:2] / point[2] * geometry.focal + geometry.principal + 0.5)  # (2, N) pixel (u, v)
-    seen = finite & (point[2] > 0)
-    # Usually every window lies inside the image: one add gives all indices, no per-cell test.
-    if seen.all() and ((centre >= geometry.half) & (centre < geometry.interior_end)).all():
-        return (centre[1] * kd.width + centre[0]).astype(np.intp)[:, None] + geometry.offsets, None
+    to, and which cells lie in the image (None: all of them; cells outside index pixel 0). NaN points have no
+    cell in the image (their comparisons are False)."""
+    pixel = point[:2] / point[2] * geometry.focal + geometry.principal + 0.5  # (2, N): floor gives the pixel (u, v)
+    # Usually every window lies inside the image: one add gives all indices, no per-cell test (the pixels are
+    # positive there, so the integer cast floors them).
+    if (point[2] > 0.0).all() and ((pixel >= geometry.interior_start) & (pixel < geometry.interior_end)).all():
+        centre = pixel.astype(np.intp)
+        return (centre[1] * width + centre[0])[:, None] + geometry.offsets, None
+    centre = np.floor(pixel)
     u, v = centre[0][:, None] + geometry.du, centre[1][:, None] + geometry.dv
-    inside = (u >= 0) & (u < kd.width) & (v >= 0) & (v < kd.height) & seen[:, None]
-    return np.where(inside, v * kd.width + u, 0).astype(np.intp), inside
+    inside = (u >= 0) & (u < width) & (v >= 0) & (v < height) & (point[2] > 0.0)[:, None]
+    return np.where(inside, v * width + u, 0).astype(np.intp), inside
 
 
 def _unregistered_patches(

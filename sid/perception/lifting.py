@@ -36,6 +36,7 @@ ground below the camera; see ``sid.perception.mount``). Units: metres, radians.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -45,22 +46,25 @@ import numpy as np
 from sid.checks import check_number, check_numbers
 from sid.perception.align import Search, depth_at_color_pixels
 from sid.perception.camera import Calibration
-from sid.perception.keypoints import COCO_KEYPOINTS, KP, NUM_KEYPOINTS, PoseDetection
+from sid.perception.keypoints import KP, NUM_KEYPOINTS, PoseDetection
 from sid.perception.mount import CameraMount
 from sid.perception.orientation import EAR_SEPARATION, HIP_SEPARATION, SHOULDER_SEPARATION, estimate_orientations
 from sid.perception.people import Person
 
-# Far-side completion. Root keypoints, each with its partner a fixed separation away: shoulders, hips, ears
-# (``widths`` order), left then right.
-_FAR = np.array([KP[f"{side}_{part}"] for side in ("left", "right") for part in ("shoulder", "hip", "ear")])
-# The other side's keypoint of each keypoint (left <-> right; the nose is its own), and of each root.
-_MIRROR = np.array([KP[n.replace("left", "@").replace("right", "left").replace("@", "right")] for n in COCO_KEYPOINTS])
-_FAR_PARTNER = _MIRROR[_FAR]
-# Followers of each root keypoint (-1: none): the arm hangs from the shoulder, the leg from the hip.
-_FOLLOWERS = np.full((NUM_KEYPOINTS, 2), -1)
-for _side in ("left", "right"):
-    _FOLLOWERS[KP[f"{_side}_shoulder"]] = KP[f"{_side}_elbow"], KP[f"{_side}_wrist"]
-    _FOLLOWERS[KP[f"{_side}_hip"]] = KP[f"{_side}_knee"], KP[f"{_side}_ankle"]
+# Far-side completion. Root keypoints and their partner a fixed separation away, as (root, partner): shoulders,
+# hips, ears (``widths`` order), left roots then right ones.
+_ROOT_PAIRS = tuple(
+    (KP[f"{side}_{part}"], KP[f"{other}_{part}"])
+    for side, other in (("left", "right"), ("right", "left"))
+    for part in ("shoulder", "hip", "ear")
+)
+# Followers of a root keypoint, each with its partner (as (follower, partner)): the arm hangs from the shoulder, the
+# leg from the hip; ears have none.
+_FOLLOWERS = {
+    KP[f"{side}_{root}"]: tuple((KP[f"{side}_{part}"], KP[f"{other}_{part}"]) for part in parts)
+    for side, other in (("left", "right"), ("right", "left"))
+    for root, parts in (("shoulder", ("elbow", "wrist")), ("hip", ("knee", "ankle")))
+}
 
 
 @dataclass(frozen=True)
@@ -167,20 +171,20 @@ def lift_people(
     # np.array of a list of equal-shape arrays stacks them, with less overhead than np.stack.
     keypoints = np.array([d.keypoints for d in detections])  # (P, 17, 2) colour pixels
     scores = np.array([d.scores for d in detections])  # (P, 17)
-    confident = (scores >= params.min_score) & np.isfinite(keypoints).all(axis=2)  # (comparisons with NaN: False)
+    confident = scores >= params.min_score  # (comparisons with NaN: False; a NaN keypoint gets no depth)
     depth = np.full(scores.shape, np.nan)
     depth[confident] = depth_at_color_pixels(
         depth_m, keypoints[confident], calib, patch=params.patch, search=params.depth_search
     )
-    usable = confident & (depth >= params.min_range) & (depth <= params.max_range)
+    usable = (depth >= params.min_range) & (depth <= params.max_range)  # NaN (not confident, no reading): False
     # Median depth per person over its usable keypoints (unusable ones sort last as +inf; np.nanmedian is ~30x
-    # slower on arrays this small).
-    ordered = np.sort(np.where(usable, depth, np.inf), axis=1)
-    count = usable.sum(axis=1)
-    rows = np.arange(len(detections))
-    median = 0.5 * (
-        ordered[rows, np.maximum(count - 1, 0) // 2] + ordered[rows, np.minimum(count // 2, ordered.shape[1] - 1)]
-    )
+    # slower on arrays this small), picked from the sorted rows in Python (a few people: cheaper than numpy).
+    ordered = np.sort(np.where(usable, depth, np.inf), axis=1).tolist()
+    middle = [
+        0.5 * (row[max(count - 1, 0) // 2] + row[min(count // 2, NUM_KEYPOINTS - 1)])
+        for row, count in zip(ordered, usable.sum(axis=1).tolist(), strict=True)
+    ]
+    median = np.array(middle)
     usable &= np.abs(depth - median[:, None]) <= params.depth_gate
     if len(detections) > 1 and math.isfinite(params.occluder_gap):
         boxes = np.array([d.box for d in detections])
@@ -189,25 +193,36 @@ def lift_people(
     # Each keypoint's viewing ray (camera frame, through K_c^-1 [u v 1] = (ray_x, ray_y, 1)) and its range along it
     # (m; NaN where unusable); depth z and range r: r = z * |(ray_x, ray_y, 1)|.
     intr = calib.color
-    ray_x = (keypoints[..., 0] - intr.cx) / intr.fx
-    ray_y = (keypoints[..., 1] - intr.cy) / intr.fy
+    ray = (keypoints - (intr.cx, intr.cy)) / (intr.fx, intr.fy)  # (P, 17, 2) as (ray_x, ray_y)
+    ray_x, ray_y = ray[..., 0], ray[..., 1]
     norm = np.sqrt(ray_x * ray_x + ray_y * ray_y + 1.0)
     ranges = np.where(usable, depth * norm + params.surface_offset, np.nan)
     inferred = np.zeros(scores.shape, dtype=bool)
     if params.complete_far_side:
-        widths = np.array([params.shoulder_separation, params.hip_separation, params.ear_separation])
-        _complete_far_side(ray_x, ray_y, norm, ranges, scores, inferred, widths, params)
+        _complete_far_side(ray, norm, ranges, scores, inferred, params)
 
     world = np.full((*scores.shape, 3), np.nan)
     z = ranges[usable] / norm[usable]
-    world[usable] = mount.camera_to_world(np.stack([ray_x[usable] * z, ray_y[usable] * z, z], axis=1))
-    counts = usable.sum(axis=1)
-    placed = np.flatnonzero(counts >= params.min_keypoints)
-    positions = np.where(usable[placed, :, None], world[placed, :, :2], 0.0).sum(axis=1) / counts[placed, None]
+    camera = np.empty((len(z), 3))  # (x, y, z) = z * (ray_x, ray_y, 1)
+    camera[:, :2] = ray[usable] * z[:, None]
+    camera[:, 2] = z
+    lifted = mount.camera_to_world(camera)  # the usable keypoints, person by person
+    world[usable] = lifted
+    counts = usable.sum(axis=1).tolist()
+    placed = [k for k, count in enumerate(counts) if count >= params.min_keypoints]
     facings = estimate_orientations(world[placed], inferred[placed])
+    # Position: the mean of the lifted keypoints' x, y, summed in keypoint order on Python floats (a few people).
+    ground = lifted[:, :2].tolist()
+    ends = list(itertools.accumulate(counts))
     people = []
-    for k, (x, y), (theta, quality) in zip(placed.tolist(), positions.tolist(), facings, strict=True):
-        people.append(Person(int(ids[k]) if ids is not None else k, x, y, theta, quality, world[k]))
+    for k, (theta, quality) in zip(placed, facings, strict=True):
+        x = y = 0.0
+        for point_x, point_y in ground[ends[k] - counts[k] : ends[k]]:
+            x += point_x
+            y += point_y
+        people.append(
+            Person(int(ids[k]) if ids is not None else k, x / counts[k], y / counts[k], theta, quality, world[k])
+        )
     return people
 
 
@@ -231,53 +246,54 @@ def _reads_someone_in_front(
 
 
 def _complete_far_side(
-    ray_x: np.ndarray,
-    ray_y: np.ndarray,
-    norm: np.ndarray,
-    ranges: np.ndarray,
-    scores: np.ndarray,
-    inferred: np.ndarray,
-    widths: np.ndarray,
-    params: LiftParams,
+    ray: np.ndarray, norm: np.ndarray, ranges: np.ndarray, scores: np.ndarray, inferred: np.ndarray, params: LiftParams
 ) -> None:
     """Far-side completion (module docstring), in place on ``ranges`` (P, 17) and ``inferred`` (P, 17).
 
-    ray_x, ray_y, norm: (P, 17) viewing rays (ray_x, ray_y, 1) in the camera frame and their lengths; ranges:
-    metres along the rays, NaN where unusable; scores: (P, 17); widths: (3,) separations W of the root pairs
-    (shoulders, hips, ears). Keypoints are addressed by flat index person * 17 + keypoint.
+    ray: (P, 17, 2) viewing rays (ray_x, ray_y, 1) in the camera frame as (ray_x, ray_y); norm: (P, 17) their
+    lengths; ranges: metres along the rays, NaN where unusable; scores: (P, 17). The few candidate pairs are worked
+    out on Python floats (cheaper than numpy on a handful of values), each new range computed from the ranges
+    before any is written.
     """
     gap = params.far_side_score_gap
+    widths = (params.shoulder_separation, params.hip_separation, params.ear_separation)  # ``_ROOT_PAIRS`` order
     # Candidates: a root keypoint scoring clearly lower than its partner (the hidden one, if the pair collapsed).
-    people, k = np.nonzero(scores[:, _FAR] <= scores[:, _FAR_PARTNER] - gap)
-    if len(people) == 0:
+    score_rows = scores.tolist()
+    candidates = [
+        (person, k, far, near)
+        for person, row in enumerate(score_rows)
+        for k, (far, near) in enumerate(_ROOT_PAIRS)
+        if row[far] <= row[near] - gap
+    ]
+    if not candidates:
         return
-    base = people * NUM_KEYPOINTS
-    far, near = base + _FAR[k], base + _FAR_PARTNER[k]
-    r, x, y, n = ranges.reshape(-1), ray_x.reshape(-1), ray_y.reshape(-1), norm.reshape(-1)  # views
-    far_range, near_range = r[far], r[near]
-    foot = (x[far] * x[near] + y[far] * y[near] + 1.0) / (n[far] * n[near]) * near_range  # u . P, u the far unit ray
-    width = widths[k % len(widths)]
-    # |far - near|^2 = r_far^2 - 2 r_far (u . P) + |P|^2; NaN (a keypoint missing) compares False: never completed.
-    collapsed = far_range * (far_range - 2 * foot) + near_range**2 < (params.min_pair_fraction * width) ** 2
-    if not collapsed.any():
-        return
-    k, base, far, foot, near_range, width = (a[collapsed] for a in (k, base, far, foot, near_range, width))
-    # The hidden keypoint at W from its partner, behind it: t = u . P + sqrt(W^2 - w^2), w^2 = |P|^2 - (u . P)^2.
-    target = foot + np.sqrt(np.maximum(width**2 - near_range**2 + foot**2, 0.0))
-    r[far] = target
-    inferred.reshape(-1)[far] = True
-
+    rays, lengths, old_ranges = ray.tolist(), norm.tolist(), ranges.tolist()
+    completed = []  # (person, keypoint, range along its ray, how far behind its partner's range)
+    for person, k, far, near in candidates:
+        (far_x, far_y), (near_x, near_y) = rays[person][far], rays[person][near]
+        far_range, near_range = old_ranges[person][far], old_ranges[person][near]
+        # u . P: the partner's point P projected on the far keypoint's unit ray u.
+        foot = (far_x * near_x + far_y * near_y + 1.0) / (lengths[person][far] * lengths[person][near]) * near_range
+        width = widths[k % len(widths)]
+        limit = params.min_pair_fraction * width
+        # |far - near|^2 = r_far^2 - 2 r_far (u . P) + |P|^2; NaN (a keypoint missing) compares False: not completed.
+        if far_range * (far_range - 2 * foot) + near_range * near_range < limit * limit:
+            # The hidden keypoint at W from its partner, behind it: t = u.P + sqrt(W^2 - w^2), w^2 = |P|^2 - (u.P)^2.
+            target = foot + math.sqrt(max(width * width - near_range * near_range + foot * foot, 0.0))
+            completed.append((person, far, target, target - near_range))
     # Followers on the hidden side scoring clearly lower than their partner: at least as far behind their partner
-    # as the root is behind its own (np.fmax keeps the keypoint's own range where its partner has none; a follower
-    # without a range of its own stays unusable whatever its range).
-    follower = _FOLLOWERS[_FAR[k]].reshape(-1)  # -1: none
-    base = np.repeat(base, 2)
-    behind = np.repeat(target - near_range, 2)
-    own, partner = base + follower, base + _MIRROR[follower]
-    flat_scores = scores.reshape(-1)
-    move = (follower >= 0) & (flat_scores[own] <= flat_scores[partner] - gap)
-    own, partner, behind = own[move], partner[move], behind[move]
-    current = r[own]
-    placed = np.fmax(current, r[partner] + behind)
-    r[own] = placed
-    inferred.reshape(-1)[own] = placed > current
+    # as the root is behind its own (fmax: the keypoint's own range where its partner has none; a follower without
+    # a range of its own stays unusable whatever its range). The followers and their partners are no roots.
+    moved = []
+    for person, root, _, behind in completed:
+        for own, partner in _FOLLOWERS.get(root, ()):
+            if score_rows[person][own] <= score_rows[person][partner] - gap:
+                current, reach = old_ranges[person][own], old_ranges[person][partner] + behind
+                placed = reach if math.isnan(current) else current if math.isnan(reach) else max(current, reach)
+                moved.append((person, own, placed, placed > current))
+    for person, far, target, _ in completed:
+        ranges[person, far] = target
+        inferred[person, far] = True
+    for person, own, placed, further in moved:
+        ranges[person, own] = placed
+        inferred[person, own] = further

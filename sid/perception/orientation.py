@@ -121,9 +121,9 @@ def _orientations(points: np.ndarray, inferred: np.ndarray | None) -> list[tuple
     # Everyone's scatter matrix at once, with a missing keypoint's row zero: it adds nothing to the sums (x + 0.0 is
     # x), so each person's matrix is the one of their usable keypoints alone.
     rows = usable[..., None]
-    with np.errstate(invalid="ignore", divide="ignore"):  # people without keypoints: 0 / 0, zeroed below
-        masked = np.where(rows, points, 0.0)
-        centred = np.where(rows, masked - masked.sum(axis=1, keepdims=True) / counts[:, None, None], 0.0)
+    masked = np.where(rows, points, 0.0)
+    # (People without keypoints divide their zero sums by 1, not 0: their rows are zeroed anyway.)
+    centred = np.where(rows, masked - masked.sum(axis=1, keepdims=True) / np.maximum(counts, 1)[:, None, None], 0.0)
     eigenvalues, eigenvectors = np.linalg.eigh(centred.transpose(0, 2, 1) @ centred)  # ascending, per person
     flags = inferred.tolist() if inferred is not None else [None] * len(points)
     return [

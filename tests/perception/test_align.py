@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -163,6 +164,51 @@ def test_nearest_surface_needs_support_so_a_single_flying_pixel_does_not_decide(
     depth[20, 20] = 0.5  # one outlier in the 5x5 patch
     assert depth_at_color_pixels(depth, np.array([[20.0, 20.0]]), calib)[0] == 3.0
     assert depth_at_color_pixels(depth, np.array([[20.0, 20.0]]), calib, method="min")[0] == 0.5
+
+
+def reference_nearest(readings: np.ndarray, min_support: int = 3) -> float:
+    """The "nearest" reduction of one patch, one sorted reading at a time (``depth_at_color_pixels``' docstring)."""
+    values = sorted(float(x) for x in readings if x > 0)
+    if not values:
+        return math.nan
+    surfaces = [[values[0]]]
+    for before, after in zip(values[:-1], values[1:], strict=True):
+        if after - before > max(0.10, 0.05 * before):
+            surfaces.append([])
+        surfaces[-1].append(after)
+    support = min(min_support, max(map(len, surfaces)))
+    chosen = next(surface for surface in surfaces if len(surface) >= support)
+    return 0.5 * (chosen[(len(chosen) - 1) // 2] + chosen[len(chosen) // 2])
+
+
+def test_nearest_surface_of_patches_with_several_surfaces_matches_a_reading_by_reading_reference() -> None:
+    """Patches of 1-4 surfaces of 0-25 readings each (single flying pixels, ties for the largest, holes)."""
+    rng = np.random.default_rng(11)
+    calib = Calibration(COLOR)
+    depth = np.zeros((COLOR.height, COLOR.width), np.float32)
+    pixels = np.array([[u, v] for v in range(2, COLOR.height - 2, 5) for u in range(2, COLOR.width - 2, 5)], float)
+    for u, v in pixels.astype(int):
+        levels = rng.choice([0.6, 1.0, 1.5, 2.2, 3.0, 4.5], size=rng.integers(1, 5), replace=False)
+        patch = rng.choice(levels, size=(5, 5)) + rng.normal(0, rng.choice([0.0, 0.01]), (5, 5))
+        patch[rng.random((5, 5)) < rng.uniform(0, 0.9)] = rng.choice([0.0, np.nan])
+        depth[v - 2 : v + 3, u - 2 : u + 3] = patch
+    got = depth_at_color_pixels(depth, pixels, calib)
+    expected = [reference_nearest(depth[v - 2 : v + 3, u - 2 : u + 3].ravel()) for u, v in pixels.astype(int)]
+    np.testing.assert_array_equal(got, expected)
+    assert np.isnan(got).sum() < len(got) // 4
+
+
+def test_an_infinite_reading_is_no_reading() -> None:
+    rng = np.random.default_rng(12)
+    depth = scene((COLOR.height, COLOR.width), seed=3)
+    holes = rng.random(depth.shape) < 0.3
+    pixels = np.column_stack([rng.uniform(-2, COLOR.width + 1, 200), rng.uniform(-2, COLOR.height + 1, 200)])
+    for method in ("nearest", "min", "median"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # no inf - inf on the way
+            got = depth_at_color_pixels(np.where(holes, np.inf, depth), pixels, Calibration(COLOR), method=method)
+        expected = depth_at_color_pixels(np.where(holes, 0.0, depth), pixels, Calibration(COLOR), method=method)
+        np.testing.assert_array_equal(got, expected)
 
 
 def test_bad_arguments_are_named() -> None:

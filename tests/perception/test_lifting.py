@@ -87,8 +87,9 @@ def test_holes_low_scores_and_outlying_depths_drop_keypoints_never_placing_them_
     paint("right_wrist", 7.5)  # beyond max_range
     paint("left_knee", 3.0)  # 1 m behind the body: fails the depth gate
     detection.scores[KP["nose"]] = 0.1  # not confident
+    detection.keypoints[KP["left_eye"]] = np.nan  # a confident keypoint without a place
     [person] = lift_people(detections, depth, REGISTERED, MOUNT)
-    dropped = [KP[n] for n in ("left_wrist", "right_wrist", "left_knee", "nose")]
+    dropped = [KP[n] for n in ("left_wrist", "right_wrist", "left_knee", "nose", "left_eye")]
     assert np.isnan(person.keypoints_world[dropped]).all()
     kept = np.setdiff1d(np.arange(NUM_KEYPOINTS), dropped)
     np.testing.assert_allclose(person.keypoints_world[kept], truths[0][kept], atol=0.005)
@@ -260,6 +261,26 @@ def test_far_side_completion_needs_a_collapsed_pair_and_a_clear_score_difference
     detections[0].scores[right] = 0.4
     [person] = lift_people(detections, depth, REGISTERED, MOUNT)
     np.testing.assert_allclose(person.keypoints_world, truth, atol=0.005)
+
+
+def test_far_side_completion_of_both_keypoints_of_a_pair_reads_the_ranges_before_either_moves():
+    """With no score gap required and equal scores, both keypoints of a collapsed pair are candidates: each is put
+    at W from its partner's measured point (never from the other's completed one), and so are the followers."""
+    detections, depth, _ = side_view(far_score=0.9)
+    params = LiftParams(far_side_score_gap=0.0)
+    [raw] = lift_people(detections, depth, REGISTERED, MOUNT, LiftParams(complete_far_side=False))
+    [person] = lift_people(detections, depth, REGISTERED, MOUNT, params)
+    for part, separation in [("shoulder", params.shoulder_separation), ("hip", params.hip_separation)]:
+        left, right = KP[f"left_{part}"], KP[f"right_{part}"]
+        for moved, partner in [(left, right), (right, left)]:
+            gap = np.linalg.norm(person.keypoints_world[moved] - raw.keypoints_world[partner])
+            assert gap == pytest.approx(separation, abs=1e-9)
+    optical_centre = np.array([0.0, 0.0, MOUNT.height])
+    for follower in ("elbow", "wrist", "knee", "ankle"):
+        for side in ("left", "right"):
+            own = np.linalg.norm(person.keypoints_world[KP[f"{side}_{follower}"]] - optical_centre)
+            measured = np.linalg.norm(raw.keypoints_world[KP[f"{side}_{follower}"]] - optical_centre)
+            assert own >= measured - 1e-12, "a follower is never pulled nearer"
 
 
 def test_accuracy_on_rendered_people_at_every_yaw_including_side_views():
