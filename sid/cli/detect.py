@@ -6,14 +6,15 @@ import argparse
 import contextlib
 import json
 import sys
-from collections.abc import Sized
+from collections.abc import Iterable, Iterator, Sized
 from pathlib import Path
-from typing import TYPE_CHECKING, TextIO
+from typing import TYPE_CHECKING, NamedTuple, TextIO
 
 import cv2
 import numpy as np
 
 from costmap.grid import Costmap2D, GridSpec
+from sid.ahead import run_ahead
 from sid.cli.common import OutputFolderError, check_output_folder, clear_owned, fail, signals_deferred
 from sid.documents import write_atomically
 from sid.perception.camera import Calibration
@@ -22,10 +23,10 @@ from sid.perception.groups import GROUP_METHODS, GroupParams
 from sid.perception.lifting import LiftParams
 from sid.perception.mount import CameraMount
 from sid.perception.overlay import draw_detections
-from sid.perception.pipeline import FrameResult, Pipeline, PoseFn, image_pose
+from sid.perception.pipeline import FrameResult, Pipeline, PosedFrame, PoseFn, image_pose
 from sid.perception.pose.contracts import PoseModelError
 from sid.perception.pose.session import PROVIDER_CHOICES
-from sid.sources import RECORDING_SUFFIXES, FrameReadError, SourceError, open_source, skip_unreadable
+from sid.sources import RECORDING_SUFFIXES, FrameReadError, SourceError, frames_or_errors, open_source
 from sid.tracking import SessionUpdate, TrackingError, TrackingSession, ViewCone, camera_fov, camera_view_cone
 
 if TYPE_CHECKING:  # costmap.render (the costmap layers, shapely) is imported only for --out: start-up time
@@ -140,6 +141,22 @@ def _skip_reason(frame: Frame) -> str | None:
     return "no depth"
 
 
+class _Skipped(NamedTuple):
+    frame: Frame
+    reason: str
+
+
+def _posed_frames(source: Iterable[Frame], pipeline: Pipeline) -> Iterator[PosedFrame | _Skipped | FrameReadError]:
+    """The first half of each frame's work, which ``run`` has done in a worker thread one frame ahead: read the
+    frame and, when it has depth, run the pose model on it. Unreadable frames come as their ``FrameReadError``."""
+    for item in frames_or_errors(source):
+        if isinstance(item, FrameReadError):
+            yield item
+            continue
+        reason = _skip_reason(item)
+        yield _Skipped(item, reason) if reason else pipeline.pose_frame(item)
+
+
 def camera_view(calibration: Calibration, mount: CameraMount) -> CameraView:
     """The colour camera seen from above: at the world origin, its field of view bounded by the image's left and
     right edges on the principal row."""
@@ -245,11 +262,15 @@ def run(args: argparse.Namespace) -> int:
     tracking = None if args.no_tracking or single else TrackingSession(group_params=pipeline.group_params)
     totals: list[float] = []
     try:
-        for frame in skip_unreadable(source, report):
+        # The next frame is read and posed in a worker thread while this one lifts, groups, tracks and writes.
+        for item in run_ahead(_posed_frames(source, pipeline)):
+            if isinstance(item, FrameReadError):
+                report(item)
+                continue
             if args.frames is not None and done + skipped >= args.frames:
                 break
-            reason = _skip_reason(frame)
-            result = None if reason else pipeline(frame)
+            frame = item.frame
+            reason, result = (item.reason, None) if isinstance(item, _Skipped) else (None, pipeline.locate(item))
             if result is not None and not result.people:
                 reason = "no people"
                 if tracking is not None:  # tracks still age through a frame without people

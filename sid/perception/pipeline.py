@@ -94,10 +94,23 @@ def _person_json(person: Person, keypoints: bool) -> dict:
     return record
 
 
+@dataclass(frozen=True)
+class PosedFrame:
+    """A frame after the pose stage: its detections (colour-image pixels) and how long the stage took (ms)."""
+
+    frame: Frame
+    detections: list[PoseDetection]
+    pose_ms: float
+
+
 @dataclass
 class Pipeline:
     """Pose -> people -> groups for one frame at a time, in the map when the frame has a robot pose (else in
-    base_footprint). Stateless between frames."""
+    base_footprint). Stateless between frames.
+
+    ``pipeline(frame)`` runs both halves; ``pose_frame`` and ``locate`` run them apart, e.g. the pose of the next
+    frame in a worker thread while this thread lifts and groups the last one (``sid detect`` with ``sid.ahead``).
+    """
 
     pose: PoseFn
     mount: CameraMount = field(default_factory=CameraMount)
@@ -107,24 +120,33 @@ class Pipeline:
     """False: skip the group stage (``groups`` empty, no "group" timing), e.g. when a tracker groups the tracks."""
 
     def __call__(self, frame: Frame) -> FrameResult:
-        t0 = time.perf_counter()
+        return self.locate(self.pose_frame(frame))
+
+    def pose_frame(self, frame: Frame) -> PosedFrame:
+        """The pose stage: the frame's 2D detections."""
+        start = time.perf_counter()
         detections = self.pose(frame)
+        return PosedFrame(frame, detections, (time.perf_counter() - start) * 1e3)
+
+    def locate(self, posed: PosedFrame) -> FrameResult:
+        """The stages after the pose: people in 3D (lift) and their groups."""
+        frame = posed.frame
         t1 = time.perf_counter()
-        people = lift_people(detections, frame.depth, frame.calibration, self.mount, self.lift_params)
+        people = lift_people(posed.detections, frame.depth, frame.calibration, self.mount, self.lift_params)
         pose = frame.robot_pose
         if pose is not None:
             people = [pose.person_to_map(p) for p in people]
         t2 = time.perf_counter()
         groups = detect_groups(people, self.group_params) if self.group else []
         t3 = time.perf_counter()
-        timing = {"pose": t1 - t0, "lift": t2 - t1} | ({"group": t3 - t2} if self.group else {}) | {"total": t3 - t0}
+        timing = {"pose": posed.pose_ms, "lift": (t2 - t1) * 1e3} | ({"group": (t3 - t2) * 1e3} if self.group else {})
         return FrameResult(
             frame.index,
             frame.timestamp,
-            detections,
+            posed.detections,
             people,
             groups,
-            {k: v * 1e3 for k, v in timing.items()},
+            timing | {"total": posed.pose_ms + (t3 - t1) * 1e3},
             BASE_FRAME if pose is None else MAP_FRAME,
             pose,
         )

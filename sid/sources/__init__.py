@@ -103,8 +103,9 @@ def _realsense() -> Any:
     return RealSenseSource
 
 
-def skip_unreadable(source: Iterable[Frame], on_error: Callable[[FrameReadError], None]) -> Iterator[Frame]:
-    """Frames of ``source``; each unreadable one is passed to ``on_error`` (e.g. to log it) and skipped."""
+def frames_or_errors(source: Iterable[Frame]) -> Iterator[Frame | FrameReadError]:
+    """The frames of ``source`` and, in their place, the ``FrameReadError`` of each unreadable one (not raised):
+    for a caller that hands the reading to another thread and reports errors in order."""
     frames = iter(source)
     while True:
         try:
@@ -112,6 +113,15 @@ def skip_unreadable(source: Iterable[Frame], on_error: Callable[[FrameReadError]
         except StopIteration:
             return
         except FrameReadError as error:
-            on_error(error)
+            yield error
             continue
         yield frame
+
+
+def skip_unreadable(source: Iterable[Frame], on_error: Callable[[FrameReadError], None]) -> Iterator[Frame]:
+    """Frames of ``source``; each unreadable one is passed to ``on_error`` (e.g. to log it) and skipped."""
+    for item in frames_or_errors(source):
+        if isinstance(item, FrameReadError):
+            on_error(item)
+        else:
+            yield item

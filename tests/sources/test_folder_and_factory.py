@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from sid.perception.camera import Calibration, Extrinsics, Intrinsics
-from sid.sources import FrameReadError, SourceError, open_source, skip_unreadable
+from sid.sources import FrameReadError, SourceError, frames_or_errors, open_source, skip_unreadable
 from sid.sources.folder import FolderSource
 from sid.sources.synthetic import SyntheticSource
 from tests.conftest import realsense
@@ -61,6 +61,11 @@ def test_sequence_folder_pairs_by_name_in_natural_order_and_skips_bad_frames(tmp
     assert "no depth image frame3.png" in str(errors[0])
     assert "no colour image" in str(errors[1])
     assert "frame5.png" in str(errors[2]) and "16-bit" in str(errors[2]) and errors[2].path is not None
+    # The same frames and errors in the order they come, for a caller that reports errors later (sid detect).
+    ordered = list(frames_or_errors(source))
+    assert [(type(item).__name__, item.index) for item in ordered] == [
+        ("Frame", 0), ("Frame", 1), ("FrameReadError", 2), ("FrameReadError", 3), ("FrameReadError", 4), ("Frame", 5)
+    ]  # fmt: skip
     # A plain for-loop stops at the first bad frame with the specific exception.
     with pytest.raises(FrameReadError):
         list(source)

@@ -1,0 +1,92 @@
+"""run_ahead: the same items in the same order, made in another thread ahead of the consumer, exceptions in place,
+and a worker that stops when the consumer does."""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Iterator
+
+import pytest
+
+from sid.ahead import run_ahead
+
+TIMEOUT = 10.0  # s; only reached when the code under test is broken
+
+
+def test_same_items_in_order():
+    assert list(run_ahead(range(100))) == list(range(100))
+    assert list(run_ahead(iter([]))) == []
+    assert list(run_ahead(["a", None, "b"], depth=3)) == ["a", None, "b"]  # None is an item like any other
+
+
+def test_items_are_made_in_a_worker_while_the_consumer_holds_the_last_one():
+    made: list[tuple[int, str]] = []
+    second_made = threading.Event()
+
+    def items() -> Iterator[int]:
+        for k in range(3):
+            made.append((k, threading.current_thread().name))
+            if k == 1:
+                second_made.set()
+            yield k
+
+    stream = run_ahead(items())
+    assert next(stream) == 0
+    assert second_made.wait(TIMEOUT)  # made while the consumer still works on item 0
+    assert {name for _, name in made} == {"sid-run-ahead"}
+    assert list(stream) == [1, 2]
+
+
+def test_an_exception_comes_after_the_items_made_before_it():
+    def items() -> Iterator[int]:
+        yield 1
+        yield 2
+        raise OSError("camera unplugged")
+
+    got = []
+    with pytest.raises(OSError, match="camera unplugged"):
+        for item in run_ahead(items()):
+            got.append(item)
+    assert got == [1, 2]
+
+
+def test_stopping_early_stops_the_worker_and_closes_the_items():
+    closed = threading.Event()
+    made = []
+
+    def items() -> Iterator[int]:
+        try:
+            for k in range(10**6):
+                made.append(k)
+                yield k
+        finally:
+            closed.set()
+
+    before = threading.active_count()
+    for item in run_ahead(items(), depth=2):
+        if item == 3:
+            break
+    assert closed.wait(TIMEOUT)
+    assert threading.active_count() == before  # the worker has ended, not left running
+    assert len(made) <= 3 + 1 + 2 + 1  # at most the depth plus the one being made beyond what was used
+
+
+def test_an_exception_in_the_consumer_stops_the_worker():
+    closed = threading.Event()
+
+    def items() -> Iterator[int]:
+        try:
+            yield from range(10**6)
+        finally:
+            closed.set()
+
+    with pytest.raises(ZeroDivisionError):
+        for item in run_ahead(items()):
+            if item == 5:
+                raise ZeroDivisionError
+    assert closed.wait(TIMEOUT)
+
+
+def test_depth_must_be_positive():
+    with pytest.raises(ValueError, match="depth must be at least 1"):
+        run_ahead(range(3), depth=0)
