@@ -41,7 +41,9 @@ class FrameResult:
     """What the pipeline found in one frame and how long each stage took (ms).
 
     people and groups (positions and keypoints in metres, facings in radians) are in ``frame_id``: ``"map"`` when
-    the robot's pose was known (``robot_pose``, base_footprint in the map), else ``"base_footprint"``.
+    the robot's pose was known (``robot_pose``, base_footprint in the map), else ``"base_footprint"``. timing_ms:
+    "pose", "lift", "group" and "total", their sum (the frame's work; its latency too unless the pose ran ahead in
+    another thread).
     """
 
     frame: int

@@ -32,6 +32,20 @@ def test_pipeline_finds_the_s1_pair_where_the_truth_puts_it():
     assert result.timing_ms["total"] >= result.timing_ms["lift"] >= 0
 
 
+def test_the_two_halves_of_a_frame_give_what_the_whole_pipeline_gives():
+    frame = SyntheticSource("S2", frames=1, seed=1)[0]
+    pipeline = Pipeline(TruthPose())
+    posed = pipeline.pose_frame(frame)
+    assert posed.frame is frame and posed.pose_ms >= 0 and len(posed.detections) == len(frame.truth.people)
+    result = pipeline.locate(posed)
+    halves, whole = result.to_json(), pipeline(frame).to_json()
+    del halves["timing_ms"], whole["timing_ms"]
+    assert halves == whole
+    timing = result.timing_ms  # the stages' own times; "total" is their sum
+    assert timing["pose"] == posed.pose_ms
+    assert timing["total"] == pytest.approx(timing["pose"] + timing["lift"] + timing["group"])
+
+
 def test_frame_result_json_has_the_documented_fields():
     frame = SyntheticSource("S3", frames=1, seed=0)[0]
     record = Pipeline(TruthPose())(frame).to_json()
