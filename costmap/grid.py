@@ -196,12 +196,14 @@ class GridSpec:
         overhead would dominate)."""
         (x0, y0), (x1, y1) = xy_min, xy_max
         res, ox, oy = self.resolution, self.origin_x, self.origin_y
-        try:
-            col0, col1 = math.floor((float(x0) - ox) / res), math.floor((float(x1) - ox) / res) + 1
-            row0, row1 = math.floor((float(y0) - oy) / res), math.floor((float(y1) - oy) / res) + 1
+        try:  # clipped to the grid here: one Window built (a window per person and group per frame)
+            col0 = max(math.floor((float(x0) - ox) / res), 0)
+            col1 = min(math.floor((float(x1) - ox) / res) + 1, self.width)
+            row0 = max(math.floor((float(y0) - oy) / res), 0)
+            row1 = min(math.floor((float(y1) - oy) / res) + 1, self.height)
         except (ValueError, OverflowError):  # nan or inf
             return None
-        return Window(row0, row1, col0, col1).clipped(self)
+        return Window(row0, row1, col0, col1) if row0 < row1 and col0 < col1 else None
 
     def window_around(self, xy: np.ndarray) -> Window | None:
         """The cells of the bounding box of world points (N, 2), clipped to the grid; None when empty or outside."""

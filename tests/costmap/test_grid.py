@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import itertools
+import math
 
 import numpy as np
 import pytest
@@ -85,3 +86,15 @@ def test_disjoint_keeps_far_changes_apart_and_merges_near_ones():
     assert disjoint([a, b], slack=2900) == [union(a, b)]
     assert disjoint([a, Window(5, 20, 5, 20), None]) == [Window(0, 20, 0, 20)]  # overlapping: always merged
     assert disjoint([]) == [] and disjoint([None]) == []
+
+
+def test_a_world_box_covers_the_cells_it_overlaps_clipped_to_the_grid():
+    spec = GridSpec.from_size(0.05, (-2.0, -5.0), (12.0, 10.0))
+    rng = np.random.default_rng(0)
+    for x0, y0, w, h in rng.uniform([-3.0, -6.0, -0.5, -0.5], [11.0, 6.0, 4.0, 4.0], (2000, 4)):
+        for box in ((x0, y0, x0 + w, y0 + h), (round(x0, 2), round(y0, 2), round(x0 + w, 1), round(y0 + h, 1))):
+            col0, col1 = math.floor((box[0] + 2.0) / 0.05), math.floor((box[2] + 2.0) / 0.05) + 1
+            row0, row1 = math.floor((box[1] + 5.0) / 0.05), math.floor((box[3] + 5.0) / 0.05) + 1
+            assert spec.window(box[:2], box[2:]) == Window(row0, row1, col0, col1).clipped(spec)
+    for box in ((np.nan, 0.0, 1.0, 1.0), (0.0, 0.0, np.inf, 1.0), (-np.inf, 0.0, 1.0, 1.0), (20.0, 0.0, 21.0, 1.0)):
+        assert spec.window(box[:2], box[2:]) is None

@@ -16,7 +16,11 @@ from costmap.layers.social import (
     SocialLayer,
     SocialParams,
     group_zone_polygon,
+    paint_bodies,
+    paint_body,
     paint_group,
+    paint_groups,
+    paint_people,
     paint_person,
     zone_hull,
 )
@@ -459,6 +463,38 @@ def test_the_group_fall_off_is_the_float64_gaussian_of_the_distance_to_the_hull_
     expected = np.floor(params.group_cost * np.exp(-(beyond**2) / (2 * params.group_sigma**2)))
     difference = np.abs(costs[window.slices].astype(int) - expected)
     assert difference.max() <= 1 and np.count_nonzero(difference) <= 3
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_people_groups_and_bodies_painted_together_equal_each_painted_alone(seed):
+    # The batched painting (a common block per batch, several batches when windows differ in size) writes what
+    # painting each alone writes, to the bit, and returns the same windows; people and hulls beyond the edges too.
+    rng = np.random.default_rng(seed)
+    params = SocialParams()
+    people = [
+        Person(i, float(rng.uniform(-2.0, 10.0)), float(rng.uniform(-5.0, 5.0)), [None, *rng.uniform(-4, 4, 4)][i % 5])
+        for i in range(12)
+    ]
+    fronts = [float(f) for f in rng.choice([0.3, 0.8, 2.5], len(people))]  # stretched walkers: several batches
+    hulls = [
+        shapely.Point(*rng.uniform(-1.5, 9.5, 2)),
+        shapely.LineString(rng.uniform(0.0, 8.0, (2, 2))),
+        *(
+            shapely.MultiPoint(rng.uniform(-0.8, 0.8, (n, 2)) + rng.uniform(-1.5, 9.5, 2)).convex_hull
+            for n in (3, 5, 9)
+        ),
+        shapely.box(1.0, -1.0, 6.0, 0.5),  # a large zone beside small ones
+    ]
+    for one, together in [
+        (lambda c: [paint_person(c, SPEC, p, params, f) for p, f in zip(people, fronts, strict=True)],
+         lambda c: paint_people(c, SPEC, people, params, fronts)),
+        (lambda c: [paint_person(c, SPEC, p, params) for p in people], lambda c: paint_people(c, SPEC, people, params)),
+        (lambda c: [paint_group(c, SPEC, h, params) for h in hulls], lambda c: paint_groups(c, SPEC, hulls, params)),
+        (lambda c: [paint_body(c, SPEC, p, 0.23) for p in people], lambda c: paint_bodies(c, SPEC, people, 0.23)),
+    ]:  # fmt: skip
+        alone, batched = np.zeros(SPEC.shape, dtype=np.uint8), np.zeros(SPEC.shape, dtype=np.uint8)
+        assert one(alone) == together(batched)
+        assert alone.any() and np.array_equal(alone, batched)
 
 
 def test_social_layer_clips_people_outside_the_map():
