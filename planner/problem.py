@@ -93,6 +93,8 @@ class CostField:
         self._inv_res = 1.0 / spec.resolution
         self._ox, self._oy = spec.origin_x, spec.origin_y
         self._w, self._h = spec.width, spec.height
+        self._origin = np.array([[self._ox], [self._oy]])  # (2, 1), world x/y of the map's corner (m)
+        self._size = np.array([[[self._w]], [[self._h]]])  # (2, 1, 1), the map's columns/rows (x/y, cells)
 
         lethal = costs == LETHAL
         if lethal.any():
@@ -175,33 +177,39 @@ class CostField:
         return self.segments_xy(np.ascontiguousarray(p.T), np.ascontiguousarray(q.T))
 
     def segments_xy(self, p: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``segments`` with the ends given coordinate-major: p, q (2, M), M >= 1 (world frame, metres). The
-        smoother's inner loop, which builds its candidates that way.
+        """``segments`` with the ends given coordinate-major: p, q (2, M), M >= 1 (world frame, metres)."""
+        d = q - p
+        return self.segments_along(p, d, np.hypot(d[0], d[1]))
+
+    def segments_along(self, p: np.ndarray, d: np.ndarray, length: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``segments_xy`` from the segments' starts p (2, M), offsets d = q - p (2, M) and lengths
+        ``np.hypot(d[0], d[1])`` (M,), M >= 1 (world frame, metres): for the smoother's inner loop, which has them
+        already. ``segments_xy`` uses q only through d, so the values are the same.
 
         Sample k of a segment of n pieces (k = 0 .. 2n: even k piece ends, odd k the midpoints the cost uses) sits in
         row k of (K, M) arrays (samples past a segment's end repeat its end), in cell units (offsets times
         1 / resolution, floored, as ``segment_cost``); each segment's cost sums its midpoints in order of k, and
         numpy's inner loops run over segments, not over two coordinates.
         """
-        d = q - p
-        length = np.hypot(d[0], d[1])
-        finite = np.isfinite(length)
-        if not finite.all():  # NaN or infinite ends: J is the length (NaN or inf), not plannable
-            cost, ok = length.copy(), np.zeros(len(length), dtype=bool)
-            if finite.any():
-                cost[finite], ok[finite] = self.segments_xy(p[:, finite], q[:, finite])
-            return cost, ok
         inv = self._inv_res
         pieces = np.ceil(length * inv - 1e-9)
         np.maximum(pieces, 1.0, out=pieces)
         last = 2.0 * pieces  # each segment's end sample
-        width = int(last.max()) + 2  # one spare sample: each segment's slice of samples ends inside its row
+        longest = float(last.max())  # NaN or infinite when any length is
+        if not math.isfinite(longest):  # NaN or infinite ends: J is the length (NaN or inf), not plannable
+            finite = np.isfinite(length)
+            cost, ok = length.copy(), np.zeros(len(length), dtype=bool)
+            if finite.any():
+                cost[finite], ok[finite] = self.segments_along(p[:, finite], d[:, finite], length[finite])
+            return cost, ok
+        width = int(longest) + 2  # one spare sample: each segment's slice of samples ends inside its row
         if width * len(last) > SAMPLES_PER_CALL and len(last) > 1:
-            return self._segments_in_chunks(p, q, last)
+            return self._segments_in_chunks(p, d, length, last)
         k = np.minimum(np.arange(width, dtype=float)[:, None], last)  # (K, M)
-        start = (p - np.array([[self._ox], [self._oy]])) * inv
-        xy = start[:, None, :] + k * (d * (inv / last))[:, None, :]  # (2, K, M) cells
-        size = np.array([[[self._w]], [[self._h]]])
+        start = (p - self._origin) * inv
+        xy = k * (d * (inv / last))[:, None, :]  # (2, K, M) cells
+        xy += start[:, None, :]
+        size = self._size
         # The samples run monotonically from one end (row 0) to the other (row K - 1): both inside, all inside.
         ends = xy[:, :: width - 1]
         if np.count_nonzero((ends >= 0.0) & (ends < size)) == ends.size:
@@ -211,7 +219,8 @@ class CostField:
             cells = np.floor(xy).astype(np.intp)
             inside = ((cells >= 0) & (cells < size)).all(axis=0)
             np.clip(cells, 0, size - 1, out=cells)
-        flat = cells[1] * self._w + cells[0]
+        flat = cells[1] * self._w
+        flat += cells[0]
         plannable = self.plannable.ravel().take(flat)
         ok = (plannable if inside is None else plannable & inside).all(axis=0)
         weights = self.weight.ravel().take(flat.T)  # (M, K): one row per segment
@@ -223,8 +232,10 @@ class CostField:
         cost = length * (1.0 + np.add.reduceat(weights.ravel(), bounds.ravel())[0::2] / pieces)
         return cost, ok
 
-    def _segments_in_chunks(self, p: np.ndarray, q: np.ndarray, last: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``segments_xy`` of many segments of unequal length (``last``: 2 x their pieces) in chunks of similar
+    def _segments_in_chunks(
+        self, p: np.ndarray, d: np.ndarray, length: np.ndarray, last: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """``segments_along`` of many segments of unequal length (``last``: 2 x their pieces) in chunks of similar
         length, each within ``SAMPLES_PER_CALL`` samples: memory stays bounded and short segments do not pay for the
         longest one's row. The same values (each segment's samples and sum do not depend on the others)."""
         order = np.argsort(last, kind="stable")
@@ -235,7 +246,7 @@ class CostField:
             fits = width[start:] * np.arange(1, len(order) - start + 1) <= SAMPLES_PER_CALL  # True..., then False...
             stop = start + (len(fits) if fits.all() else max(1, int(np.argmin(fits))))
             chunk = order[start:stop]
-            cost[chunk], ok[chunk] = self.segments_xy(p[:, chunk], q[:, chunk])
+            cost[chunk], ok[chunk] = self.segments_along(p.take(chunk, axis=1), d.take(chunk, axis=1), length[chunk])
             start = stop
         return cost, ok
 

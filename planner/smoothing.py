@@ -20,7 +20,7 @@ from planner.validity import interpolate
 
 _DIRECTIONS = np.array([[1, 0], [0, 1], [-1, 0], [0, -1], [1, 1], [-1, 1], [-1, -1], [1, -1]], float)
 _DIRECTIONS[4:] /= np.sqrt(2.0)
-_NEIGHBOURS = np.array([-1, 0, 1])
+_NEIGHBOURS = np.array([[-1], [0], [1]])  # (3, 1): before, the vertex, after
 _WINDOW = 64  # greedy_shortcut's default window (vertices)
 REFINE_SWEEPS = 2
 REFINE_MIN_STEP = 0.25
@@ -44,10 +44,11 @@ def greedy_shortcut(field: CostField, path: np.ndarray, window: int = _WINDOW) -
 def _greedy(field: CostField, path: np.ndarray, step_cost: np.ndarray, window: int) -> np.ndarray:
     """``greedy_shortcut`` of a path (N > 2, 2) whose segments cost ``step_cost`` (N - 1,)."""
     prefix = np.concatenate([[0.0], np.cumsum(step_cost)])
+    xy = path.T.copy()  # (2, N): coordinate-major, as ``CostField.segments_xy`` takes it
     kept, a = [0], 0
     while a < len(path) - 1:
         js = np.arange(a + 1, min(a + window, len(path) - 1) + 1)
-        cost, ok = field.segments(np.broadcast_to(path[a], (len(js), 2)), path[js])
+        cost, ok = field.segments_xy(np.repeat(xy[:, a : a + 1], len(js), axis=1), xy.take(js, axis=1))
         good = ok & (cost <= prefix[js] - prefix[a] + 1e-9)
         good[0] = True  # the path's own next step is always kept available
         a = int(js[np.flatnonzero(good)[-1]])
@@ -71,7 +72,8 @@ def _cheapest_subsequence(field: CostField, path: np.ndarray, reach: int | None)
     i, j = np.triu_indices(n, 1)
     if reach is not None:
         i, j = i[j - i <= reach], j[j - i <= reach]
-    cost, ok = field.segments(path[i], path[j])
+    xy = path.T.copy()  # (2, N): coordinate-major, as ``CostField.segments_xy`` takes it
+    cost, ok = field.segments_xy(xy.take(i, axis=1), xy.take(j, axis=1))
     ok |= j == i + 1
     matrix = np.full((n, n), np.inf)
     matrix[i[ok], j[ok]] = cost[ok]
@@ -101,64 +103,68 @@ def refine(field: CostField, path: np.ndarray, max_step: float, min_step: float,
     Within a step size only vertices that may move are priced again: one that moved, or whose neighbour moved. A
     vertex that did not move while its neighbours stayed would get the same answer, so the result is the same as
     pricing every vertex in every pass."""
-    path = np.asarray(path, dtype=float).reshape(-1, 2).copy()
+    path = np.asarray(path, dtype=float).reshape(-1, 2)
     if len(path) <= 2:
-        return path
+        return path.copy()
     seg_cost = field.segments(path[:-1], path[1:])[0]
+    xy = path.T.copy()  # (2, N): coordinate-major, as ``_descend`` reads and writes it
     step = max_step
     while step >= min_step:
+        moves = (_DIRECTIONS * step).T[:, :, None]  # (2, 8, 1): x/y, move (metres)
         active = np.ones(len(path), dtype=bool)
         active[[0, -1]] = False  # a new step size: every interior vertex may move again; the ends never move
         for _ in range(sweeps):
             moved = False
             for first in (1, 0):
-                idx = np.flatnonzero(active[first::2]) * 2 + first
+                idx = active[first::2].nonzero()[0] * 2 + first
                 if len(idx):
-                    moved |= _descend(field, path, seg_cost, idx, _DIRECTIONS * step, active)
+                    moved |= _descend(field, xy, seg_cost, idx, moves, active)
             if not moved:
                 break
         step /= 2
-    return path
+    return xy.T.copy()
 
 
 def _descend(
-    field: CostField, path: np.ndarray, seg_cost: np.ndarray, idx: np.ndarray, moves: np.ndarray, active: np.ndarray
+    field: CostField, xy: np.ndarray, seg_cost: np.ndarray, idx: np.ndarray, moves: np.ndarray, active: np.ndarray
 ) -> bool:
     """One pass of ``refine`` over the vertices ``idx`` (no two adjacent, none an end) with the offsets ``moves``
-    (8, 2) in metres: move each to its best plannable candidate when that lowers the cost of its two segments, in
-    place in ``path``, ``seg_cost`` (J of each segment) and ``active`` (vertices that may move). Whether any moved.
+    (2, 8, 1) in metres: move each to its best plannable candidate when that lowers the cost of its two segments, in
+    place in ``xy`` (2, N: the path's x and y in the world frame, metres), ``seg_cost`` (J of each segment) and
+    ``active`` (vertices that may move). Whether any moved.
 
     A segment costs at least its length, so a move whose two new segments are together at least as long as the
     cost to beat cannot win, nor be the best of the moves that do: only the others are priced (on the navigation
-    study's paths about a quarter of the moves). Arrays are coordinate-major, vertices last: numpy's inner loops
-    then run over vertices rather than over two coordinates."""
+    study's paths about a quarter of the moves), by ``CostField.segments_along`` from the starts, offsets and lengths
+    computed here. Arrays are coordinate-major, vertices last: numpy's inner loops then run over vertices rather than
+    over two coordinates."""
     k = len(idx)
-    before, vertex, after = path[idx[:, None] + _NEIGHBOURS].transpose(1, 2, 0)  # each (2, k): x/y, vertex
-    candidate = vertex[:, None, :] + moves.T[:, :, None]  # (2, 8, k): x/y, move, vertex
-    ends = np.empty((2, 2, 2, 8, k))  # segment start/end, x/y, in/out segment, move, vertex
-    ends[0, :, 0], ends[0, :, 1] = before[:, None, :], candidate
-    ends[1, :, 0], ends[1, :, 1] = candidate, after[:, None, :]
-    d = ends[1] - ends[0]
-    length = np.hypot(d[0], d[1])  # (2, 8, k), as ``CostField.segments_xy`` computes it
+    before, vertex, after = xy.take(idx + _NEIGHBOURS, axis=1).transpose(1, 0, 2)  # each (2, k): x/y, vertex
+    # Per candidate segment: start x/y, offset x/y to its end, length; (5, in/out segment, move, vertex).
+    segment = np.empty((5, 2, 8, k))
+    start, offset, length = segment[:2], segment[2:4], segment[4]
+    candidate = start[:, 1]  # (2, 8, k): the out segment starts at the candidate
+    np.add(vertex[:, None, :], moves, out=candidate)
+    start[:, 0] = before[:, None, :]
+    np.subtract(candidate, before[:, None, :], out=offset[:, 0])
+    np.subtract(after[:, None, :], candidate, out=offset[:, 1])
+    np.hypot(offset[0], offset[1], out=length)
     threshold = seg_cost[idx - 1] + seg_cost[idx] - 1e-9
-    hopeful = np.flatnonzero(length[0] + length[1] < threshold)  # flat (move, vertex) indices
-    cost = np.empty((2, 8, k))
-    cost.fill(np.inf)
+    hopeful = (length[0] + length[1] < threshold).ravel().nonzero()[0]  # flat (move, vertex) indices
+    cost = np.full((2, 8, k), np.inf)
     if len(hopeful):
-        p, q = ends.reshape(2, 2, 2, -1).take(hopeful, axis=3).reshape(2, 2, -1)
-        priced, ok = field.segments_xy(p, q)
-        priced[~ok] = np.inf
-        cost.reshape(2, -1)[:, hopeful] = priced.reshape(2, -1)  # a view: writes into cost
+        priced = segment.reshape(5, 2, -1).take(hopeful, axis=2).reshape(5, -1)  # (5, in/out x hopeful)
+        hopeful_cost, ok = field.segments_along(priced[:2], priced[2:4], priced[4])
+        hopeful_cost[~ok] = np.inf
+        cost.reshape(2, -1)[:, hopeful] = hopeful_cost.reshape(2, -1)  # a view: writes into cost
     total = cost[0] + cost[1]  # inf unless both segments are priced and plannable
-    best = total.argmin(axis=0)
-    rows = np.arange(k)
-    better = total[best, rows] < threshold
-    active[idx[~better]] = False
-    moving = np.flatnonzero(better)
+    better = total.min(axis=0) < threshold
+    active[idx] = better  # a vertex that stays may move again only once a neighbour moves
+    moving = better.nonzero()[0]
     if not len(moving):
         return False
-    chosen, pick = idx[moving], best[moving]
-    path[chosen] = candidate[:, pick, moving].T
+    chosen, pick = idx[moving], total[:, moving].argmin(axis=0)
+    xy[:, chosen] = candidate[:, pick, moving]
     seg_cost[chosen - 1], seg_cost[chosen] = cost[:, pick, moving]
     active[chosen - 1] = active[chosen + 1] = True
     active[0] = active[-1] = False
