@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from costmap.combine import CombinationMethod
 from costmap.grid import FREE_SPACE, GridSpec, Window, disjoint, union
 from costmap.layer import Layer, LayerInputs
-from costmap.layers.social import SocialParams, paint_body, paint_group, paint_person, zone_hull
+from costmap.layers.social import SocialParams, paint_bodies, paint_groups, paint_people, zone_hull
 from sid.checks import check_number
 
 MAX_LOOKAHEAD = 10.0
@@ -82,13 +82,15 @@ class TrackedPeopleLayer(Layer):
         for window in previous:
             self.costs[window.slices] = FREE_SPACE
         social = self.social
-        painted = [paint_group(self.costs, self.spec, hull, social) for hull in hulls]
+        fronts = []  # each person's sigma_front: a walker's personal space reaches further ahead
         for track in () if tracks is None else tracks.people:
-            person, front = by_id[track.id], social.sigma_front
+            front = social.sigma_front
             if track.walking:
-                person.theta = math.atan2(track.vy, track.vx)
+                by_id[track.id].theta = math.atan2(track.vy, track.vx)
                 front += self.params.lookahead * track.speed
-            painted.append(paint_person(self.costs, self.spec, person, social, front))
-        painted += [paint_body(self.costs, self.spec, person, self.body_radius) for person in people]
+            fronts.append(front)
+        painted = paint_groups(self.costs, self.spec, hulls, social)
+        painted += paint_people(self.costs, self.spec, people, social, fronts)
+        painted += paint_bodies(self.costs, self.spec, people, self.body_radius)
         self._painted = disjoint(painted)
         return [*previous, *self._painted]
