@@ -25,6 +25,7 @@ from costmap.scan import LaserScan
 from sid.perception.frame import Frame
 from sid.perception.pipeline import FrameResult, Pipeline
 from sid.perception.robot_pose import RobotPose
+from sid.tracking.assignment import load_solver
 from sid.tracking.records import TrackedGroup, TrackedPerson, Tracks
 from sid.tracking.session import TrackingParams, TrackingSession
 from sid.tracking.view import ViewCone, camera_view_cone
@@ -79,6 +80,7 @@ class SocialStream:
             raise ValueError("stream: costmap_params only apply when the costmap is built from a GridSpec")
         self.costmap = costmap
         self.tracking = TrackingSession(params, pipeline.group_params)
+        load_solver()  # now, not on the first ambiguous frame: a robot should not pause mid-run for an import
 
     def reset(self) -> None:
         """Forget every track and group (ids keep counting up); the costmap empties at the next update."""

@@ -25,12 +25,10 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
-from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import connected_components
 
 from sid.checks import check_number, check_numbers
 from sid.perception.groups import GroupParams, detect_groups
+from sid.tracking.assignment import gated_assignment
 from sid.tracking.records import GroupKind, TrackedGroup, TrackedPerson
 
 _NO_ZONE = np.zeros((0, 2))
@@ -169,11 +167,10 @@ class GroupTracker:
         used: set[int] = set()
         if self._tracks and candidates:
             overlap = np.array([[_jaccard(t, c) for c in candidates] for t in self._tracks])
-            rows, cols = linear_sum_assignment(-overlap)
+            rows, cols = gated_assignment(-overlap, overlap >= self.params.min_overlap)
             for row, col in zip(rows.tolist(), cols.tolist(), strict=True):
-                if overlap[row, col] >= self.params.min_overlap:
-                    matched[self._tracks[row].id] = candidates[col]
-                    used.add(col)
+                matched[self._tracks[row].id] = candidates[col]
+                used.add(col)
         for col, candidate in enumerate(candidates):
             if col not in used:
                 track = _GroupTrack(self._next_id, candidate, {}, -np.inf)
@@ -207,10 +204,8 @@ def _walking_groups(people: Sequence[TrackedPerson], params: GroupTrackerParams)
     velocity = np.array([[p.vx, p.vy] for p in walkers])
     near = np.linalg.norm(position[:, None] - position[None], axis=2) <= params.walk_distance
     alike = np.linalg.norm(velocity[:, None] - velocity[None], axis=2) <= params.walk_velocity_difference
-    count, labels = connected_components(csr_matrix(near & alike), directed=False)
     out = []
-    for label in range(count):
-        rows = np.flatnonzero(labels == label)
+    for rows in _components(near & alike):
         if len(rows) < 2:
             continue
         centre = position[rows].mean(axis=0)
@@ -218,6 +213,20 @@ def _walking_groups(people: Sequence[TrackedPerson], params: GroupTrackerParams)
         members = frozenset(walkers[i].id for i in rows.tolist())
         out.append(_Candidate("walking", members, (float(centre[0]), float(centre[1])), _NO_ZONE, 0.0, spread))
     return out
+
+
+def _components(adjacent: np.ndarray) -> list[np.ndarray]:
+    """The connected components of a symmetric (N, N) bool adjacency matrix, as index arrays ordered by their first
+    index. Reachability squared until it stops growing: a few small matrix products for the walkers in view, where
+    ``scipy.sparse.csgraph`` would add 0.4 s of imports to every start (docs/benchmarks.md, "Start-up")."""
+    reach = (adjacent | np.eye(len(adjacent), dtype=bool)).astype(np.int64)
+    while True:
+        grown = np.minimum(reach @ reach, 1)
+        if np.array_equal(grown, reach):
+            break
+        reach = grown
+    labels = reach.argmax(axis=1)  # the first index each one reaches names its component
+    return [np.flatnonzero(labels == label) for label in np.unique(labels)]
 
 
 def _report(track: _GroupTrack, by_id: dict[int, TrackedPerson]) -> TrackedGroup:

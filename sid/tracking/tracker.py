@@ -2,12 +2,12 @@
 
 Per frame (``PeopleTracker.update``): every track is predicted to the frame's timestamp (``sid.tracking.motion``);
 tracks not detected for longer than their timeout are deleted (``timeout`` in the camera's view,
-``out_of_view_timeout`` out of it: nobody looked there); detections are assigned to tracks by position alone with
-``scipy.optimize.linear_sum_assignment`` on the distance to each prediction, within a gate that grows with the
-track's uncertainty; matched tracks are corrected; a tentative track that is missed is deleted, and one detected
-``confirm_hits`` times is confirmed; every unmatched detection starts a tentative track. Facing is smoothed on the
-circle (an exponential average of unit vectors), and the state switches to walking above ``walk_speed`` and back
-to standing below ``stand_speed``.
+``out_of_view_timeout`` out of it: nobody looked there); detections are assigned to tracks by position alone, the
+least total distance to the predictions within a gate that grows with the track's uncertainty
+(``sid.tracking.assignment``); matched tracks are corrected; a tentative track that is missed is deleted, and one
+detected ``confirm_hits`` times is confirmed; every unmatched detection starts a tentative track. Facing is smoothed
+on the circle (an exponential average of unit vectors), and the state switches to walking above ``walk_speed`` and
+back to standing below ``stand_speed``.
 
 Only confirmed tracks are reported. Track ids count up from 1 and are never reused, also across ``reset``.
 """
@@ -19,10 +19,10 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 from sid.checks import check_number, check_numbers
 from sid.perception.people import Person
+from sid.tracking.assignment import gated_assignment
 from sid.tracking.motion import MotionStates
 from sid.tracking.records import TrackedPerson
 from sid.tracking.view import ViewCone
@@ -168,9 +168,7 @@ class PeopleTracker:
             heading = velocity[striding] / speed[striding, None]
             turned = heading @ facing.T < math.cos(p.heading_gate)  # NaN facing: False, allowed
             allowed[striding] &= ~turned
-        rows, cols = linear_sum_assignment(np.where(allowed, distance, _FORBIDDEN))
-        ok = allowed[rows, cols]
-        return rows[ok], cols[ok]
+        return gated_assignment(distance, allowed)
 
     def _smooth_facing(self, rows: np.ndarray, measured: np.ndarray, dt: float) -> None:
         """Average measured facings (K, 2) unit vectors (NaN: none) into the tracks ``rows`` on the unit circle."""
@@ -244,9 +242,6 @@ class PeopleTracker:
                 strict=True,
             )
         ]
-
-
-_FORBIDDEN = 1e9  # the cost of a pair outside the gate (any real distance is far smaller)
 
 
 def _measurements(people: Sequence[Person]) -> tuple[np.ndarray, np.ndarray, list[int]]:
