@@ -14,6 +14,7 @@ pause on its first crowded frame.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from functools import cache
 
@@ -29,24 +30,43 @@ def gated_assignment(cost: np.ndarray, allowed: np.ndarray) -> tuple[np.ndarray,
     if cost.ndim != 2 or allowed.shape != cost.shape:
         shapes = f"{cost.shape} and {allowed.shape}"
         raise ValueError(f"assignment: cost and allowed must be matrices of one shape, got {shapes}")
-    allowed = allowed & np.isfinite(cost)
-    rows = np.flatnonzero(allowed.any(axis=1))
-    if not len(rows):
-        return rows, rows.copy()
-    gated = np.where(allowed[rows], cost[rows], np.inf)
-    cols = gated.argmin(axis=1)
-    best = gated[np.arange(len(rows)), cols]
-    single = np.count_nonzero(gated == best[:, None], axis=1) == 1
-    if single.all() and len(np.unique(cols)) == len(cols):
-        return rows, cols
+    pairs = _own_minima(np.where(allowed, cost, np.inf))
+    if pairs is not None:
+        return pairs
     # Outside the gate a pair costs more than every allowed pair of any matching together, so the solver first
     # matches as many allowed pairs as it can, then minimises their cost.
+    allowed = allowed & np.isfinite(cost)
     lowest = float(cost[allowed].min())
     span = float(cost[allowed].max()) - lowest
     priced = np.where(allowed, cost - lowest, (span + 1.0) * (min(cost.shape) + 1))
     rows, cols = load_solver()(priced)
     kept = allowed[rows, cols]
     return rows[kept], cols[kept]
+
+
+def _own_minima(gated: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """Each row's cheapest column of ``gated`` (inf: not allowed), rows with none left out, when every such minimum
+    is finite and strict and no two rows share a column; None otherwise (the solver decides). A few numpy calls,
+    then Python on the rows: a tracker has tens of rows, where numpy's per-call cost is the whole cost."""
+    if gated.size == 0:
+        return np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp)
+    ordered = np.sort(gated, axis=1)  # a row's NaN sorts last
+    if any(last != last for last in ordered[:, -1].tolist()):  # NaN costs: the solver's path leaves them out
+        return None
+    seconds = ordered[:, 1].tolist() if gated.shape[1] > 1 else [math.inf] * len(gated)
+    rows: list[int] = []
+    cols: list[int] = []
+    taken: set[int] = set()
+    firsts, cols_by_row = ordered[:, 0].tolist(), gated.argmin(axis=1).tolist()
+    for row, (col, first, second) in enumerate(zip(cols_by_row, firsts, seconds, strict=True)):
+        if first == math.inf:  # nothing allowed
+            continue
+        if first == second or first == -math.inf or col in taken:
+            return None
+        rows.append(row)
+        cols.append(col)
+        taken.add(col)
+    return np.array(rows, dtype=np.intp), np.array(cols, dtype=np.intp)
 
 
 @cache
