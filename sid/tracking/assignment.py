@@ -36,6 +36,8 @@ def gated_assignment(cost: np.ndarray, allowed: np.ndarray) -> tuple[np.ndarray,
     # Outside the gate a pair costs more than every allowed pair of any matching together, so the solver first
     # matches as many allowed pairs as it can, then minimises their cost.
     allowed = allowed & np.isfinite(cost)
+    if not allowed.any():  # only non-finite costs were allowed
+        return np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp)
     lowest = float(cost[allowed].min())
     span = float(cost[allowed].max()) - lowest
     priced = np.where(allowed, cost - lowest, (span + 1.0) * (min(cost.shape) + 1))

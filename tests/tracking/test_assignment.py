@@ -15,11 +15,13 @@ from sid.tracking.assignment import gated_assignment
 from sid.tracking.groups import _components
 
 
-def _reference(cost: np.ndarray, allowed: np.ndarray) -> tuple[float, int]:
-    """(allowed pairs, their total cost) of SciPy's assignment with pairs outside the gate priced out."""
+def _reference(cost: np.ndarray, allowed: np.ndarray) -> tuple[int, float]:
+    """(allowed pairs, their total cost) of SciPy's assignment with pairs outside the gate (or not finite) priced
+    out."""
+    allowed = allowed & np.isfinite(cost)
     if not allowed.any():
         return 0, 0.0
-    rows, cols = linear_sum_assignment(np.where(allowed, cost, 1e9))
+    rows, cols = linear_sum_assignment(np.where(allowed, cost, 1e9))  # the costs are below 3
     kept = allowed[rows, cols]
     return int(kept.sum()), float(cost[rows[kept], cols[kept]].sum())
 
@@ -32,13 +34,15 @@ def test_matches_as_many_pairs_as_scipy_at_the_same_least_cost(seed: int) -> Non
     if seed % 4 == 0:  # ties: costs on a coarse grid
         cost = np.round(cost)
     allowed = rng.random(shape) < rng.uniform(0.2, 1.0)
+    if seed % 5 == 1:  # a few non-finite costs
+        cost[rng.random(shape) < 0.2] = rng.choice([np.nan, np.inf, -np.inf])
     rows, cols = gated_assignment(cost, allowed)
-    assert allowed[rows, cols].all()
+    assert (allowed & np.isfinite(cost))[rows, cols].all()
     assert len(set(rows.tolist())) == len(rows) and len(set(cols.tolist())) == len(cols)
     assert np.all(np.diff(rows) > 0)
     pairs, total = _reference(cost, allowed)
     assert len(rows) == pairs
-    assert cost[rows, cols].sum() == pytest.approx(total, abs=1e-9)
+    assert float(cost[rows, cols].sum()) == pytest.approx(total, abs=1e-9)
 
 
 def test_a_pair_outside_the_gate_does_not_displace_one_inside() -> None:
@@ -59,6 +63,13 @@ def test_non_finite_costs_are_never_matched() -> None:
     cost = np.array([[np.nan, 1.0], [np.inf, 2.0]])
     rows, cols = gated_assignment(cost, np.ones((2, 2), dtype=bool))
     assert rows.tolist() == [0] and cols.tolist() == [1]  # one column left: the cheaper row takes it
+
+
+@pytest.mark.parametrize("value", [np.nan, np.inf, -np.inf])
+def test_a_gate_of_non_finite_costs_matches_nothing(value: float) -> None:
+    for shape in ((1, 1), (2, 3)):
+        rows, cols = gated_assignment(np.full(shape, value), np.ones(shape, dtype=bool))
+        assert rows.size == cols.size == 0
 
 
 def test_mismatched_shapes_are_an_error() -> None:
