@@ -25,7 +25,7 @@ from sid.experiments.bench import (
     write_report,
 )
 from sid.experiments.bench.report import build_report
-from sid.perception.pose.session import PROVIDER_CHOICES
+from sid.perception.pose.session import PROVIDER_CHOICES, quiet_load_warnings
 
 PLAN_RUNS_FULL, PLAN_RUNS_QUICK = 5, 1
 SHARED_ENV = "SID_SHARED"
@@ -106,6 +106,7 @@ def _progress(index: int, total: int, name: str, status: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    quiet_load_warnings()  # the pose stages load models: onnxruntime's load-time warnings are noise here
     try:
         old = load_report(args.compare) if args.compare else None
     except ValueError as exc:

@@ -111,7 +111,9 @@ def positive_int(text: str) -> int:
 def _pose(args: argparse.Namespace) -> PoseFn:
     if args.model is not None:
         from sid.perception.pose import load_pose_estimator
+        from sid.perception.pose.session import quiet_load_warnings
 
+        quiet_load_warnings()
         return image_pose(
             load_pose_estimator(args.model, contract=args.contract, threads=args.threads, providers=args.provider)
         )

@@ -100,7 +100,9 @@ def _pose(model: Path | None, synthetic: bool) -> PoseFn:
     """The pose model's function, or the synthetic frames' ground truth when there is no model."""
     if model is not None:
         from sid.perception.pose import load_pose_estimator
+        from sid.perception.pose.session import quiet_load_warnings
 
+        quiet_load_warnings()
         return image_pose(load_pose_estimator(model))
     if synthetic:
         from sid.synthetic.pose import TruthPose

@@ -105,6 +105,10 @@ def run(args: argparse.Namespace) -> int:
         options = _options(args)
         if args.model is not None and not Path(args.model).is_file():
             raise ValueError(f"--model {args.model}: no such file")
+        if args.model is not None:
+            from sid.perception.pose.session import quiet_load_warnings
+
+            quiet_load_warnings()
         out = None if args.out is None else check_output_folder(args.out)
         world = load_scene(args.scene)
         if out is None:

@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 
 from sid.cli import COMMANDS, main
+from tests.conftest import shared_path
 
 REPO = Path(__file__).resolve().parents[2]
 PROBE = """
@@ -51,3 +52,29 @@ def test_help_and_unknown_commands_still_list_every_command(capsys: pytest.Captu
     with pytest.raises(SystemExit):
         main(["nope"])
     assert "invalid choice: 'nope'" in capsys.readouterr().err
+
+
+def test_tracking_a_sequence_does_not_import_the_assignment_solver() -> None:
+    """scipy.optimize (0.7 s of imports) loads only when a frame's assignment is ambiguous (sid.tracking.assignment):
+    a sequence of people standing apart never needs it."""
+    probe = (
+        "import contextlib, io, sys\n"
+        "from sid.cli import main\n"
+        "with contextlib.redirect_stdout(io.StringIO()):\n"
+        "    code = main(['detect', '--source', 'synthetic:S3', '--frames', '8'])\n"
+        "print(code, 'scipy.optimize' in sys.modules)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", probe], cwd=REPO, capture_output=True, text=True, timeout=300,
+                          check=True)  # fmt: skip
+    assert done.stdout.split() == ["0", "False"]
+
+
+def test_loading_the_pose_model_prints_no_onnxruntime_warnings() -> None:
+    """YOLO11n-pose's exporter sets an attribute deprecated since opset 13; onnxruntime's process-wide logger warns
+    of it twice per session unless the command quiets it (``quiet_load_warnings``)."""
+    folder = shared_path("data", "rgbd", "five_people")
+    model = shared_path("models", "yolo11n-pose-256.onnx")
+    done = subprocess.run([sys.executable, "-m", "sid", "detect", "--source", str(folder), "--model", str(model)],
+                          cwd=REPO, capture_output=True, text=True, timeout=300, check=True)  # fmt: skip
+    assert "onnxruntime" not in done.stderr
+    assert len(done.stdout.splitlines()) == 1

@@ -20,7 +20,9 @@ Choices (see docs/models.md):
   CPU.
   ``"cpu"`` and ``"openvino"`` ask for one; asking for OpenVINO where it is not installed is an error. An explicit
   list of onnxruntime provider names is passed through as it is.
-- Session log level = errors only; converter warnings about deprecated attributes are noise to a user.
+- Session log level = errors only; converter warnings about deprecated attributes are noise to a user. Those
+  printed while the model loads go through onnxruntime's process-wide logger instead: the ``sid`` commands that
+  load a model call ``quiet_load_warnings()`` first (process-wide, so an entry point's choice, not this module's).
 """
 
 from __future__ import annotations
@@ -86,6 +88,13 @@ def resolve_providers(providers: str | Sequence[str] | None = None) -> list[str]
     if not names or not all(isinstance(name, str) and name for name in names):
         raise ValueError(f"pose: providers must be a non-empty list of onnxruntime provider names, got {providers!r}")
     return names
+
+
+def quiet_load_warnings() -> None:
+    """Make onnxruntime's process-wide logger report errors only: the warnings it prints while a model loads
+    (YOLO11n-pose's exporter sets an attribute deprecated since opset 13, two lines per session) tell an operator
+    nothing. Process-wide, like ``sid.cpu.keep_freed_memory``: call it from an entry point, never from library code."""
+    ort.set_default_logger_severity(3)
 
 
 def check_threads(threads: object) -> int | None:
