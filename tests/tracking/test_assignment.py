@@ -77,18 +77,23 @@ def test_mismatched_shapes_are_an_error() -> None:
         gated_assignment(np.ones((2, 3)), np.ones((3, 2), dtype=bool))
 
 
+def _solver_loaded_before_and_after(setup: str, step: str) -> list[str]:
+    """Whether scipy.optimize is imported after ``setup`` and after ``step`` (Python lines), in a fresh process."""
+    probe = "\n".join(
+        ("import sys", setup, "print('scipy.optimize' in sys.modules)", step, "print('scipy.optimize' in sys.modules)")
+    )
+    return subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True).stdout.split()
+
+
 def test_an_unambiguous_frame_does_not_import_the_solver() -> None:
     """The fast path answers without SciPy; a tie needs the solver, imported then."""
-    script = (
-        "import sys, numpy as np\n"
+    setup = (
+        "import numpy as np\n"
         "from sid.tracking.assignment import gated_assignment\n"
-        "gated_assignment(np.array([[0.1, 2.0], [3.0, 0.2]]), np.ones((2, 2), dtype=bool))\n"
-        "print('scipy.optimize' in sys.modules)\n"
-        "gated_assignment(np.array([[0.1, 0.1], [0.1, 0.1]]), np.ones((2, 2), dtype=bool))\n"
-        "print('scipy.optimize' in sys.modules)\n"
+        "gated_assignment(np.array([[0.1, 2.0], [3.0, 0.2]]), np.ones((2, 2), dtype=bool))"
     )
-    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True).stdout
-    assert out.split() == ["False", "True"]
+    tie = "gated_assignment(np.array([[0.1, 0.1], [0.1, 0.1]]), np.ones((2, 2), dtype=bool))"
+    assert _solver_loaded_before_and_after(setup, tie) == ["False", "True"]
 
 
 @pytest.mark.parametrize("seed", range(100))
@@ -104,15 +109,11 @@ def test_components_equal_scipy(seed: int) -> None:
 
 def test_a_social_stream_loads_the_solver_up_front() -> None:
     """A robot's stream must not pause for the import on its first ambiguous frame."""
-    script = (
-        "import sys\n"
+    setup = (
         "from costmap.grid import GridSpec\n"
         "from sid.perception.pipeline import Pipeline\n"
         "from sid.stream import SocialStream\n"
-        "from sid.synthetic.pose import TruthPose\n"
-        "print('scipy.optimize' in sys.modules)\n"
-        "SocialStream(Pipeline(TruthPose()), GridSpec.from_size(0.05, (0.0, -5.0), (10.0, 10.0)))\n"
-        "print('scipy.optimize' in sys.modules)\n"
+        "from sid.synthetic.pose import TruthPose"
     )
-    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True).stdout
-    assert out.split() == ["False", "True"]
+    build = "SocialStream(Pipeline(TruthPose()), GridSpec.from_size(0.05, (0.0, -5.0), (10.0, 10.0)))"
+    assert _solver_loaded_before_and_after(setup, build) == ["False", "True"]
