@@ -6,6 +6,7 @@ import argparse
 import contextlib
 import json
 import sys
+import time
 from collections.abc import Iterable, Iterator, Sized
 from pathlib import Path
 from typing import TYPE_CHECKING, NamedTuple, TextIO
@@ -263,6 +264,7 @@ def run(args: argparse.Namespace) -> int:
     single = isinstance(source, Sized) and len(source) == 1
     tracking = None if args.no_tracking or single else TrackingSession(group_params=pipeline.group_params)
     totals: list[float] = []
+    started = time.perf_counter()
     try:
         # The next frame is read and posed in a worker thread while this one lifts, groups, tracks and writes.
         for item in run_ahead(_posed_frames(source, pipeline)):
@@ -311,6 +313,8 @@ def run(args: argparse.Namespace) -> int:
         close = getattr(source, "close", None)
         if close is not None:
             close()
+    seconds = time.perf_counter() - started  # the frames' wall-clock time, start-up (imports, model load) aside
+    rate = f" in {seconds:.1f} s ({(done + skipped) / seconds:.1f} frames/s)" if done + skipped else ""
     median = f", median {np.median(totals):.2f} ms per frame" if totals else ""
-    print(f"detect: {done} frames with people, {skipped} skipped{median}", file=sys.stderr)
+    print(f"detect: {done} frames with people, {skipped} skipped{rate}{median}", file=sys.stderr)
     return interrupted
