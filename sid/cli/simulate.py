@@ -103,9 +103,9 @@ def run(args: argparse.Namespace) -> int:
 
     try:
         options = _options(args)
-        if args.model is not None and not Path(args.model).is_file():
-            raise ValueError(f"--model {args.model}: no such file")
         if args.model is not None:
+            if not Path(args.model).is_file():
+                raise ValueError(f"--model {args.model}: no such file")
             from sid.perception.pose.session import quiet_load_warnings
 
             quiet_load_warnings()
