@@ -30,6 +30,11 @@ DEFAULT_PLANNER = "bitstar"
 DEFAULT_SETTLE_S = 0.04
 """``plan``'s default ``settle``: an anytime planner stops once its cost has not improved for this long (s).
 Measured over the navigation study's 36 tasks (docs/benchmarks.md, planning budget)."""
+DEFAULT_SOFT_LIMIT_S = 0.10
+"""``plan``'s default ``soft_limit``: an anytime planner that has a path stops after this long (s) even if its cost
+still falls, so that a plan (with the lookups, smoothing and the final check, ~10-15 ms more) returns within 0.15 s.
+Over the navigation study's 36 tasks it changed no plan's cost beyond the seeds' own spread (docs/benchmarks.md,
+planning budget)."""
 MAX_SEED = 2**32 - 1
 """The largest seed ``plan`` takes: OMPL's seed is a ``std::uint_fast32_t``, 32 bits wide on some platforms."""
 UNAVAILABLE: dict[str, str] = {
@@ -122,13 +127,16 @@ def plan(
     max_iterations: int | None = None,
     simplify: bool = True,
     settle: float | None = DEFAULT_SETTLE_S,
+    soft_limit: float | None = DEFAULT_SOFT_LIMIT_S,
 ) -> PlanResult:
     """Plan ``problem`` with the named planner (``PLANNERS``; ``"grid"`` is the Dijkstra + any-angle planner).
 
     time_limit: seconds for the planner's solve(), at most; seed / max_iterations: see the module docstring (the grid
-    planner is deterministic and ignores them). settle: BIT* stops earlier, once its path's cost has not improved for
-    ``settle`` seconds (``planner.ompl_planners.solve_ompl``; ``DEFAULT_SETTLE_S``); None, or a ``max_iterations``
-    cap (whose runs must repeat exactly), uses the whole ``time_limit``. Raises PlanningError when the start or goal
+    planner is deterministic and ignores them). settle, soft_limit: BIT* stops earlier once it has a path, when the
+    path's cost has not improved for ``settle`` seconds or after ``soft_limit`` seconds of solving
+    (``planner.ompl_planners.solve_ompl``; ``DEFAULT_SETTLE_S``, ``DEFAULT_SOFT_LIMIT_S``); without a path it goes
+    on to ``time_limit``. None (both), or a ``max_iterations`` cap (whose runs must repeat exactly), uses the whole
+    ``time_limit``. Raises PlanningError when the start or goal
     is outside the map, in collision or unreachable, and ValueError for an unknown planner or a bad budget; a
     planner that finds no path in its budget gives ``success=False`` with the reason in ``message``.
     """
@@ -137,8 +145,9 @@ def plan(
         raise ValueError(f"time_limit must be a positive number of seconds, got {time_limit}")
     if max_iterations is not None and max_iterations < 1:
         raise ValueError(f"max_iterations must be at least 1, got {max_iterations}")
-    if settle is not None and not (math.isfinite(settle) and settle > 0):
-        raise ValueError(f"settle must be a positive number of seconds or None, got {settle}")
+    for option, value in (("settle", settle), ("soft_limit", soft_limit)):
+        if value is not None and not (math.isfinite(value) and value > 0):
+            raise ValueError(f"{option} must be a positive number of seconds or None, got {value}")
     t0 = time.perf_counter()
     if name != "grid":
         seed = secrets.randbelow(2**31 - 1) + 1 if seed is None else int(seed)
@@ -155,8 +164,9 @@ def plan(
         t_solve = time.perf_counter()
         raw, iterations, solve_time = grid_search(field), 0, time.perf_counter() - t_solve
     else:
-        settle = None if max_iterations is not None else settle
-        raw, iterations, solve_time = solve_ompl(field, name, time_limit, max_iterations, settle)
+        if max_iterations is not None:  # a capped run must repeat exactly: no stop on the clock but time_limit
+            settle = soft_limit = None
+        raw, iterations, solve_time = solve_ompl(field, name, time_limit, max_iterations, settle, soft_limit)
     raw_cost = math.inf if raw is None else field.path_cost(raw)
     result = PlanResult(name, False, np.zeros((0, 2)), math.inf, 0.0, 0.0, solve_time, raw_cost, iterations, seed, "")
     if raw is None:

@@ -39,9 +39,9 @@ if stopped early, so its sample count follows the time budget, at about half the
 
 
 SETTLING_PLANNERS = ("bitstar",)
-"""The planners ``solve_ompl`` may stop early (``settle``). BIT*'s cost drops in a few steps and then flattens. RRT*
-and Informed RRT* improve in long plateaus: with the early stop Informed RRT* kept a path through a group zone in 1
-of the navigation study's 36 tasks (docs/benchmarks.md), so they keep their whole budget."""
+"""The planners ``solve_ompl`` may stop early (``settle``, ``soft_limit``). BIT*'s cost drops in a few steps and
+then flattens. RRT* and Informed RRT* improve in long plateaus: with the early stop Informed RRT* kept a path through
+a group zone in 1 of the navigation study's 36 tasks (docs/benchmarks.md), so they keep their whole budget."""
 SETTLE_GAIN = 0.001
 """A relative cost decrease smaller than this (0.1 %) does not count as an improvement for ``solve_ompl``'s settle."""
 SETTLE_POLL_S = 0.002
@@ -76,13 +76,20 @@ def seed_ompl(seed: int) -> None:
 
 
 def solve_ompl(
-    field: CostField, name: str, time_limit: float, max_iterations: int | None, settle: float | None = None
+    field: CostField,
+    name: str,
+    time_limit: float,
+    max_iterations: int | None,
+    settle: float | None = None,
+    soft_limit: float | None = None,
 ) -> tuple[np.ndarray | None, int, float]:
     """Run one OMPL planner; (path or None, termination checks, solve seconds).
 
-    settle: for the planners of ``SETTLING_PLANNERS``, stop once a solution exists and its cost has not fallen by
-    more than ``SETTLE_GAIN`` over the last ``settle`` seconds (None, and every other planner: run for the whole
-    ``time_limit``). The cost is polled every ``SETTLE_POLL_S`` seconds of the termination checks.
+    For the planners of ``SETTLING_PLANNERS``, once a solution exists: settle stops the solve when its cost has not
+    fallen by more than ``SETTLE_GAIN`` over the last ``settle`` seconds, soft_limit when ``soft_limit`` seconds of
+    solving have passed (``time_limit`` stays the cap while there is no solution). The cost is polled every
+    ``SETTLE_POLL_S`` seconds of the termination checks. None (both), and every other planner: the whole
+    ``time_limit``.
     """
     problem, spec = field.problem, field.spec
     space = ob.RealVectorStateSpace(2)
@@ -112,8 +119,10 @@ def solve_ompl(
     checks = 0
     cap = math.inf if max_iterations is None or name == "fmtstar" else max_iterations
     deadline = time.perf_counter() + time_limit
-    best_cost = planner.bestCost if settle is not None and name in SETTLING_PLANNERS else None
+    early = name in SETTLING_PLANNERS and (settle is not None or soft_limit is not None)
+    best_cost = planner.bestCost if early else None
     patience = math.inf if settle is None else settle
+    soft_deadline = math.inf if soft_limit is None else time.perf_counter() + soft_limit
     settled_cost, settled_at, next_poll = math.inf, time.perf_counter(), 0.0
 
     def stop() -> bool:
@@ -126,7 +135,7 @@ def solve_ompl(
             cost = best_cost().value()
             if cost < settled_cost * (1.0 - SETTLE_GAIN):
                 settled_cost, settled_at = cost, now
-            elif math.isfinite(cost) and now - settled_at > patience:
+            if math.isfinite(cost) and (now - settled_at > patience or now > soft_deadline):
                 return True
         checks += 1
         return False

@@ -285,15 +285,29 @@ def test_refine_equals_pricing_every_move(walls):
 
 
 def test_bitstar_stops_once_its_cost_settles_and_other_planners_use_their_budget(walls):
-    settled = plan(walls, "bitstar", time_limit=30.0, seed=3)
+    settled = plan(walls, "bitstar", time_limit=30.0, seed=3, soft_limit=None)
     assert settled.success and settled.solve_time_s < 15.0  # stopped by the settle rule, not by the 30 s budget
-    whole = plan(walls, "bitstar", time_limit=0.3, seed=3, settle=None)
+    whole = plan(walls, "bitstar", time_limit=0.3, seed=3, settle=None, soft_limit=None)
     assert whole.solve_time_s >= 0.3
     rrt = plan(walls, "rrtstar", time_limit=0.3, seed=3)  # RRT* is not stopped early (SETTLING_PLANNERS)
     assert rrt.solve_time_s >= 0.3
-    for bad in (0.0, -1.0, math.nan):
-        with pytest.raises(ValueError, match="settle must be a positive number of seconds"):
-            plan(walls, "bitstar", settle=bad)
+    for option in ("settle", "soft_limit"):
+        for bad in (0.0, -1.0, math.nan, math.inf):
+            with pytest.raises(ValueError, match=f"{option} must be a positive number of seconds"):
+                plan(walls, "bitstar", **{option: bad})
+
+
+def test_bitstar_soft_limit_stops_a_run_that_has_a_path_and_not_one_without(walls, monkeypatch):
+    """On a fake clock (each reading 10 us later), so the stop does not depend on the machine's load: with a path,
+    the solve ends within a poll of the soft limit, although the cost still falls and the budget is 30 s; a soft limit
+    shorter than the time to a first path does not stop the search for one."""
+    clock = itertools.count()
+    monkeypatch.setattr(ompl_planners, "time", SimpleNamespace(perf_counter=lambda: next(clock) * 1e-5))
+    limited = plan(walls, "bitstar", time_limit=30.0, seed=3, settle=None, soft_limit=0.2)
+    assert limited.success
+    assert 0.2 <= limited.solve_time_s <= 0.2 + 2 * ompl_planners.SETTLE_POLL_S
+    hasty = plan(walls, "bitstar", time_limit=30.0, seed=3, settle=None, soft_limit=1e-5)
+    assert hasty.success and hasty.solve_time_s < 30.0
 
 
 # ---- impossible problems and bad input -----------------------------------------------------------------------
@@ -369,7 +383,7 @@ def test_a_timed_run_is_replayed_by_its_seed_and_iteration_count(walls, name, re
     does not depend on the machine's load; the replay runs on the real clock with a generous budget."""
     clock = itertools.count()
     monkeypatch.setattr(ompl_planners, "time", SimpleNamespace(perf_counter=lambda: next(clock) * 0.3 / readings))
-    timed = plan(walls, name, time_limit=0.3, seed=21, settle=None)  # no early stop: the budget runs out
+    timed = plan(walls, name, time_limit=0.3, seed=21, settle=None, soft_limit=None)  # no early stop: budget runs out
     assert next(clock) > readings  # the fake clock ran the budget out
     monkeypatch.undo()
     replay = plan(walls, name, time_limit=30.0, seed=21, max_iterations=timed.iterations)
