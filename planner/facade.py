@@ -136,9 +136,9 @@ def plan(
     path's cost has not improved for ``settle`` seconds or after ``soft_limit`` seconds of solving
     (``planner.ompl_planners.solve_ompl``; ``DEFAULT_SETTLE_S``, ``DEFAULT_SOFT_LIMIT_S``); without a path it goes
     on to ``time_limit``. None (both), or a ``max_iterations`` cap (whose runs must repeat exactly), uses the whole
-    ``time_limit``. Raises PlanningError when the start or goal
-    is outside the map, in collision or unreachable, and ValueError for an unknown planner or a bad budget; a
-    planner that finds no path in its budget gives ``success=False`` with the reason in ``message``.
+    ``time_limit``. Raises PlanningError when the start or goal is outside the map, in collision or unreachable,
+    and ValueError for an unknown planner or a bad budget; a planner that finds no path in its budget gives
+    ``success=False`` with the reason in ``message``.
     """
     name = resolve_planner(planner)
     if not (math.isfinite(time_limit) and time_limit > 0):
