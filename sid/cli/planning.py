@@ -7,7 +7,7 @@ import argparse
 import sys
 
 from costmap.mapfile import MapFileError
-from planner.facade import DEFAULT_PLANNER, MAX_SEED, PLANNERS
+from planner.facade import DEFAULT_PLANNER, DEFAULT_SOFT_LIMIT_S, MAX_SEED, PLANNERS
 from planner.problem import DEFAULT_COST_WEIGHT, PlanningError
 from sid.experiments.harness import Comparison, goal_zone_warning
 from sid.scenario.loader import ScenarioError
@@ -44,7 +44,12 @@ def seed_number(text: str) -> int:
 def add_planning_options(parser: argparse.ArgumentParser, time_default: float) -> None:
     """The planner budget options ``sid plan`` and ``sid demo`` share."""
     parser.add_argument(
-        "--time", type=float, default=time_default, metavar="S", help=f"planner time budget in seconds ({time_default})"
+        "--time",
+        type=float,
+        default=time_default,
+        metavar="S",
+        help=f"planner time budget in seconds ({time_default}); without --iterations BIT* stops earlier once it has a "
+        f"path, when its cost settles or after {DEFAULT_SOFT_LIMIT_S} s",
     )
     parser.add_argument(
         "--seed", type=seed_number, default=None, metavar="N", help=f"random seed for OMPL, 1 to {MAX_SEED}"

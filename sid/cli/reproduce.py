@@ -102,7 +102,13 @@ def _add_navigation(studies: argparse._SubParsersAction) -> None:
     p.add_argument("--planners", nargs="+", default=None, metavar="P", help=f"default: {' '.join(PLANNERS)}")
     p.add_argument("--seeds", type=int, default=None, metavar="K", help="draws per layout (2); each in both directions")
     p.add_argument("--layouts", nargs="+", default=None, metavar="L", help=f"default: {' '.join(NAV_LAYOUTS)}")
-    p.add_argument("--time", type=float, default=None, metavar="S", help="planner time budget per plan in s (0.5)")
+    p.add_argument(
+        "--time",
+        type=float,
+        default=None,
+        metavar="S",
+        help="planner time budget per plan in s (0.5); without --iterations BIT* stops earlier once it has a path",
+    )
     p.add_argument(
         "--iterations", type=int, default=None, metavar="K",
         help="cap on planner iterations; runs that stop on the cap repeat exactly",
