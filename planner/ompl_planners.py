@@ -118,12 +118,13 @@ def solve_ompl(
     # point. FMT* stops by itself after its samples, which ``max_iterations`` sets (see FMT_SAMPLES_PER_SECOND).
     checks = 0
     cap = math.inf if max_iterations is None or name == "fmtstar" else max_iterations
-    deadline = time.perf_counter() + time_limit
+    begin = time.perf_counter()
+    deadline = begin + time_limit
     early = name in SETTLING_PLANNERS and (settle is not None or soft_limit is not None)
     best_cost = planner.bestCost if early else None
     patience = math.inf if settle is None else settle
-    soft_deadline = math.inf if soft_limit is None else time.perf_counter() + soft_limit
-    settled_cost, settled_at, next_poll = math.inf, time.perf_counter(), 0.0
+    soft_deadline = math.inf if soft_limit is None else begin + soft_limit
+    settled_cost, settled_at, next_poll = math.inf, begin, 0.0
 
     def stop() -> bool:
         nonlocal checks, settled_cost, settled_at, next_poll
