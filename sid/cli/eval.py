@@ -13,13 +13,13 @@ from pathlib import Path
 from sid.cli.groups import add_group_params, group_params_from
 from sid.experiments.fformation import (
     DEFAULT_THRESHOLDS,
-    LIKELY_METRES_M,
     Fold,
     LabelledFrame,
     cross_validate,
     load_dataset,
-    median_neighbour_distance,
+    missing_members,
     parse_threshold,
+    unit_warning,
 )
 from sid.experiments.fformation import evaluate as evaluate_fformation
 
@@ -41,10 +41,14 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     ff.add_argument(
         "--scale",
         type=float,
-        default=None,
-        help="multiply positions by this to get metres (0.01 for centimetres; default 1, with a warning when the "
-        "positions look like centimetres)",
+        nargs="+",
+        default=[1.0],
+        metavar="S",
+        help="multiply positions by this to get metres: one value for every DIR or one per DIR (0.01 for "
+        "centimetres, 0.001 for millimetres; default 1); a warning names the scale that fits when the scaled "
+        "positions are implausible for people",
     )
+    ff.add_argument("--degrees", action="store_true", help="the files' theta is in degrees (default: radians)")
     ff.add_argument(
         "--T",
         dest="thresholds",
@@ -90,12 +94,14 @@ def _grid_item(text: str) -> tuple[str, list[float]]:
 def run(args: argparse.Namespace) -> int:
     try:
         params = group_params_from(args)
+        if len(args.scale) not in (1, len(args.dirs)):
+            raise ValueError(f"--scale takes one value or one per DIR ({len(args.dirs)}), got {len(args.scale)}")
+        scales = args.scale * len(args.dirs) if len(args.scale) == 1 else args.scale
         datasets: dict[str, list[LabelledFrame]] = {}
-        for folder in args.dirs:
+        for folder, scale in zip(args.dirs, scales, strict=True):
             name = _dataset_name(folder, datasets)
-            datasets[name] = load_dataset(folder, 1.0 if args.scale is None else args.scale)
-            if args.scale is None:
-                _warn_if_not_metres(name, datasets[name])
+            datasets[name] = load_dataset(folder, scale, args.degrees)
+            _warn_about_data(name, datasets[name], scale)
         if args.grid:
             folds, table = cross_validate(datasets, dict(args.grid), params, args.thresholds[0])
             print(_folds(folds, table) if args.table else json.dumps(_folds_json(folds, table, args.grid), indent=2))
@@ -114,13 +120,16 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _warn_if_not_metres(name: str, frames: list[LabelledFrame]) -> None:
-    """Say so on stderr when a dataset's people stand implausibly far apart for metres (no --scale given)."""
-    gap = median_neighbour_distance(frames)
-    if gap is not None and gap > LIKELY_METRES_M:
+def _warn_about_data(name: str, frames: list[LabelledFrame], scale: float) -> None:
+    """On stderr: positions implausible as metres once scaled (with the --scale that fits), and ground-truth
+    members missing from their frame's people."""
+    if reason := unit_warning(frames, scale):
+        print(f"sid eval fformation: warning: {name}: {reason} (set it with --scale)", file=sys.stderr)
+    missing, total = missing_members(frames)
+    if missing:
         print(
-            f"sid eval fformation: warning: {name}: the median distance from a person to their nearest neighbour is "
-            f"{gap:.3g} units, implausible for metres; if the positions are centimetres, pass --scale 0.01",
+            f"sid eval fformation: warning: {name}: {missing} of the {total} ground-truth group members are not among "
+            "their frame's people (annotation slips if few; if many, the groups use other ids than the features)",
             file=sys.stderr,
         )
 

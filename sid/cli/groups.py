@@ -186,7 +186,10 @@ def _parse_frame(data: Any) -> dict[str, Any]:
     if not isinstance(data["people"], list):
         raise ValueError("'people' must be a list")
     check_limit("people", len(data["people"]), "people", "people")  # before any work on them (sid.checks.Limits)
-    return {"frame": data.get("frame"), "people": [_parse_person(p, k) for k, p in enumerate(data["people"])]}
+    frame = data.get("frame")  # a label, echoed back: it must stay valid JSON (1e400 would come back as Infinity)
+    if not (frame is None or isinstance(frame, str) or is_number(frame)):
+        raise ValueError(f"'frame' must be a finite number or a string, got {frame!r}")
+    return {"frame": frame, "people": [_parse_person(p, k) for k, p in enumerate(data["people"])]}
 
 
 def _parse_person(data: Any, index: int) -> Person:

@@ -3,8 +3,10 @@
 Format (``features.mat`` / ``groundtruth.mat``, MATLAB v5, one folder per sequence): ``features{t}`` is an N x 4
 array ``[id, x, y, theta]`` per frame with ``timestamp(t)``; ``GTgroups{t}`` lists the member ids of each group at
 ``GTtimestamp(t)``. x, y are ground-plane coordinates (centimetres in the public sets: use ``scale=0.01``), theta
-is the facing yaw in radians in the same frame. A dataset is a folder holding ``features.mat`` (one sequence) or
-sub-folders that do (sequences pooled frame by frame).
+is the facing yaw in radians in the same frame (``degrees=True`` for files in degrees). A dataset is a folder holding
+``features.mat`` (one sequence) or sub-folders that do (sequences pooled frame by frame). Ids are whole numbers,
+unique within a frame; timestamps are unique within a file; a ground-truth group is an id vector, a cell of them, or a
+matrix with one group per row. A ground-truth timestamp stored in single precision finds its double-precision frame.
 
 Scoring (the protocol of this literature; its source: docs/parameters.md): only frames with ground truth are scored,
 groups of one are dropped on both sides; a truth group is found when some detected group G has
@@ -34,6 +36,9 @@ from sid.perception.groups import GroupParams, detect_groups
 from sid.perception.people import Person
 
 DEFAULT_THRESHOLDS: tuple[float, ...] = (2 / 3, 1.0)
+YAW_LIMIT_RAD = 4 * math.pi
+"""No yaw in radians is written beyond two turns (an unwrapped ``a + pi`` stays well within); a file whose yaws go
+beyond is in degrees."""
 
 
 @dataclass
@@ -59,11 +64,13 @@ class Score:
         return {"precision": self.precision, "recall": self.recall, "f1": self.f1, "frames": self.frames}
 
 
-def load_sequence(folder: str | Path, scale: float = 1.0) -> list[LabelledFrame]:
+def load_sequence(folder: str | Path, scale: float = 1.0, degrees: bool = False) -> list[LabelledFrame]:
     """The ground-truth frames of one sequence folder (``features.mat`` + ``groundtruth.mat``).
 
-    Positions are multiplied by ``scale`` (0.01 turns the datasets' centimetres into metres). A NaN yaw becomes
-    an unknown facing (theta None). Raises ValueError naming the file for anything malformed.
+    Positions are multiplied by ``scale`` (0.01 turns the datasets' centimetres into metres); yaws are radians, or
+    degrees with ``degrees=True``. A NaN yaw becomes an unknown facing (theta None). Raises ValueError naming the
+    file (and the frame) for anything malformed: among others a yaw beyond two turns (4 pi) taken as radians
+    (degrees, most likely), a repeated timestamp, an id that is not a whole number or repeats within a frame.
     """
     folder = Path(folder)
     check_number("fformation", "scale", scale, low=0, low_open=True)
@@ -78,34 +85,96 @@ def load_sequence(folder: str | Path, scale: float = 1.0) -> list[LabelledFrame]
         raise ValueError(f"{features_path}: {len(frames_people)} feature frames but {len(timestamps)} timestamps")
     if len(truth_groups) != len(truth_timestamps):
         raise ValueError(f"{truth_path}: {len(truth_groups)} GTgroups frames but {len(truth_timestamps)} GTtimestamps")
-    index = {float(t): k for k, t in enumerate(timestamps)}
+    _check_unique(timestamps, features_path, "timestamp")
+    _check_unique(truth_timestamps, truth_path, "GTtimestamp")
+    index = _frame_index(timestamps)
     frames = []
     for groups_cell, stamp in zip(truth_groups, truth_timestamps, strict=True):
-        if float(stamp) not in index:
+        k = index.get(float(stamp), index.get(float(np.float32(stamp))))
+        if k is None:
             raise ValueError(f"{truth_path}: GTtimestamp {stamp} has no frame in {features_path.name}")
-        where = f"{features_path} frame at timestamp {stamp}"
-        people = _people(frames_people[index[float(stamp)]], scale, where)
-        groups = [g for g in _groups(groups_cell, f"{truth_path} at timestamp {stamp}") if len(g) > 1]
-        frames.append(LabelledFrame(folder.name, float(stamp), people, groups))
+        where = f"{features_path} frame at timestamp {timestamps[k]:g}"
+        people = _people(frames_people[k], scale, degrees, where)
+        groups = [g for g in _groups(groups_cell, f"{truth_path} at timestamp {stamp:g}") if len(g) > 1]
+        frames.append(LabelledFrame(folder.name, float(timestamps[k]), people, groups))
     return frames
 
 
-def load_dataset(folder: str | Path, scale: float = 1.0) -> list[LabelledFrame]:
-    """All ground-truth frames of a dataset folder: its own sequence, or those of its sub-folders, pooled."""
+def _check_unique(stamps: np.ndarray, path: Path, name: str) -> None:
+    values, counts = np.unique(stamps, return_counts=True)
+    if (counts > 1).any():
+        repeated = ", ".join(f"{v:g}" for v in values[counts > 1][:5])
+        raise ValueError(f"fformation: {path}: {name} repeats {repeated}: each frame needs its own timestamp")
+
+
+def _frame_index(timestamps: np.ndarray) -> dict[float, int]:
+    """Frame position by timestamp, and by the timestamp rounded to single precision where that is still unique
+    (a ground-truth file saved in single precision then finds its frames)."""
+    index = {float(t): k for k, t in enumerate(timestamps)}
+    single = timestamps.astype(np.float32).astype(float)
+    values, counts = np.unique(single, return_counts=True)
+    unique = set(values[counts == 1].tolist())
+    return {float(s): k for k, s in enumerate(single) if s in unique and s not in index} | index
+
+
+def load_dataset(folder: str | Path, scale: float = 1.0, degrees: bool = False) -> list[LabelledFrame]:
+    """All ground-truth frames of a dataset folder: its own sequence, or those of its sub-folders, pooled
+    (``load_sequence``'s ``scale`` and ``degrees``). Raises ValueError when no frame has ground truth."""
     folder = Path(folder)
     if not folder.is_dir():
         raise ValueError(f"fformation: {folder} is not a folder")
     if (folder / "features.mat").exists():
-        return load_sequence(folder, scale)
-    sequences = sorted(p.parent for p in folder.glob("*/features.mat"))
-    if not sequences:
-        raise ValueError(f"fformation: no features.mat in {folder} or its sub-folders")
-    return [frame for sequence in sequences for frame in load_sequence(sequence, scale)]
+        frames = load_sequence(folder, scale, degrees)
+    else:
+        sequences = sorted(p.parent for p in folder.glob("*/features.mat"))
+        if not sequences:
+            raise ValueError(f"fformation: no features.mat in {folder} or its sub-folders")
+        frames = [frame for sequence in sequences for frame in load_sequence(sequence, scale, degrees)]
+    if not frames:
+        raise ValueError(f"fformation: {folder} has no frame with ground truth (GTtimestamp is empty)")
+    return frames
 
 
-LIKELY_METRES_M = 5.0
-"""People in a conversation stand well within this of their nearest neighbour (m); a median nearest-neighbour distance
-above it means the positions are not in metres (the Verona sets store centimetres: pass ``scale=0.01``)."""
+PLAUSIBLE_NEIGHBOUR_M = (0.1, 5.0)
+"""The range (m) of the median distance from a person to their nearest neighbour in scenes of people talking: bodies
+keep them more than 0.1 m apart, conversation within 5 m. A median outside it means the positions, as scaled, are
+not metres (the Verona sets store centimetres: ``scale=0.01``)."""
+UNIT_SCALES: dict[str, float] = {"metres": 1.0, "centimetres": 0.01, "millimetres": 0.001}
+"""The units a dataset's positions are likely in, with the ``scale`` that turns them into metres."""
+
+
+def unit_warning(frames: Sequence[LabelledFrame], scale: float) -> str | None:
+    """Why the positions of ``frames``, loaded with ``scale``, are implausible as metres, with the scale that fits
+    them best (of ``UNIT_SCALES``); None when they look like metres (``PLAUSIBLE_NEIGHBOUR_M``) or no frame holds two
+    people."""
+    gap = median_neighbour_distance(frames)
+    low, high = PLAUSIBLE_NEIGHBOUR_M
+    if gap is None or low <= gap <= high:
+        return None
+    raw = gap / scale  # the median gap in the file's own units
+    unit, fit = min(UNIT_SCALES.items(), key=lambda item: abs(math.log10(raw * item[1])))
+    hint = (
+        f"the file's units look like {unit}, scale {fit:g}"
+        if low <= raw * fit <= high and fit != scale
+        else "check the file's units"
+    )
+    return (
+        f"scaled by {scale:g}, the median distance from a person to their nearest neighbour is {gap:.3g} m, "
+        f"implausible for people (expected {low:g}-{high:g} m); {hint}"
+    )
+
+
+def missing_members(frames: Sequence[LabelledFrame]) -> tuple[int, int]:
+    """(ground-truth group members absent from their frame's people, all members) over ``frames``: a few are
+    annotation slips (the public Cocktail Party and GDet sets have some), many mean the groups use other ids or
+    another encoding than the features."""
+    missing = total = 0
+    for frame in frames:
+        ids = {p.id for p in frame.people}
+        for group in frame.truth:
+            total += len(group)
+            missing += len(group - ids)
+    return missing, total
 
 
 def median_neighbour_distance(frames: Sequence[LabelledFrame]) -> float | None:
@@ -282,7 +351,7 @@ def _numbers(value: np.ndarray, path: Path, name: str) -> np.ndarray:
     return numbers
 
 
-def _people(cell: np.ndarray, scale: float, where: str) -> list[Person]:
+def _people(cell: np.ndarray, scale: float, degrees: bool, where: str) -> list[Person]:
     try:
         rows = np.asarray(cell, dtype=float)
     except (TypeError, ValueError):
@@ -293,28 +362,42 @@ def _people(cell: np.ndarray, scale: float, where: str) -> list[Person]:
         raise ValueError(f"fformation: {where}: features must be N x 4 [id, x, y, theta], got shape {rows.shape}")
     if not np.all(np.isfinite(rows[:, :3])):
         raise ValueError(f"fformation: {where}: non-finite id or position")
+    ids = rows[:, 0]
+    if not np.array_equal(ids, np.round(ids)):
+        raise ValueError(
+            f"fformation: {where}: ids (first column) must be whole numbers, got {ids[ids != np.round(ids)][0]:g} "
+            "(a transposed array? features are N x 4 [id, x, y, theta], one row per person)"
+        )
+    values, counts = np.unique(ids, return_counts=True)
+    if (counts > 1).any():
+        raise ValueError(f"fformation: {where}: person id {values[counts > 1][0]:g} appears more than once")
+    yaw = np.radians(rows[:, 3]) if degrees else rows[:, 3]
+    reach = float(np.abs(yaw[np.isfinite(yaw)]).max(initial=0.0))
+    if reach > YAW_LIMIT_RAD:
+        raise ValueError(
+            f"fformation: {where}: theta reaches {reach:g}, beyond two turns: not radians; for a file in degrees "
+            "load it with degrees=True (sid eval fformation --degrees)"
+        )
     # An annotated facing is taken at full quality (1), a missing one is unknown (None, quality 0).
     return [
-        Person(
-            int(r[0]),
-            float(r[1]) * scale,
-            float(r[2]) * scale,
-            *((float(r[3]), 1.0) if math.isfinite(r[3]) else (None, 0.0)),
-        )
-        for r in rows
+        Person(int(i), x * scale, y * scale, *((theta, 1.0) if math.isfinite(theta) else (None, 0.0)))
+        for i, x, y, theta in zip(ids.tolist(), rows[:, 1].tolist(), rows[:, 2].tolist(), yaw.tolist(), strict=True)
     ]
 
 
 def _groups(cell: object, where: str) -> list[frozenset[int]]:
-    """Member-id sets from a GTgroups cell: a cell array of id arrays (possibly nested), an id array, or empty."""
+    """Member-id sets from a GTgroups cell: a cell array of id arrays (possibly nested), an id vector, a matrix of
+    one group per row (equal sizes), or empty."""
     if isinstance(cell, np.ndarray) and cell.dtype == object:
         return [g for item in cell.ravel() for g in _groups(item, where)]
     try:
-        ids = np.asarray(cell, dtype=float).ravel()
+        ids = np.asarray(cell, dtype=float)
     except (TypeError, ValueError):
         raise ValueError(f"fformation: {where}: a group must list numeric ids") from None
     if ids.size == 0:
         return []
-    if not np.all(np.isfinite(ids)):
-        raise ValueError(f"fformation: {where}: non-finite group member id")
-    return [frozenset(int(i) for i in ids)]
+    if not np.all(np.isfinite(ids)) or not np.array_equal(ids, np.round(ids)):
+        raise ValueError(f"fformation: {where}: group member ids must be finite whole numbers, got {ids.ravel()[:10]}")
+    if ids.ndim == 2 and min(ids.shape) > 1:  # MATLAB's [1 2; 3 4]: two groups of two
+        return [frozenset(int(i) for i in row) for row in ids.tolist()]
+    return [frozenset(int(i) for i in ids.ravel().tolist())]

@@ -8,6 +8,7 @@ import math
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 from sid.cli import main
@@ -50,18 +51,21 @@ def test_malformed_lines_are_reported_with_their_number_and_skipped(tmp_path, ca
         '{"frame": 1, "people": [{"id": 3, "x": NaN, "y": 0.0}]}',
         json.dumps([1, 2]),
         json.dumps({"frame": 9, "people": []}),
+        '{"frame": 1e400, "people": []}',  # would be echoed as Infinity, which is not JSON
+        json.dumps({"frame": "take 2", "people": []}),
     ]
     source = tmp_path / "frames.jsonl"
     source.write_text("\n".join(lines) + "\n")
     code, out, err = run_sid(["groups", str(source)], capsys)
     assert code == 0
-    assert [json.loads(line)["frame"] for line in out] == [0, 9]
+    assert [json.loads(line)["frame"] for line in out] == [0, 9, "take 2"]
+    assert "line 8: 'frame' must be a finite number or a string, got inf" in err
     assert "line 2: not valid JSON" in err
     assert "line 3: people[0] (id 1): x must be a finite number, got 'far'" in err
     assert "line 4: groups: person ids must be unique" in err
     assert "line 5: not valid JSON (NaN is not a number)" in err
     assert "line 6: expected a JSON object" in err
-    assert "skipped 5 malformed line(s)" in err
+    assert "skipped 6 malformed line(s)" in err
 
 
 def test_strict_stops_at_the_first_bad_line_keeping_earlier_output(tmp_path, capsys):
@@ -219,10 +223,25 @@ def test_eval_fformation_on_the_real_datasets(capsys):
     assert rows[("Synth", "2/3")] > 0.9
 
 
-def test_eval_fformation_warns_when_positions_look_like_centimetres(tmp_path, capsys):
+def test_eval_fformation_warns_when_scaled_positions_are_not_metres(tmp_path, capsys):
     tiny = write_sequence(tmp_path / "Tiny", tiny_frames(), {1: [[1, 2]], 2: [[1, 2, 3]], 3: []})
     code, _, err = run_sid(["eval", "fformation", str(tiny)], capsys)
-    assert code == 0 and "Tiny: the median distance" in err and "pass --scale 0.01" in err
-    for scale in ("0.01", "1"):  # an explicit scale is the user's word: no warning
-        code, _, err = run_sid(["eval", "fformation", str(tiny), "--scale", scale], capsys)
-        assert code == 0 and "warning" not in err
+    assert code == 0 and "Tiny: scaled by 1, the median distance" in err and "centimetres, scale 0.01" in err
+    code, _, err = run_sid(["eval", "fformation", str(tiny), "--scale", "0.01"], capsys)
+    assert code == 0 and "warning" not in err
+    # One scale per DIR: the second copy, scaled as metres, is warned about by name.
+    other = write_sequence(tmp_path / "Other", tiny_frames(), {1: [[1, 2]]})
+    code, _, err = run_sid(["eval", "fformation", str(tiny), str(other), "--scale", "0.01", "1"], capsys)
+    assert code == 0 and "warning: Other: scaled by 1" in err and "Tiny" not in err
+    code, _, err = run_sid(["eval", "fformation", str(tiny), str(other), "--scale", "0.01", "1", "1"], capsys)
+    assert code == 2 and "--scale takes one value or one per DIR (2), got 3" in err
+
+
+def test_eval_fformation_reads_degrees_and_warns_about_truth_ids_it_cannot_find(tmp_path, capsys):
+    frames = [np.column_stack([f[:, :3], np.degrees(f[:, 3])]) for f in tiny_frames()]
+    folder = write_sequence(tmp_path / "Degrees", frames, {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[5, 6]]})
+    code, _, err = run_sid(["eval", "fformation", str(folder), "--scale", "0.01"], capsys)
+    assert code == 2 and "theta reaches 180, beyond two turns" in err and "--degrees" in err
+    code, out, err = run_sid(["eval", "fformation", str(folder), "--scale", "0.01", "--degrees", "--table"], capsys)
+    assert code == 0 and out[1].split()[:3] == ["Degrees", "2/3", "3"]
+    assert "Degrees: 1 of the 7 ground-truth group members are not among their frame's people" in err

@@ -11,7 +11,7 @@ import pytest
 import scipy.io
 
 from sid.experiments.fformation import (
-    LIKELY_METRES_M,
+    PLAUSIBLE_NEIGHBOUR_M,
     cross_validate,
     evaluate,
     format_threshold,
@@ -19,8 +19,10 @@ from sid.experiments.fformation import (
     load_dataset,
     load_sequence,
     median_neighbour_distance,
+    missing_members,
     parse_threshold,
     score,
+    unit_warning,
 )
 from sid.perception.groups import GroupParams, detect_groups
 from tests.conftest import shared_path
@@ -162,6 +164,85 @@ def test_malformed_files_give_clear_errors(tmp_path, tiny):
         load_sequence(tiny, scale=0.0)
 
 
+def _write_features(folder: Path, frames: list[np.ndarray], stamps: np.ndarray) -> None:
+    scipy.io.savemat(folder / "features.mat", {"features": cells(frames), "timestamp": stamps[None, :]})
+
+
+def test_ids_must_be_whole_and_unique_and_timestamps_unique(tmp_path):
+    folder = write_sequence(tmp_path / "Ids", tiny_frames(), {1: [[1, 2]]})
+    five = np.array([[k, 100.5 * k, 20.25, 0.1 * k] for k in range(1, 6)])
+    _write_features(folder, [five.T.copy()], np.array([1.0]))  # 4 x 5: "people" (1, 2, ...), (100.5, 201, ...), ...
+    with pytest.raises(ValueError, match=r"Ids/features.mat frame at timestamp 1: ids .* whole numbers, got 100.5"):
+        load_sequence(folder)
+    repeated = tiny_frames()[0].copy()
+    repeated[2, 0] = 1
+    _write_features(folder, [repeated], np.array([1.0]))
+    with pytest.raises(ValueError, match="timestamp 1: person id 1 appears more than once"):
+        load_sequence(folder)
+    _write_features(folder, tiny_frames(), np.array([1.0, 2.0, 1.0, 2.0]))  # two takes numbered alike
+    with pytest.raises(ValueError, match=r"features.mat: timestamp repeats 1, 2: each frame needs its own"):
+        load_sequence(folder)
+    groups = cells([cells([np.array([[1, 2]])]), cells([np.array([[1, 2]])])])
+    scipy.io.savemat(folder / "groundtruth.mat", {"GTgroups": groups, "GTtimestamp": np.array([[1, 1]])})
+    _write_features(folder, tiny_frames(), np.arange(1.0, 5.0))
+    with pytest.raises(ValueError, match="groundtruth.mat: GTtimestamp repeats 1"):
+        load_sequence(folder)
+    scipy.io.savemat(folder / "groundtruth.mat", {"GTgroups": cells([np.array([[1.5, 2]])]), "GTtimestamp": [[1]]})
+    with pytest.raises(ValueError, match="group member ids must be finite whole numbers"):
+        load_sequence(folder)
+
+
+def test_yaws_in_degrees_are_refused_as_radians_and_read_with_degrees(tmp_path):
+    frames = tiny_frames()
+    in_degrees = [np.column_stack([f[:, :3], np.degrees(f[:, 3])]) for f in frames]
+    folder = write_sequence(tmp_path / "Degrees", in_degrees, {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]})
+    with pytest.raises(ValueError, match=r"theta reaches 180, beyond two turns: not radians.*degrees=True"):
+        load_sequence(folder, 0.01)
+    read = load_dataset(folder, 0.01, degrees=True)
+    expected = load_dataset(
+        write_sequence(tmp_path / "Radians", frames, {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]}), 0.01
+    )
+    yaws = [p.theta for f in read for p in f.people]
+    assert yaws == pytest.approx([p.theta for f in expected for p in f.people])
+    # Unwrapped radians (the triangle's a + pi reaches 8.9 rad) are still radians.
+    assert max(abs(p.theta) for f in expected for p in f.people if p.theta is not None) > 2 * math.pi
+
+
+def test_ground_truth_encodings_and_single_precision_timestamps(tmp_path):
+    folder = tmp_path / "Encodings"
+    folder.mkdir()
+    four = np.array([[k, 100.0 * k, 0.0, 0.0] for k in range(1, 5)])
+    _write_features(folder, [four, four], np.array([0.1, 0.2]))  # double precision
+    truth = cells([np.array([[1, 2], [3, 4]]), cells([np.array([[1, 2, 3]])])])  # a matrix of rows; a cell of one
+    stamps = np.array([[0.1, 0.2]], dtype=np.float32)  # single precision: 0.1 is 0.10000000149...
+    scipy.io.savemat(folder / "groundtruth.mat", {"GTgroups": truth, "GTtimestamp": stamps})
+    frames = load_sequence(folder, 0.01)
+    assert [f.timestamp for f in frames] == [0.1, 0.2]
+    assert [sorted(map(sorted, f.truth)) for f in frames] == [[[1, 2], [3, 4]], [[1, 2, 3]]]
+    scipy.io.savemat(folder / "groundtruth.mat", {"GTgroups": cells([]), "GTtimestamp": np.zeros((1, 0))})
+    with pytest.raises(ValueError, match="Encodings has no frame with ground truth"):
+        load_dataset(folder)
+
+
+def test_unit_warning_names_the_scale_that_fits(tiny):
+    assert unit_warning(load_dataset(tiny, 0.01), 0.01) is None
+    centimetres_as_metres = unit_warning(load_dataset(tiny, 1.0), 1.0)
+    assert centimetres_as_metres is not None and "median distance" in centimetres_as_metres
+    assert "look like centimetres, scale 0.01" in centimetres_as_metres
+    # Millimetres scaled as centimetres (0.8 m gaps read as 8 m), and metres scaled as centimetres (0.008 m).
+    assert "millimetres, scale 0.001" in str(unit_warning(load_dataset(tiny, 0.1), 0.01))
+    assert "metres, scale 1" in str(unit_warning(load_dataset(tiny, 0.0001), 0.01))
+    assert "check the file's units" in str(unit_warning(load_dataset(tiny, 1e-6), 1.0))
+    assert unit_warning([], 1.0) is None
+
+
+def test_missing_members_counts_truth_ids_absent_from_their_frame(tiny):
+    frames = load_dataset(tiny, 0.01)
+    assert missing_members(frames) == (0, 7)
+    shifted = [replace(f, truth=[frozenset(i - 1 for i in g) for g in f.truth]) for f in frames]  # zero-based truth
+    assert missing_members(shifted) == (3, 7)
+
+
 # --- the real datasets (../shared/data/fformation) ---------------------------------------------------------------
 
 
@@ -226,5 +307,5 @@ def test_median_neighbour_distance_is_in_the_input_units(tiny):
     metres = median_neighbour_distance(load_dataset(tiny, 0.01))
     assert centimetres is not None and metres is not None
     assert centimetres == pytest.approx(100 * metres)
-    assert centimetres > LIKELY_METRES_M > metres
+    assert centimetres > PLAUSIBLE_NEIGHBOUR_M[1] > metres > PLAUSIBLE_NEIGHBOUR_M[0]
     assert median_neighbour_distance([]) is None
