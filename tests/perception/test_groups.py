@@ -57,6 +57,23 @@ def test_two_people_facing_each_other_meet_at_the_midpoint():
     np.testing.assert_allclose(group.zone, [[2.4, 0.3]])
 
 
+@pytest.mark.parametrize("method", ["ospace", "rays"])
+def test_a_face_to_face_pair_meets_at_its_midpoint_whatever_the_facing_noise(method):
+    # One looks straight at the other, whose facing is a few degrees off: the rays cross at a shallow angle, on the
+    # first person or anywhere between, so the crossing is not used (it used to put the interest point on B).
+    rng = np.random.default_rng(4)
+    for noise_a, noise_b in [(0.0, 7e-6), (0.0, -7e-6), *rng.normal(0.0, math.radians(3.0), (50, 2)).tolist()]:
+        people = [Person(1, 2.8, 0.0, noise_a), Person(2, 3.6, 0.0, math.pi + noise_b)]
+        [group] = detect_groups(people, GroupParams(method=method))
+        assert group.interest_point == pytest.approx((3.2, 0.0)), (noise_a, noise_b)
+    # Both turned 25 degrees towards the same side look at a spot beside the line: that crossing is kept.
+    turn = math.radians(25.0)
+    [group] = detect_groups(
+        [Person(1, 2.8, 0.0, turn), Person(2, 3.6, 0.0, math.pi - turn)], GroupParams(method=method)
+    )
+    assert group.interest_point == pytest.approx((3.2, 0.4 * math.tan(turn)))
+
+
 def test_four_people_on_a_circle_facing_its_centre():
     groups = detect_groups(circle(4, 0.8, centre=(3.0, -1.0)))
     assert len(groups) == 1
