@@ -86,10 +86,11 @@ def solve_ompl(
     """Run one OMPL planner; (path or None, termination checks, solve seconds).
 
     For the planners of ``SETTLING_PLANNERS``, once a solution exists: settle stops the solve when its cost has not
-    fallen by more than ``SETTLE_GAIN`` over the last ``settle`` seconds, soft_limit when ``soft_limit`` seconds of
-    solving have passed (``time_limit`` stays the cap while there is no solution). The cost is polled every
-    ``SETTLE_POLL_S`` seconds of the termination checks. None (both), and every other planner: the whole
-    ``time_limit``.
+    fallen by more than ``SETTLE_GAIN`` over the last ``settle`` seconds (from BIT*'s second batch on: in the
+    first, the straight line through two groups can hold for longer than ``settle`` before the way round them
+    appears at the batch's end), soft_limit when ``soft_limit`` seconds of solving have passed (``time_limit`` stays
+    the cap while there is no solution). The cost is polled every ``SETTLE_POLL_S`` seconds of the termination
+    checks. None (both), and every other planner: the whole ``time_limit``.
     """
     problem, spec = field.problem, field.spec
     space = ob.RealVectorStateSpace(2)
@@ -136,7 +137,11 @@ def solve_ompl(
             cost = best_cost().value()
             if cost < settled_cost * (1.0 - SETTLE_GAIN):
                 settled_cost, settled_at = cost, now
-            if math.isfinite(cost) and (now - settled_at > patience or now > soft_deadline):
+            # Settling waits for the end of BIT*'s first batch (``numBatches`` counts the batches started): before
+            # it BIT* has only tried the straight line and the samples of that batch, and a cost flat for
+            # ``settle`` seconds there says nothing about the routes the batch has yet to connect.
+            settled = now - settled_at > patience and planner.numBatches() > 1
+            if math.isfinite(cost) and (settled or now > soft_deadline):
                 return True
         checks += 1
         return False
