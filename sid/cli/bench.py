@@ -9,8 +9,7 @@ import sys
 from dataclasses import asdict
 from pathlib import Path
 
-from sid.cli.common import check_output_folder, fail, staged_output
-from sid.cli.detect import positive_int
+from sid.cli.common import check_output_folder, fail, positive_int, staged_output
 from sid.experiments.bench import (
     FULL,
     QUICK,

@@ -3,6 +3,7 @@ signal. The scenario and planner options live in ``sid.cli.planning``: commands 
 
 from __future__ import annotations
 
+import argparse
 import fnmatch
 import os
 import shutil
@@ -50,6 +51,17 @@ def check_output_folder(path: str | Path, option: str = "--out") -> Path:
         reason = "is a file, not a folder" if existing == folder else f"cannot create the folder, {existing} is a file"
         raise OutputFolderError(f"{option} {path}: {reason}")
     return folder
+
+
+def positive_int(text: str) -> int:
+    """argparse type: a whole number >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}")
+    return value
 
 
 def fail(command: str, error: Exception) -> int:

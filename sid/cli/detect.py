@@ -16,7 +16,14 @@ import numpy as np
 
 from costmap.grid import Costmap2D, GridSpec
 from sid.ahead import run_ahead
-from sid.cli.common import OutputFolderError, check_output_folder, clear_owned, fail, signals_deferred
+from sid.cli.common import (
+    OutputFolderError,
+    check_output_folder,
+    clear_owned,
+    fail,
+    positive_int,
+    signals_deferred,
+)
 from sid.documents import write_atomically
 from sid.perception.camera import Calibration
 from sid.perception.frame import Frame
@@ -63,7 +70,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="onnxruntime execution provider for the pose model: 'auto' (default) uses OpenVINO when "
         "onnxruntime-openvino is installed (pip install 'sid[openvino]'), else CPU",
     )
-    parser.add_argument("--frames", type=int, help="stop after this many frames (default: all; synthetic: 30)")
+    parser.add_argument("--frames", type=positive_int, help="stop after this many frames (default: all; synthetic: 30)")
     parser.add_argument("--out", type=Path, help="also write detections.jsonl, overlay and top-view PNGs here")
     parser.add_argument(
         "--align",
@@ -96,17 +103,6 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="group detector: 'ospace' (default), 'rays' or 'paper' (the paper's Algorithm 1); docs/groups.md",
     )
     parser.set_defaults(func=run)
-
-
-def positive_int(text: str) -> int:
-    """argparse type: a whole number >= 1."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}")
-    return value
 
 
 def _pose(args: argparse.Namespace) -> PoseFn:

@@ -8,7 +8,7 @@ import sys
 from collections.abc import Iterable
 from pathlib import Path
 
-from sid.cli.detect import positive_int
+from sid.cli.common import positive_int
 from sid.perception.frame import Frame
 from sid.perception.pipeline import PoseFn, image_pose
 from sid.perception.pose.contracts import PoseModelError

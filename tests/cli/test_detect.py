@@ -219,12 +219,19 @@ def test_threads_and_provider_reach_the_pose_session(monkeypatch, capsys):
     assert len(_lines(capsys.readouterr().out)) == 1
 
 
-@pytest.mark.parametrize("threads", ["0", "-1", "two", "1.5"])
-def test_bad_thread_count_is_refused(threads, capsys):
+@pytest.mark.parametrize("option", ["--threads", "--frames"])
+@pytest.mark.parametrize("count", ["0", "-1", "two", "1.5"])
+def test_bad_thread_or_frame_count_is_refused(option, count, capsys):
     with pytest.raises(SystemExit) as info:
-        main(["detect", "--source", "synthetic:S1", "--model", "m.onnx", "--threads", threads])
+        main(["detect", "--source", "synthetic:S1", "--model", "m.onnx", option, count])
     assert info.value.code == 2
-    assert f"--threads: expected a whole number >= 1, got {threads!r}" in capsys.readouterr().err
+    assert f"{option}: expected a whole number >= 1, got {count!r}" in capsys.readouterr().err
+
+
+def test_more_threads_than_the_machine_can_run_are_refused(capsys):
+    # 100000 threads used to be started: 17 GB resident, and the process no longer answered signals.
+    assert main(["detect", "--source", "synthetic:S1", "--model", "m.onnx", "--threads", "100000"]) == 2
+    assert "pose: threads must be at most" in capsys.readouterr().err
 
 
 def test_unknown_provider_is_refused(capsys):

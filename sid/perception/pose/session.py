@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 import onnxruntime as ort
 
-from sid.cpu import physical_cores
+from sid.cpu import physical_cores, usable_cpus
 from sid.perception.pose.contracts import ModelSignature, PoseModelError, supported_contracts_text
 
 CPU_PROVIDER = "CPUExecutionProvider"
@@ -97,14 +97,26 @@ def quiet_load_warnings() -> None:
     ort.set_default_logger_severity(3)
 
 
+THREADS_PER_CPU = 4
+"""``check_threads`` refuses more intra-op threads than this per logical CPU the process may use: beyond one per CPU
+they only queue behind each other, and a typo such as 100000 would start that many threads."""
+
+
 def check_threads(threads: object) -> int | None:
-    """``threads`` as an int >= 1, or None (the default, physical cores); ValueError for anything else."""
+    """``threads`` as an int in 1 .. ``THREADS_PER_CPU`` x the usable logical CPUs, or None (the default, physical
+    cores); ValueError for anything else."""
     if threads is None:
         return None
     if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)):
         raise ValueError(f"pose: threads must be a whole number >= 1, got {threads!r}")
     if threads < 1:
         raise ValueError(f"pose: threads must be >= 1, got {threads}")
+    cpus = len(usable_cpus())
+    if threads > THREADS_PER_CPU * cpus:
+        raise ValueError(
+            f"pose: threads must be at most {THREADS_PER_CPU * cpus} ({THREADS_PER_CPU} per logical CPU this process "
+            f"may use, {cpus}), got {threads}"
+        )
     return int(threads)
 
 
