@@ -24,6 +24,11 @@ MAX_IMAGE_SIDE = 100_000
 """The largest image width or height a calibration file may give (pixels)."""
 
 
+MAX_FOCAL_PER_PIXEL = 100.0
+"""Largest focal length (pixels) per pixel of image width or height that ``Intrinsics`` accepts: a field of view of
+~0.6 degrees; a larger one is a unit mistake (e.g. micrometres), not a camera."""
+
+
 @dataclass(frozen=True)
 class Intrinsics:
     """Pinhole intrinsics of one stream (pixels)."""
@@ -43,6 +48,11 @@ class Intrinsics:
         check_numbers("intrinsics", self, ("fx", "fy", "cx", "cy"), unit="pixels")
         if self.fx <= 0 or self.fy <= 0:
             raise ValueError(f"intrinsics: focal lengths must be positive, got fx={self.fx}, fy={self.fy}")
+        # A real camera's optical axis meets its own image, and its field of view spans more than half a degree.
+        check_number("intrinsics", "cx", self.cx, low=0, high=self.width, unit="pixels")
+        check_number("intrinsics", "cy", self.cy, low=0, high=self.height, unit="pixels")
+        check_number("intrinsics", "fx", self.fx, high=MAX_FOCAL_PER_PIXEL * self.width, unit="pixels")
+        check_number("intrinsics", "fy", self.fy, high=MAX_FOCAL_PER_PIXEL * self.height, unit="pixels")
 
     @property
     def K(self) -> np.ndarray:  # noqa: N802 - K is the standard name of the camera matrix

@@ -16,6 +16,9 @@ import numpy as np
 
 from sid.checks import check_number, check_numbers
 
+MAX_MOUNT_M = 10.0
+"""The farthest (m) a robot's camera is taken to sit from ``base_footprint``'s origin, up or sideways."""
+
 
 @dataclass(frozen=True)
 class CameraMount:
@@ -33,10 +36,11 @@ class CameraMount:
     yaw: float = 0.0
 
     def __post_init__(self) -> None:
-        check_number("camera mount", "height", self.height, unit="metres")
+        # On a robot: above the ground, within MAX_MOUNT_M of the robot's origin.
+        check_number("camera mount", "height", self.height, low=0, high=MAX_MOUNT_M, unit="metres")
         half_turn = np.pi / 2
         check_number("camera mount", "tilt", self.tilt, low=-half_turn, high=half_turn, low_open=True, high_open=True)
-        check_numbers("camera mount", self, ("x", "y"), unit="metres")
+        check_numbers("camera mount", self, ("x", "y"), low=-MAX_MOUNT_M, high=MAX_MOUNT_M, unit="metres")
         check_number("camera mount", "yaw", self.yaw, unit="radians")
 
     @property

@@ -39,7 +39,14 @@ def test_scaled_intrinsics_keep_pixel_centres():
 
 @pytest.mark.parametrize(
     ("field", "value", "message"),
-    [("fx", -1.0, "fx must be a positive number of pixels"), ("cx", float("nan"), "cx"), ("width", 0, "width")],
+    [
+        ("fx", -1.0, "fx must be a positive number of pixels"),
+        ("cx", float("nan"), "cx"),
+        ("width", 0, "width"),
+        ("cx", 1e6, r"cx must be a finite number of pixels in \[0, 1280\], got 1000000.0"),
+        ("cy", -1e6, r"cy must be a finite number of pixels in \[0, 720\]"),
+        ("fx", 1e308, "fx must be a finite number of pixels <= 128000"),
+    ],
 )
 def test_bad_intrinsics_are_named(field, value, message):
     data = D435_COLOR.to_dict() | {field: value}
@@ -100,6 +107,13 @@ def test_mount_round_trip_and_ground_plane(tilt, height):
 def test_mount_rejects_vertical_tilt():
     with pytest.raises(ValueError, match="tilt"):
         CameraMount(tilt=np.pi / 2)
+
+
+@pytest.mark.parametrize(("field", "value"), [("height", -5.0), ("height", 1e308), ("x", 1e300), ("y", -11.0)])
+def test_mount_rejects_a_camera_below_the_ground_or_off_the_robot(field, value):
+    # 1e308 m used to reach the PCA as overflowed coordinates ("Eigenvalues did not converge").
+    with pytest.raises(ValueError, match=rf"camera mount: {field} must be a finite number of metres in \["):
+        CameraMount(**{field: value})
 
 
 FLAT = {"width": 640, "height": 480, "fx": 525, "fy": 525, "cx": 319.5, "cy": 239.5}
