@@ -81,9 +81,28 @@ def _read_metadata(path: Path) -> dict:
     )
 
 
-def _shade(image: np.ndarray, mode: str) -> tuple[np.ndarray, np.ndarray]:
-    """Pixel shade in [0, 1] (rows, cols) and an opaque mask, as GraphicsMagick gives them to map_server."""
-    px = image.astype(np.float64) / (65535.0 if image.dtype == np.uint16 else 255.0)
+_NETPBM_MAGIC = (b"P2", b"P3", b"P5", b"P6")
+
+
+def _netpbm_maxval(image: Path) -> int | None:
+    """The maximum value declared in a PGM/PPM header (the value of white), None for other files or an unreadable
+    header. OpenCV returns the stored values unscaled and Pillow keeps the header's maximum private, so the four
+    header fields are read here (magic, width, height, maximum; ``#`` comments between them)."""
+    try:
+        with image.open("rb") as file:
+            head = file.read(1024)
+    except OSError:
+        return None
+    fields = b" ".join(line.split(b"#", 1)[0] for line in head.splitlines()).split()[:4]
+    if len(fields) < 4 or fields[0] not in _NETPBM_MAGIC or not fields[3].isdigit():
+        return None
+    return int(fields[3]) or None
+
+
+def _shade(image: np.ndarray, mode: str, white: float) -> tuple[np.ndarray, np.ndarray]:
+    """Pixel shade in [0, 1] (rows, cols) and an opaque mask, as GraphicsMagick gives them to map_server; ``white``
+    is the pixel value of full brightness (the type's maximum, or a PGM's declared maximum)."""
+    px = image.astype(np.float64) / white
     channels = 1 if px.ndim == 2 else px.shape[2]
     px = px.reshape(*px.shape[:2], channels)
     colour, alpha = (px[..., :-1], px[..., -1]) if channels in (2, 4) else (px, None)
@@ -124,7 +143,8 @@ def read_map(path: str | Path) -> OccupancyGrid:
         raise MapFileError(f"{path}: cannot read map image {meta['image']} (missing or not an image)")
     if image.dtype not in (np.uint8, np.uint16):
         raise MapFileError(f"{path}: map image {meta['image']} must be 8 or 16 bit, got {image.dtype}")
-    shade, opaque = _shade(image, meta["mode"])
+    white = _netpbm_maxval(meta["image"]) or (65535.0 if image.dtype == np.uint16 else 255.0)
+    shade, opaque = _shade(image, meta["mode"], white)
     occ = shade if meta["negate"] else 1.0 - shade
     free, occupied = meta["free"], meta["occupied"]
     if meta["mode"] == "raw":

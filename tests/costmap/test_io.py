@@ -107,6 +107,17 @@ def test_reads_map_saver_trinary_maps(tmp_path):
     assert negated.data.tolist() == [[-1, -1, 100], [0, 100, 100]]  # p = pixel / 255
 
 
+@pytest.mark.parametrize(("maxval", "dtype"), [(15, ">u1"), (1, ">u1"), (1000, ">u2")])
+def test_pgm_maps_are_scaled_by_their_declared_maximum(tmp_path, maxval, dtype):
+    # Free, occupied and mid-grey pixels at a maximum other than 255 / 65535 (map_server scales by the header's).
+    pixels = np.array([[maxval, 0, maxval // 2]], dtype=dtype)
+    (tmp_path / "other.pgm").write_bytes(b"P5\n# a comment\n3 1\n%d\n" % maxval + pixels.tobytes())
+    meta = {"image": "other.pgm", "resolution": 0.1, "origin": [0.0, 0.0, 0.0], "negate": 0}
+    (tmp_path / "other.yaml").write_text(yaml.safe_dump(meta | {"occupied_thresh": 0.65, "free_thresh": 0.196}))
+    expected = [0, 100, -1] if maxval > 1 else [0, 100, 100]  # maximum 1: no grey, 1 // 2 = 0 is black
+    assert read_map(tmp_path / "other.yaml").data.tolist() == [expected]
+
+
 def test_reads_scale_maps_with_transparency(tmp_path):
     bgra = np.zeros((1, 3, 4), dtype=np.uint8)
     bgra[0, :, :3] = np.array([0, 128, 255])[:, None]
