@@ -31,7 +31,7 @@ def load_document(path: str | Path, kind: str = "file") -> Any:
     text = decode_text(raw, f"{path}: cannot read {kind}")
     is_json = path.suffix.lower() == ".json"
     try:
-        return json.loads(text) if is_json else yaml.safe_load(text)
+        return json.loads(text, object_pairs_hook=_unique_keys) if is_json else yaml.load(text, _UniqueKeyLoader)
     except RecursionError:
         raise ValueError(f"{path}: cannot read {kind}: nested too deeply") from None
     except (json.JSONDecodeError, yaml.YAMLError, ValueError, TypeError, OverflowError) as exc:
@@ -39,6 +39,36 @@ def load_document(path: str | Path, kind: str = "file") -> Any:
         # PyYAML's messages span lines and name "<unicode string>": made one line here.
         reason = " ".join(str(exc).split()).replace(' in "<unicode string>",', " at")
         raise ValueError(f"{path}: not valid {'JSON' if is_json else 'YAML'} ({reason})") from None
+
+
+def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """A JSON object's pairs as a dict; ValueError on a key given twice (json.loads would keep the last silently)."""
+    result: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in result:
+            raise ValueError(f"duplicate key {key!r}")
+        result[key] = value
+    return result
+
+
+class _UniqueKeyLoader(yaml.SafeLoader):
+    """PyYAML's safe loader, refusing a mapping that gives a key twice (it would keep the last silently); keys
+    brought in by a ``<<`` merge may still be overridden, as YAML intends."""
+
+    def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
+        seen: set[Any] = set()
+        for key_node, _ in node.value:
+            if key_node.tag == "tag:yaml.org,2002:merge":
+                continue
+            key = self.construct_object(key_node, deep=deep)
+            try:
+                duplicate = key in seen
+            except TypeError:  # an unhashable key: the safe loader refuses it below
+                continue
+            if duplicate:
+                raise yaml.constructor.ConstructorError(None, None, f"found duplicate key {key!r}", key_node.start_mark)
+            seen.add(key)
+        return super().construct_mapping(node, deep)
 
 
 def decode_text(raw: bytes, what: str) -> str:

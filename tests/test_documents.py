@@ -24,6 +24,33 @@ def test_bad_content_names_file_and_format(tmp_path, name, text, message):
         load_document(path)
 
 
+@pytest.mark.parametrize(
+    ("name", "text", "message"),
+    [
+        ("a.json", '{"robot": 1, "name": "x", "robot": 2}', r"not valid JSON \(duplicate key 'robot'\)"),
+        ("a.json", '{"map": {"resolution": 1, "resolution": 2}}', r"not valid JSON \(duplicate key 'resolution'\)"),
+        ("a.yaml", "robot: 1\nname: x\nrobot: 2\n", r"not valid YAML \(found duplicate key 'robot' at line 3"),
+        (
+            "a.yaml",
+            "map:\n  resolution: 1\n  resolution: 2\n",
+            r"not valid YAML \(found duplicate key 'resolution' at line 3",
+        ),
+    ],
+)
+def test_a_key_given_twice_is_refused(tmp_path, name, text, message):
+    # The parsers would keep the last value silently (a second `robot:` replacing the first goal).
+    path = tmp_path / name
+    path.write_text(text)
+    with pytest.raises(ValueError, match=rf"{name}: {message}"):
+        load_document(path)
+
+
+def test_yaml_merge_keys_may_still_be_overridden(tmp_path):
+    path = tmp_path / "a.yaml"
+    path.write_text("base: &b {x: 1, y: 2}\nother:\n  <<: *b\n  x: 5\n")
+    assert load_document(path) == {"base": {"x": 1, "y": 2}, "other": {"x": 5, "y": 2}}
+
+
 def test_missing_file_names_what_was_expected(tmp_path):
     with pytest.raises(ValueError, match="missing.json: cannot read scenario file"):
         load_document(tmp_path / "missing.json", "scenario file")
