@@ -24,7 +24,7 @@ from costmap.layers.social import SocialParams
 from costmap.layers.tracked import TrackedPeopleParams
 from costmap.mapfile import MapFileError, read_map
 from costmap.occupancy import OccupancyGrid
-from costmap.plugins import PLUGINS, CostmapParams
+from costmap.plugins import PEOPLE_LAYERS, PLUGINS, CostmapParams
 from sid.checks import LimitError, check_limit
 from sid.documents import InputWarning, is_number, load_document
 from sid.perception.groups import GroupParams
@@ -187,12 +187,16 @@ def _params(value: Any, name: str, cls: type) -> Any:
 
 
 def _plugins(value: Any, name: str) -> tuple[str, ...]:
-    """Layer names in combination order, each a key of ``costmap.plugins.PLUGINS``."""
+    """Layer names in combination order, each a key of ``costmap.plugins.PLUGINS``, at least one of them a layer
+    that marks people (the LiDAR's or a people layer): without one the robot would plan through them."""
     if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
         raise _fail(name, "a list of layer names", value)
     for i, layer in enumerate(value):
         if layer not in PLUGINS:
             raise ScenarioError(f"{name}[{i}]: unknown layer {layer!r}; known layers: {', '.join(PLUGINS)}")
+    marking = ("lidar", *sorted(PEOPLE_LAYERS))
+    if not set(value) & set(marking):
+        raise ScenarioError(f"{name}: {value} has no layer that marks people; list one of {', '.join(marking)}")
     return tuple(value)
 
 

@@ -335,6 +335,8 @@ def test_a_scenario_names_its_layers_in_order(tmp_path):
         (["lidar", "sonar"], r"layers\.plugins\[1\]: unknown layer 'sonar'"),
         (["lidar", "lidar"], r"layers\.plugins: a layer is listed twice"),
         ("lidar", r"layers\.plugins: expected a list of layer names"),
+        ([], r"layers\.plugins: \[\] has no layer that marks people; list one of lidar, social, tracked_people"),
+        (["static", "inflation"], r"layers\.plugins: \['static', 'inflation'\] has no layer that marks people"),
     ):
         with pytest.raises(ScenarioError, match=message):
             scenario_from_dict({**data, "layers": {"plugins": plugins}}, base_dir=tmp_path)
