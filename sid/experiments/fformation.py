@@ -152,12 +152,11 @@ def unit_warning(frames: Sequence[LabelledFrame], scale: float) -> str | None:
     if gap is None or low <= gap <= high:
         return None
     raw = gap / scale  # the median gap in the file's own units
-    unit, fit = min(UNIT_SCALES.items(), key=lambda item: abs(math.log10(raw * item[1])))
-    hint = (
-        f"the file's units look like {unit}, scale {fit:g}"
-        if low <= raw * fit <= high and fit != scale
-        else "check the file's units"
-    )
+    hint = "check the file's units"
+    if raw > 0:  # 0: most people share their position with another, which no scale mends
+        unit, fit = min(UNIT_SCALES.items(), key=lambda item: abs(math.log10(raw * item[1])))
+        if low <= raw * fit <= high and fit != scale:
+            hint = f"the file's units look like {unit}, scale {fit:g}"
     return (
         f"scaled by {scale:g}, the median distance from a person to their nearest neighbour is {gap:.3g} m, "
         f"implausible for people (expected {low:g}-{high:g} m); {hint}"

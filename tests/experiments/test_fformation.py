@@ -234,6 +234,8 @@ def test_unit_warning_names_the_scale_that_fits(tiny):
     assert "metres, scale 1" in str(unit_warning(load_dataset(tiny, 0.0001), 0.01))
     assert "check the file's units" in str(unit_warning(load_dataset(tiny, 1e-6), 1.0))
     assert unit_warning([], 1.0) is None
+    stacked = [replace(f, people=[replace(p, x=0.0, y=0.0) for p in f.people]) for f in load_dataset(tiny, 0.01)]
+    assert "is 0 m, implausible for people" in str(unit_warning(stacked, 0.01))  # no scale mends it
 
 
 def test_missing_members_counts_truth_ids_absent_from_their_frame(tiny):
