@@ -42,6 +42,9 @@ DEFAULT_COST_WEIGHT = 4.0
 """w in J = integral of (1 + w c / 252) ds; see the module docstring. 4: on the demo scenario the smallest weight
 tried that keeps the whole path beyond Hall's personal distance (1.2 m) of every member, for a few per cent of
 length; smaller weights cut through the conversation or graze it (docs/parameters.md)."""
+MAX_COST_WEIGHT = 1000.0
+"""The largest w accepted: a metre through the costliest free cell then costs 1001 m, past any detour a map offers;
+a larger w only overflows the cost sums (1e308 did)."""
 
 
 class PlanningError(ValueError):
@@ -67,7 +70,9 @@ class PlanningProblem:
                 raise PlanningError(f"{name} must be two finite world coordinates (x, y) in metres, got {xy}")
             object.__setattr__(self, name, xy)
         check_number("planning problem", "robot_radius", self.robot_radius, low=0, unit="metres", error=PlanningError)
-        check_number("planning problem", "cost_weight", self.cost_weight, low=0, error=PlanningError)
+        check_number(
+            "planning problem", "cost_weight", self.cost_weight, low=0, high=MAX_COST_WEIGHT, error=PlanningError
+        )
 
 
 @dataclass

@@ -369,7 +369,9 @@ def test_planner_names_and_prm_exclusion():
         resolve_planner("astar")
 
 
-@pytest.mark.parametrize("bad", [dict(start=(math.nan, 1.0)), dict(robot_radius=-0.1), dict(cost_weight=math.inf)])
+@pytest.mark.parametrize(
+    "bad", [dict(start=(math.nan, 1.0)), dict(robot_radius=-0.1), dict(cost_weight=math.inf), dict(cost_weight=1e308)]
+)
 def test_bad_problem_values_are_rejected(bad):
     args = dict(costmap=walled_map(), start=(1.0, 2.0), goal=(9.0, 6.0), robot_radius=RADIUS) | bad
     with pytest.raises(PlanningError):
