@@ -63,7 +63,7 @@ def run(args: argparse.Namespace) -> int:
             f"crosses a group: {'yes' if m['crosses_group'] else 'no'}, closest person {closest}, "
             f"planning {m['planning_time_s']:.2f} s"
         )
-    if r.seed is not None:
+    if r.seed is not None and r.iterations > 0:  # no iteration ran within --time: nothing to repeat
         print(f"repeat exactly: --seed {r.seed} --iterations {r.iterations} --time {max(10.0, 4 * args.time):g}")
     print_written(files.values())
     return 0 if r.success else 1

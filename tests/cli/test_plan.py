@@ -42,6 +42,14 @@ def test_plan_writes_path_and_picture(tmp_path, capsys):
     assert "repeat exactly: --seed 3 --iterations" in printed and "wrote" in printed
 
 
+def test_a_plan_stopped_before_its_first_iteration_suggests_no_repeat(tmp_path, capsys):
+    # "--iterations 0" used to be suggested, which sid plan itself refuses.
+    out = tmp_path / "out"
+    code = main(["plan", write_scenario(tmp_path), "--out", str(out), "--planner", "rrtconnect", "--time", "1e-300"])
+    printed = capsys.readouterr().out
+    assert code == 1 and "found no path" in printed and "repeat exactly" not in printed
+
+
 def test_plan_without_social_layer_crosses_the_conversation(tmp_path):
     out = tmp_path / "out"
     assert main(["plan", write_scenario(tmp_path), "--out", str(out), "--no-social", "--planner", "grid"]) == 0
