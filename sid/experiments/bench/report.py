@@ -27,7 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from sid.cpu import physical_cores, usable_cpus
-from sid.documents import load_document
+from sid.documents import is_number, load_document
 
 FORMAT = "sid-bench/1"
 LIBRARIES = ("numpy", "scipy", "scikit-learn", "shapely", "opencv-python-headless", "onnxruntime", "ompl",
@@ -108,8 +108,9 @@ def load_report(path: str | Path) -> dict[str, Any]:
     if not isinstance(stages, dict):
         raise ValueError(f'bench: {path} is not a sid bench report (no "stages" object)')
     for name, stage in stages.items():
-        if not isinstance(stage, dict) or not isinstance(stage.get("median_ms"), int | float):
-            raise ValueError(f'bench: {path}: stage {name!r} has no numeric "median_ms"')
+        median = stage.get("median_ms") if isinstance(stage, dict) else None
+        if not is_number(median) or median <= 0:  # a ratio against 0, NaN or inf means nothing
+            raise ValueError(f'bench: {path}: stage {name!r} has no positive "median_ms", got {median!r}')
     return data
 
 

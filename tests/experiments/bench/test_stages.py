@@ -105,9 +105,10 @@ def test_compare_prints_change_per_stage(tmp_path, capsys):
 
 def test_bad_compare_file_and_unknown_stage_are_clear_errors(tmp_path, capsys):
     bad = tmp_path / "bad.json"
-    bad.write_text('{"stages": {"x": {"median_ms": "fast"}}}')
-    assert main(["bench", "--quick", "--compare", str(bad), "--out", str(tmp_path)]) == 2
-    assert "stage 'x' has no numeric \"median_ms\"" in capsys.readouterr().err
+    for median in ('"fast"', "NaN", "0"):  # a ratio against NaN or 0 printed "nan" or "inf slower"
+        bad.write_text('{"stages": {"x": {"median_ms": ' + median + "}}}")
+        assert main(["bench", "--quick", "--compare", str(bad), "--out", str(tmp_path)]) == 2
+        assert "stage 'x' has no positive \"median_ms\"" in capsys.readouterr().err
     assert main(["bench", "--quick", "--compare", str(tmp_path / "missing.json"), "--out", str(tmp_path)]) == 2
     assert "cannot read" in capsys.readouterr().err
     assert main(["bench", "--quick", "--only", "nothing/here", "--out", str(tmp_path)]) == 2
