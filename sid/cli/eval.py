@@ -12,6 +12,7 @@ from pathlib import Path
 
 from sid.cli.groups import add_group_params, group_params_from
 from sid.experiments.fformation import (
+    DEFAULT_GRID,
     DEFAULT_THRESHOLDS,
     Fold,
     LabelledFrame,
@@ -20,6 +21,7 @@ from sid.experiments.fformation import (
     missing_members,
     parse_threshold,
     unit_warning,
+    with_facing_noise,
 )
 from sid.experiments.fformation import evaluate as evaluate_fformation
 
@@ -67,6 +69,19 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="cross-validate instead: for each DIR left out, choose the values (of these GroupParams fields, e.g. "
         "group_price=0.5,0.65,0.8) with the best mean F1 at the first T on the other DIRs, and score them on it",
     )
+    grid_text = " ".join(f"{k}={','.join(f'{v:g}' for v in vs)}" for k, vs in DEFAULT_GRID.items())
+    ff.add_argument(
+        "--cross-validate",
+        action="store_true",
+        help=f"leave one DIR out at a time over the grid that chose the defaults ({grid_text}; --grid sets another)",
+    )
+    ff.add_argument(
+        "--facing-noise",
+        type=float,
+        default=0.0,
+        metavar="DEG",
+        help="add seeded Gaussian noise of this standard deviation (degrees) to every facing first (default 0)",
+    )
     add_group_params(ff)
     ff.set_defaults(func=run)
     add_tracking_parser(tasks)
@@ -102,9 +117,12 @@ def run(args: argparse.Namespace) -> int:
             name = _dataset_name(folder, datasets)
             datasets[name] = load_dataset(folder, scale, args.degrees)
             _warn_about_data(name, datasets[name], scale)
-        if args.grid:
-            folds, table = cross_validate(datasets, dict(args.grid), params, args.thresholds[0])
-            print(_folds(folds, table) if args.table else json.dumps(_folds_json(folds, table, args.grid), indent=2))
+            if args.facing_noise:
+                datasets[name] = with_facing_noise(datasets[name], math.radians(args.facing_noise))
+        grid = args.grid or ([(k, list(v)) for k, v in DEFAULT_GRID.items()] if args.cross_validate else None)
+        if grid:
+            folds, table = cross_validate(datasets, dict(grid), params, args.thresholds[0])
+            print(_folds(folds, table) if args.table else json.dumps(_folds_json(folds, table, grid), indent=2))
             return 0
         scores = evaluate_fformation(datasets, params, args.thresholds)
     except ValueError as exc:

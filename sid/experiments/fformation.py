@@ -36,6 +36,16 @@ from sid.perception.groups import GroupParams, detect_groups
 from sid.perception.people import Person
 
 DEFAULT_THRESHOLDS: tuple[float, ...] = (2 / 3, 1.0)
+DEFAULT_GRID: dict[str, tuple[float, ...]] = {
+    "alone_price": (0.5, 0.65, 0.8),
+    "group_price": (0.5, 0.65, 0.8, 1.0),
+    "facing_slack": (0.3, 0.4, 0.5),
+    "angular_weight": (0.35, 0.5, 0.75),
+    "radius_max": (0.8, 1.0),
+    "body_radius": (0.1, 0.2),
+}
+"""The o-space parameters ``sid eval fformation --cross-validate`` chooses among, the grid that chose the
+defaults (docs/groups.md)."""
 YAW_LIMIT_RAD = 4 * math.pi
 """No yaw in radians is written beyond two turns (an unwrapped ``a + pi`` stays well within); a file whose yaws go
 beyond is in degrees."""
@@ -115,6 +125,22 @@ def _frame_index(timestamps: np.ndarray) -> dict[float, int]:
     values, counts = np.unique(single, return_counts=True)
     unique = set(values[counts == 1].tolist())
     return {float(s): k for k, s in enumerate(single) if s in unique and s not in index} | index
+
+
+def with_facing_noise(frames: Sequence[LabelledFrame], sigma: float, seed: int = 0) -> list[LabelledFrame]:
+    """``frames`` with Gaussian noise of standard deviation ``sigma`` (rad) added to every known facing, drawn from
+    one generator seeded with ``seed``, frame by frame and person by person in order (the same noise on every run)."""
+    check_number("fformation", "facing noise", sigma, low=0, unit="radians")
+    rng = np.random.default_rng(seed)
+    noisy = []
+    for frame in frames:
+        draws = rng.normal(0.0, sigma, len(frame.people)).tolist()
+        people = [
+            dataclasses.replace(p, theta=None if p.theta is None else p.theta + d)
+            for p, d in zip(frame.people, draws, strict=True)
+        ]
+        noisy.append(dataclasses.replace(frame, people=people))
+    return noisy
 
 
 def load_dataset(folder: str | Path, scale: float = 1.0, degrees: bool = False) -> list[LabelledFrame]:

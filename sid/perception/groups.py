@@ -1,10 +1,12 @@
-"""Conversational groups: records, and detection by one of three methods (``GroupParams.method``).
+"""Conversational groups: records, and detection by one of four methods (``GroupParams.method``).
 
 All coordinates are in the world frame (metres, REP-103, see ``sid.perception.people``); angles in radians.
 
 - ``ospace`` (default): people are assigned to shared o-spaces by minimising a description-length cost
   (``sid.perception.ospace``; docs/groups.md); each group's zone, interest point and spread are then those of the
   paper (below), computed on its members' rays, or the fitted o-space centre when no two members' rays meet.
+- ``gcff``: the graph-cut detector of Setti et al. 2015 (``sid.perception.gcff``), the literature's reference,
+  with one stride and description length for every scene; zones as for ``ospace``.
 - ``rays``: the paper's Algorithm 1 with the two additions described below.
 - ``paper``: the literal Algorithm 1, one candidate per DBSCAN cluster (``rays`` with ``meeting_radius=math.inf``).
 
@@ -50,6 +52,7 @@ import numpy as np
 
 from sid.checks import check_number, check_numbers
 from sid.perception.cluster import dbscan_labels
+from sid.perception.gcff import GCFFParams, gcff_labels
 from sid.perception.ospace import OSpaceModel, find_ospaces
 from sid.perception.people import Person
 
@@ -69,18 +72,27 @@ _BY_X_THEN_Y = operator.attrgetter("real", "imag")
 _UNKNOWN_FACING = complex(math.nan, math.nan)
 
 
-GROUP_METHODS = ("ospace", "rays", "paper")
+GROUP_METHODS = ("ospace", "gcff", "rays", "paper")
 
 
 @dataclass(frozen=True)
 class GroupParams:
     """Parameters of the group detector (metres, square metres, radians).
 
-    Defaults come from the geometry of conversations; the F-formation benchmarks then checked that none sits on a
-    cliff (scores and one-at-a-time sensitivity: docs/parameters.md; the o-space method: docs/groups.md).
+    The o-space method's defaults were chosen by leave-one-dataset-out cross-validation over the four F-formation
+    benchmarks (``sid eval fformation --cross-validate``, docs/groups.md); the ray methods' come from the geometry
+    of conversations, checked one at a time on the benchmarks (docs/parameters.md).
 
-    method: 'ospace' (people assigned to shared o-spaces, the default), 'rays' (the paper's ray crossings with two
-      additions) or 'paper' (Algorithm 1 as written); the module docstring says more.
+    method: 'ospace' (people assigned to shared o-spaces, the default), 'gcff' (Setti et al.'s graph cuts),
+      'rays' (the paper's ray crossings with two additions) or 'paper' (Algorithm 1 as written); the module
+      docstring says more.
+
+    The graph-cut method (``method='gcff'``, ``sid.perception.gcff``):
+
+    gcff_stride: distance (m) ahead of each person at which they vote for the o-space centre. 0.45, the published
+      detector's common setting.
+    gcff_mdl: description length (m^2) of one o-space and of each person alone. 3.0 (30000 cm^2), the common
+      setting.
 
     The o-space method (``method='ospace'``):
 
@@ -89,10 +101,16 @@ class GroupParams:
     radius_max: largest o-space radius R (m). 0.8: n people on a circle 0.8-1 m apart have radius
       1 / (2 sin(pi / n)) (0.8-1.0 m at n = 6); chosen by cross-validation among 0.8-1.0 (docs/groups.md).
     radius_steps: proposals per person, at radii evenly spaced over that range. 4: one per 0.2 m.
-    group_price: price (m^2) of describing a group, and of each person left alone: two people form a group only
-      when the squared distances of their proposals p + R f from the centre sum to less than it (n people: n - 1
-      prices). Chosen by
+    group_price: price (m^2) of describing a group: n people form one when their costs and this price sum to less
+      than n alone prices. Chosen by cross-validation (docs/groups.md).
+    alone_price: price (m^2) of each person left alone, and so the most one member's cost may be. Chosen by
       cross-validation (docs/groups.md).
+    facing_slack: half-width (rad) of the cone within which a facing counts as pointing at the centre: facings
+      are estimates (a head turned from the body, a tracker's noise). Facings quantised to a few directions get
+      half their step if that is wider: a frame whose facings all differ by whole multiples of 90, 45, 30, 22.5 or
+      15 degrees is taken as quantised to the largest of these. Chosen by cross-validation (docs/groups.md).
+    angular_weight: weight of a member's facing against standing on the circle, 1 being GCFF's proposal distance.
+      Chosen by cross-validation (docs/groups.md).
     unknown_facing_cost: a person without facing may join a group formed by others when standing on its circle; the
       unexplained facing costs as much as a proposal this far (m) from the centre. 0.5: its square, 0.25 m^2, leaves
       room under the price for standing 0.6 m off the circle; a doubtful facing then gains nothing over a clear one
@@ -130,10 +148,15 @@ class GroupParams:
     radius_min: float = 0.3
     radius_max: float = 0.8
     radius_steps: int = 4
-    group_price: float = 0.65
+    group_price: float = 0.8
+    alone_price: float = 0.65
+    facing_slack: float = 0.4
+    angular_weight: float = 0.35
     unknown_facing_cost: float = 0.5
     body_radius: float = 0.1
     facing_weight_floor: float = 0.5
+    gcff_stride: float = 0.45
+    gcff_mdl: float = 3.0
     eps: float = 2.0
     min_samples: int = 2
     area_threshold: float = 0.5
@@ -146,7 +169,9 @@ class GroupParams:
         if self.method not in GROUP_METHODS:
             raise ValueError(f"groups: method must be one of {', '.join(GROUP_METHODS)}, got {self.method!r}")
         self.ospace_model  # noqa: B018 - builds (and so checks) the o-space fields, once per record
+        self.gcff_params  # noqa: B018 - likewise the graph-cut fields
         check_number("groups", "facing_weight_floor", self.facing_weight_floor, low=0, low_open=True, high=1)
+        check_number("groups", "facing_slack", self.facing_slack, low=0, high=math.pi)
         check_numbers("groups", self, ("eps", "spread_threshold", "ray_length"), low=0, low_open=True, unit="metres")
         check_number("groups", "area_threshold", self.area_threshold, low=0, unit="square metres")
         if isinstance(self.min_samples, bool) or int(self.min_samples) != self.min_samples or self.min_samples < 1:
@@ -159,6 +184,14 @@ class GroupParams:
         check_number("groups", "facing_tolerance", self.facing_tolerance, low=0, high=right_angle, high_open=True)
 
     @cached_property
+    def gcff_params(self) -> GCFFParams:
+        """The graph-cut method's constants (ValueError naming a bad field); built once per record."""
+        try:
+            return GCFFParams(stride=self.gcff_stride, mdl=self.gcff_mdl)
+        except ValueError as exc:
+            raise ValueError(str(exc).replace("gcff: ", "groups: gcff_", 1)) from None
+
+    @cached_property
     def ospace_model(self) -> OSpaceModel:
         """The o-space method's constants (ValueError naming a bad field); built once per record."""
         try:
@@ -169,6 +202,8 @@ class GroupParams:
                 self.group_price,
                 self.unknown_facing_cost,
                 self.body_radius,
+                self.alone_price,
+                self.angular_weight,
             )
         except ValueError as exc:
             names = {"price": "group_price", "unknown_cost": "unknown_facing_cost"}
@@ -222,6 +257,8 @@ def detect_groups(people: Sequence[Person], params: GroupParams = GroupParams())
         return []
     if params.method == "ospace":
         return _ospace_groups(people, ids, positions, facing, params)
+    if params.method == "gcff":
+        return _gcff_groups(people, positions, facing, params)
     if params.method == "paper" and not math.isinf(params.meeting_radius):
         params = replace(params, meeting_radius=math.inf)
     position_array, facing_array = np.array(positions, dtype=complex), np.array(facing, dtype=complex)
@@ -242,19 +279,64 @@ def _ospace_groups(
 ) -> list[Group]:
     """The o-space method's groups, each with the paper's zone geometry on its members' rays (see the module
     docstring), or the fitted o-space centre when no two members' rays meet. On Python numbers: a frame's groups
-    have a handful of members, for which numpy's overhead per call outweighs the work."""
+    have a handful of members, for which numpy's overhead per call outweighs the work.
+
+    The search sees the people sorted by id, their positions measured from their mean, and breaks ties by that
+    order: the same people, permuted, moved or turned, give the same groups."""
     floor = params.facing_weight_floor
-    weight = [floor + (1.0 - floor) * min(max(p.orientation_quality, 0.0), 1.0) for p in people]
-    found = find_ospaces(positions, facing, weight, params.ospace_model)
-    members = [ospace.members.tolist() for ospace in found]
+    order = sorted(range(len(people)), key=ids.__getitem__)
+    origin = complex(math.fsum(positions[i].real for i in order), math.fsum(positions[i].imag for i in order))
+    origin /= len(order)
+    thetas = [people[i].theta for i in order]
+    spread = max(params.facing_slack, 0.5 * facing_step(thetas))
+    found = find_ospaces(
+        [positions[i] - origin for i in order],
+        [facing[i] for i in order],
+        [floor + (1.0 - floor) * min(max(people[i].orientation_quality, 0.0), 1.0) for i in order],
+        params.ospace_model,
+        [spread] * len(order),
+    )
+    members = [sorted(order[k] for k in ospace.members.tolist()) for ospace in found]
+    centres = [ospace.centre + origin for ospace in found]
+    ranked = sorted(range(len(found)), key=lambda g: members[g][0])  # groups in order of their first member
+    return _zoned([members[g] for g in ranked], [centres[g] for g in ranked], ids, positions, facing, params)
+
+
+def _gcff_groups(
+    people: list[Person], positions: list[complex], facing: list[complex], params: GroupParams
+) -> list[Group]:
+    """The graph-cut method's groups, with the o-space method's zones; a group whose members' rays do not meet
+    gets the mean of its members' votes (position + stride x facing, known facings only) as its centre."""
+    labels = gcff_labels(
+        np.array([(p.real, p.imag) for p in positions]),
+        np.array([math.nan if p.theta is None else p.theta for p in people]),
+        params.gcff_params,
+    ).tolist()
+    members = [[j for j, label in enumerate(labels) if label == g] for g in range(max(labels, default=-1) + 1)]
+    stride = params.gcff_stride
+    votes = [[positions[j] + stride * facing[j] for j in group if facing[j] == facing[j]] for group in members]
+    centres = [sum(v, 0j) / len(v) for v in votes]
+    return _zoned(members, centres, [p.id for p in people], positions, facing, params)
+
+
+def _zoned(
+    members: list[list[int]],
+    centres: list[complex],
+    ids: list[int],
+    positions: list[complex],
+    facing: list[complex],
+    params: GroupParams,
+) -> list[Group]:
+    """Groups of the given members (indices, ascending) with the paper's zone geometry on their rays (module
+    docstring), or ``centres`` (complex, m) where no two members' rays meet."""
     groups = []
-    for ospace, group, crossings in zip(
-        found, members, _member_crossings(positions, facing, members, params), strict=True
+    for fallback, group, crossings in zip(
+        centres, members, _member_crossings(positions, facing, members, params), strict=True
     ):
         if crossings:
             area, centre, zone = _zone(crossings)
         else:  # no two members' rays meet: the fitted o-space centre
-            area, centre = 0.0, ospace.centre
+            area, centre = 0.0, fallback
             zone = np.array([[centre.real, centre.imag]])
         groups.append(
             Group(
@@ -266,6 +348,25 @@ def _ospace_groups(
             )
         )
     return groups
+
+
+QUANTISED_STEPS = tuple(math.radians(d) for d in (90.0, 45.0, 30.0, 22.5, 15.0))
+"""Steps (rad) of the facing quantisations ``facing_step`` recognises, coarsest first."""
+_STEP_RESIDUAL = 1e-3  # rad: a difference of facings this close to a whole number of steps is one
+
+
+def facing_step(thetas: Sequence[float | None]) -> float:
+    """The step (rad) to which the known facings among ``thetas`` (yaws, rad) are quantised: the coarsest of
+    ``QUANTISED_STEPS`` of which every difference between two of them is a whole multiple, or 0 (continuous
+    facings, or fewer than two known). Differences, not the yaws themselves: turning the scene keeps the step."""
+    known = [t for t in thetas if t is not None]
+    if len(known) < 2:
+        return 0.0
+    reference = known[0]
+    for step in QUANTISED_STEPS:
+        if all(abs(d - step * round(d / step)) <= _STEP_RESIDUAL for d in (t - reference for t in known[1:])):
+            return step
+    return 0.0
 
 
 def _validated(people: list[Person]) -> tuple[list[int], list[complex], list[complex]]:

@@ -2,19 +2,26 @@
 
 The model (after the F-formation literature: Setti et al.'s graph-cut detector, PLoS One 2015; written here from
 its description, no code taken). An o-space is a circle (centre c, radius R) that its members stand on and face.
-Person j with position p_j and unit facing f_j *proposes* the centre p_j + R f_j; joining o-space (c, R) costs
+Person j at p_j, rho_j = |c - p_j| from the centre, whose unit facing f_j turns phi_j away from the direction to
+the centre, joins o-space (c, R) at a cost (m^2) of
 
-    known facing:    e_j = |p_j + R f_j - c|^2                       (m^2)
-    unknown facing:  u_j = (|p_j - c| - R)^2 + unknown_cost^2        (m^2: stands on the circle, facing unexplained)
+    known facing:    e_j = (rho_j - R)^2 + a 2 R rho_j (1 - cos(max(0, phi_j - s_j)))
+    unknown facing:  u_j = (rho_j - R)^2 + unknown_cost^2           (stands on the circle, facing unexplained)
     doubtful facing: w_j e_j + (1 - w_j) u_j, w_j the facing weight in [0, 1]
 
-and each o-space is charged a price (m^2) for being described, as is every person left alone, so that two people
-form a group only when their two costs sum to less than one price (a minimum-description-length choice). A member
-whose straight line to the centre passes within ``body_radius`` of another person is refused: the o-space is
-exclusive, nobody stands between a member and the centre.
+With a = 1 and s_j = 0, e_j is |p_j + R f_j - c|^2, the squared distance of the centre from the person's
+*proposal* p_j + R f_j (GCFF's vote). s_j, the facing's slack (rad), widens the facing into a cone: a facing known
+only to within s_j costs nothing while the centre lies inside the cone (quantised facings, a head turned from the
+body); a (``angular_weight``) weighs the facing against standing on the circle.
 
-Unlike a fixed stride, each o-space takes its own radius from the data: given its members, the c and R that
-minimise the weighted sum of e_j are closed-form (c = mean proposal, R a one-dimensional least squares, clamped to
+Each o-space is charged a price (m^2) for being described, and every person left alone another (``alone_price``),
+so that two people form a group when their two costs and the group's price sum to less than two people alone (a
+minimum-description-length choice). A member whose straight line to the centre passes within ``body_radius`` of
+another person is refused: the o-space is exclusive, nobody stands between a member and the centre.
+
+Unlike a fixed stride, each o-space takes its own radius from the data: given its members and each member's
+facing turned into its cone towards the centre (f'_j), the c and R that minimise the weighted sum of
+|p_j + R f'_j - c|^2 are closed-form (c = mean proposal, R a one-dimensional least squares, clamped to
 [radius_min, radius_max]). The search alternates two steps until the partition is stable:
 
 1. assignment: candidate o-spaces are opened greedily by largest saving (the standard greedy heuristic for this
@@ -28,8 +35,12 @@ facing open an o-space and a group needs two of them; people with unknown facing
 Two implementations of the same arithmetic, cross-checked by the tests: a crowd runs on numpy arrays,
 candidate-major (row k lists the people within reach of candidate k's centre, a KD-tree's answer), so the work grows
 with the number of people near each candidate, not with N^2; a small scene runs on Python numbers, where numpy's
-overhead per call would outweigh the work. Nothing depends on the input order except the breaking of exact ties
-(lowest index first).
+overhead per call would outweigh the work.
+
+Every comparison that decides who joins whom treats values within a relative ``TIE`` of each other as equal and
+then takes the lowest index: callers that number people canonically (``sid.perception.groups`` sorts them by id
+and measures positions from their mean) get the same groups whatever the order, position or heading of the scene,
+as rounding moves the values by far less than ``TIE``.
 """
 
 from __future__ import annotations
@@ -49,6 +60,9 @@ from sid.checks import check_number
 
 # Greedy assignment and refit rounds at most; the partition is stable after 2-4 on the benchmarks.
 _MAX_ROUNDS = 8
+TIE = 1e-9
+"""Relative difference (of the price) under which two costs or savings count as equal, and a cost as on a
+threshold: rounding after a rigid motion of the scene moves them by ~1e-15."""
 # Up to this many people the search runs on Python numbers (``_find_small``): a handful of people make a few dozen
 # candidates, and numpy's overhead per call outweighs the arithmetic. Above it, numpy arrays and a KD-tree finding
 # who is within reach of each candidate (the exclusivity test grows with the square of the people listed).
@@ -65,13 +79,17 @@ class OSpaceModel:
     price: float
     unknown_cost: float
     body_radius: float
+    alone_price: float
+    angular_weight: float = 1.0
 
     def __post_init__(self) -> None:
         check_number("ospace", "radius_min", self.radius_min, low=0, low_open=True, unit="metres")
         check_number("ospace", "radius_max", self.radius_max, low=self.radius_min, unit="metres")
         check_number("ospace", "price", self.price, low=0, low_open=True, unit="square metres")
+        check_number("ospace", "alone_price", self.alone_price, low=0, low_open=True, unit="square metres")
         check_number("ospace", "unknown_cost", self.unknown_cost, low=0, unit="metres")
         check_number("ospace", "body_radius", self.body_radius, low=0, unit="metres")
+        check_number("ospace", "angular_weight", self.angular_weight, low=0, low_open=True)
         if isinstance(self.radius_steps, bool) or int(self.radius_steps) != self.radius_steps or self.radius_steps < 1:
             raise ValueError(f"ospace: radius_steps must be an integer >= 1, got {self.radius_steps}")
 
@@ -88,8 +106,9 @@ class OSpaceModel:
 
     @cached_property
     def reach(self) -> float:
-        """Distance (m) from a centre beyond which nobody can join it: every cost term is at least (|p - c| - R)^2."""
-        return self.radius_max + math.sqrt(self.price)
+        """Distance (m) from a centre beyond which nobody can join it: every cost is at least (|p - c| - R)^2, and
+        nobody joins at a cost above ``alone_price``."""
+        return self.radius_max + math.sqrt(self.alone_price)
 
     @cached_property
     def reach_squared(self) -> float:
@@ -113,18 +132,30 @@ class OSpace:
 
 
 def find_ospaces(
-    positions: Sequence[complex], facing: Sequence[complex], weight: Sequence[float], model: OSpaceModel
+    positions: Sequence[complex],
+    facing: Sequence[complex],
+    weight: Sequence[float],
+    model: OSpaceModel,
+    slack: Sequence[float] | None = None,
 ) -> list[OSpace]:
     """Groups of two or more among people at ``positions`` (complex x + iy, m) with unit ``facing`` (complex, NaN
-    when unknown) and facing weights in (0, 1]; ordered by their lowest member index."""
+    when unknown), facing weights in (0, 1] and facing slacks in [0, pi] (rad, 0 when not given); ordered by their
+    lowest member index."""
+    slack = [0.0] * len(positions) if slack is None else slack
     if len(positions) <= _SMALL_PEOPLE_MAX:
-        return _find_small(list(positions), list(facing), list(weight), model)
+        return _find_small(list(positions), list(facing), list(weight), list(slack), model)
     return _find_crowd(
-        np.array(positions, dtype=complex), np.array(facing, dtype=complex), np.array(weight, dtype=float), model
+        np.array(positions, dtype=complex),
+        np.array(facing, dtype=complex),
+        np.array(weight, dtype=float),
+        np.array(slack, dtype=float),
+        model,
     )
 
 
-def _find_crowd(positions: np.ndarray, facing: np.ndarray, weight: np.ndarray, model: OSpaceModel) -> list[OSpace]:
+def _find_crowd(
+    positions: np.ndarray, facing: np.ndarray, weight: np.ndarray, slack: np.ndarray, model: OSpaceModel
+) -> list[OSpace]:
     """``find_ospaces`` on numpy arrays, candidate-major, with a KD-tree listing the people within reach."""
     from scipy.spatial import cKDTree
 
@@ -138,9 +169,8 @@ def _find_crowd(positions: np.ndarray, facing: np.ndarray, weight: np.ndarray, m
     first_owner = owners.repeat(len(radii))
     first_radii = radii[None, :].repeat(len(owners), axis=0).ravel()
     first_centres = positions[first_owner] + first_radii * f[first_owner]
-    # Per person (rows): x, y (m), facing x, y, weight; and the weighted sums the refit needs, [w p, w f, w <p, f>, w].
-    table = np.array((positions.real, positions.imag, f.real, f.imag, w))
-    moments = np.array((*table[:4], table[0] * table[2] + table[1] * table[3], np.ones(len(w)))) * w
+    # Per person (rows): x, y (m), facing x, y, weight, cosine and sine of the facing's slack.
+    table = np.array((positions.real, positions.imag, f.real, f.imag, w, np.cos(slack), np.sin(slack)))
     known_list = known.tolist()
     tree = cKDTree(table[:2].T)
     centres, rad = first_centres, first_radii
@@ -150,9 +180,9 @@ def _find_crowd(positions: np.ndarray, facing: np.ndarray, weight: np.ndarray, m
         values = table[:, near]
         cost = _costs(values, centres, rad, near >= 0, model)
         previous = labels
-        labels, behind = _canonical(_assign(cost, near, known, model.price).tolist(), known_list)
+        labels, behind = _canonical(_assign(cost, near, known, model).tolist(), known_list)
         label_array = np.array(labels)
-        fitted_centres, fitted_radii = _refit(label_array, moments, rad[behind], model)
+        fitted_centres, fitted_radii = _refit(label_array, table, centres[behind], rad[behind], model)
         if labels == previous:
             break
         alone = label_array[first_owner] < 0
@@ -190,15 +220,20 @@ def _costs(
     values: np.ndarray, centres: np.ndarray, radii: np.ndarray, listed: np.ndarray, model: OSpaceModel
 ) -> np.ndarray:
     """(M, K) cost (m^2) of the person in column a of row k joining candidate k; inf where refused (not ``listed``,
-    blocked, or dearer than standing alone). ``values``: (5, M, K) x, y (m), facing x, y and weight of the listed
-    people. Real arithmetic on x and y: numpy's broadcast complex products are several times slower."""
-    px, py, fx, fy, weight = values
+    blocked, or not cheaper than standing alone). ``values``: (7, M, K) x, y (m), facing x, y, weight and the
+    cosine and sine of the facing's slack of the listed people. Real arithmetic on x and y: numpy's broadcast
+    complex products are several times slower."""
+    px, py, fx, fy, weight, cos_slack, sin_slack = values
     ox, oy = centres.real[:, None] - px, centres.imag[:, None] - py  # from the person to the centre
     r = radii[:, None]
-    proposal = (r * fx - ox) ** 2 + (r * fy - oy) ** 2
-    radial = (np.sqrt(ox**2 + oy**2) - r) ** 2 + model.unknown_cost**2
-    cost = weight * proposal + (1.0 - weight) * radial
-    keep = listed & (cost < model.price)
+    rho = np.sqrt(ox**2 + oy**2)
+    along, across = ox * fx + oy * fy, np.abs(ox * fy - oy * fx)
+    # 2 R rho (1 - cos(phi - s)) = 2 R (rho - along cos s - across sin s) where phi > s (along < rho cos s), else 0.
+    turn = np.where(along < rho * cos_slack, rho - along * cos_slack - across * sin_slack, 0.0)
+    on_circle = (rho - r) ** 2
+    known = on_circle + model.angular_weight * 2.0 * r * np.maximum(turn, 0.0)
+    cost = weight * known + (1.0 - weight) * (on_circle + model.unknown_cost**2)
+    keep = listed & (cost < model.alone_price * (1.0 - TIE))
     if model.body_radius > 0:
         row, column = np.nonzero(keep)
         blocked = _blocked(px, py, ox, oy, listed, row, column, model.body_radius)
@@ -225,43 +260,51 @@ def _blocked(
     length2 = sx**2 + sy**2
     dot = rx * sx + ry * sy
     cross = rx * sy - ry * sx
-    # A person is never between themselves and the centre: dot = 0.
-    between = (dot > 0) & (dot < length2) & (cross**2 < body_radius**2 * length2) & listed[row]
+    # A person is never between themselves and the centre: dot = 0. Someone on the boundary (within TIE) is not.
+    inside = (dot > TIE * length2) & (dot < (1.0 - TIE) * length2)
+    between = inside & (cross**2 < (1.0 - TIE) * body_radius**2 * length2) & listed[row]
     return np.logical_or.reduce(between, axis=1)
 
 
-def _assign(cost: np.ndarray, near: np.ndarray, known: np.ndarray, price: float) -> np.ndarray:
+def _assign(cost: np.ndarray, near: np.ndarray, known: np.ndarray, model: OSpaceModel) -> np.ndarray:
     """The candidate each person joins (-1 alone), minimising, greedily, price x (o-spaces opened) + the members'
-    costs + price x (people alone).
+    costs + alone_price x (people alone).
 
     Each pass opens every candidate with a positive saving that is the favourite (highest saving, then lowest
     index) of all the people it would serve, so candidates opened together serve nobody twice and the best one is
     always among them; passes repeat until no candidate saves anything. Only known facings count towards opening.
+    Savings and costs within ``TIE`` (of the alone price) of each other count as equal.
     """
-    count = len(known)
-    current = np.zeros(count) + price
+    count, tie = len(known), TIE * model.alone_price
+    current = np.zeros(count) + model.alone_price
     opened = np.zeros(len(cost), dtype=bool)
     opener = np.where(known[near], cost, np.inf)
     while True:
         gain = current[near] - opener
-        saving = np.add.reduce(np.maximum(gain, 0.0), axis=1) - price
-        if np.maximum.reduce(saving) <= 0:
+        saving = np.add.reduce(np.where(gain > tie, gain, 0.0), axis=1) - model.price
+        if np.maximum.reduce(saving) <= tie:
             break
-        candidate, column = np.nonzero(gain > 0)
+        candidate, column = np.nonzero(gain > tie)
         person = near[candidate, column]
-        favourite = _first_per_person(person, candidate, -saving[candidate], count)
-        accept = saving > 0
+        favourite = _first_per_person(person, candidate, -saving[candidate], count, tie)
+        accept = saving > tie
         accept[candidate[favourite[person] != candidate]] = False
         opened |= accept
         # Padding (-1) and refused entries are inf in ``opener``: they leave ``current`` as it is.
         np.minimum.at(current, near[accept], opener[accept])
     candidate, column = np.nonzero(opened[:, None] & np.isfinite(cost))
-    return _first_per_person(near[candidate, column], candidate, cost[candidate, column], count)
+    return _first_per_person(near[candidate, column], candidate, cost[candidate, column], count, tie)
 
 
-def _first_per_person(person: np.ndarray, candidate: np.ndarray, key: np.ndarray, count: int) -> np.ndarray:
+def _first_per_person(person: np.ndarray, candidate: np.ndarray, key: np.ndarray, count: int, tie: float) -> np.ndarray:
     """For each of ``count`` people, the candidate of lowest ``key`` among their (person, candidate) pairs, given in
-    ascending candidate order (ties: the lowest, as the sort is stable); -1 for people without a pair."""
+    ascending candidate order; keys within ``tie`` of a person's lowest count as equal to it, and the lowest
+    candidate among those wins; -1 for people without a pair."""
+    lowest = np.full(count, np.inf)
+    np.minimum.at(lowest, person, key)
+    keep = key <= lowest[person] + tie
+    person, candidate = person[keep], candidate[keep]
+    key = candidate  # among the near-lowest, the lowest candidate
     order = np.lexsort((key, person))
     person, candidate = person[order], candidate[order]
     first = np.empty(len(person), dtype=bool)
@@ -290,16 +333,48 @@ def _canonical(choices: list[int], known: list[bool]) -> tuple[list[int], list[i
     return labels, list(number)
 
 
-def _refit(
-    labels: np.ndarray, moments: np.ndarray, radii: np.ndarray, model: OSpaceModel
+def _turned(
+    px: np.ndarray,
+    py: np.ndarray,
+    fx: np.ndarray,
+    fy: np.ndarray,
+    cos_slack: np.ndarray,
+    sin_slack: np.ndarray,
+    cx: np.ndarray,
+    cy: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Per group (labels 0..G-1), the centre (complex, m) and radius (m) minimising sum w_j |p_j + R f_j - c|^2 over
-    its members, R clamped to the model's range; ``moments`` (6, N): w x, w y, w fx, w fy, w <p, f>, w per person;
-    ``radii`` (G,) is kept where the facings do not fix R (all parallel).
+    """Each facing (fx, fy) turned within its cone (slack's cosine and sine) as far towards the centre (cx, cy) as
+    the cone allows: the direction to the centre when it lies inside the cone, else the cone's nearer edge; a
+    facing with the centre straight behind it (within ``TIE``), or on it, is kept. Positions and centres in m."""
+    ox, oy = cx - px, cy - py
+    rho = np.sqrt(ox**2 + oy**2)
+    along, across = ox * fx + oy * fy, fx * oy - fy * ox  # across > 0: the centre lies counter-clockwise
+    inside = (along >= rho * cos_slack) & (rho > 0)
+    side = np.where(across > TIE * rho, 1.0, np.where(across < -TIE * rho, -1.0, 0.0))
+    edge_x = np.where(side == 0, fx, fx * cos_slack - side * fy * sin_slack)
+    edge_y = np.where(side == 0, fy, fy * cos_slack + side * fx * sin_slack)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(inside, ox / rho, edge_x), np.where(inside, oy / rho, edge_y)
 
-    With W = sum w, P = sum w p, F = sum w f (|f| = 1): c = (P + R F) / W and R = -(sum w <p, f> - <P, F> / W) /
+
+def _refit(
+    labels: np.ndarray, table: np.ndarray, centres: np.ndarray, radii: np.ndarray, model: OSpaceModel
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per group (labels 0..G-1), the centre (complex, m) and radius (m) minimising sum w_j |p_j + R f'_j - c|^2
+    over its members, R clamped to the model's range, f'_j member j's facing turned within its cone towards the
+    group's previous centre (``centres``, (G,) complex); ``table`` (7, N): x, y, facing x, y, weight, cosine and
+    sine of the slack per person; ``radii`` (G,) is kept where the facings do not fix R (all parallel).
+
+    With W = sum w, P = sum w p, F = sum w f' (|f'| = 1): c = (P + R F) / W and R = -(sum w <p, f'> - <P, F> / W) /
     (W - |F|^2 / W), <a, b> = Re(a conj(b)).
     """
+    px, py, fx, fy, w, cos_slack, sin_slack = table
+    member = labels >= 0
+    group = np.where(member, labels, 0)
+    previous = centres[group] if len(centres) else np.zeros(len(labels), dtype=complex)
+    tx, ty = _turned(px, py, fx, fy, cos_slack, sin_slack, previous.real, previous.imag)
+    tx, ty = np.where(member & (w > 0), tx, 0.0), np.where(member & (w > 0), ty, 0.0)
+    moments = np.array((px, py, tx, ty, px * tx + py * ty, np.ones(len(w)))) * w
     sums = (labels == np.arange(len(radii))[:, None]) @ moments.T  # (G, 6)
     p_sum, f_sum = sums[:, :4].view(complex).T
     pf_sum, total = sums[:, 4], sums[:, 5]
@@ -313,8 +388,8 @@ def _refit(
 # --- Small scenes: the same search on Python numbers, candidate by candidate -----------------------------------------
 
 
-# Per person: x, y (m), facing x, y (0 when unknown) and facing weight (0 when unknown).
-_Person = tuple[float, float, float, float, float]
+# Per person: x, y (m), facing x, y (0 when unknown), facing weight (0 when unknown), cosine and sine of the slack.
+_Person = tuple[float, float, float, float, float, float, float]
 # Relative slack on the distance bound of the exclusivity test's shortcut, far above rounding (a few 1e-16).
 _SLACK = 1e-9
 
@@ -326,7 +401,7 @@ _Row = tuple[list[tuple[int, float]], float]
 
 
 def _find_small(
-    positions: list[complex], facing: list[complex], weight: list[float], model: OSpaceModel
+    positions: list[complex], facing: list[complex], weight: list[float], slack: list[float], model: OSpaceModel
 ) -> list[OSpace]:
     """``find_ospaces`` on Python numbers (positions and facings complex, NaN facing unknown): the crowd path's
     rounds and arithmetic (``_costs``, ``_assign``, ``_refit``) with each candidate's row kept as a list of the
@@ -336,15 +411,15 @@ def _find_small(
     first: list[tuple[complex, float]] = []  # (centre, radius) of each known facing's first proposals
     first_owner: list[int] = []
     radii = model.radius_list
-    for j, (p, f, w) in enumerate(zip(positions, facing, weight, strict=True)):
+    for j, (p, f, w, s) in enumerate(zip(positions, facing, weight, slack, strict=True)):
         if f == f:  # a known facing: a complex NaN is unequal to itself
             known.append(True)
-            people.append((p.real, p.imag, f.real, f.imag, w))
+            people.append((p.real, p.imag, f.real, f.imag, w, math.cos(s), math.sin(s)))
             first += [(p + r * f, r) for r in radii]
             first_owner += [j] * len(radii)
         else:
             known.append(False)
-            people.append((p.real, p.imag, 0.0, 0.0, 0.0))
+            people.append((p.real, p.imag, 0.0, 0.0, 0.0, 1.0, 0.0))
     if len(first) < 2 * len(radii):
         return []
     scene = _SmallScene(people, known, model)
@@ -353,8 +428,8 @@ def _find_small(
     labels: list[int] = []
     for _ in range(_MAX_ROUNDS):
         previous = labels
-        labels, behind = _canonical(_assign_small(rows, known, model.price), known)
-        fitted = _refit_small(labels, people, [candidates[k][1] for k in behind], model)
+        labels, behind = _canonical(_assign_small(rows, known, model), known)
+        fitted = _refit_small(labels, people, [candidates[k] for k in behind], model)
         if labels == previous:
             break
         alone = [k for k, o in enumerate(first_owner) if labels[o] < 0]
@@ -382,7 +457,8 @@ class _SmallScene:
                     nearest[a] = distance2
                 if distance2 < nearest[b]:
                     nearest[b] = distance2
-        # Per person: index, x, y, facing x, y, weight, squared distance to the nearest other, facing known.
+        # Per person: index, x, y, facing x, y, weight, slack cosine, sine, squared distance to the nearest other,
+        # facing known.
         self._table = [(j, *person, nearest[j], known[j]) for j, person in enumerate(people)]
         self._neighbours: dict[int, list[tuple[float, float, float, int]]] = {}
 
@@ -390,36 +466,43 @@ class _SmallScene:
         """Per candidate o-space (centre complex, radius m), its row (``_Row``): the people who may join it with their
         costs (m^2), the exclusivity test only for those whose nearest neighbour could be in the way.
 
-        A clear facing (weight 1) costs the proposal's squared distance alone: the general formula adds
-        0 x (radial term) = 0 to it, exactly (the term is finite unless ``unknown_cost`` exceeds 1e154 m, where its
-        square overflows). Whether someone is within ``reach`` is decided on the squared distance
-        (``OSpaceModel.reach_squared``), as the rounded root would decide it."""
+        A clear facing (weight 1) costs its known-facing term alone (``_costs``). Whether someone is within
+        ``reach`` is decided on the squared distance (``OSpaceModel.reach_squared``), as the rounded root would
+        decide it."""
         model = self.model
-        reach2, price, sqrt = model.reach_squared, model.price, math.sqrt
+        reach2, sqrt = model.reach_squared, math.sqrt
+        limit, tie = model.alone_price * (1.0 - TIE), model.alone_price * TIE
+        twice_weight = 2.0 * model.angular_weight
         unknown2, body2 = model.unknown_cost**2, model.body_radius**2
         slack = 1.0 + _SLACK
         rows = []
         for centre, radius in candidates:
             cx, cy = centre.real, centre.imag
+            turn_weight = twice_weight * radius
             entries = []
             saving = 0.0
-            for j, px, py, fx, fy, w, nearest, known in self._table:
+            for j, px, py, fx, fy, w, cos_slack, sin_slack, nearest, known in self._table:
                 ox, oy = cx - px, cy - py  # from the person to the centre
                 length2 = ox * ox + oy * oy
                 if length2 >= reach2:
                     continue
-                dx, dy = radius * fx - ox, radius * fy - oy
-                if w == 1.0:
-                    cost = dx * dx + dy * dy
-                else:
-                    radial = sqrt(length2) - radius
-                    cost = w * (dx * dx + dy * dy) + (1.0 - w) * (radial * radial + unknown2)
+                rho = sqrt(length2)
+                along = ox * fx + oy * fy
+                off = rho - radius
+                on_circle = off * off
+                cost = on_circle
+                if along < rho * cos_slack:  # the centre lies outside the facing's cone
+                    turn = rho - along * cos_slack - abs(ox * fy - oy * fx) * sin_slack
+                    if turn > 0.0:
+                        cost += turn_weight * turn
+                if w != 1.0:
+                    cost = w * cost + (1.0 - w) * (on_circle + unknown2)
                 # Only someone nearer than sqrt(length2 + body2) can be in the way: most have no such neighbour.
-                if cost < price and ((length2 + body2) * slack <= nearest or not self._blocked(j, cx, cy)):
+                if cost < limit and ((length2 + body2) * slack <= nearest or not self._blocked(j, cx, cy)):
                     entries.append((j, cost))
-                    if known:
-                        saving += price - cost
-            rows.append((entries, saving - price))
+                    if known and model.alone_price - cost > tie:
+                        saving += model.alone_price - cost
+            rows.append((entries, saving - model.price))
         return rows
 
     def _blocked(self, j: int, cx: float, cy: float) -> bool:
@@ -431,13 +514,14 @@ class _SmallScene:
         length2 = ox * ox + oy * oy
         body2 = self.model.body_radius**2
         bound = (length2 + body2) * (1.0 + _SLACK)
+        inner, outer, wide = TIE * length2, (1.0 - TIE) * length2, (1.0 - TIE) * body2 * length2
         for distance2, rx, ry, b in self._neighbours_of(j):
             if distance2 >= bound:
                 return False
             dot = rx * ox + ry * oy
-            if 0 < dot < length2 and self._within_reach(b, cx, cy):
+            if inner < dot < outer and self._within_reach(b, cx, cy):
                 cross = rx * oy - ry * ox
-                if cross * cross < body2 * length2:
+                if cross * cross < wide:
                     return True
         return False
 
@@ -459,31 +543,37 @@ class _SmallScene:
         return self._neighbours[a]
 
 
-def _assign_small(rows: list[_Row], known: list[bool], price: float) -> list[int]:
-    """``_assign`` on rows: the candidate each person joins (-1 alone), by the same greedy passes.
+def _assign_small(rows: list[_Row], known: list[bool], model: OSpaceModel) -> list[int]:
+    """``_assign`` on rows: the candidate each person joins (-1 alone), by the same greedy passes and the same
+    ``TIE``.
 
     Only candidates with a positive saving are followed from pass to pass: a saving never grows (the people's costs
     only fall, and a sum of smaller or fewer non-negative gains rounds no larger), and a candidate without a positive
     saving is never opened, nor the favourite of anyone whom a candidate with a positive saving serves."""
-    count = len(known)
-    current = [price] * count
+    count, tie = len(known), TIE * model.alone_price
+    current = [model.alone_price] * count
     opened = [False] * len(rows)
     openers = [entries for entries, _ in rows]
     if not all(known):
         openers = [[(j, c) for j, c in entries if known[j]] for entries in openers]
     savings = [saving for _, saving in rows]
-    active = [k for k, saving in enumerate(savings) if saving > 0]
+    active = [k for k, saving in enumerate(savings) if saving > tie]
     while active:
-        # Each person's favourite: the candidate of highest saving among those that lower their cost, then lowest.
-        # A candidate opens when it is the favourite of everyone it serves.
+        # Each person's favourite: the lowest candidate within ``tie`` of the highest saving among those that lower
+        # their cost. A candidate opens when it is the favourite of everyone it serves.
         best, favourite, serves = [-math.inf] * count, [-1] * count, {}
+        for k in active:
+            saving = savings[k]
+            for j, c in openers[k]:
+                if c < current[j] - tie and saving > best[j]:
+                    best[j] = saving
         for k in active:
             saving, served = savings[k], 0
             for j, c in openers[k]:
-                if c < current[j]:
+                if c < current[j] - tie:
                     served += 1
-                    if saving > best[j]:
-                        best[j], favourite[j] = saving, k
+                    if favourite[j] < 0 and saving >= best[j] - tie:
+                        favourite[j] = k
             serves[k] = served
         for k in favourite:
             if k >= 0:
@@ -498,33 +588,42 @@ def _assign_small(rows: list[_Row], known: list[bool], price: float) -> list[int
             # (Gains added in order, not by the builtin ``sum``: it rounds differently from Python 3.12 on.)
             total = 0.0
             for j, c in openers[k]:
-                if c < current[j]:
+                if c < current[j] - tie:
                     total += current[j] - c
-            savings[k] = total - price
-        active = [k for k in active if savings[k] > 0]
-    return _cheapest_opened([entries for entries, _ in rows], opened, count)
+            savings[k] = total - model.price
+        active = [k for k in active if savings[k] > tie]
+    return _cheapest_opened([entries for entries, _ in rows], opened, count, tie)
 
 
-def _cheapest_opened(rows: list[list[tuple[int, float]]], opened: list[bool], count: int) -> list[int]:
-    """For each of ``count`` people, the opened candidate of lowest cost in its row (ties: the lowest), -1 if none."""
-    chosen = [-1] * count
+def _cheapest_opened(rows: list[list[tuple[int, float]]], opened: list[bool], count: int, tie: float) -> list[int]:
+    """For each of ``count`` people, the lowest opened candidate whose cost in its row is within ``tie`` of the
+    person's lowest, -1 if none."""
     best = [math.inf] * count
     for k, row in enumerate(rows):
         if opened[k]:
             for j, c in row:
                 if c < best[j]:
-                    best[j], chosen[j] = c, k
+                    best[j] = c
+    chosen = [-1] * count
+    for k, row in enumerate(rows):
+        if opened[k]:
+            for j, c in row:
+                if chosen[j] < 0 and c <= best[j] + tie:
+                    chosen[j] = k
     return chosen
 
 
 def _refit_small(
-    labels: list[int], people: list[_Person], radii: list[float], model: OSpaceModel
+    labels: list[int], people: list[_Person], behind: list[tuple[complex, float]], model: OSpaceModel
 ) -> list[tuple[complex, float]]:
-    """``_refit`` on Python numbers: per group (labels 0..G-1), the centre (complex, m) and radius (m); ``radii``
-    (G) is kept where the facings do not fix R."""
-    sums = [[0.0] * 6 for _ in radii]  # per group: w x, w y, w fx, w fy, w <p, f>, w
-    for label, (x, y, fx, fy, w) in zip(labels, people, strict=True):
-        if label >= 0:
+    """``_refit`` on Python numbers: per group (labels 0..G-1), the centre (complex, m) and radius (m), each
+    member's facing turned within its cone towards the centre of the candidate behind the group (``behind``: its
+    centre and radius; the radius is kept where the facings do not fix R)."""
+    sums = [[0.0] * 6 for _ in behind]  # per group: w x, w y, w fx', w fy', w <p, f'>, w
+    for label, (x, y, fx, fy, w, cos_slack, sin_slack) in zip(labels, people, strict=True):
+        if label >= 0 and w > 0:
+            centre = behind[label][0]
+            fx, fy = _turned_small(x, y, fx, fy, cos_slack, sin_slack, centre.real, centre.imag)
             group = sums[label]
             group[0] += x * w
             group[1] += y * w
@@ -533,7 +632,7 @@ def _refit_small(
             group[4] += (x * fx + y * fy) * w
             group[5] += w
     fitted = []
-    for (px, py, fx, fy, pf, total), kept in zip(sums, radii, strict=True):
+    for (px, py, fx, fy, pf, total), (_, kept) in zip(sums, behind, strict=True):
         f_norm = math.hypot(fx, fy)
         spread = total - f_norm * f_norm / total
         pull = -(pf - (px * fx + py * fy) / total)
@@ -542,3 +641,18 @@ def _refit_small(
         scale = 1.0 / total  # numpy divides a complex by a real as a product with the reciprocal
         fitted.append((complex((px + radius * fx) * scale, (py + radius * fy) * scale), radius))
     return fitted
+
+
+def _turned_small(
+    px: float, py: float, fx: float, fy: float, cos_slack: float, sin_slack: float, cx: float, cy: float
+) -> tuple[float, float]:
+    """``_turned`` on Python numbers."""
+    ox, oy = cx - px, cy - py
+    rho = math.sqrt(ox * ox + oy * oy)
+    along, across = ox * fx + oy * fy, fx * oy - fy * ox
+    if rho > 0 and along >= rho * cos_slack:
+        return ox / rho, oy / rho
+    side = 1.0 if across > TIE * rho else -1.0 if across < -TIE * rho else 0.0
+    if side == 0:
+        return fx, fy
+    return fx * cos_slack - side * fy * sin_slack, fy * cos_slack + side * fx * sin_slack

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from sid.cli import main
+from sid.experiments.fformation import DEFAULT_GRID
 from tests.conftest import REPO_ROOT, shared_path
 from tests.experiments.test_fformation import tiny_frames, write_sequence
 
@@ -174,8 +175,8 @@ def test_eval_fformation_prints_json_and_a_table(tmp_path, capsys):
 
 
 def test_orientation_quality_is_read_and_checked(capsys, monkeypatch):
-    # A pair 1.6 m apart, the second looking 70 degrees off: a clear facing is refused, a doubtful one joins.
-    people = [{"id": 1, "x": 0.0, "y": 0.0, "theta": 0.0}, {"id": 2, "x": 1.6, "y": 0.0, "theta": math.radians(250)}]
+    # A pair 1.6 m apart, the second looking 120 degrees off: a clear facing is refused, a doubtful one joins.
+    people = [{"id": 1, "x": 0.0, "y": 0.0, "theta": 0.0}, {"id": 2, "x": 1.6, "y": 0.0, "theta": math.radians(300)}]
     lines = [
         {"frame": 0, "people": people},
         {"frame": 1, "people": [people[0], people[1] | {"orientation_quality": 0}]},
@@ -191,16 +192,29 @@ def test_eval_fformation_cross_validates_over_a_grid(tmp_path, capsys):
     for name in ("A", "B"):
         write_sequence(tmp_path / name, tiny_frames(), {1: [[1, 2]], 2: [[1, 2, 3]]})
     dirs = [str(tmp_path / "A"), str(tmp_path / "B")]
-    code, out, _ = run_sid(["eval", "fformation", *dirs, "--scale", "0.01", "--grid", "group_price=0.01,0.65"], capsys)
+    code, out, _ = run_sid(["eval", "fformation", *dirs, "--scale", "0.01", "--grid", "alone_price=0.01,0.65"], capsys)
     report = json.loads("\n".join(out))
-    assert code == 0 and [f["chosen"] for f in report["folds"]] == [{"group_price": 0.65}] * 2
-    assert report["grid"][0] == {"group_price": 0.01, "f1": {"A": 0.0, "B": 0.0}}
+    assert code == 0 and [f["chosen"] for f in report["folds"]] == [{"alone_price": 0.65}] * 2
+    assert report["grid"][0] == {"alone_price": 0.01, "f1": {"A": 0.0, "B": 0.0}}
     code, out, _ = run_sid(
         ["eval", "fformation", *dirs, "--scale", "0.01", "--table", "--grid", "group_price=0.65"], capsys
     )
     assert code == 0 and out[-1].startswith("held-out F1 1.000-1.000")
     code, _, err = run_sid(["eval", "fformation", *dirs, "--grid", "stride=1"], capsys)
     assert code == 2 and "numeric fields of GroupParams" in err
+    code, out, _ = run_sid(["eval", "fformation", *dirs, "--scale", "0.01", "--cross-validate"], capsys)
+    report = json.loads("\n".join(out))
+    assert code == 0 and set(report["folds"][0]["chosen"]) == set(DEFAULT_GRID)
+    assert len(report["grid"]) == math.prod(len(values) for values in DEFAULT_GRID.values())
+
+
+def test_eval_fformation_adds_seeded_facing_noise(tmp_path, capsys):
+    tiny = write_sequence(tmp_path / "Tiny", tiny_frames(), {1: [[1, 2]], 2: [[1, 2, 3]]})
+    args = ["eval", "fformation", str(tiny), "--scale", "0.01", "--facing-noise"]
+    first, second = run_sid([*args, "20"], capsys), run_sid([*args, "20"], capsys)
+    assert first[0] == 0 and first[1] == second[1]
+    code, _, err = run_sid([*args, "-5"], capsys)
+    assert code == 2 and "facing noise" in err
 
 
 def test_eval_fformation_reports_malformed_data(tmp_path, capsys):

@@ -276,9 +276,9 @@ def test_a_person_with_unknown_facing_on_the_circle_joins_but_two_such_people_ar
 
 
 def test_a_doubtful_facing_counts_less():
-    # A pair 1.6 m apart whose second member looks 70 degrees away: with a clear facing that is too far off to join,
-    # with a doubtful one (quality 0) the position on the circle carries it.
-    pair = [Person(1, 0.0, 0.0, 0.0, 1.0), Person(2, 1.6, 0.0, math.pi + math.radians(70), 1.0)]
+    # A pair 1.6 m apart whose second member looks 120 degrees away: with a clear facing that is too far off to
+    # join, with a doubtful one (quality 0) the position on the circle carries it.
+    pair = [Person(1, 0.0, 0.0, 0.0, 1.0), Person(2, 1.6, 0.0, math.pi + math.radians(120), 1.0)]
     assert detect_groups(pair) == []
     pair[1].orientation_quality = 0.0
     assert [g.members for g in detect_groups(pair)] == [(1, 2)]

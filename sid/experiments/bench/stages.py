@@ -732,6 +732,15 @@ def benchmarks(ctx: Context) -> list[Benchmark]:
     ]
     items += [
         Benchmark(
+            f"group_gcff/{n}",
+            f"detect_groups, method gcff (graph cuts, the literature's reference), {n} people",
+            _bench_group(n, "gcff"),
+            needs=(f"group/{n}",),
+        )
+        for n in GROUP_SIZES
+    ]
+    items += [
+        Benchmark(
             f"group_rays/{n}", f"detect_groups, method rays, {n} people", _bench_group(n, "rays"), needs=(f"group/{n}",)
         )
         for n in GROUP_SIZES
