@@ -402,3 +402,25 @@ def noisy_circles(counts: list[int], seed: int = 0) -> list[Person]:
 def test_bench_grouping(benchmark, counts, expected):
     people = noisy_circles(counts)
     assert len(benchmark(detect_groups, people)) == expected
+
+
+def test_quantised_facings_widen_their_cones_to_half_the_step():
+    # Two people 1.2 m apart side by side, both facing +y, and a third far away. When every facing in the frame
+    # lies on a 90 degree grid, each is known only to +-45 degrees: the two may be turned towards each other, a
+    # pair. A third facing off the grid (37 degrees) makes the facings continuous: 23 degree cones, no pair.
+    pair = [Person(1, 0.0, 0.0, math.pi / 2, 1.0), Person(2, 1.2, 0.0, math.pi / 2, 1.0)]
+    on_grid = detect_groups([*pair, Person(3, 10.0, 10.0, math.pi, 1.0)])
+    off_grid = detect_groups([*pair, Person(3, 10.0, 10.0, math.radians(37), 1.0)])
+    assert [g.members for g in on_grid] == [(1, 2)] and off_grid == []
+    # A wider slack does what the grid did.
+    wide = GroupParams(facing_slack=math.pi / 4)
+    assert [g.members for g in detect_groups([*pair, Person(3, 10.0, 10.0, math.radians(37), 1.0)], wide)] == [(1, 2)]
+
+
+def test_gcff_is_a_method_with_zones_like_the_others():
+    ring = circle(5, 0.9, centre=(2.0, 1.0), start_deg=10, first_id=20)
+    [group] = detect_groups(ring, GroupParams(method="gcff"))
+    assert group.members == tuple(range(20, 25)) and group.spread == pytest.approx(0.9)
+    assert group.interest_point == pytest.approx((2.0, 1.0), abs=0.05)
+    with pytest.raises(ValueError, match="groups: gcff_stride"):
+        GroupParams(gcff_stride=-1.0)

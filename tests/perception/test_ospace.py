@@ -58,12 +58,14 @@ def test_the_crowd_path_gives_what_the_small_scene_path_gives(monkeypatch):
 
 
 @pytest.mark.parametrize("seed", range(12))
-def test_the_two_paths_agree_on_random_scenes(seed: int, monkeypatch) -> None:
+@pytest.mark.parametrize("slack", [0.0, 0.4, math.pi / 4])
+def test_the_two_paths_agree_on_random_scenes(seed: int, slack: float, monkeypatch) -> None:
     scene = random_scene(seed)
+    slacks = [slack] * len(scene[0])
     monkeypatch.setattr(ospace, "_SMALL_PEOPLE_MAX", 0)
-    crowd = find_ospaces(*scene, MODEL)
+    crowd = find_ospaces(*scene, MODEL, slacks)
     monkeypatch.setattr(ospace, "_SMALL_PEOPLE_MAX", 1000)
-    small = find_ospaces(*scene, MODEL)
+    small = find_ospaces(*scene, MODEL, slacks)
     assert [g.members.tolist() for g in crowd] == [g.members.tolist() for g in small]
     assert [g.centre for g in crowd] == pytest.approx([g.centre for g in small], abs=1e-9)
     assert [g.radius for g in crowd] == pytest.approx([g.radius for g in small], abs=1e-9)
