@@ -32,6 +32,7 @@ import numpy as np
 import scipy.io
 
 from sid.checks import check_number
+from sid.perception.gcff import GCFFParams
 from sid.perception.groups import GroupParams, detect_groups
 from sid.perception.people import Person
 
@@ -344,6 +345,36 @@ def parse_threshold(text: str) -> float:
     if not 0 < value <= 1:
         raise ValueError(f"threshold {text!r} must lie in (0, 1]")
     return value
+
+
+def load_settings_gc(folder: str | Path, base: GCFFParams | None = None) -> GCFFParams:
+    """The GCFF settings in ``settings_gc.mat`` of a benchmark sequence folder (or that file itself): ``stride`` in
+    centimetres and ``mdl`` in square centimetres, as the F-formation datasets store them, returned in metres and
+    square metres (stride / 100, mdl / 1e4); the other fields from ``base`` (default ``GCFFParams()``).
+
+    Raises ValueError naming the file when it is missing, unreadable, or lacks a finite scalar stride >= 0 or
+    mdl > 0.
+    """
+    path = Path(folder)
+    if path.is_dir():
+        path = path / "settings_gc.mat"
+    data = _load_mat(path, ("stride", "mdl"))
+    values = {}
+    for name in ("stride", "mdl"):
+        try:
+            array = np.asarray(data[name], dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError(f"fformation: {path}: {name} must be a number") from None
+        if array.size != 1 or not math.isfinite(float(array.ravel()[0])):
+            raise ValueError(f"fformation: {path}: {name} must be one finite number, got {array.ravel()[:4]}")
+        values[name] = float(array.ravel()[0])
+    try:
+        return dataclasses.replace(base or GCFFParams(), stride=values["stride"] / 100.0, mdl=values["mdl"] / 1e4)
+    except ValueError as exc:
+        reason = str(exc).removeprefix("gcff: ")
+        raise ValueError(
+            f"fformation: {path}: {reason} (from {values['stride']:g} cm, {values['mdl']:g} cm^2)"
+        ) from None
 
 
 def _load_mat(path: Path, keys: tuple[str, ...]) -> dict:

@@ -62,16 +62,13 @@ Decided here, where the paper is silent (the benchmark annotations all have faci
 
 from __future__ import annotations
 
-import dataclasses
-import math
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from sid.checks import check_limit, check_number
 
-__all__ = ["GCFF_ORDERS", "GCFFParams", "gcff_labels", "load_settings_gc"]
+__all__ = ["GCFF_ORDERS", "GCFFParams", "gcff_labels"]
 
 GCFF_ORDERS = ("best", "input")
 """The move orders of ``GCFFParams.order`` (module docstring)."""
@@ -104,7 +101,7 @@ class GCFFParams:
     order: ``"best"`` (steepest descent over expansion moves, independent of the input order) or ``"input"``
       (the published detector's cyclic sweep in label order, which depends on it; module docstring).
 
-    Settings of the benchmarks' ``settings_gc.mat`` files: ``load_settings_gc``.
+    Settings of the benchmarks' ``settings_gc.mat`` files: ``sid.experiments.fformation.load_settings_gc``.
     """
 
     stride: float = 0.45
@@ -126,45 +123,6 @@ class GCFFParams:
             raise ValueError(f"gcff: max_rounds must be an integer >= 1, got {rounds!r}")
         if self.order not in GCFF_ORDERS:
             raise ValueError(f"gcff: order must be one of {', '.join(GCFF_ORDERS)}, got {self.order!r}")
-
-
-def load_settings_gc(folder: str | Path, base: GCFFParams | None = None) -> GCFFParams:
-    """The settings in ``settings_gc.mat`` of a benchmark sequence folder (or that file itself): ``stride`` in
-    centimetres and ``mdl`` in square centimetres, as the F-formation datasets store them, returned in metres and
-    square metres (stride / 100, mdl / 1e4); the other fields from ``base`` (default ``GCFFParams()``).
-
-    Raises ValueError naming the file when it is missing, unreadable, or lacks a finite scalar stride >= 0 or
-    mdl > 0.
-    """
-    import scipy.io  # here, not at import: scipy.io is a noticeable part of a command's start-up
-
-    path = Path(folder)
-    if path.is_dir():
-        path = path / "settings_gc.mat"
-    if not path.is_file():
-        raise ValueError(f"gcff: {path} is missing")
-    try:
-        data = scipy.io.loadmat(str(path))
-    except Exception as exc:  # scipy raises ValueError, TypeError, MatReadError... for non-MAT input
-        raise ValueError(f"gcff: cannot read {path} as a MATLAB file ({exc})") from None
-    values = {}
-    for name in ("stride", "mdl"):
-        if name not in data:
-            present = sorted(k for k in data if not k.startswith("__"))
-            raise ValueError(f"gcff: {path} lacks the variable {name!r} (it holds {present})")
-        try:
-            array = np.asarray(data[name], dtype=float)
-        except (TypeError, ValueError):
-            raise ValueError(f"gcff: {path}: {name} must be a number") from None
-        if array.size != 1 or not math.isfinite(float(array.ravel()[0])):
-            raise ValueError(f"gcff: {path}: {name} must be one finite number, got {array.ravel()[:4]}")
-        values[name] = float(array.ravel()[0])
-    base = base if base is not None else GCFFParams()
-    try:
-        return dataclasses.replace(base, stride=values["stride"] / 100.0, mdl=values["mdl"] / 1e4)
-    except ValueError as exc:
-        reason = str(exc).removeprefix("gcff: ")
-        raise ValueError(f"gcff: {path}: {reason} (from {values['stride']:g} cm, {values['mdl']:g} cm^2)") from None
 
 
 def gcff_labels(positions: np.ndarray, yaw: np.ndarray, params: GCFFParams | None = None) -> np.ndarray:

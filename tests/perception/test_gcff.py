@@ -15,7 +15,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import sid.perception.gcff as gcff
-from sid.perception.gcff import GCFFParams, gcff_labels, load_settings_gc
+from sid.experiments.fformation import load_settings_gc
+from sid.perception.gcff import GCFFParams, gcff_labels
 from tests.conftest import SHARED
 
 
@@ -283,7 +284,7 @@ def test_settings_are_read_in_metres(tmp_path):
 @pytest.mark.parametrize(
     ("content", "message"),
     [
-        ({"stride": 45}, "lacks the variable 'mdl'"),
+        ({"stride": 45}, r"lacks the variable\(s\) \['mdl'\]"),
         ({"stride": [[45, 50]], "mdl": 30000}, "stride must be one finite number"),
         ({"stride": 45, "mdl": np.nan}, "mdl must be one finite number"),
         ({"stride": 45, "mdl": 0}, "mdl must be a positive number"),
