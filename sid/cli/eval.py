@@ -17,6 +17,7 @@ from sid.experiments.fformation import (
     Fold,
     LabelledFrame,
     cross_validate,
+    gcff_settings,
     load_dataset,
     missing_members,
     parse_threshold,
@@ -76,6 +77,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help=f"leave one DIR out at a time over the grid that chose the defaults ({grid_text}; --grid sets another)",
     )
     ff.add_argument(
+        "--gcff-settings",
+        action="store_true",
+        help="score the gcff method with each sequence's own settings_gc.mat (GCFF tuned per sequence, the "
+        "literature's reference) instead of the detector the other options choose",
+    )
+    ff.add_argument(
         "--facing-noise",
         type=float,
         default=0.0,
@@ -120,11 +127,17 @@ def run(args: argparse.Namespace) -> int:
             if args.facing_noise:
                 datasets[name] = with_facing_noise(datasets[name], math.radians(args.facing_noise))
         grid = args.grid or ([(k, list(v)) for k, v in DEFAULT_GRID.items()] if args.cross_validate else None)
+        if grid and args.gcff_settings:
+            raise ValueError("--gcff-settings scores GCFF's own settings: it takes no --grid or --cross-validate")
         if grid:
             folds, table = cross_validate(datasets, dict(grid), params, args.thresholds[0])
             print(_folds(folds, table) if args.table else json.dumps(_folds_json(folds, table, grid), indent=2))
             return 0
-        scores = evaluate_fformation(datasets, params, args.thresholds)
+        per_sequence = None
+        if args.gcff_settings:
+            per_sequence = {name: gcff_settings(folder) for name, folder in zip(datasets, args.dirs, strict=True)}
+            params = dataclasses.replace(params, method="gcff")
+        scores = evaluate_fformation(datasets, params, args.thresholds, per_sequence)
     except ValueError as exc:
         print(f"sid eval fformation: {exc}", file=sys.stderr)
         return 2

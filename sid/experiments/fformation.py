@@ -144,19 +144,36 @@ def with_facing_noise(frames: Sequence[LabelledFrame], sigma: float, seed: int =
     return noisy
 
 
-def load_dataset(folder: str | Path, scale: float = 1.0, degrees: bool = False) -> list[LabelledFrame]:
-    """All ground-truth frames of a dataset folder: its own sequence, or those of its sub-folders, pooled
-    (``load_sequence``'s ``scale`` and ``degrees``). Raises ValueError when no frame has ground truth."""
+def sequence_folders(folder: str | Path) -> list[Path]:
+    """The sequence folders of a dataset folder: itself when it holds ``features.mat``, else its sub-folders that
+    do, sorted. Raises ValueError when there is none."""
     folder = Path(folder)
     if not folder.is_dir():
         raise ValueError(f"fformation: {folder} is not a folder")
     if (folder / "features.mat").exists():
-        frames = load_sequence(folder, scale, degrees)
-    else:
-        sequences = sorted(p.parent for p in folder.glob("*/features.mat"))
-        if not sequences:
-            raise ValueError(f"fformation: no features.mat in {folder} or its sub-folders")
-        frames = [frame for sequence in sequences for frame in load_sequence(sequence, scale, degrees)]
+        return [folder]
+    sequences = sorted(p.parent for p in folder.glob("*/features.mat"))
+    if not sequences:
+        raise ValueError(f"fformation: no features.mat in {folder} or its sub-folders")
+    return sequences
+
+
+def gcff_settings(folder: str | Path) -> dict[str, GroupParams]:
+    """Per sequence of a dataset folder (by its folder's name, as ``LabelledFrame.sequence`` holds it), the
+    ``gcff`` method with that sequence's own ``settings_gc.mat``: GCFF tuned per sequence, the literature's
+    reference."""
+    return {
+        sequence.name: GroupParams(method="gcff", gcff_stride=settings.stride, gcff_mdl=settings.mdl)
+        for sequence in sequence_folders(folder)
+        for settings in (load_settings_gc(sequence),)
+    }
+
+
+def load_dataset(folder: str | Path, scale: float = 1.0, degrees: bool = False) -> list[LabelledFrame]:
+    """All ground-truth frames of a dataset folder: its own sequence, or those of its sub-folders, pooled
+    (``load_sequence``'s ``scale`` and ``degrees``). Raises ValueError when no frame has ground truth."""
+    folder = Path(folder)
+    frames = [frame for sequence in sequence_folders(folder) for frame in load_sequence(sequence, scale, degrees)]
     if not frames:
         raise ValueError(f"fformation: {folder} has no frame with ground truth (GTtimestamp is empty)")
     return frames
@@ -250,14 +267,22 @@ def evaluate(
     datasets: Mapping[str, Sequence[LabelledFrame]],
     params: GroupParams | None = None,
     thresholds: Sequence[float] = DEFAULT_THRESHOLDS,
+    per_sequence: Mapping[str, Mapping[str, GroupParams]] | None = None,
 ) -> dict[str, dict[str, dict[str, float | int]]]:
-    """Scores of ``detect_groups`` (default parameters unless given) per dataset, and pooled over all their frames.
+    """Scores of ``detect_groups`` (default parameters unless given) per dataset, and pooled over all their frames;
+    ``per_sequence`` (dataset -> sequence -> parameters, e.g. ``gcff_settings``) overrides them sequence by
+    sequence.
 
     Returns ``{dataset or "pooled": {format_threshold(T): Score.to_dict()}}``.
     """
     params = params or GroupParams()
+    per_sequence = per_sequence or {}
+
+    def chosen(name: str, frame: LabelledFrame) -> GroupParams:
+        return per_sequence.get(name, {}).get(frame.sequence, params)
+
     detected = {
-        name: [[g.members for g in detect_groups(f.people, params)] for f in frames]
+        name: [[g.members for g in detect_groups(f.people, chosen(name, f))] for f in frames]
         for name, frames in datasets.items()
     }
     result = {

@@ -259,3 +259,20 @@ def test_eval_fformation_reads_degrees_and_warns_about_truth_ids_it_cannot_find(
     code, out, err = run_sid(["eval", "fformation", str(folder), "--scale", "0.01", "--degrees", "--table"], capsys)
     assert code == 0 and out[1].split()[:3] == ["Degrees", "2/3", "3"]
     assert "Degrees: 1 of the 7 ground-truth group members are not among their frame's people" in err
+
+
+def test_eval_fformation_scores_gcff_with_each_sequences_own_settings(tmp_path, capsys):
+    import scipy.io
+
+    for name, stride in (("Seq1", 50), ("Seq2", 20)):
+        write_sequence(tmp_path / "Set" / name, tiny_frames(), {1: [[1, 2]], 2: [[1, 2, 3]]})
+        scipy.io.savemat(tmp_path / "Set" / name / "settings_gc.mat", {"stride": stride, "mdl": 30000})
+    code, out, _ = run_sid(["eval", "fformation", str(tmp_path / "Set"), "--scale", "0.01", "--gcff-settings"], capsys)
+    report = json.loads("\n".join(out))
+    assert code == 0 and report["params"]["method"] == "gcff" and report["scores"]["Set"]["2/3"]["frames"] == 4
+    args = ["eval", "fformation", str(tmp_path / "Set"), str(tmp_path / "Set"), "--gcff-settings", "--cross-validate"]
+    code, _, err = run_sid(args, capsys)
+    assert code == 2 and "--gcff-settings" in err
+    (tmp_path / "Set" / "Seq2" / "settings_gc.mat").unlink()
+    code, _, err = run_sid(["eval", "fformation", str(tmp_path / "Set"), "--gcff-settings"], capsys)
+    assert code == 2 and "settings_gc.mat is missing" in err
