@@ -288,13 +288,13 @@ def _ospace_groups(
     origin = complex(math.fsum(positions[i].real for i in order), math.fsum(positions[i].imag for i in order))
     origin /= len(order)
     thetas = [people[i].theta for i in order]
-    spread = max(params.facing_slack, 0.5 * facing_step(thetas))
+    slack = max(params.facing_slack, 0.5 * facing_step(thetas))  # rad, every facing's cone
     found = find_ospaces(
         [positions[i] - origin for i in order],
         [facing[i] for i in order],
         [floor + (1.0 - floor) * min(max(people[i].orientation_quality, 0.0), 1.0) for i in order],
         params.ospace_model,
-        [spread] * len(order),
+        [slack] * len(order),
     )
     members = [sorted(order[k] for k in ospace.members.tolist()) for ospace in found]
     centres = [ospace.centre + origin for ospace in found]
