@@ -335,7 +335,7 @@ def _zoned(
     ):
         if crossings:
             area, centre, zone = _zone(crossings)
-        else:  # no two members' rays meet: the fitted o-space centre
+        else:  # no two members' rays meet: the centre given (fitted o-space, or mean vote)
             area, centre = 0.0, fallback
             zone = np.array([[centre.real, centre.imag]])
         groups.append(

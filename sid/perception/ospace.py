@@ -297,22 +297,15 @@ def _assign(cost: np.ndarray, near: np.ndarray, known: np.ndarray, model: OSpace
 
 
 def _first_per_person(person: np.ndarray, candidate: np.ndarray, key: np.ndarray, count: int, tie: float) -> np.ndarray:
-    """For each of ``count`` people, the candidate of lowest ``key`` among their (person, candidate) pairs, given in
-    ascending candidate order; keys within ``tie`` of a person's lowest count as equal to it, and the lowest
-    candidate among those wins; -1 for people without a pair."""
+    """For each of ``count`` people, the lowest candidate among their (person, candidate) pairs whose ``key`` is
+    within ``tie`` of the person's lowest key; -1 for people without a pair."""
     lowest = np.full(count, np.inf)
     np.minimum.at(lowest, person, key)
     keep = key <= lowest[person] + tie
-    person, candidate = person[keep], candidate[keep]
-    key = candidate  # among the near-lowest, the lowest candidate
-    order = np.lexsort((key, person))
-    person, candidate = person[order], candidate[order]
-    first = np.empty(len(person), dtype=bool)
-    first[:1] = True
-    first[1:] = person[1:] != person[:-1]
-    result = np.zeros(count, dtype=int) - 1
-    result[person[first]] = candidate[first]
-    return result
+    beyond = int(candidate.max()) + 1 if len(candidate) else 0  # above every candidate: no pair yet
+    chosen = np.full(count, beyond)
+    np.minimum.at(chosen, person[keep], candidate[keep])
+    return np.where(np.isfinite(lowest), chosen, -1)
 
 
 def _canonical(choices: list[int], known: list[bool]) -> tuple[list[int], list[int]]:
