@@ -12,10 +12,12 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 from sid.checks import check_number, check_numbers
 from sid.perception.groups import GroupParams
+from sid.perception.people import Person
 from sid.perception.pipeline import FrameResult
 from sid.perception.robot_pose import RobotPose
 from sid.tracking.groups import GroupTracker, GroupTrackerParams
@@ -90,12 +92,24 @@ class TrackingSession:
             self.people.reset()
             self.groups.reset()
         self._last = (result.timestamp, result.frame_id, result.robot_pose)
+        update = self._track(result.people, result.timestamp, view)
+        update.reset = reset
+        return update
+
+    def track(self, people: Sequence[Person], timestamp: float, view: ViewCone | None = None) -> SessionUpdate:
+        """Track detected ``people`` given in one fixed ground frame at ``timestamp`` (s), with no robot pose to
+        check (``sid track``, ``sid eval crowd``). ``view``: where the detector looked (None: everywhere)."""
+        self.check(timestamp, None)
+        self._last = (timestamp, "ground", None)
+        return self._track(people, timestamp, view)
+
+    def _track(self, people: Sequence[Person], timestamp: float, view: ViewCone | None) -> SessionUpdate:
         t0 = time.perf_counter()
-        people = self.people.update(result.people, result.timestamp, view)
+        tracked = self.people.update(people, timestamp, view)
         t1 = time.perf_counter()
-        groups = self.groups.update(people, result.timestamp)
+        groups = self.groups.update(tracked, timestamp)
         t2 = time.perf_counter()
-        return SessionUpdate(people, groups, reset, {"track": (t1 - t0) * 1e3, "track_groups": (t2 - t1) * 1e3})
+        return SessionUpdate(tracked, groups, None, {"track": (t1 - t0) * 1e3, "track_groups": (t2 - t1) * 1e3})
 
     def _reset_reason(self, result: FrameResult) -> str | None:
         """Why the tracks no longer hold at this result (None: they do)."""
