@@ -23,7 +23,7 @@ from sid.perception.robot_pose import RobotPose
 from sid.tracking.groups import GroupTracker, GroupTrackerParams
 from sid.tracking.records import TrackedGroup, TrackedPerson
 from sid.tracking.tracker import PeopleTracker, TrackerParams, TrackingError
-from sid.tracking.view import ViewCone
+from sid.tracking.view import View
 
 
 @dataclass(frozen=True)
@@ -83,7 +83,7 @@ class TrackingSession:
                 raise TrackingError(f"{what}: robot_pose must be a RobotPose, got {type(pose).__name__}")
             check_numbers(f"{what}: robot pose", pose, ("x", "y", "yaw"), error=TrackingError)
 
-    def update(self, result: FrameResult, view: ViewCone | None = None) -> SessionUpdate:
+    def update(self, result: FrameResult, view: View | None = None) -> SessionUpdate:
         """Track the people and groups of ``result``; ``view``: the camera's field of view in ``result.frame_id``
         (None: everything counts as in view)."""
         self.check(result.timestamp, result.robot_pose, f"frame {result.frame}")
@@ -96,14 +96,15 @@ class TrackingSession:
         update.reset = reset
         return update
 
-    def track(self, people: Sequence[Person], timestamp: float, view: ViewCone | None = None) -> SessionUpdate:
+    def track(self, people: Sequence[Person], timestamp: float, view: View | None = None) -> SessionUpdate:
         """Track detected ``people`` given in one fixed ground frame at ``timestamp`` (s), with no robot pose to
         check (``sid track``, ``sid eval crowd``). ``view``: where the detector looked (None: everywhere)."""
         self.check(timestamp, None)
+        update = self._track(people, timestamp, view)  # a TrackingError here (bad people) changes nothing
         self._last = (timestamp, "ground", None)
-        return self._track(people, timestamp, view)
+        return update
 
-    def _track(self, people: Sequence[Person], timestamp: float, view: ViewCone | None) -> SessionUpdate:
+    def _track(self, people: Sequence[Person], timestamp: float, view: View | None) -> SessionUpdate:
         t0 = time.perf_counter()
         tracked = self.people.update(people, timestamp, view)
         t1 = time.perf_counter()

@@ -25,7 +25,7 @@ from sid.perception.people import Person
 from sid.tracking.assignment import gated_assignment
 from sid.tracking.motion import MotionStates
 from sid.tracking.records import TrackedPerson
-from sid.tracking.view import ViewCone
+from sid.tracking.view import View
 
 
 class TrackingError(ValueError):
@@ -103,7 +103,7 @@ class PeopleTracker:
         """Tracks held, tentative ones included."""
         return len(self._ids)
 
-    def update(self, people: Sequence[Person], timestamp: float, view: ViewCone | None = None) -> list[TrackedPerson]:
+    def update(self, people: Sequence[Person], timestamp: float, view: View | None = None) -> list[TrackedPerson]:
         """Bring the tracks to the frame at ``timestamp`` (s) with its detected ``people``; the confirmed tracks.
 
         ``view``: the camera's field of view in the same frame as the positions (None: everything is in view).

@@ -7,7 +7,8 @@ the tracker keeps it longer (``TrackerParams.out_of_view_timeout``) than one mis
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -39,6 +40,46 @@ class ViewCone:
         distance = np.sqrt(d[:, 0] ** 2 + d[:, 1] ** 2)
         along = d[:, 0] * math.cos(self.yaw) + d[:, 1] * math.sin(self.yaw)  # cos(off-axis angle) * distance
         return (along >= distance * math.cos(self.fov / 2)) & (distance <= self.max_range)
+
+
+@dataclass(frozen=True, eq=False)
+class ViewRegion:
+    """An area seen from above, e.g. the ground a fixed camera covers: a simple polygon (K, 2) in m, in the same frame
+    as the tracked positions. ``scene_view`` makes one from the positions where people were seen."""
+
+    polygon: np.ndarray
+    _shape: Any = field(init=False, repr=False)  # the prepared shapely polygon
+
+    def __post_init__(self) -> None:
+        polygon = np.asarray(self.polygon, dtype=float)
+        if polygon.ndim != 2 or polygon.shape[1] != 2 or len(polygon) < 3 or not np.isfinite(polygon).all():
+            raise ValueError(f"view: a region needs 3 or more finite (x, y) corners, got shape {polygon.shape}")
+        object.__setattr__(self, "polygon", polygon)
+        import shapely.prepared  # here, not at start-up: 80 ms that a camera's view cone never needs
+
+        object.__setattr__(self, "_shape", shapely.prepared.prep(shapely.Polygon(polygon)))
+
+    def contains(self, points: np.ndarray) -> np.ndarray:
+        """(N,) bool: which of the (N, 2) points lie inside the region (or on its edge)."""
+        import shapely
+
+        p = np.asarray(points, dtype=float).reshape(-1, 2)
+        return shapely.intersects_xy(self._shape.context, p[:, 0], p[:, 1]).astype(bool)
+
+
+View = ViewCone | ViewRegion
+"""Where the detector looks: a camera's cone or a fixed region."""
+
+
+def scene_view(positions: np.ndarray, margin: float = 0.0) -> ViewRegion:
+    """The convex hull of (N, 2) positions (m) where people were seen, grown by ``margin`` (m)."""
+    import shapely
+
+    points = shapely.MultiPoint(np.asarray(positions, dtype=float).reshape(-1, 2))
+    hull = points.convex_hull.buffer(margin) if margin > 0 else points.convex_hull
+    if not isinstance(hull, shapely.Polygon) or hull.is_empty:
+        raise ValueError("view: the positions span no area (fewer than three points not on one line)")
+    return ViewRegion(np.array(hull.exterior.coords)[:-1])
 
 
 def camera_fov(calibration: Calibration, mount: CameraMount) -> tuple[float, float]:

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from sid.perception.people import Person
-from sid.tracking import PeopleTracker, TrackerParams, TrackingError, ViewCone
+from sid.tracking import PeopleTracker, TrackerParams, TrackingError, ViewCone, ViewRegion, scene_view
 
 FPS = 15.0
 
@@ -199,3 +199,30 @@ def test_a_walker_who_stops_and_turns_round_keeps_the_id() -> None:
         tracks = tracker.update([Person(0, 3.0, y, theta)], k / FPS)
     (track,) = tracks
     assert track.id == 1 and track.state == "standing" and track.visible
+
+
+def test_a_track_outside_a_view_region_is_kept_like_one_outside_the_cone() -> None:
+    params = TrackerParams(timeout=0.5, out_of_view_timeout=3.0)
+    tracker = PeopleTracker(params)
+    view = ViewRegion(np.array([[0.0, -1.0], [4.0, -1.0], [4.0, 1.0], [0.0, 1.0]]))
+    t0 = _confirmed(tracker, 5.0, 0.0)  # beyond the region's far edge
+    for k in range(1, int(2.0 * FPS)):  # 2 s unseen, out of view: kept
+        (track,) = tracker.update([], t0 + k / FPS, view)
+        assert not track.in_view
+    inside = PeopleTracker(params)
+    t1 = _confirmed(inside, 2.0, 0.0)
+    assert inside.update([], t1 + 1.0, view) == []  # missed in plain view: gone after the 0.5 s timeout
+
+
+def test_scene_view_is_the_hull_of_where_people_were_seen() -> None:
+    view = scene_view(np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0], [1.0, 1.0]]))
+    assert view.contains(np.array([[1.0, 1.9], [2.0, 1.0], [2.1, 1.0], [-0.5, 0.0]])).tolist() == [
+        True,
+        True,
+        False,
+        False,
+    ]
+    with pytest.raises(ValueError, match="span no area"):
+        scene_view(np.array([[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]]))
+    with pytest.raises(ValueError, match="3 or more finite"):
+        ViewRegion(np.array([[0.0, 0.0], [1.0, np.nan], [2.0, 0.0]]))
