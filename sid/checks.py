@@ -26,7 +26,8 @@ class Limits:
     lidar_beams: beams of a simulated scan (100000 beams: about 0.6 GB and 20 s for ``sid costmap``).
     scan_cells: beams x the longest LiDAR range in cells (``lidar.range_max`` or ``raytrace_max_range``), the
     samples a simulated scan and the LiDAR layer's ray tracing take (720 beams x 10 m at 5 cm: 144000).
-    people: people in one frame (a scenario, a ``sid groups`` line); grouping time grows faster than the square.
+    people: people in one frame (a scenario, a ``sid groups`` or ``sid track`` line); grouping time grows faster
+    than the square.
     Raise one with ``SID_LIMITS="NAME=VALUE,..."`` (an environment variable, read at each check).
     """
 

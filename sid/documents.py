@@ -31,7 +31,7 @@ def load_document(path: str | Path, kind: str = "file") -> Any:
     text = decode_text(raw, f"{path}: cannot read {kind}")
     is_json = path.suffix.lower() == ".json"
     try:
-        return json.loads(text, object_pairs_hook=_unique_keys) if is_json else yaml.load(text, _UniqueKeyLoader)
+        return json.loads(text, object_pairs_hook=unique_keys) if is_json else yaml.load(text, _UniqueKeyLoader)
     except RecursionError:
         raise ValueError(f"{path}: cannot read {kind}: nested too deeply") from None
     except (json.JSONDecodeError, yaml.YAMLError, ValueError, TypeError, OverflowError) as exc:
@@ -41,7 +41,7 @@ def load_document(path: str | Path, kind: str = "file") -> Any:
         raise ValueError(f"{path}: not valid {'JSON' if is_json else 'YAML'} ({reason})") from None
 
 
-def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+def unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
     """A JSON object's pairs as a dict; ValueError on a key given twice (json.loads would keep the last silently)."""
     result: dict[str, Any] = {}
     for key, value in pairs:
@@ -84,8 +84,14 @@ def decode_text(raw: bytes, what: str) -> str:
 
 
 def is_number(value: Any) -> TypeGuard[int | float]:
-    """Whether a parsed JSON / YAML value is a finite number (an int or a float; booleans do not count)."""
-    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+    """Whether a parsed JSON / YAML value is a finite number (an int or a float; booleans do not count, nor an int
+    too large for a float, e.g. 400 digits)."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return False
+    try:
+        return math.isfinite(value)
+    except OverflowError:  # an int beyond the float range
+        return False
 
 
 TEMPORARY_PREFIX = ".sid-partial-"

@@ -1,6 +1,7 @@
 """The ``sid`` command line: one subcommand per module in this package.
 
-``common`` is the exception: the options and messages several subcommands share.
+``common``, ``planning`` and ``grouping`` are the exceptions: the options, readers and messages several subcommands
+share.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from sid.documents import InputWarning
 COMMANDS: tuple[str, ...] = (
     "detect",
     "groups",
+    "track",
     "eval",
     "costmap",
     "plan",

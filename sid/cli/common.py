@@ -1,22 +1,25 @@
-"""What every ``sid`` subcommand shares: how it reports errors and files, writes its output folder and stops on a
-signal. The scenario and planner options live in ``sid.cli.planning``: commands that do not plan never import OMPL."""
+"""What every ``sid`` subcommand shares: how it reports errors and files, reads JSON lines, writes its output folder
+and stops on a signal. The scenario and planner options live in ``sid.cli.planning`` (commands that do not plan never
+import OMPL), the group detector's in ``sid.cli.grouping``."""
 
 from __future__ import annotations
 
 import argparse
 import fnmatch
+import json
 import os
 import shutil
 import signal
 import sys
 import tempfile
 import threading
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
+from typing import IO, Any, TextIO
 
-from sid.documents import TEMPORARY_PREFIX
+from sid.documents import TEMPORARY_PREFIX, unique_keys
 
 
 class OutputFolderError(ValueError):
@@ -68,6 +71,120 @@ def fail(command: str, error: Exception) -> int:
     """Print ``command: error`` on stderr; the exit code of bad input (2)."""
     print(f"{command}: {error}", file=sys.stderr)
     return 2
+
+
+LineHandler = Callable[[Any], dict[str, Any]]
+"""What a JSON-lines command does with one parsed line: the JSON object it writes for it; ValueError for a bad line."""
+
+
+def run_json_lines(
+    command: str, file: str, handle: LineHandler, *, strict: bool = False, refuse_duplicate_keys: bool = False
+) -> int:
+    """``process_json_lines`` on ``file`` read as bytes (``-``: stdin), writing to stdout; its exit code, or 2 when
+    ``file`` cannot be read. When the reader of stdout goes away (a broken pipe, e.g. ``| head``) the run stops
+    quietly with exit 0, as Unix tools do."""
+    try:
+        # Bytes, decoded line by line: a line that is not UTF-8 is reported and skipped like any malformed line.
+        if file == "-":
+            stream: IO[Any] = getattr(sys.stdin, "buffer", sys.stdin)
+        else:
+            stream = open(file, "rb")  # noqa: SIM115
+    except OSError as exc:
+        print(f"{command}: cannot read {file}: {exc.strerror}", file=sys.stderr)
+        return 2
+    with stream:
+        try:
+            return process_json_lines(
+                command,
+                stream,
+                sys.stdout,
+                sys.stderr,
+                handle,
+                strict=strict,
+                refuse_duplicate_keys=refuse_duplicate_keys,
+            )
+        except BrokenPipeError:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error when Python exits
+            return 0
+        except OSError as exc:  # e.g. FILE is a directory, or the disk fails mid-read
+            print(f"{command}: cannot read {file}: {exc.strerror or exc}", file=sys.stderr)
+            return 2
+
+
+def process_json_lines(
+    command: str,
+    lines: Iterable[str | bytes],
+    out: TextIO,
+    err: TextIO,
+    handle: LineHandler,
+    *,
+    strict: bool = False,
+    refuse_duplicate_keys: bool = False,
+) -> int:
+    """Write ``handle(value)`` on ``out`` as one JSON line, flushed, for each non-blank line of ``lines``
+    (``read_json_lines``). A line that cannot be read, or that ``handle`` refuses (ValueError), is reported on ``err``
+    as ``COMMAND: line N: problem`` and skipped, or, with ``strict``, ends the run: exit code 1. Returns the exit
+    code."""
+    skipped = 0
+    for number, value, problem in read_json_lines(lines, refuse_duplicate_keys=refuse_duplicate_keys):
+        if problem is None:
+            try:
+                record = handle(value)
+            except ValueError as exc:
+                problem = str(exc)
+        if problem is not None:
+            print(f"{command}: line {number}: {problem}", file=err, flush=True)
+            if strict:
+                return 1
+            skipped += 1
+            continue
+        out.write(json.dumps(record) + "\n")
+        out.flush()
+    if skipped:
+        print(f"{command}: skipped {skipped} malformed line(s)", file=err, flush=True)
+    return 0
+
+
+def read_json_lines(
+    lines: Iterable[str | bytes], *, refuse_duplicate_keys: bool = False
+) -> Iterator[tuple[int, Any, str | None]]:
+    """(line number, parsed value, None) for each non-blank line, or (line number, None, problem) for one that is not
+    UTF-8 text or not JSON. Bytes are decoded here line by line as UTF-8 (a byte-order mark before the first line is
+    dropped); NaN and Infinity are refused, and with ``refuse_duplicate_keys`` an object giving a key twice."""
+    hook = unique_keys if refuse_duplicate_keys else None
+    for number, raw in enumerate(lines, start=1):
+        if isinstance(raw, bytes):
+            try:
+                line = raw.decode("utf-8")
+            except UnicodeDecodeError as exc:
+                if number == 1 and raw[:2] in (b"\xff\xfe", b"\xfe\xff"):
+                    yield number, None, "not UTF-8 text (it starts with a UTF-16 byte-order mark; save it as UTF-8)"
+                else:
+                    yield (
+                        number,
+                        None,
+                        f"not UTF-8 text (byte 0x{raw[exc.start]:02x} at byte {exc.start + 1} of the line)",
+                    )
+                continue
+        else:
+            line = raw
+        if number == 1:
+            line = line.removeprefix("\ufeff")  # a byte-order mark (some Windows editors write one)
+        if not line.strip():
+            continue
+        try:
+            value = json.loads(line, parse_constant=_reject_constant, object_pairs_hook=hook)
+        except ValueError as exc:  # json.JSONDecodeError, NaN or Infinity, a duplicate key
+            yield number, None, f"not valid JSON ({exc})"
+            continue
+        except RecursionError:
+            yield number, None, "not valid JSON (nested too deeply)"
+            continue
+        yield number, value, None
+
+
+def _reject_constant(name: str) -> float:
+    raise ValueError(f"{name} is not a number")
 
 
 def print_written(paths: Iterable[object]) -> None:

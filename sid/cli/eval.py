@@ -10,7 +10,7 @@ import math
 import sys
 from pathlib import Path
 
-from sid.cli.groups import add_group_params, group_params_from
+from sid.cli.grouping import add_group_params, group_params_from
 from sid.experiments.fformation import (
     DEFAULT_GRID,
     DEFAULT_THRESHOLDS,

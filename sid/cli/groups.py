@@ -13,17 +13,14 @@ or ends the run with --strict (exit 1); everything written before it stays writt
 from __future__ import annotations
 
 import argparse
-import dataclasses
-import json
-import os
-import re
-import sys
-from collections.abc import Iterable, Iterator
-from typing import IO, Any, TextIO
+from collections.abc import Iterable
+from typing import Any, TextIO
 
 from sid.checks import check_limit
+from sid.cli.common import fail, process_json_lines, run_json_lines
+from sid.cli.grouping import add_group_params, group_params_from
 from sid.documents import is_number
-from sid.perception.groups import GROUP_METHODS, Group, GroupParams, detect_groups
+from sid.perception.groups import Group, GroupParams, detect_groups
 from sid.perception.people import Person
 
 
@@ -40,67 +37,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.set_defaults(func=run)
 
 
-def add_group_params(parser: argparse.ArgumentParser) -> None:
-    """One option per GroupParams field (--method, --group-price, --eps, ...), defaulting to the record's defaults."""
-    group = parser.add_argument_group("group detector parameters (metres, square metres, radians)")
-    for field in dataclasses.fields(GroupParams):
-        if field.name == "method":
-            group.add_argument(
-                "--method",
-                "--group-method",
-                dest="group_method",
-                choices=GROUP_METHODS,
-                default=field.default,
-                help=f"{_field_help(field.name)} (default {field.default}; docs/groups.md)",
-            )
-            continue
-        kind = int if isinstance(field.default, int) else float
-        group.add_argument(
-            "--" + field.name.replace("_", "-"),
-            dest=f"group_{field.name}",
-            type=kind,
-            default=field.default,
-            metavar="N" if kind is int else "X",
-            help=f"{_field_help(field.name)} (default {field.default})",
-        )
-
-
-def group_params_from(args: argparse.Namespace) -> GroupParams:
-    """The GroupParams given on the command line (ValueError for invalid values)."""
-    return GroupParams(**{f.name: getattr(args, f"group_{f.name}") for f in dataclasses.fields(GroupParams)})
-
-
-def _field_help(name: str) -> str:
-    """The first sentence of the field's entry in the GroupParams docstring."""
-    doc = GroupParams.__doc__ or ""
-    match = re.search(rf"^\s*{name}: (.+?\.)(?=\s+[A-Z0-9(`]|\s*$)", doc, flags=re.MULTILINE | re.DOTALL)
-    return " ".join(match.group(1).split()) if match else name.replace("_", " ")
-
-
 def run(args: argparse.Namespace) -> int:
     try:
         params = group_params_from(args)
     except ValueError as exc:
-        print(f"sid groups: {exc}", file=sys.stderr)
-        return 2
-    try:
-        # Bytes, decoded line by line: a line that is not UTF-8 is reported and skipped like any malformed line.
-        if args.file == "-":
-            stream: IO[Any] = getattr(sys.stdin, "buffer", sys.stdin)
-        else:
-            stream = open(args.file, "rb")  # noqa: SIM115
-    except OSError as exc:
-        print(f"sid groups: cannot read {args.file}: {exc.strerror}", file=sys.stderr)
-        return 2
-    with stream:
-        try:
-            return process(stream, sys.stdout, sys.stderr, params, strict=args.strict)
-        except BrokenPipeError:  # the reader went away (e.g. `| head`): stop quietly, as Unix tools do
-            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-            return 0
-        except OSError as exc:  # e.g. FILE is a directory, or the disk fails mid-read
-            print(f"sid groups: cannot read {args.file}: {exc.strerror or exc}", file=sys.stderr)
-            return 2
+        return fail("sid groups", exc)
+    return run_json_lines("sid groups", args.file, lambda data: _groups_line(data, params), strict=args.strict)
 
 
 def process(lines: Iterable[str | bytes], out: TextIO, err: TextIO, params: GroupParams, strict: bool = False) -> int:
@@ -108,24 +50,13 @@ def process(lines: Iterable[str | bytes], out: TextIO, err: TextIO, params: Grou
 
     ``lines`` are text, or bytes decoded here line by line as UTF-8 (a byte-order mark before the first is dropped).
     """
-    skipped = 0
-    for number, frame, problem in _frames(lines):
-        if problem is None:
-            try:
-                groups = detect_groups(frame["people"], params)
-            except ValueError as exc:
-                problem = str(exc)
-        if problem is not None:
-            print(f"sid groups: line {number}: {problem}", file=err, flush=True)
-            if strict:
-                return 1
-            skipped += 1
-            continue
-        out.write(json.dumps({"frame": frame["frame"], "groups": [group_to_json(g) for g in groups]}) + "\n")
-        out.flush()
-    if skipped:
-        print(f"sid groups: skipped {skipped} malformed line(s)", file=err, flush=True)
-    return 0
+    return process_json_lines("sid groups", lines, out, err, lambda data: _groups_line(data, params), strict=strict)
+
+
+def _groups_line(data: Any, params: GroupParams) -> dict[str, Any]:
+    """The output line of one parsed input line: its frame label and groups (ValueError for a malformed line)."""
+    frame = _parse_frame(data)
+    return {"frame": frame["frame"], "groups": [group_to_json(g) for g in detect_groups(frame["people"], params)]}
 
 
 def group_to_json(group: Group) -> dict[str, Any]:
@@ -136,46 +67,6 @@ def group_to_json(group: Group) -> dict[str, Any]:
         "spread": group.spread,
         "zone": group.zone.tolist(),
     }
-
-
-def _frames(lines: Iterable[str | bytes]) -> Iterator[tuple[int, dict[str, Any], str | None]]:
-    """(line number, {"frame", "people": [Person]}, problem or None) for each non-blank line."""
-    for number, raw in enumerate(lines, start=1):
-        if isinstance(raw, bytes):
-            try:
-                line = raw.decode("utf-8")
-            except UnicodeDecodeError as exc:
-                if number == 1 and raw[:2] in (b"\xff\xfe", b"\xfe\xff"):
-                    yield number, {}, "not UTF-8 text (it starts with a UTF-16 byte-order mark; save it as UTF-8)"
-                else:
-                    yield (
-                        number,
-                        {},
-                        f"not UTF-8 text (byte 0x{raw[exc.start]:02x} at byte {exc.start + 1} of the line)",
-                    )
-                continue
-        else:
-            line = raw
-        if number == 1:
-            line = line.removeprefix("\ufeff")  # a byte-order mark (some Windows editors write one)
-        if not line.strip():
-            continue
-        try:
-            data = json.loads(line, parse_constant=_reject_constant)
-        except (json.JSONDecodeError, ValueError) as exc:
-            yield number, {}, f"not valid JSON ({exc})"
-            continue
-        except RecursionError:
-            yield number, {}, "not valid JSON (nested too deeply)"
-            continue
-        try:
-            yield number, _parse_frame(data), None
-        except ValueError as exc:
-            yield number, {}, str(exc)
-
-
-def _reject_constant(name: str) -> float:
-    raise ValueError(f"{name} is not a number")
 
 
 def _parse_frame(data: Any) -> dict[str, Any]:

@@ -69,6 +69,14 @@ def test_malformed_lines_are_reported_with_their_number_and_skipped(tmp_path, ca
     assert "skipped 6 malformed line(s)" in err
 
 
+def test_a_number_too_large_for_a_float_is_a_malformed_line(capsys, monkeypatch):
+    huge = "1" + "0" * 400  # a JSON int no float can hold (it used to end the run with an OverflowError)
+    monkeypatch.setattr(sys, "stdin", io.StringIO(f'{{"frame": {huge}, "people": []}}\n' + json.dumps(PAIR) + "\n"))
+    code, out, err = run_sid(["groups", "-"], capsys)
+    assert code == 0 and [json.loads(line)["frame"] for line in out] == [0]
+    assert err.splitlines()[0] == f"sid groups: line 1: 'frame' must be a finite number or a string, got {huge}"
+
+
 def test_strict_stops_at_the_first_bad_line_keeping_earlier_output(tmp_path, capsys):
     source = tmp_path / "frames.jsonl"
     source.write_text(json.dumps(PAIR) + "\n" + '{"people": 3}\n' + json.dumps(PAIR) + "\n")

@@ -23,7 +23,7 @@ print(sorted(m for m in sys.modules if m.startswith("sid.cli.")))
 """
 
 
-@pytest.mark.parametrize("command", ["groups", "detect"])
+@pytest.mark.parametrize("command", ["groups", "track", "detect"])
 def test_a_command_imports_only_its_own_module(command: str) -> None:
     done = subprocess.run([sys.executable, "-c", PROBE.format(command=command)], cwd=REPO, capture_output=True,
                           text=True, timeout=300, check=True)  # fmt: skip

@@ -1,0 +1,115 @@
+"""``sid track FILE|-``: track people and groups over JSON-lines detections, one time step per line.
+
+Input, one time step per line, in one fixed ground frame (REP-103: metres, radians counter-clockwise from +x;
+timestamp in seconds, each after the last good line's; theta null or absent = unknown facing; id: the detector's
+integer id of the detection, default its index in the list, echoed back as the track's "detection"):
+    {"timestamp": 0.0, "people": [{"id": 7, "x": 2.0, "y": 0.5, "theta": 3.1}, {"x": 2.0, "y": -0.5}]}
+Output, one line per good input line, flushed as it is written, the tracks as `sid detect` writes them
+(docs/tracking.md; a track is listed from its third detection, velocity in m/s, group members as track ids):
+    {"timestamp": 0.0, "people": [{"id": 1, "x": 2.0, "y": 0.5, "theta": 3.1, "velocity": [vx, vy],
+                                   "state": "standing"|"walking", "visible": true, "detection": 7}],
+     "groups": [{"id": 1, "kind": "conversation"|"walking", "members": [1, 2], "interest_point": [x, y],
+                 "area": a, "spread": d, "zone": [[x, y], ...], "velocity": [vx, vy]}],
+     "timing_ms": {"track": ms, "track_groups": ms}}
+A malformed line (not UTF-8 JSON, a key given twice, an unknown field, a missing or non-finite number, a timestamp
+not after the last good line's, two people with one id) is reported on stderr with its line number and skipped,
+or ends the run with --strict (exit 1); everything written before it stays written. The people and group trackers
+run with their defaults; the group detector that finds conversations among the tracks takes the options below.
+"""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from sid.checks import check_limit
+from sid.cli.common import fail, run_json_lines
+from sid.cli.grouping import add_group_params, group_params_from
+from sid.documents import is_number
+from sid.perception.people import Person
+from sid.tracking import TrackingSession
+
+LINE_FIELDS = ("timestamp", "people")
+PERSON_FIELDS = ("id", "x", "y", "theta")
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "track",
+        help="track people and groups over JSON-lines detections",
+        description=__doc__.split("\n\n", 1)[1].split("\n\n")[0] if __doc__ else None,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("file", metavar="FILE", help="JSON-lines input, or - for stdin")
+    parser.add_argument("--strict", action="store_true", help="stop at the first malformed line (exit 1)")
+    add_group_params(parser)
+    parser.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    try:
+        session = TrackingSession(group_params=group_params_from(args))
+    except ValueError as exc:
+        return fail("sid track", exc)
+    return run_json_lines(
+        "sid track", args.file, lambda data: _track_line(data, session), strict=args.strict, refuse_duplicate_keys=True
+    )
+
+
+def _track_line(data: Any, session: TrackingSession) -> dict[str, Any]:
+    """The output line of one parsed input line, after ``session`` tracked its people (ValueError for a malformed
+    line, the session unchanged)."""
+    timestamp, people = _parse_line(data)
+    update = session.track(people, float(timestamp))
+    return {
+        "timestamp": timestamp,
+        "people": [person.to_json() | {"detection": person.detection} for person in update.people],
+        "groups": [group.to_json() for group in update.groups],
+        "timing_ms": {name: round(ms, 3) for name, ms in update.timing_ms.items()},
+    }
+
+
+def _parse_line(data: Any) -> tuple[int | float, list[Person]]:
+    """The timestamp (s, as given) and people of a line."""
+    if not isinstance(data, dict):
+        raise ValueError("expected a JSON object with 'timestamp' and 'people'")
+    _refuse_unknown(data, LINE_FIELDS)
+    for key in LINE_FIELDS:
+        if key not in data:
+            raise ValueError(f"missing {key!r}")
+    timestamp = data["timestamp"]
+    if not is_number(timestamp):
+        raise ValueError(f"'timestamp' must be a finite number of seconds, got {timestamp!r}")
+    if not isinstance(data["people"], list):
+        raise ValueError("'people' must be a list")
+    check_limit("people", len(data["people"]), "people", "people")  # before any work on them (sid.checks.Limits)
+    return timestamp, [_parse_person(person, k) for k, person in enumerate(data["people"])]
+
+
+def _parse_person(data: Any, index: int) -> Person:
+    """A detection of the line's ``people`` list at ``index`` (id defaults to ``index``)."""
+    where = f"people[{index}]"
+    if not isinstance(data, dict):
+        raise ValueError(f"{where} must be an object with x, y and optionally theta and id")
+    _refuse_unknown(data, PERSON_FIELDS, f"{where}: ")
+    person_id = data.get("id", index)
+    if isinstance(person_id, bool) or not isinstance(person_id, int):
+        raise ValueError(f"{where}: id must be an integer, got {person_id!r}")
+    for key in ("x", "y"):
+        if key not in data:
+            raise ValueError(f"{where} is missing {key!r}")
+        if not is_number(data[key]):
+            raise ValueError(f"{where}: {key} must be a finite number of metres, got {data[key]!r}")
+    theta = data.get("theta")
+    if theta is not None and not is_number(theta):
+        raise ValueError(f"{where}: theta must be a finite number of radians, or null when unknown, got {theta!r}")
+    if theta is None:
+        return Person(person_id, float(data["x"]), float(data["y"]))
+    return Person(person_id, float(data["x"]), float(data["y"]), float(theta), 1.0)
+
+
+def _refuse_unknown(data: dict[str, Any], known: tuple[str, ...], prefix: str = "") -> None:
+    """ValueError naming the first key of ``data`` not in ``known`` (a misspelt field would otherwise be lost)."""
+    unknown = [key for key in data if key not in known]
+    if unknown:
+        raise ValueError(f"{prefix}unknown field {unknown[0]!r} (the fields are {', '.join(known)})")
