@@ -234,18 +234,27 @@ def median_neighbour_distance(frames: Sequence[LabelledFrame]) -> float | None:
     return float(np.median(distances)) if distances else None
 
 
+def frame_matches(
+    detected: Sequence[Iterable[int]], truth: Sequence[Iterable[int]], threshold: float
+) -> tuple[int, int, int]:
+    """(true groups found, groups detected, true groups) of one frame under the tolerance ``threshold`` (T); groups
+    of one are ignored."""
+    found_sets = [frozenset(g) for g in detected if len(frozenset(g)) > 1]
+    true_sets = [frozenset(g) for g in truth if len(frozenset(g)) > 1]
+    true_positives = sum(any(len(g & t) / max(len(g), len(t)) >= threshold for g in found_sets) for t in true_sets)
+    return true_positives, len(found_sets), len(true_sets)
+
+
 def frame_precision_recall(
     detected: Sequence[Iterable[int]], truth: Sequence[Iterable[int]], threshold: float
 ) -> tuple[float, float]:
     """Precision and recall of one frame under the tolerance ``threshold`` (T); groups of one are ignored."""
-    found_sets = [frozenset(g) for g in detected if len(frozenset(g)) > 1]
-    true_sets = [frozenset(g) for g in truth if len(frozenset(g)) > 1]
-    true_positives = sum(any(len(g & t) / max(len(g), len(t)) >= threshold for g in found_sets) for t in true_sets)
-    if not found_sets and not true_sets:
+    true_positives, found, true = frame_matches(detected, truth, threshold)
+    if not found and not true:
         return 1.0, 1.0
-    precision = true_positives / len(found_sets) if found_sets else 1.0
-    recall = true_positives / len(true_sets) if true_sets else 1.0
-    if found_sets and not true_sets:
+    precision = true_positives / found if found else 1.0
+    recall = true_positives / true if true else 1.0
+    if found and not true:
         precision = 0.0
     return precision, recall
 

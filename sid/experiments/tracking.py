@@ -124,9 +124,9 @@ def evaluate_tracking(settings: TrackingEvalSettings | None = None, progress: Pr
         logs_by_name[name] = logs
         accumulator = _accumulate(logs, settings.match_distance)
         accumulators.append(accumulator)
-        per_sequence[name] = {"frames": len(logs), **_people_scores([accumulator], [name])[name]}
+        per_sequence[name] = {"frames": len(logs), **mot_scores([accumulator], [name])[name]}
         per_sequence[name] |= _group_scores(logs, settings)
-    overall = _people_scores(accumulators, list(settings.sequences), overall=True)["OVERALL"]
+    overall = mot_scores(accumulators, list(settings.sequences), overall=True)["OVERALL"]
     all_logs = [log for logs in logs_by_name.values() for log in logs]
     overall |= _group_scores(all_logs, settings)
     return {
@@ -213,7 +213,7 @@ def _accumulate(logs: Sequence[_FrameLog], match_distance: float) -> Any:
     return accumulator
 
 
-def _people_scores(accumulators: list[Any], names: list[str], overall: bool = False) -> dict[str, dict[str, Any]]:
+def mot_scores(accumulators: list[Any], names: list[str], overall: bool = False) -> dict[str, dict[str, Any]]:
     import motmetrics
 
     metrics = [
@@ -243,9 +243,7 @@ def _people_scores(accumulators: list[Any], names: list[str], overall: bool = Fa
     return out
 
 
-def _identify(
-    positions: np.ndarray, truth_ids: list[int], truth_positions: np.ndarray, gate: float
-) -> list[int | None]:
+def identify(positions: np.ndarray, truth_ids: list[int], truth_positions: np.ndarray, gate: float) -> list[int | None]:
     """The true person id of each of ``positions`` (N, 2) by minimum total distance within ``gate`` (m)."""
     out: list[int | None] = [None] * len(positions)
     if not len(positions) or not len(truth_positions):
@@ -258,7 +256,7 @@ def _identify(
     return out
 
 
-def _as_truth_ids(groups: list[tuple[int, ...]], key: list[int], identity: list[int | None]) -> list[frozenset[int]]:
+def as_truth_ids(groups: list[tuple[int, ...]], key: list[int], identity: list[int | None]) -> list[frozenset[int]]:
     """Groups of ``key`` ids (detection indexes or track ids) as groups of true ids; unidentified members are
     kept as distinct negative ids (they count against the group, as a stranger would)."""
     lookup = {k: (i if i is not None else -1 - n) for n, (k, i) in enumerate(zip(key, identity, strict=True))}
@@ -276,10 +274,10 @@ def _group_scores(logs: Sequence[_FrameLog], settings: TrackingEvalSettings) -> 
         hidden = {i for i, seen in zip(ids, _seen(log).tolist(), strict=True) if not seen}
         walking = {p.id for p in log.truth.people if p.walking}
         frames.append(LabelledFrame("", log.time, [], [frozenset(g.members) - hidden for g in log.truth.groups]))
-        raw_identity = _identify(log.raw_positions, ids, positions, settings.match_distance)
-        raw_groups = [g - hidden for g in _as_truth_ids(log.raw_groups, list(range(len(raw_identity))), raw_identity)]
-        track_identity = _identify(log.track_positions, ids, positions, settings.match_distance)
-        track_groups = [g - hidden for g in _as_truth_ids(log.track_groups, log.track_ids, track_identity)]
+        raw_identity = identify(log.raw_positions, ids, positions, settings.match_distance)
+        raw_groups = [g - hidden for g in as_truth_ids(log.raw_groups, list(range(len(raw_identity))), raw_identity)]
+        track_identity = identify(log.track_positions, ids, positions, settings.match_distance)
+        track_groups = [g - hidden for g in as_truth_ids(log.track_groups, log.track_ids, track_identity)]
         raw.append(raw_groups)
         tracked.append(track_groups)
         walkers_raw += any(g & walking for g in raw_groups)

@@ -54,6 +54,7 @@ class GroupTrackerParams:
     leave_distance: float = 1.6
     walk_distance: float = 2.0
     walk_velocity_difference: float = 0.4
+    walk_window: float = 2.0
     max_speed_sigma: float = 0.4
 
     def __post_init__(self) -> None:
@@ -70,6 +71,16 @@ class GroupTrackerParams:
         check_number("group tracker", "min_overlap", self.min_overlap, low=0, high=1, low_open=True)
         check_numbers("group tracker", self, ("leave_distance", "walk_distance"), low=0, low_open=True, unit="metres")
         check_numbers("group tracker", self, ("walk_velocity_difference", "max_speed_sigma"), low=0, unit="m/s")
+        check_number("group tracker", "walk_window", self.walk_window, low=0, high=60, unit="seconds")
+
+
+@dataclass(frozen=True)
+class _Positions:
+    """The tracks at one past frame: timestamp (s), sorted track ids, (K, 2) positions (m)."""
+
+    timestamp: float
+    ids: np.ndarray
+    positions: np.ndarray
 
 
 @dataclass
@@ -104,17 +115,20 @@ class GroupTracker:
         self.group_params = group_params or GroupParams()
         self._next_id = 1
         self._tracks: list[_GroupTrack] = []
+        self._history: deque[_Positions] = deque()
 
     def reset(self) -> None:
         """Forget every group (ids keep counting up)."""
         self._tracks = []
+        self._history = deque()
 
     def update(self, people: Sequence[TrackedPerson], timestamp: float) -> list[TrackedGroup]:
         """The confirmed groups among ``people`` (this frame's tracks) at ``timestamp`` (s)."""
         by_id = {p.id: p for p in people}
         if len(by_id) != len(people):
             raise ValueError("group tracker: a track id appears twice in one frame")
-        candidates = self._conversations(people) + _walking_groups(people, self.params)
+        self._remember(people, timestamp)
+        candidates = self._conversations(people) + _walking_groups(people, self._history, self.params)
         matched = self._match(candidates)
         found_now = {m for candidate in candidates for m in candidate.members}
         p = self.params
@@ -145,6 +159,15 @@ class GroupTracker:
                 kept.append(track)
         self._tracks = kept
         return [_report(track, by_id) for track in self._tracks if track.confirmed]
+
+    def _remember(self, people: Sequence[TrackedPerson], timestamp: float) -> None:
+        """Keep the tracks' positions of the last ``walk_window`` seconds (this frame's included)."""
+        order = sorted(range(len(people)), key=lambda k: people[k].id)
+        ids = np.array([people[k].id for k in order], dtype=np.int64)
+        positions = np.array([[people[k].x, people[k].y] for k in order]).reshape(-1, 2)
+        self._history.append(_Positions(timestamp, ids, positions))
+        while timestamp - self._history[0].timestamp > self.params.walk_window:
+            self._history.popleft()
 
     def _conversations(self, people: Sequence[TrackedPerson]) -> list[_Candidate]:
         settled = self.params.max_speed_sigma
@@ -196,16 +219,19 @@ def _jaccard(track: _GroupTrack, candidate: _Candidate) -> float:
     return len(members & candidate.members) / len(members | candidate.members)
 
 
-def _walking_groups(people: Sequence[TrackedPerson], params: GroupTrackerParams) -> list[_Candidate]:
+def _walking_groups(
+    people: Sequence[TrackedPerson], history: deque[_Positions], params: GroupTrackerParams
+) -> list[_Candidate]:
     walkers = [p for p in people if p.walking]
     if len(walkers) < 2:
         return []
+    ids = np.array([p.id for p in walkers], dtype=np.int64)
     position = np.array([[p.x, p.y] for p in walkers])
-    velocity = np.array([[p.vx, p.vy] for p in walkers])
-    near = np.linalg.norm(position[:, None] - position[None], axis=2) <= params.walk_distance
-    alike = np.linalg.norm(velocity[:, None] - velocity[None], axis=2) <= params.walk_velocity_difference
+    near = _pair_distance(position) <= params.walk_distance
+    alike = _relative_speed(ids, position, np.array([[p.vx, p.vy] for p in walkers]), history, params)
+    alike = alike <= params.walk_velocity_difference
     out = []
-    for rows in _components(near & alike):
+    for rows in connected_components(near & alike):
         if len(rows) < 2:
             continue
         centre = position[rows].mean(axis=0)
@@ -215,10 +241,43 @@ def _walking_groups(people: Sequence[TrackedPerson], params: GroupTrackerParams)
     return out
 
 
-def _components(adjacent: np.ndarray) -> list[np.ndarray]:
+def _relative_speed(
+    ids: np.ndarray, position: np.ndarray, velocity: np.ndarray, history: deque[_Positions], params: GroupTrackerParams
+) -> np.ndarray:
+    """(N, N) speed (m/s) at which each pair of tracks moves apart: their relative displacement since the oldest
+    frame of the last ``walk_window`` seconds in which both were tracked, over that time; for a pair with less than
+    half the window in common, the difference of their filtered velocities (noisier)."""
+    speed = _pair_distance(velocity)
+    now = history[-1].timestamp if history else None
+    filled = np.zeros(speed.shape, dtype=bool)
+    for old in history:
+        if now is None or now - old.timestamp < params.walk_window / 2:
+            break
+        rows = np.searchsorted(old.ids, ids)
+        rows = np.minimum(rows, len(old.ids) - 1)
+        present = old.ids[rows] == ids if len(old.ids) else np.zeros(len(ids), dtype=bool)
+        both = present[:, None] & present[None, :] & ~filled
+        if not both.any():
+            continue
+        then = old.positions[rows]
+        moved = (position[:, None, :] - position[None, :, :]) - (then[:, None, :] - then[None, :, :])
+        relative = np.sqrt(moved[..., 0] ** 2 + moved[..., 1] ** 2) / (now - old.timestamp)
+        speed = np.where(both, relative, speed)
+        filled |= both
+    return speed
+
+
+def _pair_distance(points: np.ndarray) -> np.ndarray:
+    d = points[:, None, :] - points[None, :, :]
+    return np.sqrt(d[..., 0] ** 2 + d[..., 1] ** 2)
+
+
+def connected_components(adjacent: np.ndarray) -> list[np.ndarray]:
     """The connected components of a symmetric (N, N) bool adjacency matrix, as index arrays ordered by their first
     index. Reachability squared until it stops growing: a few small matrix products for the walkers in view, where
     ``scipy.sparse.csgraph`` would add 0.4 s of imports to every start (docs/benchmarks.md, "Start-up")."""
+    if not len(adjacent):
+        return []
     reach = (adjacent | np.eye(len(adjacent), dtype=bool)).astype(np.int64)
     while True:
         grown = np.minimum(reach @ reach, 1)

@@ -11,9 +11,9 @@ from sid.experiments import tracking
 from sid.experiments.tracking import (
     MissingDependencyError,
     TrackingEvalSettings,
-    _as_truth_ids,
-    _identify,
+    as_truth_ids,
     evaluate_tracking,
+    identify,
     measure_flicker,
 )
 
@@ -46,8 +46,8 @@ def test_flicker_counts_the_cells_a_missed_person_leaves_blank() -> None:
 def test_people_are_identified_by_nearest_position_within_the_gate() -> None:
     truth = np.array([[1.0, 0.0], [2.0, 0.0]])
     found = np.array([[2.1, 0.0], [5.0, 5.0], [1.05, 0.0]])
-    assert _identify(found, [7, 8], truth, 0.5) == [8, None, 7]
-    assert _as_truth_ids([(0, 1, 2)], [0, 1, 2], [8, None, 7]) == [frozenset({8, -2, 7})]
+    assert identify(found, [7, 8], truth, 0.5) == [8, None, 7]
+    assert as_truth_ids([(0, 1, 2)], [0, 1, 2], [8, None, 7]) == [frozenset({8, -2, 7})]
 
 
 def test_a_missing_motmetrics_is_explained(monkeypatch: pytest.MonkeyPatch) -> None:

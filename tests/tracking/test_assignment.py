@@ -8,11 +8,10 @@ import sys
 import numpy as np
 import pytest
 from scipy.optimize import linear_sum_assignment
-from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import connected_components
+from scipy.sparse import csgraph, csr_matrix
 
 from sid.tracking.assignment import gated_assignment
-from sid.tracking.groups import _components
+from sid.tracking.groups import connected_components
 
 
 def _reference(cost: np.ndarray, allowed: np.ndarray) -> tuple[int, float]:
@@ -102,9 +101,9 @@ def test_components_equal_scipy(seed: int) -> None:
     n = int(rng.integers(1, 15))
     upper = np.triu(rng.random((n, n)) < rng.uniform(0.05, 0.5), 1)
     adjacent = upper | upper.T
-    count, labels = connected_components(csr_matrix(adjacent), directed=False)
+    count, labels = csgraph.connected_components(csr_matrix(adjacent), directed=False)
     expected = [np.flatnonzero(labels == label).tolist() for label in range(count)]
-    assert [rows.tolist() for rows in _components(adjacent)] == expected
+    assert [rows.tolist() for rows in connected_components(adjacent)] == expected
 
 
 def test_a_social_stream_loads_the_solver_up_front() -> None:

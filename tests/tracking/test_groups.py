@@ -163,3 +163,25 @@ def test_a_member_missed_for_a_moment_stays_and_one_who_joins_another_group_move
     for k in range(6, 12):
         groups = tracker.update(_circle((1, 2, 3)) + far, k * DT)
     assert sorted(g.members for g in groups) == [(1, 2, 3), (4, 5)]
+
+
+def test_walkers_moving_together_are_a_group_through_noisy_velocity_estimates() -> None:
+    # The filtered velocities differ by 0.6 m/s (above walk_velocity_difference) in alternate frames, as a young
+    # track's do, but the pair's relative position holds: over the walk window they move apart at 0 m/s.
+    tracker = GroupTracker(GroupTrackerParams(walk_window=2.0, walk_velocity_difference=0.4))
+    found = []
+    for k in range(40):
+        x, wobble = 1.0 + 1.2 * k * DT, 0.3 if k % 2 else -0.3
+        people = [_person(1, x, 0.3, 0.0, (1.2 + wobble, 0.0)), _person(2, x, -0.3, 0.0, (1.2 - wobble, 0.0))]
+        found.append([g.members for g in tracker.update(people, k * DT)])
+    assert all(groups == [(1, 2)] for groups in found[20:])  # once the window is filled (1 s of history)
+
+
+def test_walkers_who_drift_apart_are_no_group_even_when_their_velocities_look_alike() -> None:
+    # Each frame's velocities are equal but the positions spread at 0.6 m/s: the displacement over the window counts.
+    tracker = GroupTracker(GroupTrackerParams(walk_window=2.0, walk_distance=3.0))
+    for k in range(40):
+        x, spread = 1.0 + 1.2 * k * DT, 0.3 * k * DT
+        people = [_person(1, x, 0.3 + spread, 0.0, (1.2, 0.0)), _person(2, x, -0.3 - spread, 0.0, (1.2, 0.0))]
+        groups = tracker.update(people, k * DT)
+    assert groups == []

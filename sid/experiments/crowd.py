@@ -1,0 +1,277 @@
+"""People and walking groups over time on real pedestrian trajectories (``sid eval crowd``; docs/tracking.md).
+
+Protocol:
+
+- detections: each set replayed by ``sid.experiments.trajectories.replay`` (annotation times or a camera's rate,
+  seeded 0.1 m noise, 10 % misses, optionally a field of view), fed to ``TrackingSession.track``: the people tracker
+  and then the group tracker, the classes ``sid track`` runs. The tracker is told where the detector looks: the
+  robot's view when one is set, else the area the set's camera covered (the convex hull of all annotated
+  positions), so that a track coasting out of the scene is not counted as a person in it. The coherent-motion
+  reference (``sid.tracking.coherent``) runs on the same tracks.
+- people (py-motmetrics): ground truth = the people present (inside the robot's view when one is set);
+  hypotheses = the confirmed tracks detected in the frame or inside the view. A track within ``match_distance`` may
+  match. MOTA, IDF1, identity switches (also per 100 true tracks).
+- groups: each frame's tracks are identified with true people by minimum total distance within ``match_distance``
+  (an unidentified member is a stranger). Truth = the annotated groups holding among the people present (two or
+  more members there). G-MITRE (``sid.experiments.gmitre``): link counts over the people present, everyone not
+  in a group alone, pooled over all frames. Group matching at T = 2/3 and T = 1 (``fformation.frame_matches``): the
+  true groups found, groups reported and true groups, summed over all frames (frames without any group on either
+  side then count for nothing).
+- ``cross_validate``: leave one set out over a grid of the group trackers' parameters, choosing the best mean
+  G-MITRE F1 on the others.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib.util
+import itertools
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from sid.experiments.fformation import format_threshold, frame_matches
+from sid.experiments.gmitre import LinkCounts, gmitre_counts
+from sid.experiments.tracking import MissingDependencyError, as_truth_ids, identify, mot_scores
+from sid.experiments.trajectories import ReplaySettings, TrajectorySet, replay
+from sid.tracking.coherent import CoherentMotion, CoherentMotionParams
+from sid.tracking.groups import GroupTracker, GroupTrackerParams
+from sid.tracking.records import TrackedPerson
+from sid.tracking.session import TrackingParams, TrackingSession
+from sid.tracking.view import scene_view
+
+__all__ = ["CrowdSettings", "TrackLog", "cross_validate", "evaluate_crowd", "record_tracks", "score_groups"]
+
+Progress = Callable[[int, int, str], None]
+"""progress(done, total, what) after each frame (``sid.experiments.progress.ProgressBar``)."""
+
+DEFAULT_GRID: dict[str, dict[str, tuple[float, ...]]] = {
+    "groups": {"walk_distance": (1.5, 2.0, 2.5), "walk_velocity_difference": (0.3, 0.4, 0.5, 0.6)},
+    "coherent": {"distance": (1.5, 2.0, 2.5), "velocity_difference": (0.3, 0.4, 0.5), "share": (0.6, 0.8, 1.0)},
+}
+"""What ``cross_validate`` chooses among: the group tracker's and the reference's parameters."""
+
+
+@dataclass(frozen=True)
+class CrowdSettings:
+    """What ``evaluate_crowd`` runs: the replay, the trackers' and the reference's parameters, the matching
+    distance (m) and the group tolerances T."""
+
+    replay: ReplaySettings = field(default_factory=ReplaySettings)
+    tracking: TrackingParams = field(default_factory=TrackingParams)
+    coherent: CoherentMotionParams = field(default_factory=CoherentMotionParams)
+    match_distance: float = 0.5
+    thresholds: tuple[float, ...] = (2 / 3, 1.0)
+
+
+@dataclass(frozen=True, eq=False)
+class TrackLog:
+    """One replayed set through the people tracker: per frame the time (s), the truth (ids, (K, 2) positions m)
+    and the confirmed tracks (``TrackedPerson``s) that count as hypotheses."""
+
+    name: str
+    times: list[float]
+    truth_ids: list[np.ndarray]
+    truth_positions: list[np.ndarray]
+    tracks: list[list[TrackedPerson]]
+
+    def track_positions(self, frame: int) -> np.ndarray:
+        return np.array([[p.x, p.y] for p in self.tracks[frame]]).reshape(-1, 2)
+
+
+def record_tracks(
+    trajectories: TrajectorySet, settings: CrowdSettings | None = None, progress: Progress | None = None
+) -> TrackLog:
+    """Replay ``trajectories`` through the people tracker (``TrackingSession.track``, groups left to the caller)."""
+    settings = settings or CrowdSettings()
+    session = TrackingSession(settings.tracking)
+    log = TrackLog(trajectories.name, [], [], [], [])
+    total = _frame_count(trajectories, settings.replay)
+    view = settings.replay.view or scene_view(np.concatenate(trajectories.positions))
+    for k, frame in enumerate(replay(trajectories, settings.replay)):
+        people = session.people.update(frame.detections, frame.timestamp, view)
+        log.times.append(frame.timestamp)
+        log.truth_ids.append(frame.truth_ids)
+        log.truth_positions.append(frame.truth_positions)
+        log.tracks.append([p for p in people if p.visible or p.in_view])
+        if progress is not None:
+            progress(k + 1, total, trajectories.name)
+    return log
+
+
+def score_groups(
+    trajectories: TrajectorySet,
+    log: TrackLog,
+    groups: Sequence[Sequence[frozenset[int]]],
+    settings: CrowdSettings | None = None,
+) -> dict[str, Any]:
+    """G-MITRE and per-frame matching of ``groups`` (per frame of ``log``: member track ids) against the truth."""
+    settings = settings or CrowdSettings()
+    links = LinkCounts()
+    matches = {t: np.zeros(3, dtype=np.int64) for t in settings.thresholds}
+    for k, found in enumerate(groups):
+        ids = log.truth_ids[k].tolist()
+        present = set(ids)
+        truth = trajectories.truth_groups(present)
+        track_ids = [p.id for p in log.tracks[k]]
+        identity = identify(log.track_positions(k), ids, log.truth_positions[k], settings.match_distance)
+        as_truth = as_truth_ids([tuple(g) for g in found], track_ids, identity)
+        in_scene = [g & present for g in as_truth]
+        grouped = set().union(*truth)
+        found_grouped = set().union(*in_scene) if in_scene else set()
+        links += gmitre_counts(
+            truth + [{i} for i in present - grouped],
+            [g for g in in_scene if g] + [{i} for i in present - found_grouped],
+        )
+        for threshold in settings.thresholds:
+            matches[threshold] += frame_matches(as_truth, truth, threshold)
+    out: dict[str, Any] = {
+        "gmitre": {"precision": links.precision, "recall": links.recall, "f1": links.f1},
+    }
+    for threshold, (hits, found_count, true_count) in matches.items():
+        precision = hits / found_count if found_count else 1.0
+        recall = hits / true_count if true_count else 1.0
+        f1 = 2 * precision * recall / (precision + recall) if precision + recall > 0 else 0.0
+        out[f"groups_T{format_threshold(threshold)}"] = {
+            "precision": precision,
+            "recall": recall,
+            "f1": f1,
+            "true_groups": int(true_count),
+            "found_groups": int(found_count),
+        }
+    return out
+
+
+def run_group_trackers(
+    log: TrackLog, settings: CrowdSettings
+) -> tuple[list[list[frozenset[int]]], list[list[frozenset[int]]]]:
+    """Per frame of ``log``: the group tracker's confirmed groups (any kind) and the reference's groups."""
+    tracker = GroupTracker(settings.tracking.groups)
+    reference = CoherentMotion(settings.coherent)
+    ours, theirs = [], []
+    for time, people in zip(log.times, log.tracks, strict=True):
+        ours.append([frozenset(g.members) for g in tracker.update(people, time)])
+        theirs.append(reference.update(people, time))
+    return ours, theirs
+
+
+def evaluate_crowd(
+    sets: Sequence[TrajectorySet], settings: CrowdSettings | None = None, progress: Progress | None = None
+) -> dict[str, Any]:
+    """Tracking and group scores of every set, sid's group tracker beside the coherent-motion reference."""
+    _require_motmetrics()
+    settings = settings or CrowdSettings()
+    out: dict[str, Any] = {"settings": _settings_json(settings), "sets": {}}
+    for trajectories in sets:
+        log = record_tracks(trajectories, settings, progress)
+        ours, theirs = run_group_trackers(log, settings)
+        people = mot_scores([_accumulate(log, settings.match_distance)], [trajectories.name])[trajectories.name]
+        true_tracks = trajectories.people
+        people["true_tracks"] = true_tracks
+        people["id_switches_per_100_tracks"] = 100 * people["id_switches"] / true_tracks if true_tracks else 0.0
+        out["sets"][trajectories.name] = {
+            "frames": len(log.times),
+            "notes": list(trajectories.notes),
+            "people": people,
+            "groups": score_groups(trajectories, log, ours, settings),
+            "coherent_motion": score_groups(trajectories, log, theirs, settings),
+        }
+    return out
+
+
+def cross_validate(
+    sets: Sequence[TrajectorySet],
+    settings: CrowdSettings | None = None,
+    grid: Mapping[str, Mapping[str, Sequence[float]]] | None = None,
+    progress: Progress | None = None,
+) -> dict[str, Any]:
+    """Leave one set out: for each set, the grid point with the best mean G-MITRE F1 on the others, and its score on
+    the held-out set; for the group tracker (``grid["groups"]``) and the reference (``grid["coherent"]``)."""
+    settings = settings or CrowdSettings()
+    grid = grid or DEFAULT_GRID
+    logs = [record_tracks(s, settings, progress) for s in sets]
+    points = {
+        "groups": _points(settings.tracking.groups, grid.get("groups", {})),
+        "coherent": _points(settings.coherent, grid.get("coherent", {})),
+    }
+    f1: dict[str, np.ndarray] = {}
+    for which, candidates in points.items():
+        table = np.zeros((len(candidates), len(sets)))
+        for row, candidate in enumerate(candidates):
+            trial = _with(settings, which, candidate)
+            for col, (trajectories, log) in enumerate(zip(sets, logs, strict=True)):
+                found = run_group_trackers(log, trial)[0 if which == "groups" else 1]
+                table[row, col] = score_groups(trajectories, log, found, trial)["gmitre"]["f1"]
+        f1[which] = table
+    folds = []
+    for col, trajectories in enumerate(sets):
+        fold: dict[str, Any] = {"held_out": trajectories.name}
+        for which, candidates in points.items():
+            others = np.delete(f1[which], col, axis=1).mean(axis=1)
+            best = int(np.argmax(others))  # the first of equals: the grid's order
+            fold[which] = {
+                "chosen": _changed(candidates[best], grid.get(which, {})),
+                "train_f1": float(others[best]),
+                "held_out_f1": float(f1[which][best, col]),
+            }
+        folds.append(fold)
+    return {"folds": folds, "grid": {k: {n: list(v) for n, v in g.items()} for k, g in grid.items()}}
+
+
+def _points(base: Any, axes: Mapping[str, Sequence[float]]) -> list[Any]:
+    names = list(axes)
+    return [
+        dataclasses.replace(base, **dict(zip(names, values, strict=True)))
+        for values in itertools.product(*axes.values())
+    ]
+
+
+def _changed(params: Any, axes: Mapping[str, Sequence[float]]) -> dict[str, float]:
+    return {name: getattr(params, name) for name in axes}
+
+
+def _with(settings: CrowdSettings, which: str, params: Any) -> CrowdSettings:
+    if which == "groups":
+        assert isinstance(params, GroupTrackerParams)
+        return dataclasses.replace(settings, tracking=dataclasses.replace(settings.tracking, groups=params))
+    assert isinstance(params, CoherentMotionParams)
+    return dataclasses.replace(settings, coherent=params)
+
+
+def _accumulate(log: TrackLog, match_distance: float) -> Any:
+    import motmetrics
+
+    accumulator = motmetrics.MOTAccumulator(auto_id=True)
+    for k in range(len(log.times)):
+        distances = motmetrics.distances.norm2squared_matrix(
+            log.truth_positions[k], log.track_positions(k), max_d2=match_distance**2
+        )
+        accumulator.update(log.truth_ids[k].tolist(), [p.id for p in log.tracks[k]], distances)
+    return accumulator
+
+
+def _frame_count(trajectories: TrajectorySet, replay_settings: ReplaySettings) -> int:
+    if replay_settings.rate is None or not len(trajectories.times):
+        return len(trajectories.times)
+    return int((trajectories.times[-1] - trajectories.times[0]) * replay_settings.rate + 1e-9) + 1
+
+
+def _settings_json(settings: CrowdSettings) -> dict[str, Any]:
+    replay_settings = dataclasses.asdict(settings.replay)
+    return {
+        "replay": replay_settings,
+        "tracker": dataclasses.asdict(settings.tracking.tracker),
+        "group_tracker": dataclasses.asdict(settings.tracking.groups),
+        "coherent_motion": dataclasses.asdict(settings.coherent),
+        "match_distance": settings.match_distance,
+        "thresholds": list(settings.thresholds),
+    }
+
+
+def _require_motmetrics() -> None:
+    if importlib.util.find_spec("motmetrics") is None:
+        raise MissingDependencyError(
+            "the crowd evaluation needs py-motmetrics: pip install 'sid[eval]' (or pip install motmetrics)"
+        )

@@ -1,0 +1,235 @@
+"""Real pedestrian trajectories with walking groups (ETH/BIWI, UCY), and their replay as a robot's detections.
+
+Format (one folder per set): ``obsmat.txt``, one row per annotated person and frame,
+``frame pedestrian_id pos_x pos_z pos_y v_x v_z v_y`` (metres and m/s on the ground plane; the z columns are unused);
+``groups.txt``, one line per group of people who walk together, their ids separated by spaces (people not listed
+walk alone; a group holds for as long as at least two of its members are in the scene). Annotations come every
+``interval`` seconds (0.4 s in the public sets, whatever their video's frame rate): the most common step between
+frame numbers is taken as one interval (seq_eth has a few odd steps).
+
+``replay`` feeds them as a perception stage would: detections at the annotation times or at a camera's rate by
+linear interpolation (only between annotations one step apart), seeded Gaussian position noise, seeded missed
+detections, and optionally only the people inside a robot's field of view. Positions are in the set's own ground
+frame; the facing is unknown (None): the sets have none.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from sid.checks import check_number
+from sid.perception.people import Person
+from sid.tracking.view import View
+
+__all__ = ["ReplayFrame", "ReplaySettings", "TrajectoryError", "TrajectorySet", "load_trajectory_set", "replay"]
+
+
+class TrajectoryError(ValueError):
+    """A trajectory folder that cannot be read: the message names the file, the line and the problem."""
+
+
+@dataclass(frozen=True, eq=False)
+class TrajectorySet:
+    """One set of annotated trajectories.
+
+    name: the folder's name. times: (F,) annotation times (s, from 0). ids, positions, velocities: per frame, the
+    people present, (K,) int, (K, 2) m and (K, 2) m/s in the set's ground frame. groups: the annotated walking
+    groups (member ids; two or more each).
+    """
+
+    name: str
+    times: np.ndarray
+    ids: tuple[np.ndarray, ...]
+    positions: tuple[np.ndarray, ...]
+    velocities: tuple[np.ndarray, ...]
+    groups: tuple[frozenset[int], ...]
+    notes: tuple[str, ...] = ()
+
+    @property
+    def people(self) -> int:
+        """Distinct people annotated."""
+        return len(np.unique(np.concatenate(self.ids))) if self.ids else 0
+
+    def truth_groups(self, present: set[int] | frozenset[int]) -> list[frozenset[int]]:
+        """The annotated groups holding among ``present`` people: their members present, when two or more."""
+        held = [group & present for group in self.groups]
+        return [group for group in held if len(group) >= 2]
+
+
+@dataclass(frozen=True)
+class ReplaySettings:
+    """How ``replay`` turns annotations into detections.
+
+    rate: detections per second (None: at the annotation times; e.g. 15 for a camera, by interpolation).
+    noise: standard deviation (m) of the Gaussian noise added to each coordinate. miss_rate: probability that a
+    person is not detected in a frame. seed: of both. view: the robot's field of view in the set's frame (None:
+    everyone is seen).
+    """
+
+    rate: float | None = None
+    noise: float = 0.1
+    miss_rate: float = 0.1
+    seed: int = 0
+    view: View | None = None
+
+    def __post_init__(self) -> None:
+        if self.rate is not None:
+            check_number("replay", "rate", self.rate, low=0, low_open=True, high=1000, unit="Hz")
+        check_number("replay", "noise", self.noise, low=0, high=10, unit="metres")
+        check_number("replay", "miss_rate", self.miss_rate, low=0, high=1, high_open=True)
+
+
+@dataclass(frozen=True)
+class ReplayFrame:
+    """One replayed time step: ``timestamp`` (s), the detections (``Person.id`` = the true id; ``theta`` None), and
+    the truth: the ids and (K, 2) positions (m) of the people present, inside the view when one is set."""
+
+    timestamp: float
+    detections: list[Person]
+    truth_ids: np.ndarray
+    truth_positions: np.ndarray
+
+
+def load_trajectory_set(folder: str | Path, interval: float = 0.4) -> TrajectorySet:
+    """The set in ``folder`` (``obsmat.txt``, ``groups.txt``); ``interval``: seconds between annotation steps."""
+    folder = Path(folder)
+    check_number("trajectories", "interval", interval, low=0, low_open=True, unit="seconds")
+    obsmat, groups_file = folder / "obsmat.txt", folder / "groups.txt"
+    for path in (obsmat, groups_file):
+        if not path.is_file():
+            raise TrajectoryError(f"{folder}: no {path.name} (a trajectory set holds obsmat.txt and groups.txt)")
+    rows = _read_obsmat(obsmat)
+    frames = rows[:, 0].astype(np.int64)
+    steps, counts = np.unique(np.diff(np.unique(frames)), return_counts=True)
+    step = int(steps[np.argmax(counts)]) if len(steps) else 1
+    order = np.lexsort((rows[:, 1], frames))
+    rows, frames = rows[order], frames[order]
+    ids = rows[:, 1].astype(np.int64)
+    twice = np.flatnonzero((frames[1:] == frames[:-1]) & (ids[1:] == ids[:-1]))  # sorted: repeats are neighbours
+    if len(twice):
+        raise TrajectoryError(f"{obsmat}: pedestrian {ids[twice[0]]} appears twice in frame {frames[twice[0]]}")
+    starts = np.flatnonzero(np.r_[True, frames[1:] != frames[:-1]])
+    bounds = np.r_[starts, len(frames)]
+    times = (frames[starts] - frames[0]) / step * interval
+    position, velocity = rows[:, [2, 4]], rows[:, [5, 7]]
+    groups, notes = _read_groups(groups_file, set(ids.tolist()))
+    return TrajectorySet(
+        folder.name,
+        times,
+        tuple(ids[a:b] for a, b in zip(bounds[:-1], bounds[1:], strict=True)),
+        tuple(position[a:b] for a, b in zip(bounds[:-1], bounds[1:], strict=True)),
+        tuple(velocity[a:b] for a, b in zip(bounds[:-1], bounds[1:], strict=True)),
+        groups,
+        notes,
+    )
+
+
+def replay(trajectories: TrajectorySet, settings: ReplaySettings | None = None) -> Iterator[ReplayFrame]:
+    """The detections a robot's perception would give, time step by time step (see the module's docstring)."""
+    settings = settings or ReplaySettings()
+    rng = np.random.default_rng(settings.seed)
+    for timestamp, ids, positions in _steps(trajectories, settings.rate):
+        if settings.view is not None:
+            inside = settings.view.contains(positions)
+            ids, positions = ids[inside], positions[inside]
+        measured = positions + rng.normal(0.0, settings.noise, positions.shape)
+        seen = rng.random(len(ids)) >= settings.miss_rate
+        detections = [
+            Person(int(i), float(x), float(y))
+            for i, (x, y), keep in zip(ids.tolist(), measured.tolist(), seen.tolist(), strict=True)
+            if keep
+        ]
+        yield ReplayFrame(float(timestamp), detections, ids, positions)
+
+
+def _steps(trajectories: TrajectorySet, rate: float | None) -> Iterator[tuple[float, np.ndarray, np.ndarray]]:
+    """(time, ids, true positions) at the annotation times, or every 1 / rate seconds by interpolation."""
+    times = trajectories.times
+    if rate is None:
+        yield from zip(times.tolist(), trajectories.ids, trajectories.positions, strict=True)
+        return
+    if len(times) == 0:
+        return
+    interval = float(np.min(np.diff(times))) if len(times) > 1 else 0.0
+    count = int(math.floor((times[-1] - times[0]) * rate + 1e-9)) + 1
+    for k in range(count):
+        t = times[0] + k / rate
+        i = int(np.searchsorted(times, t, side="right")) - 1
+        if i == len(times) - 1 or abs(t - times[i]) < 1e-9:
+            yield t, trajectories.ids[i], trajectories.positions[i]
+            continue
+        a_ids, b_ids = trajectories.ids[i], trajectories.ids[i + 1]
+        if times[i + 1] - times[i] > interval * 1.5:  # a gap in the annotations: nobody to interpolate
+            yield t, a_ids[:0], trajectories.positions[i][:0]
+            continue
+        both, a_rows, b_rows = np.intersect1d(a_ids, b_ids, assume_unique=True, return_indices=True)
+        w = (t - times[i]) / (times[i + 1] - times[i])
+        position = (1 - w) * trajectories.positions[i][a_rows] + w * trajectories.positions[i + 1][b_rows]
+        yield t, both, position
+
+
+def _read_obsmat(path: Path) -> np.ndarray:
+    rows: list[list[float]] = []
+    for number, line in _lines(path):
+        try:
+            values = [float(v) for v in line.split()]
+        except ValueError:
+            raise TrajectoryError(f"{path}:{number}: not numbers: {line.strip()[:80]!r}") from None
+        if len(values) != 8:
+            raise TrajectoryError(f"{path}:{number}: {len(values)} columns, expected 8 (frame id x z y vx vz vy)")
+        if not all(math.isfinite(v) for v in values):
+            raise TrajectoryError(f"{path}:{number}: a value is not finite")
+        if any(v != int(v) or abs(v) > _LARGEST_ID for v in values[:2]):
+            raise TrajectoryError(f"{path}:{number}: frame and pedestrian id must be whole numbers up to 2^53")
+        rows.append(values)
+    if not rows:
+        raise TrajectoryError(f"{path}: no annotations")
+    return np.array(rows)
+
+
+def _read_groups(path: Path, known: set[int]) -> tuple[tuple[frozenset[int], ...], tuple[str, ...]]:
+    """The groups of ``groups.txt`` and notes on it. Lines that share a person are one group (a person walks in one
+    group; the public seq_eth lists some people on two lines): they are joined, and a note says which."""
+    lines: list[tuple[int, frozenset[int]]] = []
+    for number, line in _lines(path):
+        try:
+            members = frozenset(int(v) for v in line.split())
+        except ValueError:
+            raise TrajectoryError(f"{path}:{number}: pedestrian ids must be whole numbers") from None
+        unknown = sorted(members - known)
+        if unknown:
+            raise TrajectoryError(f"{path}:{number}: pedestrian {unknown[0]} is not in obsmat.txt")
+        lines.append((number, members))
+    joined: list[tuple[list[int], frozenset[int]]] = []
+    for number, members in lines:
+        overlapping = [j for j in joined if j[1] & members]
+        numbers = [number] + [n for j in overlapping for n in j[0]]
+        union = members.union(*(j[1] for j in overlapping))
+        joined = [j for j in joined if not j[1] & members] + [(sorted(numbers), union)]
+    notes = tuple(
+        f"{path.name}: lines {', '.join(map(str, numbers))} share people: taken as one group of {len(members)}"
+        for numbers, members in joined
+        if len(numbers) > 1
+    )
+    groups = [members for _, members in sorted(joined) if len(members) >= 2]
+    return tuple(groups), notes
+
+
+_LARGEST_ID = 2**53  # frame numbers and ids are read as floats: whole numbers beyond this are not exact
+
+
+def _lines(path: Path) -> Iterator[tuple[int, str]]:
+    """(line number, line) for the non-blank lines of a UTF-8 text file; TrajectoryError naming a line that is not."""
+    with path.open("rb") as handle:
+        for number, raw in enumerate(handle, 1):
+            try:
+                line = raw.decode("utf-8")
+            except UnicodeDecodeError:
+                raise TrajectoryError(f"{path}:{number}: not UTF-8 text") from None
+            if line.strip():
+                yield number, line

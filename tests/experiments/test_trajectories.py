@@ -1,0 +1,124 @@
+"""Reading trajectory sets (obsmat.txt + groups.txt) and replaying them as detections."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sid.experiments.trajectories import (
+    ReplaySettings,
+    TrajectoryError,
+    load_trajectory_set,
+    replay,
+)
+from sid.tracking import ViewCone
+from tests.conftest import shared_path
+
+
+def _write_set(folder: Path, rows: list[tuple[float, ...]], groups: str = "") -> Path:
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "obsmat.txt").write_text("\n".join(" ".join(f"{v:.6e}" for v in row) for row in rows) + "\n")
+    (folder / "groups.txt").write_text(groups)
+    return folder
+
+
+def _walkers(frames: int = 5, step: int = 10) -> list[tuple[float, ...]]:
+    """Pedestrians 1 and 2 side by side along +x at 1 m/s, 3 alone going -x; one row per 0.4 s step."""
+    rows = []
+    for k in range(frames):
+        x = 0.4 * k
+        rows += [
+            (k * step, 1, x, 0, 0.0, 1, 0, 0),
+            (k * step, 2, x, 0, 0.6, 1, 0, 0),
+            (k * step, 3, 5 - x, 0, 3, -1, 0, 0),
+        ]
+    return rows
+
+
+def test_a_set_is_read_into_frames_with_times_positions_and_groups(tmp_path: Path) -> None:
+    folder = _write_set(tmp_path / "pairs", _walkers(), "1 2\n")
+    trajectories = load_trajectory_set(folder)
+    assert trajectories.name == "pairs" and trajectories.people == 3
+    assert trajectories.times.tolist() == pytest.approx([0.0, 0.4, 0.8, 1.2, 1.6])  # frame step 10 = 0.4 s
+    assert trajectories.ids[2].tolist() == [1, 2, 3]
+    np.testing.assert_allclose(trajectories.positions[2], [[0.8, 0.0], [0.8, 0.6], [4.2, 3.0]])
+    assert trajectories.velocities[0].tolist() == [[1, 0], [1, 0], [-1, 0]]
+    assert trajectories.groups == (frozenset({1, 2}),)
+    assert trajectories.truth_groups({1, 3}) == []  # a group holds while two of its members are present
+
+
+def test_lines_sharing_a_person_are_one_group_with_a_note(tmp_path: Path) -> None:
+    folder = _write_set(tmp_path / "s", _walkers(), "1 2\n2 3\n")
+    trajectories = load_trajectory_set(folder)
+    assert trajectories.groups == (frozenset({1, 2, 3}),)
+    assert trajectories.notes == ("groups.txt: lines 1, 2 share people: taken as one group of 3",)
+
+
+@pytest.mark.parametrize(
+    ("obsmat", "groups", "problem"),
+    [
+        ("0 1 0 0 0 0 0\n", "", "obsmat.txt:1: 7 columns, expected 8"),
+        ("0 1 0 0 0 0 0 nan\n", "", "obsmat.txt:1: a value is not finite"),
+        ("0 1 0 0 zero 0 0 0\n", "", "obsmat.txt:1: not numbers"),
+        ("0.5 1 0 0 0 0 0 0\n", "", "obsmat.txt:1: frame and pedestrian id must be whole numbers"),
+        ("0 1e300 0 0 0 0 0 0\n", "", "obsmat.txt:1: frame and pedestrian id must be whole numbers up to 2^53"),
+        ("0 1 0 0 0 0 0 0\n0 1 1 0 0 0 0 0\n", "", "obsmat.txt: pedestrian 1 appears twice in frame 0"),
+        ("\n\n", "", "obsmat.txt: no annotations"),
+        ("0 1 0 0 0 0 0 0\n", "1 7\n", "groups.txt:1: pedestrian 7 is not in obsmat.txt"),
+        ("0 1 0 0 0 0 0 0\n", "1 two\n", "groups.txt:1: pedestrian ids must be whole numbers"),
+    ],
+)
+def test_bad_files_are_refused_naming_the_file_line_and_problem(
+    tmp_path: Path, obsmat: str, groups: str, problem: str
+) -> None:
+    (tmp_path / "obsmat.txt").write_text(obsmat)
+    (tmp_path / "groups.txt").write_text(groups)
+    with pytest.raises(TrajectoryError, match=problem.replace("^", r"\^")):
+        load_trajectory_set(tmp_path)
+
+
+def test_a_missing_file_or_bytes_that_are_not_text_are_refused(tmp_path: Path) -> None:
+    with pytest.raises(TrajectoryError, match="no obsmat.txt"):
+        load_trajectory_set(tmp_path)
+    (tmp_path / "obsmat.txt").write_bytes(b"0 1 0 0 0 0 0 0\n\xff\xfe\n")
+    (tmp_path / "groups.txt").write_text("")
+    with pytest.raises(TrajectoryError, match="obsmat.txt:2: not UTF-8 text"):
+        load_trajectory_set(tmp_path)
+
+
+def test_replay_is_seeded_noisy_and_drops_detections_at_the_miss_rate(tmp_path: Path) -> None:
+    trajectories = load_trajectory_set(_write_set(tmp_path / "s", _walkers(frames=200)))
+    settings = ReplaySettings(noise=0.1, miss_rate=0.2, seed=4)
+    frames = list(replay(trajectories, settings))
+    again = list(replay(trajectories, settings))
+    assert [[(p.x, p.y) for p in f.detections] for f in frames] == [[(p.x, p.y) for p in f.detections] for f in again]
+    seen = sum(len(f.detections) for f in frames)
+    assert 0.75 < seen / (3 * 200) < 0.85
+    errors = np.array(
+        [[p.x - f.truth_positions[list(f.truth_ids).index(p.id)][0]] for f in frames for p in f.detections]
+    )
+    assert 0.08 < errors.std() < 0.12
+    assert all(p.theta is None for f in frames for p in f.detections)  # the sets have no facing
+
+
+def test_replay_at_a_camera_rate_interpolates_between_annotations(tmp_path: Path) -> None:
+    trajectories = load_trajectory_set(_write_set(tmp_path / "s", _walkers(frames=3)))
+    frames = list(replay(trajectories, ReplaySettings(rate=5.0, noise=0.0, miss_rate=0.0)))
+    assert [f.timestamp for f in frames] == pytest.approx([0.0, 0.2, 0.4, 0.6, 0.8])
+    assert frames[1].truth_positions[0].tolist() == pytest.approx([0.2, 0.0])  # halfway between 0 and 0.4 m
+
+
+def test_replay_in_a_field_of_view_keeps_only_the_people_inside(tmp_path: Path) -> None:
+    trajectories = load_trajectory_set(_write_set(tmp_path / "s", _walkers(frames=1)))
+    view = ViewCone(-1.0, 0.3, 0.0, np.radians(40), max_range=3.0)  # looking along +x from behind the pair
+    (frame,) = replay(trajectories, ReplaySettings(noise=0.0, miss_rate=0.0, view=view))
+    assert frame.truth_ids.tolist() == [1, 2] and [p.id for p in frame.detections] == [1, 2]
+
+
+def test_the_shared_sets_load_with_their_groups() -> None:
+    for name, people in (("seq_eth", 360), ("seq_hotel", 390), ("zara01", 148)):
+        trajectories = load_trajectory_set(shared_path("data", "trajectories", name))
+        assert trajectories.people == people and len(trajectories.groups) > 30
+        assert np.diff(trajectories.times).min() == pytest.approx(0.4)

@@ -1,0 +1,60 @@
+"""CoherentMotion, the walking-group reference, on tracks generated here (ground frame, metres, 2.5 Hz)."""
+
+from __future__ import annotations
+
+import pytest
+
+from sid.tracking import TrackedPerson
+from sid.tracking.coherent import CoherentMotion, CoherentMotionParams
+
+DT = 0.4
+
+
+def _track(track_id: int, x: float, y: float, vx: float, vy: float) -> TrackedPerson:
+    state = "walking" if abs(vx) + abs(vy) > 0.5 else "standing"
+    return TrackedPerson(track_id, x, y, vx, vy, None, state, True, True, 0.0, None, 0.1, 0.1)
+
+
+def _frames(reference: CoherentMotion, count: int, start: int = 0) -> list[list[frozenset[int]]]:
+    """A pair (1, 2) 0.6 m apart at 1.2 m/s, 3 walking the other way 1 m beside them, 4 standing 5 m away."""
+    out = []
+    for k in range(start, start + count):
+        x = 1.2 * DT * k
+        people = [_track(1, x, 0.0, 1.2, 0.0), _track(2, x, 0.6, 1.2, 0.0), _track(3, 10 - x, 1.6, -1.2, 0.0)]
+        people.append(_track(4, 5.0, -5.0, 0.0, 0.0))
+        out.append(reference.update(people, k * DT))
+    return out
+
+
+def test_a_pair_walking_together_is_a_group_once_it_held_long_enough() -> None:
+    reference = CoherentMotion(CoherentMotionParams(min_frames=3))
+    groups = _frames(reference, 8)
+    assert groups[:2] == [[], []]  # two frames together are not yet three
+    assert all(g == [frozenset({1, 2})] for g in groups[2:])  # never 3 (opposite velocity) or 4 (too far)
+
+
+def test_people_who_part_stop_being_a_group_after_the_window() -> None:
+    reference = CoherentMotion(CoherentMotionParams(window=2.0, share=0.8))
+    _frames(reference, 6)
+    apart = []
+    for k in range(6, 16):
+        people = [_track(1, 1.2 * DT * k, 0.0, 1.2, 0.0), _track(2, 3.0, 4.0, 0.0, 1.2)]  # 2 turned away, far off
+        apart.append(reference.update(people, k * DT))
+    assert apart[0] == [frozenset({1, 2})]  # 5 of the last 6 frames still coherent: 0.83 >= share
+    assert apart[-1] == []
+
+
+def test_reset_forgets_the_history() -> None:
+    reference = CoherentMotion()
+    _frames(reference, 6)
+    reference.reset()
+    assert _frames(reference, 1, start=6) == [[]]
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "problem"),
+    [("distance", 0.0, "distance"), ("share", 1.5, "share"), ("min_frames", 0, "min_frames"), ("window", -1, "window")],
+)
+def test_bad_parameters_are_refused(field: str, value: float, problem: str) -> None:
+    with pytest.raises(ValueError, match=f"coherent motion: {problem}"):
+        CoherentMotionParams(**{field: value})
