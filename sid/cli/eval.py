@@ -1,5 +1,5 @@
 """``sid eval fformation DIR...``: score the group detector on F-formation benchmark datasets; ``sid eval tracking``:
-score the trackers on the synthetic sequences."""
+score the trackers on the synthetic sequences; ``sid eval crowd`` (``sid.cli.eval_crowd``): on real trajectories."""
 
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ import math
 import sys
 from pathlib import Path
 
+from sid.cli.eval_crowd import add_crowd_parser
 from sid.cli.grouping import add_group_params, group_params_from
 from sid.experiments.fformation import (
     DEFAULT_GRID,
@@ -92,6 +93,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     add_group_params(ff)
     ff.set_defaults(func=run)
     add_tracking_parser(tasks)
+    add_crowd_parser(tasks)
 
 
 def _threshold(text: str) -> float:

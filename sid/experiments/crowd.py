@@ -40,18 +40,36 @@ from sid.tracking.coherent import CoherentMotion, CoherentMotionParams
 from sid.tracking.groups import GroupTracker, GroupTrackerParams
 from sid.tracking.records import TrackedPerson
 from sid.tracking.session import TrackingParams, TrackingSession
+from sid.tracking.tracker import TrackerParams
 from sid.tracking.view import scene_view
 
-__all__ = ["CrowdSettings", "TrackLog", "cross_validate", "evaluate_crowd", "record_tracks", "score_groups"]
+__all__ = [
+    "DEFAULT_GRID",
+    "CrowdSettings",
+    "TrackLog",
+    "cross_validate",
+    "evaluate_crowd",
+    "find_coherent_groups",
+    "find_groups",
+    "record_tracks",
+    "score_groups",
+    "score_people",
+]
 
 Progress = Callable[[int, int, str], None]
 """progress(done, total, what) after each frame (``sid.experiments.progress.ProgressBar``)."""
 
 DEFAULT_GRID: dict[str, dict[str, tuple[float, ...]]] = {
+    "tracker": {
+        "measurement_sigma": (0.1, 0.15, 0.2),
+        "acceleration_sigma": (0.3, 0.5),
+        "max_gate": (1.0, 1.5),
+        "timeout": (1.0, 1.5, 2.0),
+    },
     "groups": {"walk_distance": (1.5, 2.0, 2.5), "walk_velocity_difference": (0.3, 0.4, 0.5, 0.6)},
     "coherent": {"distance": (1.5, 2.0, 2.5), "velocity_difference": (0.3, 0.4, 0.5), "share": (0.6, 0.8, 1.0)},
 }
-"""What ``cross_validate`` chooses among: the group tracker's and the reference's parameters."""
+"""What ``cross_validate`` chooses among: the people tracker's, the group tracker's and the reference's parameters."""
 
 
 @dataclass(frozen=True)
@@ -144,39 +162,42 @@ def score_groups(
     return out
 
 
-def run_group_trackers(
-    log: TrackLog, settings: CrowdSettings
-) -> tuple[list[list[frozenset[int]]], list[list[frozenset[int]]]]:
-    """Per frame of ``log``: the group tracker's confirmed groups (any kind) and the reference's groups."""
-    tracker = GroupTracker(settings.tracking.groups)
-    reference = CoherentMotion(settings.coherent)
-    ours, theirs = [], []
-    for time, people in zip(log.times, log.tracks, strict=True):
-        ours.append([frozenset(g.members) for g in tracker.update(people, time)])
-        theirs.append(reference.update(people, time))
-    return ours, theirs
+def find_groups(log: TrackLog, params: GroupTrackerParams) -> list[list[frozenset[int]]]:
+    """Per frame of ``log``: the group tracker's confirmed groups (any kind), as member track ids."""
+    tracker = GroupTracker(params)
+    frames = zip(log.times, log.tracks, strict=True)
+    return [[frozenset(g.members) for g in tracker.update(people, t)] for t, people in frames]
+
+
+def find_coherent_groups(log: TrackLog, params: CoherentMotionParams) -> list[list[frozenset[int]]]:
+    """Per frame of ``log``: the coherent-motion reference's groups, as member track ids."""
+    reference = CoherentMotion(params)
+    return [reference.update(people, t) for t, people in zip(log.times, log.tracks, strict=True)]
+
+
+def score_people(trajectories: TrajectorySet, log: TrackLog, match_distance: float) -> dict[str, Any]:
+    """MOTA, IDF1, identity switches (also per 100 true tracks) and the other motmetrics counts of ``log``."""
+    people: dict[str, Any] = mot_scores([_accumulate(log, match_distance)], [trajectories.name])[trajectories.name]
+    people["true_tracks"] = trajectories.people
+    people["id_switches_per_100_tracks"] = 100 * people["id_switches"] / max(trajectories.people, 1)
+    return people
 
 
 def evaluate_crowd(
     sets: Sequence[TrajectorySet], settings: CrowdSettings | None = None, progress: Progress | None = None
 ) -> dict[str, Any]:
     """Tracking and group scores of every set, sid's group tracker beside the coherent-motion reference."""
-    _require_motmetrics()
+    require_motmetrics()
     settings = settings or CrowdSettings()
     out: dict[str, Any] = {"settings": _settings_json(settings), "sets": {}}
     for trajectories in sets:
         log = record_tracks(trajectories, settings, progress)
-        ours, theirs = run_group_trackers(log, settings)
-        people = mot_scores([_accumulate(log, settings.match_distance)], [trajectories.name])[trajectories.name]
-        true_tracks = trajectories.people
-        people["true_tracks"] = true_tracks
-        people["id_switches_per_100_tracks"] = 100 * people["id_switches"] / true_tracks if true_tracks else 0.0
         out["sets"][trajectories.name] = {
             "frames": len(log.times),
             "notes": list(trajectories.notes),
-            "people": people,
-            "groups": score_groups(trajectories, log, ours, settings),
-            "coherent_motion": score_groups(trajectories, log, theirs, settings),
+            "people": score_people(trajectories, log, settings.match_distance),
+            "groups": score_groups(trajectories, log, find_groups(log, settings.tracking.groups), settings),
+            "coherent_motion": score_groups(trajectories, log, find_coherent_groups(log, settings.coherent), settings),
         }
     return out
 
@@ -187,34 +208,60 @@ def cross_validate(
     grid: Mapping[str, Mapping[str, Sequence[float]]] | None = None,
     progress: Progress | None = None,
 ) -> dict[str, Any]:
-    """Leave one set out: for each set, the grid point with the best mean G-MITRE F1 on the others, and its score on
-    the held-out set; for the group tracker (``grid["groups"]``) and the reference (``grid["coherent"]``)."""
+    """Leave one set out, in two stages per held-out set: the people tracker's grid point (``grid["tracker"]``) with
+    the best mean IDF1 on the other sets, then, on that tracker's tracks, the group tracker's (``grid["groups"]``) and
+    the reference's (``grid["coherent"]``) points with the best mean G-MITRE F1 on the other sets; each scored on the
+    held-out set. Ties go to the first point in the grid's order."""
+    require_motmetrics()
     settings = settings or CrowdSettings()
-    grid = grid or DEFAULT_GRID
-    logs = [record_tracks(s, settings, progress) for s in sets]
-    points = {
+    grid = grid if grid is not None else DEFAULT_GRID
+    trackers = _points(settings.tracking.tracker, grid.get("tracker", {}))
+    candidates = {
         "groups": _points(settings.tracking.groups, grid.get("groups", {})),
         "coherent": _points(settings.coherent, grid.get("coherent", {})),
     }
-    f1: dict[str, np.ndarray] = {}
-    for which, candidates in points.items():
-        table = np.zeros((len(candidates), len(sets)))
-        for row, candidate in enumerate(candidates):
-            trial = _with(settings, which, candidate)
-            for col, (trajectories, log) in enumerate(zip(sets, logs, strict=True)):
-                found = run_group_trackers(log, trial)[0 if which == "groups" else 1]
-                table[row, col] = score_groups(trajectories, log, found, trial)["gmitre"]["f1"]
-        f1[which] = table
+    total = len(trackers) * len(sets)
+    logs: list[list[TrackLog]] = []
+    idf1 = np.zeros((len(trackers), len(sets)))
+    for row, tracker in enumerate(trackers):
+        trial = _with_tracker(settings, tracker)
+        logs.append([record_tracks(s, trial) for s in sets])
+        for col, (trajectories, log) in enumerate(zip(sets, logs[row], strict=True)):
+            idf1[row, col] = score_people(trajectories, log, settings.match_distance)["idf1"]
+            if progress is not None:
+                progress(row * len(sets) + col + 1, total, f"tracker {row + 1}/{len(trackers)}")
+    group_f1: dict[tuple[str, int], np.ndarray] = {}  # (which, tracker row) -> (points, sets)
+
+    def f1_table(which: str, row: int) -> np.ndarray:
+        if (which, row) not in group_f1:
+            table = np.zeros((len(candidates[which]), len(sets)))
+            for k, params in enumerate(candidates[which]):
+                for col, (trajectories, log) in enumerate(zip(sets, logs[row], strict=True)):
+                    found = find_groups(log, params) if which == "groups" else find_coherent_groups(log, params)
+                    table[k, col] = score_groups(trajectories, log, found, settings)["gmitre"]["f1"]
+            group_f1[which, row] = table
+        return group_f1[which, row]
+
     folds = []
     for col, trajectories in enumerate(sets):
-        fold: dict[str, Any] = {"held_out": trajectories.name}
-        for which, candidates in points.items():
-            others = np.delete(f1[which], col, axis=1).mean(axis=1)
-            best = int(np.argmax(others))  # the first of equals: the grid's order
+        train = np.delete(idf1, col, axis=1).mean(axis=1)
+        row = int(np.argmax(train))
+        fold: dict[str, Any] = {
+            "held_out": trajectories.name,
+            "tracker": {
+                "chosen": _changed(trackers[row], grid.get("tracker", {})),
+                "train_idf1": float(train[row]),
+                "held_out_idf1": float(idf1[row, col]),
+            },
+        }
+        for which, points in candidates.items():
+            table = f1_table(which, row)
+            others = np.delete(table, col, axis=1).mean(axis=1)
+            best = int(np.argmax(others))
             fold[which] = {
-                "chosen": _changed(candidates[best], grid.get(which, {})),
+                "chosen": _changed(points[best], grid.get(which, {})),
                 "train_f1": float(others[best]),
-                "held_out_f1": float(f1[which][best, col]),
+                "held_out_f1": float(table[best, col]),
             }
         folds.append(fold)
     return {"folds": folds, "grid": {k: {n: list(v) for n, v in g.items()} for k, g in grid.items()}}
@@ -222,22 +269,16 @@ def cross_validate(
 
 def _points(base: Any, axes: Mapping[str, Sequence[float]]) -> list[Any]:
     names = list(axes)
-    return [
-        dataclasses.replace(base, **dict(zip(names, values, strict=True)))
-        for values in itertools.product(*axes.values())
-    ]
+    combos = itertools.product(*axes.values())
+    return [dataclasses.replace(base, **dict(zip(names, values, strict=True))) for values in combos]
 
 
 def _changed(params: Any, axes: Mapping[str, Sequence[float]]) -> dict[str, float]:
     return {name: getattr(params, name) for name in axes}
 
 
-def _with(settings: CrowdSettings, which: str, params: Any) -> CrowdSettings:
-    if which == "groups":
-        assert isinstance(params, GroupTrackerParams)
-        return dataclasses.replace(settings, tracking=dataclasses.replace(settings.tracking, groups=params))
-    assert isinstance(params, CoherentMotionParams)
-    return dataclasses.replace(settings, coherent=params)
+def _with_tracker(settings: CrowdSettings, tracker: TrackerParams) -> CrowdSettings:
+    return dataclasses.replace(settings, tracking=dataclasses.replace(settings.tracking, tracker=tracker))
 
 
 def _accumulate(log: TrackLog, match_distance: float) -> Any:
@@ -270,7 +311,7 @@ def _settings_json(settings: CrowdSettings) -> dict[str, Any]:
     }
 
 
-def _require_motmetrics() -> None:
+def require_motmetrics() -> None:
     if importlib.util.find_spec("motmetrics") is None:
         raise MissingDependencyError(
             "the crowd evaluation needs py-motmetrics: pip install 'sid[eval]' (or pip install motmetrics)"

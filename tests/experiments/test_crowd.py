@@ -10,25 +10,13 @@ import pytest
 from sid.experiments.crowd import CrowdSettings, cross_validate, evaluate_crowd
 from sid.experiments.trajectories import ReplaySettings, load_trajectory_set
 from tests.conftest import shared_path
+from tests.experiments.trajectory_files import pair_and_strangers
 
 pytestmark = pytest.mark.skipif(importlib.util.find_spec("motmetrics") is None, reason="py-motmetrics not installed")
 
 
-def _write_scene(folder: Path, frames: int = 40) -> Path:
-    """Pedestrians 1 and 2 walk side by side (0.6 m apart, +x, 1.2 m/s), 3 and 4 alone the other way 4 m away."""
-    folder.mkdir(parents=True)
-    rows = []
-    for k in range(frames):
-        x = 0.48 * k
-        rows += [(k, 1, x, 0, 0.0, 1.2, 0, 0), (k, 2, x, 0, 0.6, 1.2, 0, 0)]
-        rows += [(k, 3, 19 - x, 0, 4.0, -1.2, 0, 0), (k, 4, 19 - x, 0, 7.0, -1.2, 0, 0)]
-    (folder / "obsmat.txt").write_text("\n".join(" ".join(str(v) for v in row) for row in rows) + "\n")
-    (folder / "groups.txt").write_text("1 2\n")
-    return folder
-
-
 def test_a_clean_scene_is_tracked_and_grouped_without_mistakes(tmp_path: Path) -> None:
-    scene = load_trajectory_set(_write_scene(tmp_path / "scene"))
+    scene = load_trajectory_set(pair_and_strangers(tmp_path / "scene"))
     settings = CrowdSettings(replay=ReplaySettings(noise=0.05, miss_rate=0.0))
     result = evaluate_crowd([scene], settings)["sets"]["scene"]
     people, groups = result["people"], result["groups"]
@@ -40,11 +28,16 @@ def test_a_clean_scene_is_tracked_and_grouped_without_mistakes(tmp_path: Path) -
 
 
 def test_cross_validation_reports_each_held_out_set(tmp_path: Path) -> None:
-    sets = [load_trajectory_set(_write_scene(tmp_path / name, frames=15)) for name in ("a", "b")]
-    grid = {"groups": {"walk_distance": (1.0, 2.0)}, "coherent": {"share": (0.5, 1.0)}}
+    sets = [load_trajectory_set(pair_and_strangers(tmp_path / name, frames=15)) for name in ("a", "b")]
+    grid = {
+        "tracker": {"timeout": (1.0, 1.5)},
+        "groups": {"walk_distance": (1.0, 2.0)},
+        "coherent": {"share": (0.5, 1.0)},
+    }
     result = cross_validate(sets, CrowdSettings(), grid)
     assert [fold["held_out"] for fold in result["folds"]] == ["a", "b"]
     for fold in result["folds"]:
+        assert fold["tracker"]["chosen"]["timeout"] in (1.0, 1.5) and 0.5 < fold["tracker"]["held_out_idf1"] <= 1
         assert fold["groups"]["chosen"]["walk_distance"] in (1.0, 2.0)
         assert 0.0 <= fold["coherent"]["held_out_f1"] <= 1.0
 

@@ -15,13 +15,7 @@ from sid.experiments.trajectories import (
 )
 from sid.tracking import ViewCone
 from tests.conftest import shared_path
-
-
-def _write_set(folder: Path, rows: list[tuple[float, ...]], groups: str = "") -> Path:
-    folder.mkdir(parents=True, exist_ok=True)
-    (folder / "obsmat.txt").write_text("\n".join(" ".join(f"{v:.6e}" for v in row) for row in rows) + "\n")
-    (folder / "groups.txt").write_text(groups)
-    return folder
+from tests.experiments.trajectory_files import write_set
 
 
 def _walkers(frames: int = 5, step: int = 10) -> list[tuple[float, ...]]:
@@ -38,7 +32,7 @@ def _walkers(frames: int = 5, step: int = 10) -> list[tuple[float, ...]]:
 
 
 def test_a_set_is_read_into_frames_with_times_positions_and_groups(tmp_path: Path) -> None:
-    folder = _write_set(tmp_path / "pairs", _walkers(), "1 2\n")
+    folder = write_set(tmp_path / "pairs", _walkers(), "1 2\n")
     trajectories = load_trajectory_set(folder)
     assert trajectories.name == "pairs" and trajectories.people == 3
     assert trajectories.times.tolist() == pytest.approx([0.0, 0.4, 0.8, 1.2, 1.6])  # frame step 10 = 0.4 s
@@ -50,7 +44,7 @@ def test_a_set_is_read_into_frames_with_times_positions_and_groups(tmp_path: Pat
 
 
 def test_lines_sharing_a_person_are_one_group_with_a_note(tmp_path: Path) -> None:
-    folder = _write_set(tmp_path / "s", _walkers(), "1 2\n2 3\n")
+    folder = write_set(tmp_path / "s", _walkers(), "1 2\n2 3\n")
     trajectories = load_trajectory_set(folder)
     assert trajectories.groups == (frozenset({1, 2, 3}),)
     assert trajectories.notes == ("groups.txt: lines 1, 2 share people: taken as one group of 3",)
@@ -89,7 +83,7 @@ def test_a_missing_file_or_bytes_that_are_not_text_are_refused(tmp_path: Path) -
 
 
 def test_replay_is_seeded_noisy_and_drops_detections_at_the_miss_rate(tmp_path: Path) -> None:
-    trajectories = load_trajectory_set(_write_set(tmp_path / "s", _walkers(frames=200)))
+    trajectories = load_trajectory_set(write_set(tmp_path / "s", _walkers(frames=200)))
     settings = ReplaySettings(noise=0.1, miss_rate=0.2, seed=4)
     frames = list(replay(trajectories, settings))
     again = list(replay(trajectories, settings))
@@ -104,14 +98,14 @@ def test_replay_is_seeded_noisy_and_drops_detections_at_the_miss_rate(tmp_path: 
 
 
 def test_replay_at_a_camera_rate_interpolates_between_annotations(tmp_path: Path) -> None:
-    trajectories = load_trajectory_set(_write_set(tmp_path / "s", _walkers(frames=3)))
+    trajectories = load_trajectory_set(write_set(tmp_path / "s", _walkers(frames=3)))
     frames = list(replay(trajectories, ReplaySettings(rate=5.0, noise=0.0, miss_rate=0.0)))
     assert [f.timestamp for f in frames] == pytest.approx([0.0, 0.2, 0.4, 0.6, 0.8])
     assert frames[1].truth_positions[0].tolist() == pytest.approx([0.2, 0.0])  # halfway between 0 and 0.4 m
 
 
 def test_replay_in_a_field_of_view_keeps_only_the_people_inside(tmp_path: Path) -> None:
-    trajectories = load_trajectory_set(_write_set(tmp_path / "s", _walkers(frames=1)))
+    trajectories = load_trajectory_set(write_set(tmp_path / "s", _walkers(frames=1)))
     view = ViewCone(-1.0, 0.3, 0.0, np.radians(40), max_range=3.0)  # looking along +x from behind the pair
     (frame,) = replay(trajectories, ReplaySettings(noise=0.0, miss_rate=0.0, view=view))
     assert frame.truth_ids.tolist() == [1, 2] and [p.id for p in frame.detections] == [1, 2]
