@@ -4,11 +4,11 @@
 ...     frame.depth, frame.truth.people[0].x
 
 Specs (``sid detect --source synthetic:SPEC``): a layout name (``S1``..``S5``, see ``sid.synthetic.layouts``), a
-built-in sequence name (``crossing_walkers``, ``drive_past_group``, ``walking_pairs``, see
-``sid.synthetic.sequence``), or the path of a scene file (static, see ``sid.synthetic.scene``) or of a costmap
-scenario file (JSON or YAML; people and robot may move, see docs/scenario.md). Frames of a scenario carry the robot's
-pose, so the pipeline reports in the scenario's map frame; frame ``i`` shows time ``i / fps`` (s). Each frame draws
-fresh depth and keypoint noise, reproducibly from ``seed`` and the frame index.
+built-in sequence name (``crossing_walkers``, ``drive_past_group``, ``walking_pairs``, ``file_behind_group``,
+``close_crossing``, see ``sid.synthetic.sequence``), or the path of a scene file (static, see ``sid.synthetic.scene``)
+or of a costmap scenario file (JSON or YAML; people and robot may move, see docs/scenario.md). Frames of a scenario
+carry the robot's pose, so the pipeline reports in the scenario's map frame; frame ``i`` shows time ``i / fps`` (s).
+Each frame draws fresh depth and keypoint noise, reproducibly from ``seed`` and the frame index.
 """
 
 from __future__ import annotations

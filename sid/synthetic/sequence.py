@@ -10,7 +10,9 @@ people on open ground. Metres, radians, seconds.
 Built-in sequences (scenario files shipped in ``sid/synthetic/sequences``, loaded by name with ``builtin_sequence``
 or ``synthetic:NAME``): ``crossing_walkers`` (two conversations, three walkers crossing the view and hiding them for
 a while), ``drive_past_group`` (the robot drives past a conversation of three), ``walking_pairs`` (two people walking
-in file, two side by side).
+in file, two side by side), ``file_behind_group`` (two walkers in file passing behind a conversation of three, hidden
+by it for longer than the tracker's timeout), ``close_crossing`` (two walkers crossing under 0.4 m apart, one in front
+of the other).
 """
 
 from __future__ import annotations
@@ -29,7 +31,7 @@ from sid.scenario.motion import MotionState, Trajectory
 from sid.synthetic.scene import Scene, ScenePerson
 
 SEQUENCES_DIR = Path(__file__).parent / "sequences"
-SEQUENCES = ("crossing_walkers", "drive_past_group", "walking_pairs")
+SEQUENCES = ("crossing_walkers", "drive_past_group", "walking_pairs", "file_behind_group", "close_crossing")
 
 
 @dataclass(frozen=True)

@@ -1,13 +1,13 @@
 """Multi-person tracking on the ground plane: stable ids, constant-velocity motion, standing / walking.
 
 Per frame (``PeopleTracker.update``): every track is predicted to the frame's timestamp (``sid.tracking.motion``);
-tracks not detected for longer than their timeout are deleted (``timeout`` in the camera's view,
-``out_of_view_timeout`` out of it: nobody looked there); detections are assigned to tracks by position alone, the
-least total distance to the predictions within a gate that grows with the track's uncertainty
+tracks not detected for longer than their timeout are deleted (``timeout`` in the camera's view, ``out_of_view_timeout``
+out of it or behind someone detected nearer to a camera: nobody looked there); detections are assigned to tracks by
+position alone, the least total distance to the predictions within a gate that grows with the track's uncertainty
 (``sid.tracking.assignment``); matched tracks are corrected; a tentative track that is missed is deleted, and one
-detected ``confirm_hits`` times is confirmed; every unmatched detection starts a tentative track. Facing is smoothed
-on the circle (an exponential average of unit vectors), and the state switches to walking above ``walk_speed`` and
-back to standing below ``stand_speed``.
+detected ``confirm_hits`` times is confirmed; every unmatched detection starts a tentative track. Facing is smoothed on
+the circle (an exponential average of unit vectors), and the state switches to walking above ``walk_speed`` and back to
+standing below ``stand_speed``.
 
 Only confirmed tracks are reported. Track ids count up from 1 and are never reused, also across ``reset``.
 """
@@ -25,7 +25,10 @@ from sid.perception.people import Person
 from sid.tracking.assignment import gated_assignment
 from sid.tracking.motion import MotionStates
 from sid.tracking.records import TrackedPerson
-from sid.tracking.view import View
+from sid.tracking.view import View, ViewCone
+
+OCCLUDER_RADIUS = 0.2
+"""A person's half-width (m) seen from above, to tell who is behind whom in the camera's view (``ViewCone.behind``)."""
 
 
 class TrackingError(ValueError):
@@ -41,10 +44,10 @@ class TrackerParams:
     gate_sigmas, min_gate, max_gate: a detection may join a track when it lies within gate_sigmas standard
     deviations of the prediction, bounded to [min_gate, max_gate] (m). confirm_hits: detections that confirm a
     track. timeout: seconds a confirmed track in view survives without a detection; out_of_view_timeout: the same
-    outside the camera's view. walk_speed, stand_speed: speeds (m/s) above which a standing track walks and below
-    which a walking track stands (hysteresis). facing_tau: time constant (s) of the facing average. heading_gate: a
-    walking track faster than walk_speed, missed in the last frame, takes no detection facing more than this (rad) away
-    from its velocity.
+    outside the camera's view or behind someone detected nearer to it. walk_speed, stand_speed: speeds (m/s) above which
+    a standing track walks and below which a walking track stands (hysteresis). facing_tau: time constant (s) of the
+    facing average. heading_gate: a walking track faster than walk_speed, missed in the last frame, takes no detection
+    facing more than this (rad) away from its velocity.
     """
 
     measurement_sigma: float = 0.1
@@ -122,7 +125,7 @@ class PeopleTracker:
         self._time = float(timestamp)
         self._motion.predict(dt, q)
         self._in_view = np.ones(len(self._ids), dtype=bool) if view is None else view.contains(self._motion.position)
-        self._keep(~self._expired(timestamp))
+        self._keep(~self._expired(timestamp, self._in_view & ~_behind(view, self._motion.position, positions)))
         rows, cols = self._assign(positions, facing, r)
         self._motion.correct(rows, positions[cols], r)
         self._smooth_facing(rows, facing[cols], dt)
@@ -142,10 +145,11 @@ class PeopleTracker:
         self._walking = np.where(self._walking, speed > p.stand_speed, speed - speed_sigma > p.walk_speed)
         return self._report(ids)
 
-    def _expired(self, now: float) -> np.ndarray:
-        """(N,) bool: the tracks undetected for longer than their timeout (in view or out of it)."""
+    def _expired(self, now: float, watched: np.ndarray) -> np.ndarray:
+        """(N,) bool: the tracks undetected for longer than their timeout: ``timeout`` where the camera could see them
+        (``watched``), else ``out_of_view_timeout``."""
         p = self.params
-        return now - self._last_hit > np.where(self._in_view, p.timeout, p.out_of_view_timeout)
+        return now - self._last_hit > np.where(watched, p.timeout, p.out_of_view_timeout)
 
     def _assign(self, positions: np.ndarray, facing: np.ndarray, r: float) -> tuple[np.ndarray, np.ndarray]:
         """Rows of tracks and columns of detections matched by minimum total distance, each within its gate.
@@ -242,6 +246,16 @@ class PeopleTracker:
                 strict=True,
             )
         ]
+
+
+def _behind(view: View | None, positions: np.ndarray, detections: np.ndarray) -> np.ndarray:
+    """(N,) bool: which of the (N, 2) track ``positions`` a camera's cone sees behind one of this frame's (M, 2)
+    ``detections``. A person walking behind a group is hidden for longer than ``timeout`` and must keep their track:
+    with the in-view timeout it was deleted while hidden, and the person came out under a new id. Without a camera
+    (no view, or a region seen from above) nobody hides anybody."""
+    if not isinstance(view, ViewCone):
+        return np.zeros(len(positions), dtype=bool)
+    return view.behind(positions, detections, OCCLUDER_RADIUS)
 
 
 def _measurements(people: Sequence[Person]) -> tuple[np.ndarray, np.ndarray, list[int]]:

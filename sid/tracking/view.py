@@ -1,7 +1,8 @@
 """The camera's field of view on the ground: where the tracker can expect to see people.
 
 A track whose predicted position lies outside the view was not missed by the detector, it was not looked at, so
-the tracker keeps it longer (``TrackerParams.out_of_view_timeout``) than one missed in plain view.
+the tracker keeps it longer (``TrackerParams.out_of_view_timeout``) than one missed in plain view; so it does a track
+that a camera's cone sees behind someone nearer (``ViewCone.behind``): the camera looked, but at the person in front.
 """
 
 from __future__ import annotations
@@ -40,6 +41,21 @@ class ViewCone:
         distance = np.sqrt(d[:, 0] ** 2 + d[:, 1] ** 2)
         along = d[:, 0] * math.cos(self.yaw) + d[:, 1] * math.sin(self.yaw)  # cos(off-axis angle) * distance
         return (along >= distance * math.cos(self.fov / 2)) & (distance <= self.max_range)
+
+    def behind(self, points: np.ndarray, occluders: np.ndarray, radius: float) -> np.ndarray:
+        """(N,) bool: which of the (N, 2) points the apex sees behind one of the (M, 2) ``occluders``, all of them
+        people of ``radius`` (m) seen from above: an occluder nearer by two radii or more (its whole body in front)
+        whose outline overlaps the point's (their bearings differ by less than the sum of their angular radii)."""
+        p = np.asarray(points, dtype=float).reshape(-1, 2) - (self.x, self.y)
+        o = np.asarray(occluders, dtype=float).reshape(-1, 2) - (self.x, self.y)
+        p_range, o_range = np.sqrt(p[:, 0] ** 2 + p[:, 1] ** 2), np.sqrt(o[:, 0] ** 2 + o[:, 1] ** 2)
+        cross = p[:, None, 0] * o[None, :, 1] - p[:, None, 1] * o[None, :, 0]
+        dot = p[:, None, 0] * o[None, :, 0] + p[:, None, 1] * o[None, :, 1]
+        apart = np.arctan2(np.abs(cross), dot)  # angle between the two lines of sight
+        with np.errstate(divide="ignore"):  # a point at the apex: angular radius pi / 2
+            p_half, o_half = (np.arcsin(np.minimum(radius / r, 1.0)) for r in (p_range, o_range))
+        overlap = apart < p_half[:, None] + o_half[None, :]
+        return np.count_nonzero(overlap & (p_range[:, None] - o_range[None, :] >= 2 * radius), axis=1) > 0
 
 
 @dataclass(frozen=True, eq=False)

@@ -3,6 +3,10 @@
 from __future__ import annotations
 
 import importlib.util
+import math
+from collections import Counter
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import pytest
@@ -15,7 +19,10 @@ from sid.experiments.tracking import (
     evaluate_tracking,
     identify,
     measure_flicker,
+    mot_scores,
 )
+from sid.synthetic.sequence import builtin_sequence
+from sid.tracking import TrackerParams
 
 pytestmark = pytest.mark.skipif(importlib.util.find_spec("motmetrics") is None, reason="py-motmetrics not installed")
 
@@ -54,3 +61,66 @@ def test_a_missing_motmetrics_is_explained(monkeypatch: pytest.MonkeyPatch) -> N
     monkeypatch.setattr(tracking.importlib.util, "find_spec", lambda name: None)
     with pytest.raises(MissingDependencyError, match=r"pip install 'sid\[eval\]'"):
         evaluate_tracking(TrackingEvalSettings(sequences=("walking_pairs",), frames=2))
+
+
+@dataclass
+class _Walkers:
+    """A sequence's walkers (true ids) through the replay: the track ids identified with each, the frames each counts
+    as ground truth and those with a track on them, the longest run (s) of such frames without a detection matched to
+    that track (it coasts), and the walkers' closest approach (m, centre to centre)."""
+
+    tracks: dict[int, set[int]] = field(default_factory=dict)
+    truth_frames: Counter[int] = field(default_factory=Counter)
+    tracked_frames: Counter[int] = field(default_factory=Counter)
+    longest_coast: dict[int, float] = field(default_factory=dict)
+    closest: float = math.inf
+
+
+def _replay(name: str, seconds: float) -> tuple[dict[str, Any], _Walkers]:
+    """The first ``seconds`` of a built-in sequence through the replay of ``sid eval tracking`` (the pipeline on
+    ``TruthPose``, a ``SocialStream``): its motmetrics scores, and its two walkers identified as the evaluation
+    identifies people (minimum total distance within its match distance)."""
+    settings = TrackingEvalSettings(sequences=(name,), frames=round(seconds * TrackingEvalSettings().fps) + 1)
+    logs = tracking._run_sequence(name, settings, None)
+    scores = mot_scores([tracking._accumulate(logs, settings.match_distance)], [name])[name]
+    walkers = sorted(p.id for p in builtin_sequence(name).people if p.trajectory.path)
+    out = _Walkers({w: set() for w in walkers}, longest_coast=dict.fromkeys(walkers, 0.0))
+    coasting = dict.fromkeys(walkers, 0)
+    for log in logs:
+        ids = [p.id for p in log.truth.people]
+        positions = np.array([[p.x, p.y] for p in log.truth.people])
+        seen = dict(zip(ids, tracking._seen(log).tolist(), strict=True))
+        track_of = dict(
+            zip(identify(log.track_positions, ids, positions, settings.match_distance), log.track_ids, strict=True)
+        )
+        visible = dict(zip(log.track_ids, log.track_visible.tolist(), strict=True))
+        for w in walkers:
+            if w in track_of:
+                out.tracks[w].add(track_of[w])
+            out.truth_frames[w] += seen[w]
+            out.tracked_frames[w] += seen[w] and w in track_of
+            coasting[w] = coasting[w] + 1 if seen[w] and not visible.get(track_of.get(w), False) else 0
+            out.longest_coast[w] = max(out.longest_coast[w], coasting[w] / settings.fps)
+        first, second = (positions[ids.index(w)] for w in walkers)
+        out.closest = min(out.closest, float(np.linalg.norm(first - second)))
+    return scores, out
+
+
+def _assert_one_track_each(scores: dict[str, Any], walkers: _Walkers) -> None:
+    assert scores["id_switches"] == 0 and scores["id_transfers"] == 0
+    assert all(len(ids) == 1 for ids in walkers.tracks.values()), walkers.tracks
+    assert len(set.union(*walkers.tracks.values())) == len(walkers.tracks)  # one track each, not one for both
+    for w, frames in walkers.truth_frames.items():  # so it cannot pass by tracking nobody
+        assert frames >= 30 and walkers.tracked_frames[w] >= 0.85 * frames, (w, walkers.tracked_frames[w], frames)
+
+
+def test_walkers_in_file_behind_a_group_keep_their_tracks() -> None:
+    scores, walkers = _replay("file_behind_group", 4.6)  # until both are out from behind the group
+    _assert_one_track_each(scores, walkers)
+    assert walkers.longest_coast[4] > TrackerParams().timeout  # the leader is hidden for longer than the timeout
+
+
+def test_walkers_crossing_closer_than_0_4_m_keep_their_tracks() -> None:
+    scores, walkers = _replay("close_crossing", 3.5)  # a second past the crossing
+    _assert_one_track_each(scores, walkers)
+    assert walkers.closest < 0.4

@@ -177,6 +177,33 @@ def test_the_view_cone_contains_what_it_should() -> None:
     assert inside.tolist() == [True, True, False, False, False]
 
 
+def test_the_view_cone_sees_who_is_behind_whom() -> None:
+    view = ViewCone(0.0, 0.0, 0.0, math.radians(90))
+    points = np.array([[4.0, 0.0], [4.0, 0.5], [4.0, 0.7], [2.3, 0.0], [1.0, 0.0]])
+    # straight behind, outlines overlapping, beside, too close behind to be hidden whole, in front
+    assert view.behind(points, np.array([[2.0, 0.0]]), 0.2).tolist() == [True, True, False, False, False]
+    assert not view.behind(points, np.zeros((0, 2)), 0.2).any()
+
+
+def test_a_walker_hidden_behind_someone_nearer_keeps_the_track_past_the_timeout() -> None:
+    view = ViewCone(0.0, 0.0, 0.0, math.radians(90))
+    walker_ids = []
+    for someone_in_front in (True, False):
+        tracker = PeopleTracker(TrackerParams(timeout=1.0))
+        found: set[int] = set()
+        for k in range(int(5.0 * FPS)):
+            t = k / FPS
+            y = -1.5 + 0.6 * t  # walking +y 4 m ahead; behind the person standing at (2, 0) while |y| < 0.6 m
+            people = [Person(0, 2.0, 0.0, math.pi)] if someone_in_front else []
+            if abs(y) >= 0.5:  # the detector misses the walker for 1.7 s
+                people.append(Person(1, 4.0, y, math.pi / 2))
+            found |= {p.id for p in tracker.update(people, t, view) if p.detection == 1}
+        walker_ids.append(found)
+    hidden, missed = walker_ids
+    assert len(hidden) == 1  # coasted behind the person in front, found again when out
+    assert len(missed) == 2  # missed in plain view for longer than the timeout: deleted, a new track
+
+
 def test_a_walker_track_does_not_take_over_someone_walking_the_other_way() -> None:
     tracker = PeopleTracker()
     for k in range(15):  # walking +y at 1.2 m/s, facing +y
