@@ -1,13 +1,13 @@
 """Multi-person tracking on the ground plane: stable ids, constant-velocity motion, standing / walking.
 
 Per frame (``PeopleTracker.update``): every track is predicted to the frame's timestamp (``sid.tracking.motion``);
-tracks not detected for longer than their timeout are deleted (``timeout`` in the camera's view, ``out_of_view_timeout``
-out of it or behind someone detected nearer to a camera: nobody looked there); detections are assigned to tracks by
-position alone, the least total distance to the predictions within a gate that grows with the track's uncertainty
-(``sid.tracking.assignment``); matched tracks are corrected; a tentative track that is missed is deleted, and one
-detected ``confirm_hits`` times is confirmed; every unmatched detection starts a tentative track. Facing is smoothed on
-the circle (an exponential average of unit vectors), and the state switches to walking above ``walk_speed`` and back to
-standing below ``stand_speed``.
+tracks not detected for longer than their timeout are deleted (``timeout`` in the camera's view,
+``out_of_view_timeout`` out of it or behind someone detected nearer to a camera: nobody looked there); detections are
+assigned to tracks by position alone, the least total distance to the predictions within a gate that grows with the
+track's uncertainty (``sid.tracking.assignment``); matched tracks are corrected; a tentative track that is missed is
+deleted, and one detected ``confirm_hits`` times (or twice in a row ``confirm_time`` apart) is confirmed; every
+unmatched detection starts a tentative track. Facing is smoothed on the circle (an exponential average of unit
+vectors), and the state switches to walking above ``walk_speed`` and back to standing below ``stand_speed``.
 
 Only confirmed tracks are reported. Track ids count up from 1 and are never reused, also across ``reset``.
 """
@@ -43,11 +43,13 @@ class TrackerParams:
     velocity (m/s^2, white-noise acceleration). initial_speed_sigma: the velocity uncertainty of a new track (m/s).
     gate_sigmas, min_gate, max_gate: a detection may join a track when it lies within gate_sigmas standard
     deviations of the prediction, bounded to [min_gate, max_gate] (m). confirm_hits: detections that confirm a
-    track. timeout: seconds a confirmed track in view survives without a detection; out_of_view_timeout: the same
-    outside the camera's view or behind someone detected nearer to it. walk_speed, stand_speed: speeds (m/s) above which
-    a standing track walks and below which a walking track stands (hysteresis). facing_tau: time constant (s) of the
-    facing average. heading_gate: a walking track faster than walk_speed, missed in the last frame, takes no detection
-    facing more than this (rad) away from its velocity.
+    track; confirm_time: two detections in a row at least this far apart (s) confirm it too, so that a slow detector
+    (a few Hz) does not hold a person back for confirm_hits long frames. timeout: seconds a confirmed track in view
+    survives without a detection; out_of_view_timeout: the same outside the camera's view or behind someone detected
+    nearer to it. walk_speed, stand_speed: speeds (m/s) above which a standing track walks and below which a walking
+    track stands (hysteresis). facing_tau: time constant (s) of the facing average. heading_gate: a walking track
+    faster than walk_speed, missed in the last frame, takes no detection facing more than this (rad) away from its
+    velocity.
     """
 
     measurement_sigma: float = 0.1
@@ -57,6 +59,7 @@ class TrackerParams:
     min_gate: float = 0.5
     max_gate: float = 1.5
     confirm_hits: int = 3
+    confirm_time: float = 0.2
     timeout: float = 1.0
     out_of_view_timeout: float = 4.0
     walk_speed: float = 0.5
@@ -68,7 +71,8 @@ class TrackerParams:
         positive = ("measurement_sigma", "acceleration_sigma", "initial_speed_sigma", "gate_sigmas", "min_gate")
         check_numbers("tracker", self, positive, low=0, low_open=True)
         check_number("tracker", "max_gate", self.max_gate, low=self.min_gate, unit="metres")
-        check_numbers("tracker", self, ("timeout", "out_of_view_timeout", "facing_tau"), low=0, unit="seconds")
+        seconds = ("confirm_time", "timeout", "out_of_view_timeout", "facing_tau")
+        check_numbers("tracker", self, seconds, low=0, unit="seconds")
         check_number("tracker", "heading_gate", self.heading_gate, low=0, high=math.pi, low_open=True, unit="radians")
         check_number("tracker", "walk_speed", self.walk_speed, low=0, low_open=True, unit="m/s")
         check_number("tracker", "stand_speed", self.stand_speed, low=0, high=self.walk_speed, unit="m/s")
@@ -93,6 +97,7 @@ class PeopleTracker:
         self._confirmed = np.zeros(0, dtype=bool)
         self._walking = np.zeros(0, dtype=bool)
         self._last_hit = np.zeros(0)
+        self._first_hit = np.zeros(0)
         self._facing = np.zeros((0, 2))  # unit vectors, NaN while unknown
         self._detection = np.zeros(0, dtype=np.intp)  # index of this frame's matched detection, -1: none
         self._in_view = np.zeros(0, dtype=bool)  # the predicted position lies in the camera's view
@@ -131,7 +136,9 @@ class PeopleTracker:
         self._smooth_facing(rows, facing[cols], dt)
         self._hits[rows] += 1
         self._last_hit[rows] = timestamp
-        self._confirmed |= self._hits >= p.confirm_hits
+        self._confirmed |= (self._hits >= p.confirm_hits) | (
+            (self._hits >= 2) & (timestamp - self._first_hit >= p.confirm_time - 1e-9)
+        )
         self._detection[:] = -1
         self._detection[rows] = cols
         self._keep(self._confirmed | (self._detection >= 0))  # a tentative track dies at its first miss
@@ -198,6 +205,7 @@ class PeopleTracker:
         self._confirmed = np.concatenate((self._confirmed, np.full(k, p.confirm_hits <= 1)))
         self._walking = np.concatenate((self._walking, np.zeros(k, dtype=bool)))
         self._last_hit = np.concatenate((self._last_hit, np.full(k, timestamp)))
+        self._first_hit = np.concatenate((self._first_hit, np.full(k, timestamp)))
         self._detection = np.concatenate((self._detection, cols))
         self._in_view = np.concatenate((self._in_view, np.ones(k, dtype=bool)))  # just detected
         self._facing = np.concatenate((self._facing, facing[cols]))
@@ -207,7 +215,11 @@ class PeopleTracker:
             return
         self._motion.keep(mask)
         self._ids, self._hits, self._confirmed = self._ids[mask], self._hits[mask], self._confirmed[mask]
-        self._walking, self._last_hit = self._walking[mask], self._last_hit[mask]
+        self._walking, self._last_hit, self._first_hit = (
+            self._walking[mask],
+            self._last_hit[mask],
+            self._first_hit[mask],
+        )
         self._detection, self._facing, self._in_view = self._detection[mask], self._facing[mask], self._in_view[mask]
 
     def _report(self, ids: list[int]) -> list[TrackedPerson]:

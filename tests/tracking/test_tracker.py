@@ -253,3 +253,12 @@ def test_scene_view_is_the_hull_of_where_people_were_seen() -> None:
         scene_view(np.array([[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]]))
     with pytest.raises(ValueError, match="3 or more finite"):
         ViewRegion(np.array([[0.0, 0.0], [1.0, np.nan], [2.0, 0.0]]))
+
+
+@pytest.mark.parametrize(("rate", "hits_to_confirm"), [(15.0, 3), (10.0, 3), (5.0, 2), (2.5, 2)])
+def test_a_slow_detector_confirms_a_track_after_two_detections_confirm_time_apart(
+    rate: float, hits_to_confirm: int
+) -> None:
+    tracker = PeopleTracker(TrackerParams(confirm_hits=3, confirm_time=0.2))
+    reported = [bool(tracker.update([Person(0, 2.0, 0.0)], k / rate)) for k in range(4)]
+    assert reported == [k + 1 >= hits_to_confirm for k in range(4)]
