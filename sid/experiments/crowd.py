@@ -62,12 +62,12 @@ Progress = Callable[[int, int, str], None]
 DEFAULT_GRID: dict[str, dict[str, tuple[float, ...]]] = {
     "tracker": {
         "measurement_sigma": (0.1, 0.15, 0.2),
-        "acceleration_sigma": (0.3, 0.5),
+        "acceleration_sigma": (0.2, 0.3, 0.5),
         "max_gate": (1.0, 1.5),
         "timeout": (1.0, 1.5, 2.0),
     },
-    "groups": {"walk_distance": (1.5, 2.0, 2.5), "walk_velocity_difference": (0.3, 0.4, 0.5, 0.6)},
-    "coherent": {"distance": (1.5, 2.0, 2.5), "velocity_difference": (0.3, 0.4, 0.5), "share": (0.6, 0.8, 1.0)},
+    "groups": {"walk_distance": (1.2, 1.5, 2.0), "walk_velocity_difference": (0.3, 0.4, 0.5, 0.6, 0.8)},
+    "coherent": {"distance": (1.0, 1.5, 2.0), "velocity_difference": (0.3, 0.4, 0.5, 0.6), "share": (0.4, 0.6, 0.8)},
 }
 """What ``cross_validate`` chooses among: the people tracker's, the group tracker's and the reference's parameters."""
 
@@ -239,6 +239,8 @@ def cross_validate(
                 for col, (trajectories, log) in enumerate(zip(sets, logs[row], strict=True)):
                     found = find_groups(log, params) if which == "groups" else find_coherent_groups(log, params)
                     table[k, col] = score_groups(trajectories, log, found, settings)["gmitre"]["f1"]
+                if progress is not None:
+                    progress(k + 1, len(candidates[which]), f"{which} on tracker {row + 1}")
             group_f1[which, row] = table
         return group_f1[which, row]
 

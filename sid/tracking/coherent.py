@@ -27,10 +27,10 @@ class CoherentMotionParams:
     """distance (m), velocity_difference (m/s): what a coherent pair is in one frame; window (s), share (0-1],
     min_frames: how long it must hold."""
 
-    distance: float = 2.0
-    velocity_difference: float = 0.4
+    distance: float = 1.5
+    velocity_difference: float = 0.6
     window: float = 2.0
-    share: float = 0.8
+    share: float = 0.6
     min_frames: int = 3
 
     def __post_init__(self) -> None:

@@ -52,8 +52,8 @@ class GroupTrackerParams:
     miss_timeout: float = 1.0
     min_overlap: float = 0.5
     leave_distance: float = 1.6
-    walk_distance: float = 2.0
-    walk_velocity_difference: float = 0.4
+    walk_distance: float = 1.5
+    walk_velocity_difference: float = 0.6
     walk_window: float = 2.0
     max_speed_sigma: float = 0.4
 

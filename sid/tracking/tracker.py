@@ -52,15 +52,15 @@ class TrackerParams:
     velocity.
     """
 
-    measurement_sigma: float = 0.1
-    acceleration_sigma: float = 0.5
+    measurement_sigma: float = 0.15
+    acceleration_sigma: float = 0.3
     initial_speed_sigma: float = 1.0
     gate_sigmas: float = 3.0
     min_gate: float = 0.5
-    max_gate: float = 1.5
+    max_gate: float = 1.0
     confirm_hits: int = 3
     confirm_time: float = 0.2
-    timeout: float = 1.0
+    timeout: float = 1.5
     out_of_view_timeout: float = 4.0
     walk_speed: float = 0.5
     stand_speed: float = 0.3

@@ -179,7 +179,7 @@ def test_walkers_moving_together_are_a_group_through_noisy_velocity_estimates() 
 
 def test_walkers_who_drift_apart_are_no_group_even_when_their_velocities_look_alike() -> None:
     # Each frame's velocities are equal but the positions spread at 0.6 m/s: the displacement over the window counts.
-    tracker = GroupTracker(GroupTrackerParams(walk_window=2.0, walk_distance=3.0))
+    tracker = GroupTracker(GroupTrackerParams(walk_window=2.0, walk_distance=3.0, walk_velocity_difference=0.4))
     for k in range(40):
         x, spread = 1.0 + 1.2 * k * DT, 0.3 * k * DT
         people = [_person(1, x, 0.3 + spread, 0.0, (1.2, 0.0)), _person(2, x, -0.3 - spread, 0.0, (1.2, 0.0))]
