@@ -189,7 +189,14 @@ class GroupTracker:
         matched: dict[int, _Candidate] = {}
         used: set[int] = set()
         if self._tracks and candidates:
-            overlap = np.array([[_jaccard(t, c) for c in candidates] for t in self._tracks])
+            overlap = np.zeros((len(self._tracks), len(candidates)))  # 0 unless they share a member
+            holding: dict[int, list[int]] = {}  # track id -> the candidates holding it
+            for col, candidate in enumerate(candidates):
+                for member in candidate.members:
+                    holding.setdefault(member, []).append(col)
+            for row, track in enumerate(self._tracks):
+                for col in {c for member in track.members for c in holding.get(member, ())}:
+                    overlap[row, col] = _jaccard(track, candidates[col])
             rows, cols = gated_assignment(-overlap, overlap >= self.params.min_overlap)
             for row, col in zip(rows.tolist(), cols.tolist(), strict=True):
                 matched[self._tracks[row].id] = candidates[col]
@@ -227,11 +234,14 @@ def _walking_groups(
         return []
     ids = np.array([p.id for p in walkers], dtype=np.int64)
     position = np.array([[p.x, p.y] for p in walkers])
-    near = _pair_distance(position) <= params.walk_distance
-    alike = _relative_speed(ids, position, np.array([[p.vx, p.vy] for p in walkers]), history, params)
-    alike = alike <= params.walk_velocity_difference
+    i, j = np.nonzero(np.triu(_pair_distance(position) <= params.walk_distance, 1))
+    velocity = np.array([[p.vx, p.vy] for p in walkers])
+    alike = _relative_speed(ids, position, velocity, history, params, i, j) <= params.walk_velocity_difference
+    linked = np.zeros((len(walkers), len(walkers)), dtype=bool)
+    linked[i[alike], j[alike]] = True
+    linked |= linked.T
     out = []
-    for rows in connected_components(near & alike):
+    for rows in connected_components(linked):
         if len(rows) < 2:
             continue
         centre = position[rows].mean(axis=0)
@@ -242,26 +252,35 @@ def _walking_groups(
 
 
 def _relative_speed(
-    ids: np.ndarray, position: np.ndarray, velocity: np.ndarray, history: deque[_Positions], params: GroupTrackerParams
+    ids: np.ndarray,
+    position: np.ndarray,
+    velocity: np.ndarray,
+    history: deque[_Positions],
+    params: GroupTrackerParams,
+    i: np.ndarray,
+    j: np.ndarray,
 ) -> np.ndarray:
-    """(N, N) speed (m/s) at which each pair of tracks moves apart: their relative displacement since the oldest
-    frame of the last ``walk_window`` seconds in which both were tracked, over that time; for a pair with less than
-    half the window in common, the difference of their filtered velocities (noisier)."""
-    speed = _pair_distance(velocity)
+    """(P,) speed (m/s) at which each pair (i[k], j[k]) of tracks moves apart: their relative displacement since the
+    oldest frame of the last ``walk_window`` seconds in which both were tracked, over that time; for a pair with less
+    than half the window in common, the difference of their filtered velocities (noisier). Only the pairs asked for
+    (those near each other), and no older frame once every pair has its answer."""
+    dv = velocity[i] - velocity[j]
+    speed = np.sqrt(dv[:, 0] ** 2 + dv[:, 1] ** 2)
     now = history[-1].timestamp if history else None
-    filled = np.zeros(speed.shape, dtype=bool)
+    filled = np.zeros(len(i), dtype=bool)
     for old in history:
-        if now is None or now - old.timestamp < params.walk_window / 2:
+        if now is None or now - old.timestamp < params.walk_window / 2 or filled.all():
             break
-        rows = np.searchsorted(old.ids, ids)
-        rows = np.minimum(rows, len(old.ids) - 1)
-        present = old.ids[rows] == ids if len(old.ids) else np.zeros(len(ids), dtype=bool)
-        both = present[:, None] & present[None, :] & ~filled
+        if not len(old.ids):
+            continue
+        rows = np.minimum(np.searchsorted(old.ids, ids), len(old.ids) - 1)
+        present = old.ids[rows] == ids
+        both = present[i] & present[j] & ~filled
         if not both.any():
             continue
         then = old.positions[rows]
-        moved = (position[:, None, :] - position[None, :, :]) - (then[:, None, :] - then[None, :, :])
-        relative = np.sqrt(moved[..., 0] ** 2 + moved[..., 1] ** 2) / (now - old.timestamp)
+        moved = (position[i] - position[j]) - (then[i] - then[j])
+        relative = np.sqrt(moved[:, 0] ** 2 + moved[:, 1] ** 2) / (now - old.timestamp)
         speed = np.where(both, relative, speed)
         filled |= both
     return speed
@@ -274,27 +293,34 @@ def _pair_distance(points: np.ndarray) -> np.ndarray:
 
 def connected_components(adjacent: np.ndarray) -> list[np.ndarray]:
     """The connected components of a symmetric (N, N) bool adjacency matrix, as index arrays ordered by their first
-    index. Reachability squared until it stops growing: a few small matrix products for the walkers in view, where
-    ``scipy.sparse.csgraph`` would add 0.4 s of imports to every start (docs/benchmarks.md, "Start-up")."""
+    index. Union-find over the links (a few per walker), where ``scipy.sparse.csgraph`` would add 0.4 s of imports to
+    every start (docs/benchmarks.md, "Start-up") and squaring the reachability matrix costs O(N^3) per product."""
     if not len(adjacent):
         return []
-    reach = (adjacent | np.eye(len(adjacent), dtype=bool)).astype(np.int64)
-    while True:
-        grown = np.minimum(reach @ reach, 1)
-        if np.array_equal(grown, reach):
-            break
-        reach = grown
-    labels = reach.argmax(axis=1)  # the first index each one reaches names its component
+    parent = list(range(len(adjacent)))  # union-find over the links; a component's root is its first index
+
+    def root(a: int) -> int:
+        while parent[a] != a:
+            parent[a] = parent[parent[a]]
+            a = parent[a]
+        return a
+
+    for a, b in zip(*np.nonzero(np.triu(adjacent, 1)), strict=True):
+        ra, rb = root(int(a)), root(int(b))
+        if ra != rb:
+            parent[max(ra, rb)] = min(ra, rb)
+    labels = np.array([root(a) for a in range(len(adjacent))])
     return [np.flatnonzero(labels == label) for label in np.unique(labels)]
 
 
 def _report(track: _GroupTrack, by_id: dict[int, TrackedPerson]) -> TrackedGroup:
     members = sorted(track.members)
-    velocity = np.mean([[by_id[m].vx, by_id[m].vy] for m in members], axis=0)
+    people = [by_id[m] for m in members]
+    velocity = (sum(p.vx for p in people) / len(people), sum(p.vy for p in people) / len(people))
     found = track.found
     interest = found.interest_point
     if found.kind == "walking":  # walkers move on: the centroid of this frame, not of the last time found
-        interest = tuple(np.mean([[by_id[m].x, by_id[m].y] for m in members], axis=0).tolist())
+        interest = (sum(p.x for p in people) / len(people), sum(p.y for p in people) / len(people))
     return TrackedGroup(
         track.id,
         found.kind,
