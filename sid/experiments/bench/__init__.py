@@ -6,8 +6,9 @@
 >>> result.stages["group_baseline/4"]["ratio"]   # the authors' approach / ours, same scene, same run
 
 Modules: ``runner`` (timing harness), ``stages`` (what is timed, on which input, and the paper's figure for it),
-``baseline`` (the paper authors' grouping approach, re-implemented as a timing baseline only), ``suite``
-(selection, progress, ratios), ``report`` (bench.json / bench.md, comparison of two reports).
+``baseline`` (the paper authors' grouping approach, re-implemented as a timing baseline only), ``crowd_scene``
+(real pedestrian trajectories stacked into a crowd of N for ``crowd/N``), ``suite`` (selection, progress, ratios),
+``report`` (bench.json / bench.md, comparison of two reports).
 """
 
 from sid.experiments.bench.baseline import BaselineGroup, BaselineParams, baseline_groups

@@ -27,6 +27,7 @@ from sid.experiments.bench.runner import RunSettings, Stats, measure, measure_pa
 from sid.perception.people import Person
 
 if TYPE_CHECKING:
+    from sid.experiments.bench.crowd_scene import CrowdReplay
     from sid.experiments.harness import Task
     from sid.perception.align import SplatMode
     from sid.perception.frame import Frame
@@ -712,12 +713,106 @@ def _bench_track(n: int) -> Callable[[Context], Records]:
     return run
 
 
+# --- tracking in a real-crowd-like scene --------------------------------------------------------------------------
+
+CROWD_SIZES = (20, 60, 100)
+CROWD_SETS = ("seq_eth", "seq_hotel", "zara01")
+CROWD_FPS = 15.0
+CROWD_WARMUP_FRAMES = 45  # 3 s: tracks confirmed, groups reported, the reference's 2 s window full
+CROWD_RESOLUTION = 0.05  # m per cell of the tracked-people layer's grid
+CROWD_TARGET_MS = {100: 10.0}  # issue 25: people tracker + group tracker + layer per frame
+
+
+def crowd_sets(shared: Path) -> list[Path]:
+    """The folders of ``CROWD_SETS`` under ``shared``/data/trajectories that hold a set (none when absent)."""
+    folder = shared / "data" / "trajectories"
+    return [folder / name for name in CROWD_SETS if (folder / name / "obsmat.txt").is_file()]
+
+
+def _crowd_replay(ctx: Context) -> CrowdReplay:
+    """``sid.experiments.bench.crowd_scene.CrowdReplay`` of the sets in ../shared, built once per run."""
+
+    def build() -> CrowdReplay:
+        from sid.experiments.bench.crowd_scene import CrowdReplay
+        from sid.experiments.trajectories import load_trajectory_set
+
+        return CrowdReplay([load_trajectory_set(path) for path in crowd_sets(ctx.shared)], rate=CROWD_FPS)
+
+    return ctx.cached("crowd", build)
+
+
+def _bench_crowd(n: int) -> Callable[[Context], Records]:
+    """``crowd/N``: one frame of the people tracker and the group tracker (``TrackingSession.track``, with the
+    scene's area as the view) and the tracked-people layer on that frame's tracks (a 5 cm grid covering the scene),
+    on ``CrowdReplay.scene`` (N or more people of the real sets present in every frame) at 15 Hz, after
+    ``CROWD_WARMUP_FRAMES`` untimed frames; ``crowd/N/coherent``: the coherent-motion reference on the same tracks,
+    with its ratio to the group tracker."""
+
+    def run(ctx: Context) -> Records:
+        from costmap.grid import GridSpec
+        from costmap.layer import LayerInputs
+        from costmap.layers.tracked import TrackedPeopleLayer
+        from sid.tracking import TrackingSession, Tracks, scene_view
+        from sid.tracking.coherent import CoherentMotion
+
+        s = ctx.settings
+        scene = _crowd_replay(ctx).scene(n, CROWD_WARMUP_FRAMES + s.warmup + s.max_runs)
+        lo, hi = scene.bounds()
+        view = scene_view(np.concatenate([f.truth_positions for f in scene.frames]))
+        origin, size = lo - 3.0, hi - lo + 6.0
+        spec = GridSpec.from_size(
+            CROWD_RESOLUTION, (float(origin[0]), float(origin[1])), (float(size[0]), float(size[1]))
+        )
+        session, layer, reference = TrackingSession(), TrackedPeopleLayer(spec), CoherentMotion()
+        frames = iter(scene.frames)
+        seen: list[tuple[int, int, int, int]] = []  # per call: people present, tracks, groups, reference's groups
+
+        def call() -> dict[str, float]:
+            frame = next(frames)
+            tracked = session.track(frame.detections, frame.timestamp, view)
+            t0 = time.perf_counter_ns()
+            layer.update(LayerInputs(tracks=Tracks(tracked.people, tracked.groups)), None)
+            t1 = time.perf_counter_ns()
+            coherent = reference.update(tracked.people, frame.timestamp)
+            t2 = time.perf_counter_ns()
+            seen.append((len(frame.truth_ids), len(tracked.people), len(tracked.groups), len(coherent)))
+            parts = {"people": tracked.timing_ms["track"], "groups": tracked.timing_ms["track_groups"],
+                     "layer": (t1 - t0) / 1e6}  # fmt: skip
+            return parts | {"total": sum(parts.values()), "coherent": (t2 - t1) / 1e6}
+
+        for _ in range(CROWD_WARMUP_FRAMES):
+            call()
+        parts = measure_parts(call, s)
+        measured = np.array(seen[-parts["total"].runs :])  # the timed frames, after the warm-up calls
+        present, tracks, groups, coherent = (measured[:, k] for k in range(4))
+        name = f"crowd/{n}"
+        out = {
+            name: record(
+                parts["total"],
+                people=int(present.min()),
+                people_max=int(present.max()),
+                tracks=int(np.median(tracks)),
+                groups=int(np.median(groups)),
+                copies=len(scene.copies),
+                cells=spec.width * spec.height,
+                target_ms=CROWD_TARGET_MS.get(n),
+            )
+        }
+        for part in ("people", "groups", "layer"):
+            out[f"{name}/{part}"] = record(parts[part])
+        out[f"{name}/coherent"] = record(parts["coherent"], groups=int(np.median(coherent)), ratio_to=f"{name}/groups")
+        return out
+
+    return run
+
+
 # --- the suite ----------------------------------------------------------------------------------------------------
 
 
 def benchmarks(ctx: Context) -> list[Benchmark]:
     """Every benchmark of ``sid bench`` in report order: pose benchmarks for the models found under ``ctx.shared``
-    (a note when there are none), planning benchmarks for every registered planner."""
+    and crowd benchmarks for its trajectory sets (a note when there are none), planning benchmarks for every
+    registered planner."""
     try:
         from planner.facade import PLANNERS as planners
     except ImportError as exc:  # OMPL missing: the rest of the suite still runs
@@ -797,6 +892,20 @@ def benchmarks(ctx: Context) -> list[Benchmark]:
     items += [
         Benchmark(f"track/{n}", f"people + group tracking and the tracked-people layer, {n} people", _bench_track(n))
         for n in TRACK_SIZES
+    ]
+    sets = crowd_sets(ctx.shared)
+    if not sets:
+        folder = ctx.shared / "data" / "trajectories"
+        ctx.note(f"crowd benchmarks skipped: no trajectory set ({', '.join(CROWD_SETS)}) in {folder}")
+    items += [
+        Benchmark(
+            f"crowd/{n}",
+            f"people + group trackers + tracked-people layer, and the coherent-motion reference, on {n}+ people of "
+            f"real trajectories ({', '.join(p.name for p in sets)}: disjoint stretches side by side, loners trimmed)",
+            _bench_crowd(n),
+        )
+        for n in CROWD_SIZES
+        if sets
     ]
     items += [Benchmark(f"plan/{p}", f"planner {p} on the demo scenario", _bench_plan(p)) for p in planners]
     if planners:
