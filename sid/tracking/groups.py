@@ -38,7 +38,8 @@ _NO_ZONE = np.zeros((0, 2))
 class GroupTrackerParams:
     """Parameters of ``GroupTracker`` (metres, seconds, m/s; measured in docs/tracking.md).
 
-    confirm_hits of confirm_window: a group is reported after being found in that many of its last frames.
+    confirm_hits of confirm_window: a group is reported after being found in that many of its last frames, or in
+    two frames in a row at least confirm_time apart (s; a slow detector, as ``TrackerParams.confirm_time``).
     miss_timeout: seconds a reported group survives while not found. min_overlap: the Jaccard index of member sets
     above which a candidate continues a group. leave_distance: a member of a conversation farther than this from
     its interest point (m) has left. walk_distance (m), walk_velocity_difference (m/s): walkers closer than this,
@@ -49,6 +50,7 @@ class GroupTrackerParams:
 
     confirm_hits: int = 3
     confirm_window: int = 5
+    confirm_time: float = 0.2
     miss_timeout: float = 1.0
     min_overlap: float = 0.5
     leave_distance: float = 1.6
@@ -68,6 +70,7 @@ class GroupTrackerParams:
                 f"({self.confirm_window})"
             )
         check_number("group tracker", "miss_timeout", self.miss_timeout, low=0, unit="seconds")
+        check_number("group tracker", "confirm_time", self.confirm_time, low=0, unit="seconds")
         check_number("group tracker", "min_overlap", self.min_overlap, low=0, high=1, low_open=True)
         check_numbers("group tracker", self, ("leave_distance", "walk_distance"), low=0, low_open=True, unit="metres")
         check_numbers("group tracker", self, ("walk_velocity_difference", "max_speed_sigma"), low=0, unit="m/s")
@@ -116,11 +119,13 @@ class GroupTracker:
         self._next_id = 1
         self._tracks: list[_GroupTrack] = []
         self._history: deque[_Positions] = deque()
+        self._last_time: float | None = None  # of the last update
 
     def reset(self) -> None:
         """Forget every group (ids keep counting up)."""
         self._tracks = []
         self._history = deque()
+        self._last_time = None
 
     def update(self, people: Sequence[TrackedPerson], timestamp: float) -> list[TrackedGroup]:
         """The confirmed groups among ``people`` (this frame's tracks) at ``timestamp`` (s)."""
@@ -133,6 +138,8 @@ class GroupTracker:
         found_now = {m for candidate in candidates for m in candidate.members}
         p = self.params
         kept: list[_GroupTrack] = []
+        slow = self._last_time is not None and timestamp - self._last_time >= p.confirm_time - 1e-9
+        self._last_time = timestamp
         for track in self._tracks:
             candidate = matched.get(track.id)
             track.history.append(candidate is not None)
@@ -154,7 +161,8 @@ class GroupTracker:
                     and self._stays(track, by_id.get(m))
                 )
             }
-            track.confirmed |= sum(track.history) >= p.confirm_hits
+            twice = slow and len(track.history) >= 2 and track.history[-1] and track.history[-2]
+            track.confirmed |= sum(track.history) >= p.confirm_hits or twice
             if len(track.members) >= 2:
                 kept.append(track)
         self._tracks = kept

@@ -185,3 +185,17 @@ def test_walkers_who_drift_apart_are_no_group_even_when_their_velocities_look_al
         people = [_person(1, x, 0.3 + spread, 0.0, (1.2, 0.0)), _person(2, x, -0.3 - spread, 0.0, (1.2, 0.0))]
         groups = tracker.update(people, k * DT)
     assert groups == []
+
+
+@pytest.mark.parametrize(("dt", "frames_to_report"), [(1 / 15, 3), (0.4, 2)])
+def test_a_slow_detector_reports_a_group_found_twice_in_a_row_confirm_time_apart(
+    dt: float, frames_to_report: int
+) -> None:
+    tracker = GroupTracker(GroupTrackerParams(confirm_hits=3, confirm_window=5, confirm_time=0.2))
+    v = (1.2, 0.0)
+    reported = []
+    for k in range(4):
+        x = 1.0 + 1.2 * k * dt
+        people = [_person(1, x, 0.3, 0.0, v), _person(2, x, -0.3, 0.0, v)]
+        reported.append(bool(tracker.update(people, k * dt)))
+    assert reported == [k + 1 >= frames_to_report for k in range(4)]
