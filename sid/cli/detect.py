@@ -27,10 +27,11 @@ from sid.cli.common import (
 from sid.documents import write_atomically
 from sid.perception.camera import Calibration
 from sid.perception.frame import Frame
-from sid.perception.groups import GROUP_METHODS, GroupParams
+from sid.perception.groups import GROUP_METHODS, Group, GroupParams
 from sid.perception.lifting import LiftParams
 from sid.perception.mount import CameraMount
 from sid.perception.overlay import draw_detections
+from sid.perception.people import Person
 from sid.perception.pipeline import FrameResult, Pipeline, PosedFrame, PoseFn, image_pose
 from sid.perception.pose.contracts import PoseModelError
 from sid.perception.pose.session import PROVIDER_CHOICES
@@ -164,19 +165,44 @@ def camera_view(calibration: Calibration, mount: CameraMount) -> CameraView:
     return CameraView(0.0, 0.0, *camera_fov(calibration, mount))
 
 
-def _pictures(frame: Frame, result: FrameResult, mount: CameraMount) -> dict[str, bytes]:
-    """A frame's overlay and top view, encoded as PNG, by file name."""
+class PictureRecords(NamedTuple):
+    """What a frame's pictures draw, the same records its JSON line holds: per pose detection the person it
+    labels in the overlay (None: unlabelled, e.g. a detection no confirmed track took), and the people and groups of
+    the top view (world frame, m)."""
+
+    labels: list[Person | None]
+    people: list[Person]
+    groups: list[Group]
+
+
+def picture_records(result: FrameResult, tracked: SessionUpdate | None) -> PictureRecords:
+    """The frame's own people and groups, or with tracking the confirmed tracks (ids: track ids) and the groups
+    the JSON line reports: a detection is labelled with the track that took it."""
+    if tracked is None:
+        by_id = {p.id: p for p in result.people}
+        return PictureRecords(
+            [by_id.get(i) for i in range(len(result.detections))], list(result.people), list(result.groups)
+        )
+    people = [track.as_person() for track in tracked.people]
+    by_detection = {t.detection: p for t, p in zip(tracked.people, people, strict=True) if t.detection is not None}
+    return PictureRecords(
+        [by_detection.get(i) for i in range(len(result.detections))],
+        people,
+        [group.as_group() for group in tracked.groups],
+    )
+
+
+def _pictures(frame: Frame, result: FrameResult, records: PictureRecords, mount: CameraMount) -> dict[str, bytes]:
+    """A frame's overlay and top view of ``records``, encoded as PNG, by file name."""
     from costmap.render import render_costmap
 
-    by_id = {p.id: p for p in result.people}
-    people = [by_id.get(i) for i in range(len(result.detections))]
-    overlay = draw_detections(frame.color, result.detections, people)
+    overlay = draw_detections(frame.color, result.detections, records.labels)
     top = render_costmap(
         Costmap2D.filled(TOP_VIEW),
-        result.people,
-        result.groups,
-        title=f"frame {frame.index}: {_count(len(result.people), 'person', 'people')}, "
-        f"{_count(len(result.groups), 'group', 'groups')}",
+        records.people,
+        records.groups,
+        title=f"frame {frame.index}: {_count(len(records.people), 'person', 'people')}, "
+        f"{_count(len(records.groups), 'group', 'groups')}",
         camera=camera_view(frame.calibration, mount),
         scale=6,
     )
@@ -281,14 +307,17 @@ def run(args: argparse.Namespace) -> int:
                 print(f"detect: frame {frame.index}: skipped, {reason}", file=sys.stderr)
                 continue
             record = result.to_json(keypoints=not args.no_keypoints)
+            tracked = None
             if tracking is not None:
                 try:
-                    record = _tracked_json(record, tracking.update(result, _view(frame, pipeline)))
+                    tracked = tracking.update(result, _view(frame, pipeline))
                 except TrackingError as exc:
                     skipped += 1
                     print(f"detect: frame {frame.index}: skipped, {exc}", file=sys.stderr)
                     continue
-            pictures = _pictures(frame, result, mount) if args.out is not None else {}
+                record = _tracked_json(record, tracked)
+            records = picture_records(result, tracked)
+            pictures = _pictures(frame, result, records, mount) if args.out is not None else {}
             with signals_deferred():  # a frame's line and both its pictures, or none of them
                 _emit(record, streams)
                 for name, png in pictures.items():

@@ -1,4 +1,4 @@
-"""Overlay pictures: pose detections (skeletons, boxes, scores) and optional person facing arrows on a colour image.
+"""Overlay pictures: pose detections (skeletons, boxes, detection scores) and facing arrows on a colour image.
 
 Colours (BGR): the person's left side orange, right side blue, centre line (nose, shoulders and hips links) white,
 boxes green. Facing arrows are a top view laid on the image: "up" is away from the camera (world +x), "right"
@@ -124,10 +124,10 @@ def draw_detections(
         for k in np.flatnonzero(ok):
             cv2.circle(image, _pt(det.keypoints[k]), thick + 2, _side_colour(int(k)), cv2.FILLED, cv2.LINE_AA)
             cv2.circle(image, _pt(det.keypoints[k]), thick + 2, (0, 0, 0), 1, cv2.LINE_AA)
-        lines = [f"{det.box_score:.2f}"]
+        lines = [f"score {det.box_score:.2f}"]
         if person is not None:
             name, where = person_label(person)
-            lines = [f"{name}  ({lines[0]})", where]
+            lines = [f"{name}  {lines[0]}", where]
         labels.append(lines)
     sizes = [_block_size(lines, font_scale) for lines in labels]
     corners = place_labels(sizes, [det.box for det in detections], (h, w))

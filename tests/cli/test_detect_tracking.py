@@ -40,3 +40,29 @@ def test_no_tracking_gives_each_frames_own_detections(capsys) -> None:
     for record in records:
         assert sorted(p["id"] for p in record["people"]) == [0, 1]
         assert "velocity" not in record["people"][0] and "id" not in record["groups"][0]
+
+
+def test_pictures_draw_the_records_of_the_json_line(tmp_path, capsys, monkeypatch) -> None:
+    """Every frame's overlay labels and top view hold the people (track ids) and groups of its JSON line."""
+    from sid.cli import detect
+
+    drawn: dict[int, detect.PictureRecords] = {}
+    draw = detect._pictures
+
+    def spy(frame, result, records, mount):  # type: ignore[no-untyped-def]
+        drawn[frame.index] = records
+        return draw(frame, result, records, mount)
+
+    monkeypatch.setattr(detect, "_pictures", spy)
+    arguments = ["--source", "synthetic:crossing_walkers", "--frames", "40", "--no-keypoints"]
+    assert main(["detect", *arguments, "--out", str(tmp_path)]) == 0
+    records = _lines(capsys.readouterr().out)
+    assert len(records) == len(drawn) == 40
+    assert any(r["people"] for r in records) and any(r["groups"] for r in records)
+    assert any(not r["people"] for r in records)  # the first frames, before a track is confirmed
+    for record, (index, pictured) in zip(records, sorted(drawn.items()), strict=True):
+        ids = sorted(p["id"] for p in record["people"])
+        assert sorted(p.id for p in pictured.people) == ids, index
+        assert {p.id for p in pictured.labels if p is not None} <= set(ids), index
+        assert [list(g.members) for g in pictured.groups] == [g["members"] for g in record["groups"]], index
+        assert (tmp_path / f"overlay_{index:06d}.png").exists() and (tmp_path / f"topview_{index:06d}.png").exists()
