@@ -21,7 +21,7 @@ from planner.validity import interpolate
 _DIRECTIONS = np.array([[1, 0], [0, 1], [-1, 0], [0, -1], [1, 1], [-1, 1], [-1, -1], [1, -1]], float)
 _DIRECTIONS[4:] /= np.sqrt(2.0)
 _NEIGHBOURS = np.array([[-1], [0], [1]])  # (3, 1): before, the vertex, after
-_WINDOW = 64  # greedy_shortcut's default window (vertices)
+_WINDOW = 64  # the any-angle pass looks at most this many vertices ahead
 REFINE_SWEEPS = 2
 REFINE_MIN_STEP = 0.25
 """``smooth``'s refinement: at most this many sweeps per step size, down to this step (in cells). Over the navigation
@@ -32,17 +32,10 @@ DP_REACH = 12
 already bent the path, so longer shortcuts rarely pay, and all pairs cost O(N^2) segments."""
 
 
-def greedy_shortcut(field: CostField, path: np.ndarray, window: int = _WINDOW) -> np.ndarray:
-    """Any-angle pass: from each kept vertex jump to the farthest of the next ``window`` vertices that a straight,
-    plannable segment reaches at no more cost than the path between them. O(len(path)) numpy calls."""
-    path = np.asarray(path, dtype=float).reshape(-1, 2)
-    if len(path) <= 2:
-        return path.copy()
-    return _greedy(field, path, field.segments(path[:-1], path[1:])[0], window)
-
-
 def _greedy(field: CostField, path: np.ndarray, step_cost: np.ndarray, window: int) -> np.ndarray:
-    """``greedy_shortcut`` of a path (N > 2, 2) whose segments cost ``step_cost`` (N - 1,)."""
+    """Any-angle pass over a path (N > 2, 2) whose segments cost ``step_cost`` (N - 1,): from each kept vertex jump to
+    the farthest of the next ``window`` vertices that a straight, plannable segment reaches at no more cost than the
+    path between them. O(N) numpy calls."""
     prefix = np.concatenate([[0.0], np.cumsum(step_cost)])
     xy = path.T.copy()  # (2, N): coordinate-major, as ``CostField.segments_xy`` takes it
     kept, a = [0], 0

@@ -96,7 +96,7 @@ def _trace_lines(spec: GridSpec, c0: np.ndarray, delta: np.ndarray, n: int) -> t
 
 
 _PAIRS_PER_CHUNK = 2**20
-"""``clear_discs`` tests at most this many (mark, person) pairs at once (a few MB of float64)."""
+"""``_marks_near`` tests at most this many (mark, person) pairs at once (a few MB of float64)."""
 
 
 _INCREMENTAL_SHARE = 0.5
@@ -251,11 +251,6 @@ class ObstacleLayer(Layer):
             return _ScanMarks(traced, hits)
         crossed = self._hits[self._beams.coverage[self._hits] > 0]
         return _ScanMarks(np.concatenate((traced, crossed)), hits)
-
-    def clear_discs(self, centres: np.ndarray, radius: float) -> None:
-        """Turn LETHAL marks whose cell centre lies within ``radius`` metres of any centre (N, 2) into FREE."""
-        near = self._marks_near(np.asarray(centres, dtype=float).reshape(-1, 2), radius, np.zeros(0, dtype=np.int64))
-        self.costs.ravel()[near] = FREE_SPACE
 
     def _marks_near(self, centres: np.ndarray, radius: float, also: np.ndarray) -> np.ndarray:
         """Flat indices of the cells, among the LETHAL ones and those of ``also`` (flat indices), whose centre lies

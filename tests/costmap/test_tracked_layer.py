@@ -41,6 +41,10 @@ def test_standing_people_and_their_group_cost_what_the_social_layer_draws() -> N
     social.update(LayerInputs(people, [Group((7, 8, 9), (4.0, 0.0), 0.05, zone, 0.6)]), None)
     np.testing.assert_array_equal(tracked.costs, social.costs)
     assert _cost(tracked, 4.0, 0.0) == 240
+    people_only = TrackedPeopleLayer(SPEC)  # the zone is drawn: without the group the centre costs less
+    people_only.update(LayerInputs(tracks=Tracks(tracks, [])), None)
+    assert _cost(people_only, 4.0, 0.0) < 240
+    assert np.count_nonzero(tracked.costs > people_only.costs) > 1000
 
 
 def test_a_walker_costs_more_ahead_than_behind_and_than_standing() -> None:

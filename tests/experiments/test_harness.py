@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import itertools
 
 import pytest
 
@@ -99,3 +100,19 @@ def test_summary_counts_failures_and_orders_without_first():
     assert by_layout["layout"] == "L" and "planner" not in by_layout
     failed = summarise([_record(False, False)], ("planner",))[0]
     assert failed["success_rate"] == 0.0 and failed["intrusion_rate"] is None and failed["median_cost_ratio"] is None
+
+
+def test_summary_does_not_depend_on_the_order_of_the_records():
+    """Every order of the same runs gives the same rows (a statistic that skips a first or last run would not)."""
+    records = [
+        _record(False, True, ospace_intrusion_m=v, crosses_group=v > 0, min_person_distance_m=d, length_ratio=lr,
+                cost_ratio=c, planning_time_s=t)
+        for v, d, lr, c, t in [(0.0, 1.3, 1.1, 1.01, 0.1), (0.7, 0.4, 1.0, 1.0, 0.2), (0.0, 0.9, 1.2, 1.3, 0.4),
+                               (0.2, 0.6, 1.05, 1.2, 0.3)]
+    ]  # fmt: skip
+    expected = summarise(records)
+    for permutation in itertools.permutations(records):
+        assert summarise(list(permutation)) == expected
+    (row,) = expected
+    assert row["intrusion_rate"] == 0.5 and row["crossing_rate"] == 0.5 and row["worst_min_person_distance_m"] == 0.4
+    assert row["worst_cost_ratio"] == 1.3 and row["mean_intrusion_m"] == pytest.approx(0.225)
