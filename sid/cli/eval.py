@@ -20,6 +20,7 @@ from sid.experiments.fformation import (
     cross_validate,
     gcff_settings,
     load_dataset,
+    load_dataset_in_metres,
     missing_members,
     parse_threshold,
     unit_warning,
@@ -44,13 +45,14 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     ff.add_argument("dirs", nargs="+", metavar="DIR", help="dataset folder (e.g. ../shared/data/fformation/Synth)")
     ff.add_argument(
         "--scale",
-        type=float,
+        type=_scale,
         nargs="+",
-        default=[1.0],
+        default=["auto"],
         metavar="S",
-        help="multiply positions by this to get metres: one value for every DIR or one per DIR (0.01 for "
-        "centimetres, 0.001 for millimetres; default 1); a warning names the scale that fits when the scaled "
-        "positions are implausible for people",
+        help="multiply positions by this to get metres: one value for every DIR or one per DIR (1 for metres, "
+        "0.01 for centimetres, 0.001 for millimetres), or auto (the default): the unit in which the median distance "
+        "from a person to their nearest neighbour is plausible for people (0.1-5 m), said on stderr when it is not "
+        "metres; a warning names the scale that fits when the scaled positions are implausible",
     )
     ff.add_argument("--degrees", action="store_true", help="the files' theta is in degrees (default: radians)")
     ff.add_argument(
@@ -103,6 +105,19 @@ def _threshold(text: str) -> float:
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
+def _scale(text: str) -> float | str:
+    """'auto', or a positive number."""
+    if text == "auto":
+        return text
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"expected a positive number or auto, got {text!r}")
+    return value
+
+
 def _grid_item(text: str) -> tuple[str, list[float]]:
     """'group_price=0.5,0.8' -> ('group_price', [0.5, 0.8])."""
     name, _, values = text.partition("=")
@@ -124,7 +139,12 @@ def run(args: argparse.Namespace) -> int:
         datasets: dict[str, list[LabelledFrame]] = {}
         for folder, scale in zip(args.dirs, scales, strict=True):
             name = _dataset_name(folder, datasets)
-            datasets[name] = load_dataset(folder, scale, args.degrees)
+            if scale == "auto":
+                datasets[name], unit, scale = load_dataset_in_metres(folder, args.degrees)
+                if unit != "metres":
+                    print(f"sid eval fformation: {name}: positions read as {unit} (--scale {scale:g})", file=sys.stderr)
+            else:
+                datasets[name] = load_dataset(folder, scale, args.degrees)
             _warn_about_data(name, datasets[name], scale)
             if args.facing_noise:
                 datasets[name] = with_facing_noise(datasets[name], math.radians(args.facing_noise))

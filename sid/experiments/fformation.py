@@ -187,24 +187,43 @@ UNIT_SCALES: dict[str, float] = {"metres": 1.0, "centimetres": 0.01, "millimetre
 """The units a dataset's positions are likely in, with the ``scale`` that turns them into metres."""
 
 
+def fitting_unit(frames: Sequence[LabelledFrame], scale: float = 1.0) -> tuple[str, float] | None:
+    """The unit of ``UNIT_SCALES`` (name, scale to metres) in which the positions of ``frames``, loaded with
+    ``scale``, look like people's (``PLAUSIBLE_NEIGHBOUR_M``), nearest to it first; None when none does or no frame
+    holds two people."""
+    gap = median_neighbour_distance(frames)
+    if not gap:  # None, or 0: most people share their position with another, which no scale mends
+        return None
+    raw = gap / scale  # the median gap in the file's own units
+    low, high = PLAUSIBLE_NEIGHBOUR_M
+    fits = [(unit, fit) for unit, fit in UNIT_SCALES.items() if low <= raw * fit <= high]
+    return min(fits, key=lambda item: abs(math.log10(raw * item[1])), default=None)
+
+
 def unit_warning(frames: Sequence[LabelledFrame], scale: float) -> str | None:
     """Why the positions of ``frames``, loaded with ``scale``, are implausible as metres, with the scale that fits
-    them best (of ``UNIT_SCALES``); None when they look like metres (``PLAUSIBLE_NEIGHBOUR_M``) or no frame holds two
+    them best (``fitting_unit``); None when they look like metres (``PLAUSIBLE_NEIGHBOUR_M``) or no frame holds two
     people."""
     gap = median_neighbour_distance(frames)
     low, high = PLAUSIBLE_NEIGHBOUR_M
     if gap is None or low <= gap <= high:
         return None
-    raw = gap / scale  # the median gap in the file's own units
     hint = "check the file's units"
-    if raw > 0:  # 0: most people share their position with another, which no scale mends
-        unit, fit = min(UNIT_SCALES.items(), key=lambda item: abs(math.log10(raw * item[1])))
-        if low <= raw * fit <= high and fit != scale:
-            hint = f"the file's units look like {unit}, scale {fit:g}"
+    if (unit_fit := fitting_unit(frames, scale)) is not None and unit_fit[1] != scale:
+        hint = f"the file's units look like {unit_fit[0]}, scale {unit_fit[1]:g}"
     return (
         f"scaled by {scale:g}, the median distance from a person to their nearest neighbour is {gap:.3g} m, "
         f"implausible for people (expected {low:g}-{high:g} m); {hint}"
     )
+
+
+def load_dataset_in_metres(folder: str | Path, degrees: bool = False) -> tuple[list[LabelledFrame], str, float]:
+    """``load_dataset`` in the unit its positions fit (``fitting_unit``: metres when they look like metres, else
+    centimetres or millimetres): the frames in metres, the unit's name and its scale. Positions that fit no unit are
+    loaded as metres (``unit_warning`` says why)."""
+    frames = load_dataset(folder, 1.0, degrees)
+    unit, scale = fitting_unit(frames) or ("metres", 1.0)
+    return (frames if scale == 1.0 else load_dataset(folder, scale, degrees)), unit, scale
 
 
 def missing_members(frames: Sequence[LabelledFrame]) -> tuple[int, int]:

@@ -182,6 +182,25 @@ def test_eval_fformation_prints_json_and_a_table(tmp_path, capsys):
     assert out[1].split() == ["Tiny", "1/2", "3", "1.000", "0.667", "0.800"]
 
 
+def test_eval_fformation_reads_the_unit_by_default(tmp_path, capsys):
+    """Without --scale the positions' unit is read off the people's spacing: centimetres here, said on stderr."""
+    tiny = write_sequence(tmp_path / "Tiny", tiny_frames(), {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]})
+    code, out, err = run_sid(["eval", "fformation", str(tiny)], capsys)
+    assert code == 0 and "Tiny: positions read as centimetres (--scale 0.01)" in err and "warning" not in err
+    assert json.loads("\n".join(out))["scores"]["Tiny"]["2/3"]["f1"] == pytest.approx(0.8)
+    metres = [frame * np.array([1, 0.01, 0.01, 1]) for frame in tiny_frames()]
+    in_metres = write_sequence(tmp_path / "Metres", metres, {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]})
+    code, out, err = run_sid(["eval", "fformation", str(in_metres), str(tiny), "--scale", "auto", "0.01"], capsys)
+    assert code == 0 and "positions read as" not in err
+    scores = json.loads("\n".join(out))["scores"]
+    assert scores["Metres"]["2/3"] == scores["Tiny"]["2/3"]
+    code, _, err = run_sid(["eval", "fformation", str(tiny), "--scale", "1"], capsys)  # as asked, with the warning
+    assert code == 0 and "look like centimetres, scale 0.01" in err
+    with pytest.raises(SystemExit):
+        main(["eval", "fformation", str(tiny), "--scale", "-1"])
+    assert "expected a positive number or auto" in capsys.readouterr().err
+
+
 def test_orientation_quality_is_read_and_checked(capsys, monkeypatch):
     # A pair 1.6 m apart, the second looking 120 degrees off: a clear facing is refused, a doubtful one joins.
     people = [{"id": 1, "x": 0.0, "y": 0.0, "theta": 0.0}, {"id": 2, "x": 1.6, "y": 0.0, "theta": math.radians(300)}]
@@ -247,7 +266,7 @@ def test_eval_fformation_on_the_real_datasets(capsys):
 
 def test_eval_fformation_warns_when_scaled_positions_are_not_metres(tmp_path, capsys):
     tiny = write_sequence(tmp_path / "Tiny", tiny_frames(), {1: [[1, 2]], 2: [[1, 2, 3]], 3: []})
-    code, _, err = run_sid(["eval", "fformation", str(tiny)], capsys)
+    code, _, err = run_sid(["eval", "fformation", str(tiny), "--scale", "1"], capsys)
     assert code == 0 and "Tiny: scaled by 1, the median distance" in err and "centimetres, scale 0.01" in err
     code, _, err = run_sid(["eval", "fformation", str(tiny), "--scale", "0.01"], capsys)
     assert code == 0 and "warning" not in err
