@@ -66,7 +66,11 @@ DEFAULT_GRID: dict[str, dict[str, tuple[float, ...]]] = {
         "max_gate": (1.0, 1.5),
         "timeout": (1.0, 1.5, 2.0),
     },
-    "groups": {"walk_distance": (1.2, 1.5, 2.0), "walk_velocity_difference": (0.3, 0.4, 0.5, 0.6, 0.8)},
+    "groups": {
+        "walk_distance": (1.2, 1.5, 2.0),
+        "walk_velocity_difference": (0.3, 0.4, 0.5, 0.6, 0.8, 1.0),
+        "moving_speed": (0.2, 0.3, 0.4),
+    },
     "coherent": {"distance": (1.0, 1.5, 2.0), "velocity_difference": (0.3, 0.4, 0.5, 0.6), "share": (0.4, 0.6, 0.8)},
 }
 """What ``cross_validate`` chooses among: the people tracker's, the group tracker's and the reference's parameters."""

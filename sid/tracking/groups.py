@@ -4,8 +4,10 @@ Per frame (``GroupTracker.update``), on the tracked people (``sid.tracking.track
 
 - conversations: ``sid.perception.groups.detect_groups`` on the standing tracks (smoothed positions and facings).
   Walking tracks are left out, so people walking together are never an o-space, whatever their facings.
-- walking groups: walking tracks within ``walk_distance`` of each other whose velocities differ by at most
-  ``walk_velocity_difference`` (side by side or in file), joined transitively (connected components).
+- walking groups: moving tracks (walking, or faster than ``moving_speed``: the tracker calls a young track walking
+  only once its speed is known, a second or more after it appeared) within ``walk_distance`` of each other whose
+  velocities differ by at most ``walk_velocity_difference`` (side by side or in file), joined transitively
+  (connected components).
 - each candidate is matched to a group track of its kind by member overlap (Jaccard index >= ``min_overlap``,
   ``scipy.optimize.linear_sum_assignment`` on 1 - overlap); an unmatched candidate starts a tentative group.
 - a group is reported once it was found in ``confirm_hits`` of its last ``confirm_window`` frames; it survives
@@ -13,7 +15,8 @@ Per frame (``GroupTracker.update``), on the tracked people (``sid.tracking.track
   leaves (track deleted, starts walking for a conversation or stops for a walking group, or goes farther than
   ``leave_distance`` from the interest point, or is found in another group) leaves the group at once, and one
   not found with the group for ``miss_timeout`` leaves too; fewer than two members end it.
-- only standing tracks whose velocity is settled (``max_speed_sigma``) take part in conversations.
+- only standing tracks that are not moving and whose velocity is settled (``max_speed_sigma``) take part in
+  conversations.
 
 Group ids count up from 1 and are never reused, also across ``reset``.
 """
@@ -45,7 +48,8 @@ class GroupTrackerParams:
     its interest point (m) has left. walk_distance (m), walk_velocity_difference (m/s): walkers closer than this,
     whose velocities differ by less than that, walk together. max_speed_sigma: a standing track joins conversations
     only once its velocity is known within this (m/s, ``TrackedPerson.speed_sigma``): a track just started may be a
-    walker whose motion is not yet seen.
+    walker whose motion is not yet seen. moving_speed: a track faster than this (m/s) takes part in walking groups
+    whatever its walking / standing state.
     """
 
     confirm_hits: int = 3
@@ -55,9 +59,10 @@ class GroupTrackerParams:
     min_overlap: float = 0.5
     leave_distance: float = 1.6
     walk_distance: float = 1.5
-    walk_velocity_difference: float = 0.6
+    walk_velocity_difference: float = 0.8
     walk_window: float = 2.0
     max_speed_sigma: float = 0.4
+    moving_speed: float = 0.3
 
     def __post_init__(self) -> None:
         for name in ("confirm_hits", "confirm_window"):
@@ -73,7 +78,8 @@ class GroupTrackerParams:
         check_number("group tracker", "confirm_time", self.confirm_time, low=0, unit="seconds")
         check_number("group tracker", "min_overlap", self.min_overlap, low=0, high=1, low_open=True)
         check_numbers("group tracker", self, ("leave_distance", "walk_distance"), low=0, low_open=True, unit="metres")
-        check_numbers("group tracker", self, ("walk_velocity_difference", "max_speed_sigma"), low=0, unit="m/s")
+        speeds = ("walk_velocity_difference", "max_speed_sigma", "moving_speed")
+        check_numbers("group tracker", self, speeds, low=0, unit="m/s")
         check_number("group tracker", "walk_window", self.walk_window, low=0, high=60, unit="seconds")
 
 
@@ -179,7 +185,7 @@ class GroupTracker:
 
     def _conversations(self, people: Sequence[TrackedPerson]) -> list[_Candidate]:
         settled = self.params.max_speed_sigma
-        standing = [p.as_person() for p in people if not p.walking and p.speed_sigma <= settled]
+        standing = [p.as_person() for p in people if not _moving(p, self.params) and p.speed_sigma <= settled]
         return [
             _Candidate(
                 "conversation",
@@ -222,7 +228,7 @@ class GroupTracker:
         if person is None:
             return False
         if track.found.kind == "walking":
-            return person.walking
+            return _moving(person, self.params)
         x, y = track.found.interest_point
         return not person.walking and np.hypot(person.x - x, person.y - y) <= self.params.leave_distance
 
@@ -237,7 +243,7 @@ def _jaccard(track: _GroupTrack, candidate: _Candidate) -> float:
 def _walking_groups(
     people: Sequence[TrackedPerson], history: deque[_Positions], params: GroupTrackerParams
 ) -> list[_Candidate]:
-    walkers = [p for p in people if p.walking]
+    walkers = [p for p in people if _moving(p, params)]
     if len(walkers) < 2:
         return []
     ids = np.array([p.id for p in walkers], dtype=np.int64)
@@ -257,6 +263,10 @@ def _walking_groups(
         members = frozenset(walkers[i].id for i in rows.tolist())
         out.append(_Candidate("walking", members, (float(centre[0]), float(centre[1])), _NO_ZONE, 0.0, spread))
     return out
+
+
+def _moving(person: TrackedPerson, params: GroupTrackerParams) -> bool:
+    return person.walking or person.vx * person.vx + person.vy * person.vy > params.moving_speed**2
 
 
 def _relative_speed(

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -199,3 +200,18 @@ def test_a_slow_detector_reports_a_group_found_twice_in_a_row_confirm_time_apart
         people = [_person(1, x, 0.3, 0.0, v), _person(2, x, -0.3, 0.0, v)]
         reported.append(bool(tracker.update(people, k * dt)))
     assert reported == [k + 1 >= frames_to_report for k in range(4)]
+
+
+def test_young_tracks_moving_together_are_a_walking_group_before_the_tracker_calls_them_walking() -> None:
+    """The tracker's state says standing while a new track's speed is uncertain; moving_speed does not wait."""
+    v = (0.9, 0.0)
+
+    def pair(k: int) -> list[TrackedPerson]:
+        x = 1.0 + v[0] * k * DT
+        return [dataclasses.replace(_person(i, x, y, None, v), state="standing") for i, y in ((1, 0.35), (2, -0.35))]
+
+    early = GroupTracker()
+    groups = [early.update(pair(k), k * DT) for k in range(6)]
+    assert groups[-1] and groups[-1][0].kind == "walking" and groups[-1][0].members == (1, 2)
+    waiting = GroupTracker(GroupTrackerParams(moving_speed=1.0))  # only the tracker's walking state counts
+    assert all(waiting.update(pair(k), k * DT) == [] for k in range(6))
