@@ -138,13 +138,14 @@ INPUT_ERRORS = (PoseModelError, SourceError, ValueError, OSError)
 
 def run_quantize(args: argparse.Namespace) -> int:
     from sid.perception.pose import load_pose_estimator
-    from sid.perception.pose.quantize import quantize_model
+    from sid.perception.pose.quantize import check_paths, quantize_model
     from sid.perception.pose.session import quiet_load_warnings
 
     command = "sid model quantize"
     quiet_load_warnings()
     try:
-        load_pose_estimator(args.model, threads=1)  # a bad model is said before the sources are read
+        check_paths(args.model, args.output)  # a bad model or output is said before the sources are read
+        load_pose_estimator(args.model, threads=1)
         frames = _open_all(args, command)
         report = quantize_model(
             args.model,

@@ -29,6 +29,13 @@ def test_a_missing_model_is_named(tmp_path, capsys):
     assert not (tmp_path / "out.onnx").exists()
 
 
+def test_an_output_in_a_missing_folder_is_named_before_any_work(tmp_path, capsys):
+    model = build_yolo_pose_model(tmp_path / "tiny.onnx", np.zeros((56, 4), np.float32))
+    code = main(["model", "quantize", str(model), str(tmp_path / "no" / "out.onnx"), "--calibrate", "synthetic:S1"])
+    assert code == 2 and f"the folder {tmp_path / 'no'} does not exist" in _error(capsys)
+    assert main(["model", "simplify", str(model), str(model)]) == 2 and "is the input model" in _error(capsys)
+
+
 def test_a_file_that_is_not_a_model_is_named(tmp_path, capsys):
     fake = tmp_path / "fake.onnx"
     fake.write_text("not a model")

@@ -168,7 +168,7 @@ def simplify_model(source: str | Path, output: str | Path) -> int:
     many nodes it removed. Raises PoseModelError when ``source`` is not a pose model sid can load."""
     from sid.perception.pose import load_pose_estimator
 
-    source, output = _paths(source, output)
+    source, output = check_paths(source, output)
     contract = load_pose_estimator(source, threads=1).contract
     onnx = _onnx()
     model = onnx.load(str(source))
@@ -202,7 +202,7 @@ def quantize_model(
     from sid.perception.pose import load_pose_estimator
 
     started = time.perf_counter()
-    source, output = _paths(source, output)
+    source, output = check_paths(source, output)
     estimator = load_pose_estimator(source, threads=1)
     input_name = estimator.model.signature.inputs[0].name
     tensors = [estimator.preprocess(image)[0] for image in _first(images, max_images)]
@@ -268,12 +268,16 @@ def _first(images: Iterable[np.ndarray], limit: int | None) -> Iterator[np.ndarr
         yield image
 
 
-def _paths(source: str | Path, output: str | Path) -> tuple[Path, Path]:
+def check_paths(source: str | Path, output: str | Path) -> tuple[Path, Path]:
+    """``source`` and ``output`` as Paths; ValueError when the output is the source, a folder, or in a folder that
+    does not exist (checked before any work)."""
     source, output = Path(source), Path(output)
     if source.exists() and output.exists() and source.resolve() == output.resolve():
         raise ValueError(f"sid model: the output {output} is the input model; write to another file")
     if output.is_dir():
         raise ValueError(f"sid model: the output {output} is a folder; name a .onnx file")
+    if not output.parent.is_dir():
+        raise ValueError(f"sid model: cannot write {output}: the folder {output.parent} does not exist")
     return source, output
 
 
