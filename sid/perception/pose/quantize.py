@@ -82,8 +82,9 @@ def simplify_graph(model: onnx.ModelProto) -> int:
         if info.type.HasField("tensor_type") and info.type.tensor_type.HasField("shape"):
             dims = info.type.tensor_type.shape.dim
             shapes[info.name] = tuple(d.dim_value if d.HasField("dim_value") else None for d in dims)
+    nodes = list(graph.node)  # one Python object per node for the whole pass: their ids identify them
     consumers: dict[str, list[Any]] = {}
-    for node in graph.node:
+    for node in nodes:
         for name in node.input:
             consumers.setdefault(name, []).append(node)
     outputs = {output.name for output in graph.output}
@@ -101,7 +102,7 @@ def simplify_graph(model: onnx.ModelProto) -> int:
 
     replaced: dict[str, str] = {}  # output name -> the tensor it equals
     removed: set[int] = set()
-    for node in graph.node:
+    for node in nodes:
         if id(node) in removed:
             continue
         negated = scalar_operand(node, -1.0, ("Mul",), commutes=True)
@@ -125,7 +126,7 @@ def simplify_graph(model: onnx.ModelProto) -> int:
             name = replaced[name]
         return name
 
-    kept = [node for node in graph.node if id(node) not in removed]
+    kept = [node for node in nodes if id(node) not in removed]
     for node in kept:
         for k, name in enumerate(node.input):
             node.input[k] = resolve(name)
