@@ -43,7 +43,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     quantize.add_argument(
         "--float-layers",
-        type=int,
+        type=_layer_count,
         default=FLOAT_LAYERS,
         metavar="K",
         help="keep the last K weighted layers on every path to the outputs, and the decoding after them, float "
@@ -71,6 +71,17 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     compare.add_argument("candidate", type=Path, metavar="CANDIDATE.onnx", help="e.g. its INT8 quantization")
     _add_sources(compare, "--source", "sources")
     compare.set_defaults(func=run_compare)
+
+
+def _layer_count(text: str) -> int:
+    """argparse type: a whole number >= 0."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {text!r}")
+    return value
 
 
 def _add_sources(parser: argparse.ArgumentParser, option: str, what: str) -> None:

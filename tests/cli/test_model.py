@@ -36,6 +36,12 @@ def test_an_output_in_a_missing_folder_is_named_before_any_work(tmp_path, capsys
     assert main(["model", "simplify", str(model), str(model)]) == 2 and "is the input model" in _error(capsys)
 
 
+def test_a_negative_layer_count_is_a_usage_error(tmp_path, capsys):
+    with pytest.raises(SystemExit) as stop:
+        main(["model", "quantize", "a.onnx", "b.onnx", "--calibrate", "synthetic:S1", "--float-layers", "-1"])
+    assert stop.value.code == 2 and "expected a whole number >= 0, got '-1'" in capsys.readouterr().err
+
+
 def test_a_file_that_is_not_a_model_is_named(tmp_path, capsys):
     fake = tmp_path / "fake.onnx"
     fake.write_text("not a model")

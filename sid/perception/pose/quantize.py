@@ -202,6 +202,8 @@ def quantize_model(
 
     from sid.perception.pose import load_pose_estimator
 
+    if isinstance(float_layers, bool) or not isinstance(float_layers, int) or float_layers < 0:
+        raise ValueError(f"sid model: float_layers must be a whole number >= 0, got {float_layers!r}")
     started = time.perf_counter()
     source, output = check_paths(source, output)
     estimator = load_pose_estimator(source, threads=1)

@@ -98,6 +98,8 @@ def test_no_calibration_image_and_output_onto_input_are_refused(tmp_path):
         quantize_model(path, tmp_path / "out.onnx", [])
     with pytest.raises(ValueError, match="is the input model"):
         quantize_model(path, path, [np.zeros((48, 64, 3), np.uint8)])
+    with pytest.raises(ValueError, match="float_layers must be a whole number >= 0"):
+        quantize_model(path, tmp_path / "out.onnx", [np.zeros((48, 64, 3), np.uint8)], float_layers=-1)
     with pytest.raises(PoseModelError, match="not found"):
         quantize_model(tmp_path / "missing.onnx", tmp_path / "out.onnx", [np.zeros((48, 64, 3), np.uint8)])
 
