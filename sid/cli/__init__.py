@@ -30,6 +30,7 @@ COMMANDS: tuple[str, ...] = (
     "compare",
     "reproduce",
     "bench",
+    "model",
     "ros",
 )
 

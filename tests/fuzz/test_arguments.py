@@ -64,7 +64,7 @@ def test_any_command_line_parses_or_gets_a_usage_error(argv):
 
 def test_every_command_is_fuzzed():
     assert {command[0] for command in SUBCOMMANDS} >= {
-        "detect", "groups", "eval", "costmap", "plan", "demo", "compare", "reproduce", "bench"
+        "detect", "groups", "eval", "costmap", "plan", "demo", "compare", "reproduce", "bench", "model"
     }  # fmt: skip
 
 

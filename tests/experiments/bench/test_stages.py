@@ -244,6 +244,22 @@ def test_pose_stage_on_the_real_models(tmp_path):
         _check_stage(stages[f"pose/yolo11n-pose-256/{part}"])
 
 
+def test_int8_pose_stage_times_both_models_in_the_same_calls_and_checks_the_results(tmp_path):
+    model = shared_path("models", "yolo11n-pose-256.onnx")
+    shared_path("data", "rgbd", "hero")
+    out = tmp_path / "bench"
+    assert main(["bench", "--quick", "--only", f"pose_int8/{model.stem}", "--out", str(out)]) == 0
+    stages = load_report(out / "bench.json")["stages"]
+    int8 = stages[f"pose_int8/{model.stem}"]
+    for name in ("", "/float", "/simplified"):
+        _check_stage(stages[f"pose_int8/{model.stem}{name}"])
+    float_ms = stages[f"pose_int8/{model.stem}/float"]["median_ms"]
+    assert int8["runs"] == stages[f"pose_int8/{model.stem}/float"]["runs"]  # one sample of each per call
+    assert int8["speedup"] == pytest.approx(float_ms / int8["median_ms"])
+    assert int8["calibration_frames"] == int8["compared_frames"] == 6  # five_people and the five hero frames
+    assert int8["frames_with_other_results"] == 0 and int8["lowest_mean_oks"] >= 0.9
+
+
 def test_frame_and_lift_stages_without_shared_data(tmp_path):
     """Without ../shared the per-frame pipeline still runs, with TruthPose as its pose stage, and says so."""
     out = tmp_path / "bench"

@@ -1,0 +1,293 @@
+"""Static INT8 quantization of a pose model with onnxruntime's tools, calibrated on sid's own pre-processing.
+
+``quantize_model(IN, OUT, images)`` writes an ONNX file with the same input and output (the same contract, so it
+loads wherever the float model does) whose convolutions and matrix products run on 8-bit integers:
+
+1. ``simplify_graph``: exact rewrites that leave every output bit for bit unchanged: pairs of multiplications by -1
+   (TFLite converters write SiLU as ``x * sigmoid(x)`` through four of them), subtractions of zero and
+   multiplications or divisions by one are removed (``simplify_model`` writes this float graph alone).
+2. ``onnxruntime.quantization.quant_pre_process``: shape inference and onnxruntime's basic graph optimisations.
+3. ``onnxruntime.quantization.quantize_static`` in QDQ format: activations uint8 with a per-tensor scale (min/max
+   over the calibration images), weights int8 with a per-output-channel scale: the combination onnxruntime runs on
+   integer dot-product instructions (VNNI on x86, SDOT on ARMv8.2+); int8 activations fall back to slower kernels
+   on x86. The last ``FLOAT_LAYERS`` weighted layers of every path to the outputs and the decoding after them
+   (keypoint offsets, anchors, scores, the output concatenation) stay float (``decoding_nodes``): 8-bit steps there
+   move keypoints by pixels, and the facings lifted from them by degrees. See docs/models.md for what each choice
+   costs.
+
+Calibration tensors are made by the model's own estimator (``preprocess`` of ``sid.perception.pose``: letterbox,
+padding value, dtype, layout), from whole RGB images, exactly as ``sid detect`` feeds the model.
+
+Needs the ``onnx`` package (``pip install 'sid[quantize]'``); onnxruntime's quantization tools import it.
+"""
+
+from __future__ import annotations
+
+import tempfile
+import time
+from collections.abc import Iterable, Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from sid.perception.pose.contracts import PoseModelError
+
+if TYPE_CHECKING:
+    import onnx
+
+WEIGHTED_OPS = ("Conv", "ConvTranspose", "MatMul", "Gemm")
+"""Operators whose int8 kernels make the speed-up; the graph after the last of them is the decoding, kept float."""
+FLOAT_LAYERS = 4
+"""``quantize_model``'s default: the last 4 weighted layers on every path to the outputs stay float, with the decoding
+after them (docs/models.md has the measurements that chose it)."""
+ONNX_MISSING = "sid model: quantizing needs the onnx package: pip install 'sid[quantize]' (or pip install onnx)"
+
+
+@dataclass(frozen=True)
+class QuantizeReport:
+    """What ``quantize_model`` did: the contract both files follow, how many calibration images it used, how many
+    nodes the exact simplification removed, how many nodes it quantized and kept float, and its duration (s)."""
+
+    source: Path
+    output: Path
+    contract: str
+    calibration_images: int
+    removed_nodes: int
+    quantized_nodes: int
+    float_nodes: int
+    seconds: float
+
+
+def _onnx() -> Any:
+    try:
+        import onnx
+    except ImportError:
+        raise PoseModelError(ONNX_MISSING) from None
+    return onnx
+
+
+def simplify_graph(model: onnx.ModelProto) -> int:
+    """Remove, in place, nodes of ``model`` that leave their input unchanged bit for bit: ``Mul`` by -1 followed
+    only by another ``Mul`` by -1, ``Sub`` of a zero constant, ``Mul`` or ``Div`` by a one constant, each only where
+    shape inference shows that the constant does not broadcast the input to another shape (``Add`` of zero is
+    left: it turns -0 into +0). Returns how many nodes went."""
+    from onnx import numpy_helper, shape_inference
+
+    graph = model.graph
+    constants = {init.name: numpy_helper.to_array(init) for init in graph.initializer}
+    shapes: dict[str, tuple[int | None, ...]] = {}
+    for info in (*shape_inference.infer_shapes(model).graph.value_info, *graph.input):
+        if info.type.HasField("tensor_type") and info.type.tensor_type.HasField("shape"):
+            dims = info.type.tensor_type.shape.dim
+            shapes[info.name] = tuple(d.dim_value if d.HasField("dim_value") else None for d in dims)
+    nodes = list(graph.node)  # one Python object per node for the whole pass: their ids identify them
+    consumers: dict[str, list[Any]] = {}
+    for node in nodes:
+        for name in node.input:
+            consumers.setdefault(name, []).append(node)
+    outputs = {output.name for output in graph.output}
+
+    def scalar_operand(node: Any, value: float, ops: tuple[str, ...], commutes: bool) -> str | None:
+        """The other input of ``node`` when it is one of ``ops`` with a constant of ``value`` everywhere, else None."""
+        if node.op_type not in ops or len(node.input) != 2 or node.output[0] in outputs:
+            return None
+        first, second = node.input
+        for constant, other in ((second, first), (first, second)) if commutes else ((second, first),):
+            array = constants.get(constant)
+            if array is not None and array.size >= 1 and np.all(array == value) and _keeps_shape(shapes, other, array):
+                return other
+        return None
+
+    replaced: dict[str, str] = {}  # output name -> the tensor it equals
+    removed: set[int] = set()
+    for node in nodes:
+        if id(node) in removed:
+            continue
+        negated = scalar_operand(node, -1.0, ("Mul",), commutes=True)
+        if negated is not None:
+            following = consumers.get(node.output[0], [])
+            if len(following) == 1 and scalar_operand(following[0], -1.0, ("Mul",), commutes=True) is not None:
+                removed |= {id(node), id(following[0])}
+                replaced[following[0].output[0]] = negated
+            continue
+        same = (
+            scalar_operand(node, 0.0, ("Sub",), False)
+            or scalar_operand(node, 1.0, ("Mul",), commutes=True)
+            or scalar_operand(node, 1.0, ("Div",), False)
+        )
+        if same is not None:
+            removed.add(id(node))
+            replaced[node.output[0]] = same
+
+    def resolve(name: str) -> str:
+        while name in replaced:
+            name = replaced[name]
+        return name
+
+    kept = [node for node in nodes if id(node) not in removed]
+    for node in kept:
+        for k, name in enumerate(node.input):
+            node.input[k] = resolve(name)
+    del graph.node[:]
+    graph.node.extend(kept)
+    used = {name for node in graph.node for name in node.input}
+    live = [init for init in graph.initializer if init.name in used]
+    del graph.initializer[:]
+    graph.initializer.extend(live)
+    return len(removed)
+
+
+def _keeps_shape(shapes: dict[str, tuple[int | None, ...]], name: str, constant: np.ndarray) -> bool:
+    """Whether broadcasting ``constant`` against the tensor ``name`` leaves that tensor's (inferred) shape as it is."""
+    shape = shapes.get(name)
+    if shape is None or constant.ndim > len(shape):
+        return False
+    trailing = shape[len(shape) - constant.ndim :]
+    return all(c == 1 or c == d for c, d in zip(constant.shape, trailing, strict=True))
+
+
+def decoding_nodes(model: onnx.ModelProto, layers: int = FLOAT_LAYERS) -> list[str]:
+    """Names of the nodes followed by fewer than ``layers`` weighted operators (``WEIGHTED_OPS``) on every path to
+    the outputs, in the graph's order: with ``layers`` = K, the last K weighted layers of each path and everything
+    after them (the decoding), without the activations that feed the first of those layers."""
+    nodes = list(model.graph.node)
+    consumers: dict[str, list[Any]] = {}
+    for node in nodes:
+        for name in node.input:
+            consumers.setdefault(name, []).append(node)
+    after: dict[int, int] = {}  # node -> most weighted operators on a path from its output to the graph's outputs
+    for node in reversed(nodes):  # ONNX graphs are topologically sorted: consumers come after producers
+        following = [c for output in node.output for c in consumers.get(output, [])]
+        after[id(node)] = max((after[id(c)] + (c.op_type in WEIGHTED_OPS) for c in following), default=0)
+    return [node.name for node in nodes if after[id(node)] < layers]
+
+
+def simplify_model(source: str | Path, output: str | Path) -> int:
+    """Write ``simplify_graph`` of the model at ``source`` to ``output`` (float, outputs unchanged); returns how
+    many nodes it removed. Raises PoseModelError when ``source`` is not a pose model sid can load."""
+    from sid.perception.pose import load_pose_estimator
+
+    source, output = check_paths(source, output)
+    contract = load_pose_estimator(source, threads=1).contract
+    onnx = _onnx()
+    model = onnx.load(str(source))
+    removed = simplify_graph(model)
+    onnx.save(model, str(output))
+    _check_contract(output, contract)
+    return removed
+
+
+def quantize_model(
+    source: str | Path,
+    output: str | Path,
+    images: Iterable[np.ndarray],
+    *,
+    per_channel: bool = True,
+    float_layers: int = FLOAT_LAYERS,
+    max_images: int | None = None,
+) -> QuantizeReport:
+    """Quantize the pose model at ``source`` to INT8 (module docstring) and write it to ``output``.
+
+    images: RGB uint8 (H, W, 3) calibration images, e.g. the colour images of a sid source; each goes through the
+    model's own pre-processing. max_images: use at most this many. per_channel: weights get one scale per output
+    channel (else one per tensor). float_layers: leave ``decoding_nodes`` with that many layers float (0: none).
+
+    Raises PoseModelError (source missing or not a pose model, onnx not installed, nothing to quantize, the written
+    model not loading with the same contract), ValueError (no calibration image, output = source).
+    """
+    from onnxruntime.quantization import CalibrationMethod, QuantFormat, QuantType, quantize_static
+    from onnxruntime.quantization.shape_inference import quant_pre_process
+
+    from sid.perception.pose import load_pose_estimator
+
+    if isinstance(float_layers, bool) or not isinstance(float_layers, int) or float_layers < 0:
+        raise ValueError(f"sid model: float_layers must be a whole number >= 0, got {float_layers!r}")
+    started = time.perf_counter()
+    source, output = check_paths(source, output)
+    estimator = load_pose_estimator(source, threads=1)
+    input_name = estimator.model.signature.inputs[0].name
+    tensors = [estimator.preprocess(image)[0] for image in _first(images, max_images)]
+    if not tensors:
+        raise ValueError("sid model: no calibration image: the calibration source gave no frames")
+    onnx = _onnx()
+    model = onnx.load(str(source))
+    removed = simplify_graph(model)
+    weighted = sum(node.op_type in WEIGHTED_OPS for node in model.graph.node)
+    if weighted == 0:
+        raise PoseModelError(f"{source}: no {', '.join(WEIGHTED_OPS)} node to quantize")
+    with tempfile.TemporaryDirectory(prefix="sid-quantize-") as work:
+        simplified, prepared = Path(work) / "simplified.onnx", Path(work) / "prepared.onnx"
+        onnx.save(model, str(simplified))
+        quant_pre_process(str(simplified), str(prepared), skip_symbolic_shape=True)
+        prepared_model = onnx.load(str(prepared))
+        keep_float = decoding_nodes(prepared_model, float_layers) if float_layers else []
+        quantize_static(
+            str(prepared),
+            str(output),
+            _CalibrationImages(input_name, tensors),
+            quant_format=QuantFormat.QDQ,
+            per_channel=per_channel,
+            activation_type=QuantType.QUInt8,
+            weight_type=QuantType.QInt8,
+            calibrate_method=CalibrationMethod.MinMax,
+            nodes_to_exclude=keep_float,
+        )
+        nodes = len(prepared_model.graph.node)
+    _check_contract(output, estimator.contract)
+    return QuantizeReport(
+        source,
+        output,
+        estimator.contract,
+        len(tensors),
+        removed,
+        nodes - len(keep_float),
+        len(keep_float),
+        time.perf_counter() - started,
+    )
+
+
+class _CalibrationImages:
+    """onnxruntime's ``CalibrationDataReader`` protocol (``get_next``, ``rewind``) over prepared input tensors."""
+
+    def __init__(self, input_name: str, tensors: Sequence[np.ndarray]) -> None:
+        self.input_name = input_name
+        self.tensors = tensors
+        self._next = iter(tensors)
+
+    def get_next(self) -> dict[str, np.ndarray] | None:
+        tensor = next(self._next, None)
+        return None if tensor is None else {self.input_name: tensor}
+
+    def rewind(self) -> None:
+        self._next = iter(self.tensors)
+
+
+def _first(images: Iterable[np.ndarray], limit: int | None) -> Iterator[np.ndarray]:
+    for count, image in enumerate(images):
+        if limit is not None and count >= limit:
+            return
+        yield image
+
+
+def check_paths(source: str | Path, output: str | Path) -> tuple[Path, Path]:
+    """``source`` and ``output`` as Paths; ValueError when the output is the source, a folder, or in a folder that
+    does not exist (checked before any work)."""
+    source, output = Path(source), Path(output)
+    if source.exists() and output.exists() and source.resolve() == output.resolve():
+        raise ValueError(f"sid model: the output {output} is the input model; write to another file")
+    if output.is_dir():
+        raise ValueError(f"sid model: the output {output} is a folder; name a .onnx file")
+    if not output.parent.is_dir():
+        raise ValueError(f"sid model: cannot write {output}: the folder {output.parent} does not exist")
+    return source, output
+
+
+def _check_contract(path: Path, contract: str) -> None:
+    """The written model must load and follow the source's contract (so it works wherever the source does)."""
+    from sid.perception.pose import load_pose_estimator
+
+    written = load_pose_estimator(path, threads=1).contract
+    if written != contract:
+        raise PoseModelError(f"{path}: the written model follows {written}, not the source's {contract}")
