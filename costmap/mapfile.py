@@ -26,11 +26,12 @@ from costmap.grid import GridSpec
 from costmap.occupancy import OCC_OCCUPIED, OCC_UNKNOWN, OccupancyGrid
 from sid.checks import check_limit
 from sid.documents import is_number, load_document
+from sid.errors import SidError
 
 MODES = ("trinary", "scale", "raw")
 
 
-class MapFileError(ValueError):
+class MapFileError(SidError, ValueError):
     """A map YAML or its image cannot be used; the message names the file and the problem."""
 
 

@@ -32,6 +32,7 @@ from scipy import ndimage
 
 from costmap.grid import INSCRIBED, LETHAL, MAX_NON_OBSTACLE, NO_INFORMATION, Costmap2D
 from sid.checks import check_number
+from sid.errors import SidError
 
 _LOOP_MAX = 20  # segment_cost sums this many samples or fewer in a Python loop, more with numpy (docs/parameters.md)
 SAMPLES_PER_CALL = 2**20
@@ -47,7 +48,7 @@ MAX_COST_WEIGHT = 1000.0
 a larger w only overflows the cost sums (1e308 did)."""
 
 
-class PlanningError(ValueError):
+class PlanningError(SidError, ValueError):
     """A problem that cannot be planned (start or goal outside the map or in collision, no free path); the message
     names the reason."""
 

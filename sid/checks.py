@@ -13,6 +13,8 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
 
+from sid.errors import SidError
+
 LIMITS_ENV = "SID_LIMITS"
 """The environment variable that raises (or lowers) limits: ``SID_LIMITS="map_cells=16000000,people=300"``."""
 
@@ -37,7 +39,7 @@ class Limits:
     people: int = 100
 
 
-class LimitError(ValueError):
+class LimitError(SidError, ValueError):
     """An input above a limit of ``Limits``; the message names the field, the value, the limit and how to raise it."""
 
 

@@ -20,9 +20,10 @@ from pathlib import Path
 from typing import IO, Any, TextIO
 
 from sid.documents import TEMPORARY_PREFIX, unique_keys
+from sid.errors import SidError
 
 
-class OutputFolderError(ValueError):
+class OutputFolderError(SidError, ValueError):
     """``--out`` names something that cannot be (or become) a writable folder."""
 
 

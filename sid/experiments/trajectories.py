@@ -23,13 +23,14 @@ from pathlib import Path
 import numpy as np
 
 from sid.checks import check_number
+from sid.errors import SidError
 from sid.perception.people import Person
 from sid.tracking.view import View
 
 __all__ = ["ReplayFrame", "ReplaySettings", "TrajectoryError", "TrajectorySet", "load_trajectory_set", "replay"]
 
 
-class TrajectoryError(ValueError):
+class TrajectoryError(SidError, ValueError):
     """A trajectory folder that cannot be read: the message names the file, the line and the problem."""
 
 

@@ -27,6 +27,7 @@ from costmap.occupancy import OccupancyGrid
 from costmap.plugins import PEOPLE_LAYERS, PLUGINS, CostmapParams
 from sid.checks import LimitError, check_limit
 from sid.documents import InputWarning, is_number, load_document
+from sid.errors import SidError
 from sid.perception.groups import GroupParams
 from sid.perception.people import Person
 from sid.scenario.motion import Trajectory
@@ -105,7 +106,7 @@ class Scenario:
         return self.walks.get(person.id) or Trajectory(person.x, person.y, person.theta)
 
 
-class ScenarioError(ValueError):
+class ScenarioError(SidError, ValueError):
     """A scenario file or mapping that cannot be used; the message names the offending field."""
 
 

@@ -21,13 +21,14 @@ from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
+from sid.errors import SidError
 from sid.perception.frame import Frame
 
 RECORDING_SUFFIXES = (".db3", ".bag", ".mcap")
 ROSBAG2_METADATA = "metadata.yaml"
 
 
-class SourceError(RuntimeError):
+class SourceError(SidError, RuntimeError):
     """A source cannot be opened or cannot go on (no camera, unreadable recording, missing folder)."""
 
 

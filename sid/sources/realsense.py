@@ -35,6 +35,7 @@ from typing import Literal
 import numpy as np
 import pyrealsense2 as rs
 
+from sid.errors import SidError
 from sid.perception.align import Aligner
 from sid.perception.camera import Calibration, Extrinsics
 from sid.perception.frame import Frame
@@ -154,7 +155,7 @@ class RealSenseSource:
         self.close()
 
 
-class IncompleteFrame(Exception):
+class IncompleteFrame(SidError):
     """A recorded frame whose other stream never came (reported by the source as a FrameReadError)."""
 
 

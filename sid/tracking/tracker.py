@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sid.checks import check_number, check_numbers
+from sid.errors import SidError
 from sid.perception.people import Person
 from sid.tracking.assignment import gated_assignment
 from sid.tracking.motion import MotionStates
@@ -31,7 +32,7 @@ OCCLUDER_RADIUS = 0.2
 """A person's half-width (m) seen from above, to tell who is behind whom in the camera's view (``ViewCone.behind``)."""
 
 
-class TrackingError(ValueError):
+class TrackingError(SidError, ValueError):
     """Input a tracker cannot use: a frame out of time order, a non-finite position, an id given twice."""
 
 

@@ -14,6 +14,8 @@ from typing import Any
 
 import numpy as np
 
+from sid.errors import SidError
+
 MOVENET_MULTIPOSE = "movenet_multipose"
 MOVENET_SINGLEPOSE = "movenet_singlepose"
 YOLO_POSE = "yolo_pose"
@@ -29,7 +31,7 @@ _ORT_DTYPES: dict[str, np.dtype] = {
 }
 
 
-class PoseModelError(Exception):
+class PoseModelError(SidError):
     """A pose model file that cannot be used: missing, not ONNX, or with a signature no contract matches."""
 
 

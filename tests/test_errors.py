@@ -1,0 +1,53 @@
+"""One error base: every exception class sid, costmap and planner define derives from ``sid.errors.SidError``."""
+
+from __future__ import annotations
+
+import importlib
+import inspect
+import pkgutil
+
+import pytest
+
+import costmap
+import planner
+import sid
+from sid.errors import SidError
+
+
+def _modules() -> list[str]:
+    names = []
+    for package in (sid, costmap, planner):
+        names.append(package.__name__)
+        names += [m.name for m in pkgutil.walk_packages(package.__path__, f"{package.__name__}.")]
+    return sorted(names)
+
+
+def _defined_errors() -> list[type[Exception]]:
+    found = []
+    for name in _modules():
+        if name.endswith("__main__"):
+            continue
+        try:
+            module = importlib.import_module(name)
+        except ImportError as exc:  # an optional extra (ROS 2, OpenVINO, Ray) that is not installed
+            if exc.name and exc.name.split(".")[0] in {"sid", "costmap", "planner"}:
+                raise
+            continue
+        for _, value in inspect.getmembers(module, inspect.isclass):
+            is_error = issubclass(value, Exception) and not issubclass(value, Warning)  # not signals (Terminated)
+            if is_error and value.__module__ == name:
+                found.append(value)
+    return found
+
+
+ERRORS = _defined_errors()
+
+
+def test_the_packages_define_errors() -> None:
+    names = {e.__name__ for e in ERRORS}
+    assert {"ScenarioError", "SourceError", "PlanningError", "MapFileError", "LimitError"} <= names
+
+
+@pytest.mark.parametrize("error", ERRORS, ids=lambda e: f"{e.__module__}.{e.__name__}")
+def test_every_error_derives_from_the_one_base(error: type[Exception]) -> None:
+    assert issubclass(error, SidError)
