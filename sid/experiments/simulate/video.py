@@ -102,7 +102,8 @@ def _robot_extras(view: StepView, world: SimWorld, driven: np.ndarray) -> list[E
 def _map_picture_size(spec: GridSpec, people: int) -> tuple[int, int]:
     """Height and width (px) of every step's costmap picture in a run: room for the map and for the longest legend
     the run can have (every entry, one per possible group), so that the video's frames are all one size."""
-    rows = 2 + min(people // 2, MAX_GROUP_ENTRIES) + 1 + len(LEGEND) + 5
+    groups = people // 2
+    rows = 1 + min(groups, MAX_GROUP_ENTRIES) + (groups > MAX_GROUP_ENTRIES) + len(LEGEND) - 2 + 5  # no robot task
     scale = default_scale(spec)
     height = max(MARGIN_TOP + spec.height * scale + MARGIN_BOTTOM, MARGIN_TOP + 10 + 224 + 74 + LEGEND_ROW * rows)
     return height, MARGIN_LEFT + spec.width * scale + LEGEND_WIDTH
@@ -141,8 +142,11 @@ def frame_picture(view: StepView, world: SimWorld, driven: np.ndarray, title: st
             inset, (INSET_WIDTH, height), interpolation=cv2.INTER_AREA
         )
         cv2.rectangle(strip, (7, 33), (8 + INSET_WIDTH, 34 + height), (40, 40, 40), 1)
-    caption = "the robot's camera" if view.image is not None else "no camera image (no recognition, or exact people)"
-    cv2.putText(strip, caption, (8, 26), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (40, 40, 40), 1, cv2.LINE_AA)
+    captions = (
+        ["the robot's camera"] if view.image is not None else ["no camera image:", "no recognition, or exact people"]
+    )
+    for row, caption in enumerate(captions):
+        cv2.putText(strip, caption, (8, 26 + 22 * row), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (40, 40, 40), 1, cv2.LINE_AA)
     return np.hstack([img, strip])
 
 
