@@ -65,7 +65,7 @@ GROUP_COLOURS = ((40, 150, 20), (120, 30, 210), (190, 60, 100), (0, 120, 120), (
 ZONE = GROUP_COLOURS[0]
 START = (90, 40, 0)  # BGR: navy, the robot
 GOAL = (30, 30, 220)  # red
-SCAN = (0, 0, 255)  # pure red dots with a white rim: clear on black walls, steel blue and the costs
+SCAN = (0, 0, 255)  # pure red dots with a black rim: clear on black walls, steel blue, the costs and white
 CAMERA = (90, 60, 60)  # dark slate
 OBSTACLE = (150, 150, 0)  # teal: the outlines of known obstacles, clear on black lethal cells and on steel blue
 INSCRIBED_COLOUR = (200, 140, 110)  # RGB (110, 140, 200), steel blue
@@ -167,7 +167,7 @@ def _legend_camera(img: np.ndarray, u: int, v: int) -> None:
 
 
 def _scan_dot(img: np.ndarray, u: int, v: int) -> None:
-    cv2.circle(img, (u, v), 3, (255, 255, 255), -1)
+    cv2.circle(img, (u, v), 3, (0, 0, 0), -1)
     cv2.circle(img, (u, v), 2, SCAN, -1)
 
 
