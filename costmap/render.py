@@ -174,7 +174,7 @@ def _scan_dot(img: np.ndarray, u: int, v: int) -> None:
 LEGEND: dict[str, Swatch] = {  # the fixed entries, name -> swatch
     "unknown facing: id?": lambda img, u, v: _text(img, "3?", (u - 8, v + 5), 0.45, PERSON, 1),
     "o-space (the group's zone)": lambda img, u, v: cv2.rectangle(img, (u - 8, v - 5), (u + 8, v + 5), TEXT, 1),
-    "o-space of area about 0: a point": lambda img, u, v: cv2.circle(img, (u, v), 4, TEXT, 1, cv2.LINE_AA),
+    "o-space: one point, or under 10 px": lambda img, u, v: cv2.circle(img, (u, v), 4, TEXT, 1, cv2.LINE_AA),
     "interest point": lambda img, u, v: cv2.drawMarker(img, (u, v), TEXT, cv2.MARKER_CROSS, 10, 2, cv2.LINE_AA),
     "interaction zone (costmap)": lambda img, u, v: cv2.rectangle(img, (u - 9, v - 6), (u + 9, v + 6), TEXT, 2),
     "known obstacle": lambda img, u, v: cv2.rectangle(img, (u - 9, v - 6), (u + 9, v + 6), OBSTACLE, 2),
@@ -332,8 +332,8 @@ def _draw_groups(
 ) -> dict[str, bool]:  # fmt: skip
     """Each group in its colour: the interaction zone (members' hull grown by ``margin``, as the social layer and
     the metrics use it; not drawn when None), the o-space as the group's record holds it (``zone``: a polygon or a
-    segment; a point, or a zone under 3 px across, as a ring) and the interest point. Returns which legend entries
-    were drawn."""
+    segment; a point, or a zone under 10 px across (the interest point's mark would hide it), as a ring around the
+    mark) and the interest point. Returns which legend entries were drawn."""
     by_id = {p.id: p for p in people}
     drawn = dict.fromkeys(LEGEND, False)
     for i, group in enumerate(groups):
@@ -343,12 +343,12 @@ def _draw_groups(
             cv2.polylines(img, [ring], True, colour, 2, cv2.LINE_AA, shift=4)
             drawn["interaction zone (costmap)"] = True
         zone = _px(np.asarray(group.zone, dtype=float).reshape(-1, 2), spec, scale)
-        if len(zone) and np.ptp(zone, axis=0).max() >= 3 * 16:
+        if len(zone) and np.ptp(zone, axis=0).max() >= 10 * 16:
             cv2.polylines(img, [zone], True, colour, 1, cv2.LINE_AA, shift=4)
             drawn["o-space (the group's zone)"] = True
-        elif len(zone):  # one point, or smaller than 3 px
-            cv2.circle(img, tuple(np.rint(zone.mean(axis=0)).astype(int)), 5 * 16, colour, 1, cv2.LINE_AA, shift=4)
-            drawn["o-space of area about 0: a point"] = True
+        elif len(zone):  # one point, or smaller than 10 px
+            cv2.circle(img, tuple(np.rint(zone.mean(axis=0)).astype(int)), 7 * 16, colour, 1, cv2.LINE_AA, shift=4)
+            drawn["o-space: one point, or under 10 px"] = True
         centre = (_px([group.interest_point], spec, scale)[0] // 16).tolist()
         cv2.drawMarker(img, tuple(centre), colour, cv2.MARKER_CROSS, 10, 2, cv2.LINE_AA)
         drawn["interest point"] = True
