@@ -77,7 +77,7 @@ def union(*windows: Window | None) -> Window | None:
 SEPARATE_WINDOW_CELLS = 50_000
 """``disjoint`` keeps two windows apart only when that spares more than this many cells: every window costs each layer
 of a costmap a write and inflation a search for changes, about what this many more cells cost in one window
-(measured on sid bench's scene with its groups 1-3x as far apart, docs/benchmarks.md)."""
+(docs/benchmarks.md, "Costmap")."""
 
 
 def disjoint(windows: Iterable[Window | None], slack: int = SEPARATE_WINDOW_CELLS) -> list[Window]:
@@ -109,7 +109,7 @@ def disjoint(windows: Iterable[Window | None], slack: int = SEPARATE_WINDOW_CELL
 
 def nonzero_cells(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(rows, cols) of the True cells of a 2-D boolean ``mask``, as ``np.nonzero`` gives them, but through the flat
-    indices: numpy's 2-D ``nonzero`` is ~20x slower on a sparse mask."""
+    indices: numpy's 2-D ``nonzero`` is much slower on a sparse mask."""
     rows, cols = np.divmod(np.flatnonzero(mask), mask.shape[1])
     return rows, cols
 

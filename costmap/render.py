@@ -1,15 +1,17 @@
-"""Pictures of costmaps (OpenCV, BGR uint8): costs, known obstacles' outlines, people with facing arrows, group zones,
-a colour scale.
+"""Pictures of costmaps (OpenCV, BGR uint8): costs, known obstacles' outlines, people with facing arrows coloured by
+group, each group's o-space as its record holds it (a polygon, a segment or a point) and its interaction zone, a colour
+scale and a legend of exactly what is drawn.
 
 Image layout: world x to the right, world y up; the map sits at (MARGIN_LEFT, MARGIN_TOP) with ``scale`` pixels
-per cell, axes in metres below and left of it, the colour scale and a legend of what is drawn to its right.
+per cell, axes in metres below and left of it, the colour scale and a legend of what is drawn to its right. People's
+id labels are placed last, clear of each other and of everything drawn on the map.
 ``world_to_image`` maps world points to pixel coordinates of that layout so other modules (the planner) can draw on
 top.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -22,6 +24,7 @@ from costmap.layered import LayeredCostmap
 from costmap.layers.social import SocialLayer, SocialParams, group_zone_polygon
 from costmap.scan import LaserScan
 from sid.perception.groups import Group
+from sid.perception.overlay import place_labels
 from sid.perception.people import Person
 
 MARGIN_LEFT, MARGIN_TOP, MARGIN_BOTTOM, PANEL_WIDTH, PANEL_HEIGHT = 56, 40, 44, 190, 450
@@ -55,11 +58,14 @@ class CameraView:
 
 FONT = cv2.FONT_HERSHEY_SIMPLEX
 TEXT = (40, 40, 40)
-PERSON = (200, 110, 20)  # BGR: blue
-ZONE = (40, 150, 0)  # green
-START = (60, 140, 0)
+PERSON = (200, 110, 20)  # BGR: blue, a person in no group
+# BGR, one per group in the order given (then again): green, crimson, violet, olive, dark cyan, brown; clear of the
+# yellow-to-brown costs, the blue of people alone and the paths' purple and red.
+GROUP_COLOURS = ((40, 150, 20), (120, 30, 210), (190, 60, 100), (0, 120, 120), (140, 120, 0), (20, 70, 140))
+ZONE = GROUP_COLOURS[0]
+START = (90, 40, 0)  # BGR: navy, the robot
 GOAL = (30, 30, 220)  # red
-SCAN = (60, 60, 230)
+SCAN = (0, 0, 255)  # pure red dots with a black rim: clear on black walls, steel blue, the costs and white
 CAMERA = (90, 60, 60)  # dark slate
 OBSTACLE = (150, 150, 0)  # teal: the outlines of known obstacles, clear on black lethal cells and on steel blue
 INSCRIBED_COLOUR = (200, 140, 110)  # RGB (110, 140, 200), steel blue
@@ -124,9 +130,34 @@ def _axes(img: np.ndarray, spec: GridSpec, scale: int) -> None:
     _text(img, "y (m)", (4, MARGIN_TOP - 8), 0.45)
 
 
-def _legend_person(img: np.ndarray, u: int, v: int) -> None:
-    cv2.circle(img, (u, v), 6, PERSON, -1, cv2.LINE_AA)
-    cv2.arrowedLine(img, (u, v), (u + 15, v), PERSON, 2, cv2.LINE_AA, tipLength=0.4)
+Swatch = Callable[[np.ndarray, int, int], object]
+"""Draws a legend entry's symbol centred at pixel (u, v) of an image (in place; what it returns is ignored)."""
+
+
+@dataclass(frozen=True)
+class Extra:
+    """Something a caller draws on the map and its legend entry: ``draw(img, spec, scale)`` draws in place in
+    ``render_costmap``'s layout (world points through ``world_to_image``), ``swatch`` is the legend's symbol."""
+
+    label: str
+    swatch: Swatch
+    draw: Callable[[np.ndarray, GridSpec, int], None]
+
+
+def _person_swatch(colour: tuple[int, int, int]) -> Swatch:
+    def swatch(img: np.ndarray, u: int, v: int) -> None:
+        cv2.circle(img, (u - 4, v), 6, colour, -1, cv2.LINE_AA)
+        cv2.arrowedLine(img, (u - 4, v), (u + 12, v), colour, 2, cv2.LINE_AA, tipLength=0.4)
+
+    return swatch
+
+
+def _group_swatch(colour: tuple[int, int, int]) -> Swatch:
+    def swatch(img: np.ndarray, u: int, v: int) -> None:
+        for du in (-6, 6):
+            cv2.circle(img, (u + du, v), 5, colour, -1, cv2.LINE_AA)
+
+    return swatch
 
 
 def _legend_camera(img: np.ndarray, u: int, v: int) -> None:
@@ -135,20 +166,58 @@ def _legend_camera(img: np.ndarray, u: int, v: int) -> None:
     _camera_glyph(img, np.array([u - 6, v]), 0.0)
 
 
-LEGEND = {  # name -> swatch drawn centred at (u, v)
-    "person, facing": _legend_person,
-    "group zone": lambda img, u, v: cv2.rectangle(img, (u - 9, v - 6), (u + 9, v + 6), ZONE, 2),
-    "interest point": lambda img, u, v: cv2.drawMarker(img, (u, v), ZONE, cv2.MARKER_CROSS, 10, 2, cv2.LINE_AA),
+def _scan_dot(img: np.ndarray, u: int, v: int) -> None:
+    cv2.circle(img, (u, v), 3, (0, 0, 0), -1)
+    cv2.circle(img, (u, v), 2, SCAN, -1)
+
+
+LEGEND: dict[str, Swatch] = {  # the fixed entries, name -> swatch
+    "unknown facing: id?": lambda img, u, v: _text(img, "3?", (u - 8, v + 5), 0.45, PERSON, 1),
+    "o-space (the group's zone)": lambda img, u, v: cv2.rectangle(img, (u - 8, v - 5), (u + 8, v + 5), TEXT, 1),
+    "o-space: one point, or under 10 px": lambda img, u, v: cv2.circle(img, (u, v), 4, TEXT, 1, cv2.LINE_AA),
+    "interest point": lambda img, u, v: cv2.drawMarker(img, (u, v), TEXT, cv2.MARKER_CROSS, 10, 2, cv2.LINE_AA),
+    "interaction zone (costmap)": lambda img, u, v: cv2.rectangle(img, (u - 9, v - 6), (u + 9, v + 6), TEXT, 2),
     "known obstacle": lambda img, u, v: cv2.rectangle(img, (u - 9, v - 6), (u + 9, v + 6), OBSTACLE, 2),
-    "LiDAR hits": lambda img, u, v: cv2.circle(img, (u, v), 2, SCAN, -1),
+    "LiDAR hits": _scan_dot,
     "robot start": lambda img, u, v: cv2.circle(img, (u, v), 6, START, 2, cv2.LINE_AA),
     "goal": lambda img, u, v: cv2.drawMarker(img, (u, v), GOAL, cv2.MARKER_TILTED_CROSS, 12, 2, cv2.LINE_AA),
     "camera, field of view": _legend_camera,
 }
+LEGEND_ROW, MAX_GROUP_ENTRIES = 22, 6
 
 
-def _panel(img: np.ndarray, spec: GridSpec, scale: int, costs: np.ndarray, legend: Sequence[str]) -> None:
-    """Right of the map: the colour scale if any cost is graded, the special values present, then ``legend``."""
+def _members(group: Group) -> str:
+    ids = ", ".join(str(m) for m in group.members)
+    return f"group of {ids}" if len(ids) <= 18 else f"group of {len(group.members)}"
+
+
+def _legend_rows(
+    people: Sequence[Person], groups: Sequence[Group], drawn: dict[str, bool], extras: Sequence[Extra]
+) -> list[tuple[str, Swatch]]:
+    """The legend, in order: people alone, one row per group in its colour, then each fixed entry drawn, then the
+    callers' ``extras``."""
+    grouped = {m for g in groups for m in g.members}
+    rows: list[tuple[str, Swatch]] = []
+    if any(p.id not in grouped for p in people):
+        rows.append(("person in no group, facing", _person_swatch(PERSON)))
+    for i, group in enumerate(groups[:MAX_GROUP_ENTRIES]):
+        rows.append((_members(group), _group_swatch(GROUP_COLOURS[i % len(GROUP_COLOURS)])))
+    if len(groups) > MAX_GROUP_ENTRIES:
+        rows.append((f"{len(groups) - MAX_GROUP_ENTRIES} more groups", lambda img, u, v: None))
+    rows += [(name, LEGEND[name]) for name in LEGEND if drawn.get(name)]
+    return rows + [(extra.label, extra.swatch) for extra in extras]
+
+
+def _panel_size(costs: np.ndarray, rows: Sequence[tuple[str, Swatch]]) -> tuple[int, int]:
+    """Width and height (px) of ``_panel`` for these costs and legend rows."""
+    height = 10 + (224 if np.any((costs > 0) & (costs <= MAX_NON_OBSTACLE)) else 14)
+    height += LEGEND_ROW * sum(bool(np.any(costs == value)) for value in (INSCRIBED, LETHAL, NO_INFORMATION)) + 8
+    widths = [cv2.getTextSize(name, FONT, 0.4, 1)[0][0] for name, _ in rows]
+    return max(PANEL_WIDTH, 22 + 34 + max(widths, default=0) + 10), height + LEGEND_ROW * len(rows)
+
+
+def _panel(img: np.ndarray, spec: GridSpec, scale: int, costs: np.ndarray, rows: Sequence[tuple[str, Swatch]]) -> None:
+    """Right of the map: the colour scale if any cost is graded, the special values present, then the legend."""
     left, y = MARGIN_LEFT + spec.width * scale + 22, MARGIN_TOP + 10
     width = 22
     if np.any((costs > 0) & (costs <= MAX_NON_OBSTACLE)):
@@ -169,12 +238,12 @@ def _panel(img: np.ndarray, spec: GridSpec, scale: int, costs: np.ndarray, legen
             cv2.rectangle(img, (left, y - 11), (left + width, y + 3), tuple(int(c) for c in COST_COLOURS[value]), -1)
             cv2.rectangle(img, (left, y - 11), (left + width, y + 3), TEXT, 1)
             _text(img, label, (left + width + 7, y), 0.4)
-            y += 22
+            y += LEGEND_ROW
     y += 8
-    for name in legend:
-        LEGEND[name](img, left + 11, y - 4)
+    for name, swatch in rows:
+        swatch(img, left + 11, y - 4)
         _text(img, name, (left + 34, y), 0.4)
-        y += 22
+        y += LEGEND_ROW
 
 
 def _camera_glyph(img: np.ndarray, apex: np.ndarray, yaw: float) -> None:
@@ -213,34 +282,77 @@ def _draw_outlines(img: np.ndarray, spec: GridSpec, scale: int, outlines: Sequen
         cv2.polylines(img, [ring], bool(closed), OBSTACLE, 2, cv2.LINE_AA, shift=4)
 
 
-def _draw_people(img: np.ndarray, spec: GridSpec, scale: int, people: Sequence[Person], body_radius: float) -> None:
-    px_per_m = scale / spec.resolution
-    radius = max(3, int(round(body_radius * px_per_m)))
+def person_colours(people: Sequence[Person], groups: Sequence[Group]) -> dict[int, tuple[int, int, int]]:
+    """Each person's colour (BGR) by id: their group's (``GROUP_COLOURS`` in the order of ``groups``), or ``PERSON``."""
+    colours = {p.id: PERSON for p in people}
+    for i, group in enumerate(groups):
+        colours.update(dict.fromkeys(group.members, GROUP_COLOURS[i % len(GROUP_COLOURS)]))
+    return colours
+
+
+def _draw_people(
+    img: np.ndarray, spec: GridSpec, scale: int, people: Sequence[Person], colours: dict[int, tuple[int, int, int]],
+    radius: int,
+) -> None:  # fmt: skip
     for p in people:
         centre = _px([[p.x, p.y]], spec, scale)[0]
-        cv2.circle(img, tuple(centre), radius * 16, PERSON, -1, cv2.LINE_AA, shift=4)
+        cv2.circle(img, tuple(centre), radius * 16, colours[p.id], -1, cv2.LINE_AA, shift=4)
         cv2.circle(img, tuple(centre), radius * 16, (255, 255, 255), 1, cv2.LINE_AA, shift=4)
         if p.theta is not None:
             tip = _px([[p.x + 0.6 * np.cos(p.theta), p.y + 0.6 * np.sin(p.theta)]], spec, scale)[0]
-            cv2.arrowedLine(img, tuple(centre), tuple(tip), PERSON, 2, cv2.LINE_AA, shift=4, tipLength=0.3)
-        label = str(p.id) if p.theta is not None else f"{p.id}?"
-        u, v = (centre // 16).tolist()
-        _text(img, label, (u + radius + 2, v - radius - 2), 0.4, PERSON, 1)
+            cv2.arrowedLine(img, tuple(centre), tuple(tip), colours[p.id], 2, cv2.LINE_AA, shift=4, tipLength=0.3)
+
+
+def _draw_labels(
+    img: np.ndarray, spec: GridSpec, scale: int, people: Sequence[Person], colours: dict[int, tuple[int, int, int]],
+    radius: int, avoid: np.ndarray,
+) -> None:  # fmt: skip
+    """Each person's id ("id?" when the facing is unknown) in their colour on a white tag, placed inside the map
+    clear of the other tags and of the ``avoid`` pixels of the map (h, w)."""
+    texts = [str(p.id) if p.theta is not None else f"{p.id}?" for p in people]
+    sizes = [(w + 6, h + base + 4) for (w, h), base in (cv2.getTextSize(t, FONT, 0.45, 1) for t in texts)]
+    boxes, prefer = [], []
+    for p, (w, h) in zip(people, sizes, strict=True):
+        u, v = world_to_image([[p.x, p.y]], spec, scale)[0] - (MARGIN_LEFT, MARGIN_TOP)
+        boxes.append((u - radius, v - radius, u + radius, v + radius))
+        back = np.pi + (np.pi / 4 if p.theta is None else p.theta)  # behind the person, up-right when unknown
+        reach = radius + 3 + max(w, h) / 2
+        prefer.append((int(u + reach * np.cos(back) - w / 2), int(v - reach * np.sin(back) - h / 2)))
+    corners = place_labels(sizes, boxes, avoid.shape, gap=2, avoid=avoid, prefer=prefer)
+    for p, text, (w, h), (u, v) in zip(people, texts, sizes, corners, strict=True):
+        u, v = u + MARGIN_LEFT, v + MARGIN_TOP
+        cv2.rectangle(img, (u, v), (u + w - 1, v + h - 1), (255, 255, 255), -1)
+        cv2.rectangle(img, (u, v), (u + w - 1, v + h - 1), colours[p.id], 1)
+        _text(img, text, (u + 3, v + h - 5), 0.45, colours[p.id], 1)
 
 
 def _draw_groups(
-    img: np.ndarray, spec: GridSpec, scale: int, groups: Sequence[Group], people: Sequence[Person], margin: float
-) -> None:
+    img: np.ndarray, spec: GridSpec, scale: int, groups: Sequence[Group], people: Sequence[Person],
+    margin: float | None,
+) -> dict[str, bool]:  # fmt: skip
+    """Each group in its colour: the interaction zone (members' hull grown by ``margin``, as the social layer and
+    the metrics use it; not drawn when None), the o-space as the group's record holds it (``zone``: a polygon or a
+    segment; a point, or a zone under 10 px across (the interest point's mark would hide it), as a ring around the
+    mark) and the interest point. Returns which legend entries were drawn."""
     by_id = {p.id: p for p in people}
-    for group in groups:
-        polygon = group_zone_polygon(group, by_id, margin)
-        ring = _px(np.asarray(polygon.exterior.coords), spec, scale)
-        cv2.polylines(img, [ring], True, ZONE, 2, cv2.LINE_AA, shift=4)
-        zone = np.asarray(group.zone, dtype=float).reshape(-1, 2)
-        if len(zone) >= 2:
-            cv2.polylines(img, [_px(zone, spec, scale)], True, ZONE, 1, cv2.LINE_AA, shift=4)
+    drawn = dict.fromkeys(LEGEND, False)
+    for i, group in enumerate(groups):
+        colour = GROUP_COLOURS[i % len(GROUP_COLOURS)]
+        if margin is not None and all(m in by_id for m in group.members):
+            ring = _px(np.asarray(group_zone_polygon(group, by_id, margin).exterior.coords), spec, scale)
+            cv2.polylines(img, [ring], True, colour, 2, cv2.LINE_AA, shift=4)
+            drawn["interaction zone (costmap)"] = True
+        zone = _px(np.asarray(group.zone, dtype=float).reshape(-1, 2), spec, scale)
+        if len(zone) and np.ptp(zone, axis=0).max() >= 10 * 16:
+            cv2.polylines(img, [zone], True, colour, 1, cv2.LINE_AA, shift=4)
+            drawn["o-space (the group's zone)"] = True
+        elif len(zone):  # one point, or smaller than 10 px
+            cv2.circle(img, tuple(np.rint(zone.mean(axis=0)).astype(int)), 7 * 16, colour, 1, cv2.LINE_AA, shift=4)
+            drawn["o-space: one point, or under 10 px"] = True
         centre = (_px([group.interest_point], spec, scale)[0] // 16).tolist()
-        cv2.drawMarker(img, tuple(centre), ZONE, cv2.MARKER_CROSS, 10, 2, cv2.LINE_AA)
+        cv2.drawMarker(img, tuple(centre), colour, cv2.MARKER_CROSS, 10, 2, cv2.LINE_AA)
+        drawn["interest point"] = True
+    return drawn
 
 
 def _draw_robot(img: np.ndarray, spec: GridSpec, scale: int, robot: RobotTask) -> None:
@@ -267,14 +379,18 @@ def render_costmap(
     zone_margin: float | None = None,
     camera: CameraView | None = None,
     outlines: Sequence[Outline] = (),
+    extras: Sequence[Extra] = (),
 ) -> np.ndarray:
-    """A readable BGR picture of a costmap (world y up) with people, group zones, robot task, camera and colour scale.
+    """A readable BGR picture of a costmap (world y up) with people, groups, robot task, camera and colour scale.
 
     ``outlines``: shapes of the known map (e.g. a scenario's declared obstacles), each (world points (N, 2), closed),
-    drawn as lines over the costs, so a shape shows whole whatever the scan saw of it.
+    drawn as lines over the costs, so a shape shows whole whatever the scan saw of it. ``extras``: what else the
+    caller draws (paths, a robot), drawn over the rest before the id labels, each with its legend entry.
 
     With a LayeredCostmap, its combined grid is drawn; people, groups and scan default to the inputs it last applied,
-    body radius and zone margin to its social layer's. ``scale``: pixels per cell (default: a map about 800 px wide).
+    body radius to its social layer's, and each group's interaction zone is drawn with the social layer's margin
+    (or the default margin the metrics use, without one). A plain Costmap2D draws the interaction zone only when
+    ``zone_margin`` is given. ``scale``: pixels per cell (default: a map about 800 px wide).
     """
     if isinstance(source, LayeredCostmap):
         costmap = source.master
@@ -284,7 +400,8 @@ def render_costmap(
         social = next((layer for layer in source.layers if isinstance(layer, SocialLayer)), None)
         if social is not None:
             body_radius = social.body_radius if body_radius is None else body_radius
-            zone_margin = social.params.group_margin if zone_margin is None else zone_margin
+        margin = social.params.group_margin if social is not None else SocialParams().group_margin
+        zone_margin = margin if zone_margin is None else zone_margin
     else:
         costmap = source
     spec = costmap.spec
@@ -293,11 +410,11 @@ def render_costmap(
         raise ValueError(f"render scale must be >= 1 pixel per cell, got {scale}")
     people, groups = list(people or []), list(groups or [])
     body_radius = 0.2 if body_radius is None else body_radius
-    zone_margin = SocialParams().group_margin if zone_margin is None else zone_margin
+    radius = max(3, int(round(body_radius * scale / spec.resolution)))
+    colours = person_colours(people, groups)
 
     w_px, h_px = spec.width * scale, spec.height * scale
-    height = max(MARGIN_TOP + h_px + MARGIN_BOTTOM, PANEL_HEIGHT)
-    img = np.full((height, MARGIN_LEFT + w_px + PANEL_WIDTH, 3), 255, dtype=np.uint8)
+    img = np.full((MARGIN_TOP + h_px + MARGIN_BOTTOM, MARGIN_LEFT + w_px + 20, 3), 255, dtype=np.uint8)
     tiles = COST_COLOURS[np.flipud(costmap.costs)]
     img[MARGIN_TOP : MARGIN_TOP + h_px, MARGIN_LEFT : MARGIN_LEFT + w_px] = cv2.resize(
         tiles, (w_px, h_px), interpolation=cv2.INTER_NEAREST
@@ -306,25 +423,34 @@ def render_costmap(
     if camera is not None:
         _draw_camera(img, spec, scale, camera)
     _draw_outlines(img, spec, scale, outlines)
+    ground = img.copy()  # what the labels may cover: costs, the camera's view, outlines
     if scan is not None:
         for u, v in (world_to_image(scan.hit_points(), spec, scale)).astype(int):
-            cv2.circle(img, (int(u), int(v)), 1, SCAN, -1)
-    _draw_groups(img, spec, scale, groups, people, zone_margin)
-    _draw_people(img, spec, scale, people, body_radius)
+            _scan_dot(img, int(u), int(v))
+    drawn = _draw_groups(img, spec, scale, groups, people, zone_margin)
+    _draw_people(img, spec, scale, people, colours, radius)
     if robot is not None:
         _draw_robot(img, spec, scale, robot)
+    for extra in extras:
+        extra.draw(img, spec, scale)
+    on_map = (slice(MARGIN_TOP, MARGIN_TOP + h_px), slice(MARGIN_LEFT, MARGIN_LEFT + w_px))
+    _draw_labels(img, spec, scale, people, colours, radius, np.any(img[on_map] != ground[on_map], axis=2))
     _axes(img, spec, scale)
-    drawn = {
-        "person, facing": bool(people),
-        "group zone": bool(groups),
-        "interest point": bool(groups),
+    drawn |= {
+        "unknown facing: id?": any(p.theta is None for p in people),
         "known obstacle": bool(outlines),
         "LiDAR hits": scan is not None,
         "robot start": robot is not None,
         "goal": robot is not None,
         "camera, field of view": camera is not None,
     }
-    _panel(img, spec, scale, costmap.costs, [name for name in LEGEND if drawn[name]])
+    rows = _legend_rows(people, groups, drawn, extras)
+    panel_w, panel_h = _panel_size(costmap.costs, rows)
+    canvas = np.full(
+        (max(img.shape[0], MARGIN_TOP + panel_h, PANEL_HEIGHT), MARGIN_LEFT + w_px + panel_w, 3), 255, np.uint8
+    )
+    canvas[: img.shape[0], : img.shape[1]] = img  # the map, its axes and the last tick's label
+    _panel(canvas, spec, scale, costmap.costs, rows)
     if title:
-        _text(img, title, (MARGIN_LEFT, 26), 0.6, TEXT, 1)
-    return img
+        _text(canvas, title, (MARGIN_LEFT, 26), 0.6, TEXT, 1)
+    return canvas

@@ -29,12 +29,11 @@ PLANNERS: tuple[str, ...] = (*OMPL_PLANNERS, "grid")
 DEFAULT_PLANNER = "bitstar"
 DEFAULT_SETTLE_S = 0.04
 """``plan``'s default ``settle``: an anytime planner stops once its cost has not improved for this long (s).
-Measured over the navigation study's 36 tasks (docs/benchmarks.md, planning budget)."""
+Chosen over the navigation study's tasks (docs/benchmarks.md, "Planning: when BIT* stops")."""
 DEFAULT_SOFT_LIMIT_S = 0.10
 """``plan``'s default ``soft_limit``: an anytime planner that has a path stops after this long (s) even if its cost
-still falls, so that a plan (with the lookups, smoothing and the final check, ~10-15 ms more) returns within 0.15 s.
-Over the navigation study's 36 tasks it changed no plan's cost beyond the seeds' own spread (docs/benchmarks.md,
-planning budget)."""
+still falls, so that a plan (with the lookups, smoothing and the final check) returns within 0.15 s without costing
+more than the seeds' own spread (docs/benchmarks.md, "Planning: when BIT* stops")."""
 MAX_SEED = 2**32 - 1
 """The largest seed ``plan`` takes: OMPL's seed is a ``std::uint_fast32_t``, 32 bits wide on some platforms."""
 UNAVAILABLE: dict[str, str] = {

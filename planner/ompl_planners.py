@@ -35,13 +35,13 @@ ou.setLogLevel(ou.LOG_WARN)  # the default level prints OMPL's debug messages to
 FMT_SAMPLES_PER_SECOND = 250
 """Samples of FMT* per second of time budget. FMT* is not anytime: it plans on a fixed sample set and returns nothing
 if stopped early, so its sample count follows the time budget, at about half the rate it reaches on the demo scenario
-(a margin for a busy machine; docs/parameters.md), or equals ``max_iterations`` when that is given."""
+(a margin for a slower or loaded machine; docs/parameters.md), or equals ``max_iterations`` when that is given."""
 
 
 SETTLING_PLANNERS = ("bitstar",)
 """The planners ``solve_ompl`` may stop early (``settle``, ``soft_limit``). BIT*'s cost drops in a few steps and
-then flattens. RRT* and Informed RRT* improve in long plateaus: with the early stop Informed RRT* kept a path through
-a group zone in 1 of the navigation study's 36 tasks (docs/benchmarks.md), so they keep their whole budget."""
+then flattens. RRT* and Informed RRT* improve in long plateaus: stopped early, Informed RRT* kept paths through group
+zones (docs/benchmarks.md, "Planning: when BIT* stops"), so they keep their whole budget."""
 SETTLE_GAIN = 0.001
 """A relative cost decrease smaller than this (0.1 %) does not count as an improvement for ``solve_ompl``'s settle."""
 SETTLE_POLL_S = 0.002

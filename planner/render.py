@@ -14,7 +14,7 @@ import numpy as np
 
 from costmap.grid import Costmap2D, GridSpec
 from costmap.layered import LayeredCostmap
-from costmap.render import Outline, RobotTask, default_scale, render_costmap, world_to_image
+from costmap.render import Extra, Outline, RobotTask, default_scale, render_costmap, world_to_image
 from planner.validity import interpolate
 from sid.perception.groups import Group
 
@@ -56,12 +56,21 @@ def draw_path(img: np.ndarray, path: np.ndarray, spec: GridSpec, scale: int, sty
         cv2.polylines(img, [_pixels(p, spec, scale) for p in pieces], False, colour, thickness, cv2.LINE_AA, shift=4)
 
 
-def _legend_swatch(img: np.ndarray, x: int, y: int, style: PathStyle) -> None:
+def _legend_swatch(img: np.ndarray, x: int, y: int, style: PathStyle, length: int = 36) -> None:
     if style.dashed:
-        for start in range(x, x + 36, 12):
+        for start in range(x, x + length, 12):
             cv2.line(img, (start, y), (start + 6, y), style.colour, 3, cv2.LINE_AA)
     else:
-        cv2.line(img, (x, y), (x + 36, y), style.colour, 3, cv2.LINE_AA)
+        cv2.line(img, (x, y), (x + length, y), style.colour, 3, cv2.LINE_AA)
+
+
+def path_extra(path: np.ndarray, style: PathStyle, width: int = 3) -> Extra:
+    """A path for ``render_costmap``'s ``extras``: drawn as ``draw_path`` does, listed in the legend by its label."""
+    return Extra(
+        style.label,
+        lambda img, u, v: _legend_swatch(img, u - 11, v, style, 24),
+        lambda img, spec, scale: draw_path(img, path, spec, scale, style, width),
+    )
 
 
 def add_table(
@@ -110,7 +119,8 @@ def render_paths(
     ``outlines``: shapes of the known map to draw whole (``costmap.render.render_costmap``)."""
     spec = layered.spec
     scale = default_scale(spec) if scale is None else scale
-    img = render_costmap(layered, groups=groups, robot=robot, title=title, scale=scale, outlines=outlines)
-    for path, style in paths:
-        draw_path(img, path, spec, scale, style)
+    extras = [path_extra(path, style) for path, style in paths]
+    img = render_costmap(
+        layered, groups=groups, robot=robot, title=title, scale=scale, outlines=outlines, extras=extras
+    )
     return img, scale

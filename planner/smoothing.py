@@ -24,9 +24,9 @@ _NEIGHBOURS = np.array([[-1], [0], [1]])  # (3, 1): before, the vertex, after
 _WINDOW = 64  # the any-angle pass looks at most this many vertices ahead
 REFINE_SWEEPS = 2
 REFINE_MIN_STEP = 0.25
-"""``smooth``'s refinement: at most this many sweeps per step size, down to this step (in cells). Over the navigation
-study's 72 plans, against 4 sweeps down to 1/8 cell: 1.8x faster, mean cost ratio to the grid reference 0.9999 vs
-0.9997, the same plans within 1 % (docs/benchmarks.md)."""
+"""``smooth``'s refinement: at most this many sweeps per step size, down to this step (in cells): the cheapest
+setting that keeps the navigation study's plans as close to the grid reference as finer ones (docs/benchmarks.md,
+"Planning: the smoother")."""
 DP_REACH = 12
 """The last shortcut pass joins refined vertices (about 6 cells apart) at most this many apart: refinement has
 already bent the path, so longer shortcuts rarely pay, and all pairs cost O(N^2) segments."""

@@ -2,7 +2,7 @@
 
 ``sid detect`` reads and poses frame n + 1 (file or camera I/O and onnxruntime, which release the GIL) while the
 main thread lifts, groups, tracks and writes frame n, so a frame costs about the longer of the two halves instead
-of their sum (docs/benchmarks.md, "sid detect").
+of their sum (docs/benchmarks.md, "Start-up and the detect loop").
 
 The standard library has thread pools but no bounded read-ahead of one iterator that keeps its items in order and
 its exceptions in place; this module is that, on ``threading`` and ``queue``.

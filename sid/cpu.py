@@ -43,8 +43,8 @@ def keep_freed_memory(keep_bytes: int = 256 * 2**20) -> bool:
     handing large blocks back to the kernel at every free; returns whether it applied (False off glibc).
 
     numpy's temporaries of a few hundred kB to a few MB (image-sized arrays in the renderer, the costmap's grids)
-    are otherwise mapped and unmapped at every call, and each new mapping is paid again in page faults: on the
-    development VM that was 11 of 28 s of a ``sid simulate paper`` run, in the kernel (docs/benchmarks.md). The same
+    are otherwise mapped and unmapped at every call, and each new mapping is paid again in page faults, in the
+    kernel (docs/benchmarks.md, "The allocator", has the measurement). The same
     settings as the ``MALLOC_MMAP_THRESHOLD_`` / ``MALLOC_TRIM_THRESHOLD_`` / ``MALLOC_TOP_PAD_`` environment
     variables, set from inside the process. Process-wide: call it once, from an entry point (the ``sid`` command,
     a worker process), never from library code.

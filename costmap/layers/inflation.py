@@ -129,7 +129,7 @@ class InflationLayer(Layer):
     def _affected(self, changed: np.ndarray, source: Window) -> list[Window]:
         """Windows holding every cell within reach of the ``changed`` cells (bool over ``source``), clipped to the
         grid: the grid is cut into tiles of ``cell_radius`` cells, the tiles holding a change and their
-        neighbours are grouped into 8-connected clusters (OpenCV on the small tile grid: a few times faster than
+        neighbours are grouped into 8-connected clusters (OpenCV on the small tile grid: faster than
         scipy.ndimage's dilation and labelling there) and each cluster's bounding box is one window. A tile's
         neighbours reach at least ``cell_radius`` cells beyond it."""
         t = max(self.cell_radius, 1)

@@ -105,7 +105,7 @@ incrementally (``_BeamCells``); otherwise whole."""
 
 _ONE = np.int32(1)
 """The coverage counts' step: a numpy scalar of their dtype keeps ``np.add.at`` on its fast path (a Python int is
-~30x slower)."""
+much slower)."""
 
 
 class _BeamCells:

@@ -122,8 +122,9 @@ def _polynomials(spec: GridSpec, window: Window, x: float, y: float, coefficient
     float32 (k, rows, cols). ``coefficients``: 9 per polynomial, those of 1, dx, dx^2, dy, dy dx, dy dx^2, dy^2, ...
 
     Two matrix products (the x powers first, then the y powers): one BLAS call writes every cell of every polynomial,
-    ~2x faster here than a broadcast add of a row and a column vector per polynomial. In float32, on offsets from a
-    point near the cells, so the terms stay small: within 1 cost unit of float64 (the tests check it).
+    faster than a broadcast add of a row and a column vector per polynomial (docs/benchmarks.md, "Costmap"). In
+    float32, on offsets from a point near the cells, so the terms stay small: within 1 cost unit of float64 (the
+    tests check it).
     """
     xs, ys = spec.cell_axes(window)
     cols = xs.shape[1]
@@ -167,7 +168,7 @@ def _distance_to_hull(spec: GridSpec, window: Window, ring: list[list[float]], p
     np.abs(beyond, out=beyond)
     beyond -= np.array(halves, dtype=np.float32)[:, None, None]
     flat = beyond.reshape(-1, cols)
-    cv2.threshold(flat, 0.0, 0.0, cv2.THRESH_TOZERO, dst=flat)  # max(beyond, 0), ~2x numpy's here
+    cv2.threshold(flat, 0.0, 0.0, cv2.THRESH_TOZERO, dst=flat)  # max(beyond, 0), in place, faster than numpy
     cv2.magnitude(flat, normal.reshape(-1, cols), magnitude=flat)
     best = beyond.min(axis=0)
     if polygon:  # inside: n >= 0 for every edge
@@ -414,7 +415,7 @@ def _paint_polygons(
     np.abs(beyond, out=beyond)
     beyond -= np.array(halves, dtype=np.float32).T[:, :, None, None]
     flat = beyond.reshape(-1, cols)
-    cv2.threshold(flat, 0.0, 0.0, cv2.THRESH_TOZERO, dst=flat)  # max(beyond, 0), ~2x numpy's here
+    cv2.threshold(flat, 0.0, 0.0, cv2.THRESH_TOZERO, dst=flat)  # max(beyond, 0), in place, faster than numpy
     cv2.magnitude(flat, normal.reshape(-1, cols), magnitude=flat)
     best = beyond.min(axis=0)
     best *= normal.min(axis=0) < 0  # inside: n >= 0 for every edge

@@ -16,8 +16,9 @@ from sid.experiments.progress import ProgressBar
 from sid.experiments.simulate.loop import PERCEPTIONS, RunOptions
 from sid.experiments.simulate.scenes import SCENE_ORDER, load_scene, scene_list
 
-RUN_FILES = ("run.json", "run.mp4", "run.gif")
-"""The files one run writes into --out (run.gif with --gif): an earlier run's are replaced or removed."""
+RUN_FILES = ("run.json", "run.mp4", "run.gif", "run.png")
+"""The files one run writes into --out (run.gif with --gif, run.png with --still): an earlier run's are replaced or
+removed."""
 SWEEP_FILES = ("simulate.md", "simulate.json", "simulate.png")
 """The files a sweep writes into --out."""
 
@@ -66,7 +67,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "people in view",
     )  # fmt: skip
     parser.add_argument("--unknown-map", action="store_true", help="no known map: the LiDAR discovers obstacles too")
-    parser.add_argument("--gif", action="store_true", help="also write run.gif (half size, every other frame)")
+    parser.add_argument("--gif", action="store_true", help="also write run.gif (every other frame)")
+    parser.add_argument(
+        "--still", type=float, default=None, metavar="T", help="also write run.png, the picture at T seconds"
+    )
     parser.add_argument("--list", action="store_true", help="list the built-in scenes and exit")
     sweep = parser.add_argument_group("sweeps")
     sweep.add_argument("--sweep", nargs="+", default=None, metavar="SCENE", help="scenes (or 'all') to sweep")
@@ -115,14 +119,17 @@ def run(args: argparse.Namespace) -> int:
             record = write_run(world, options, None, gif=args.gif, progress=ProgressBar("simulate"))
         else:  # whole files only, even when interrupted; an earlier run's files go
             with staged_output(out, RUN_FILES) as staged:
-                record = write_run(world, options, staged.path, gif=args.gif, progress=ProgressBar("simulate"))
+                record = write_run(
+                    world, options, staged.path, gif=args.gif, progress=ProgressBar("simulate"), still_s=args.still
+                )
     except (*INPUT_ERRORS, OSError) as exc:
         return fail("sid simulate", exc)
     for key in SUMMARY_KEYS:
         value = record[key]
         print(f"{key:22s} {round(value, 3) if isinstance(value, float) else value}")
     if out is not None:
-        print_written(out / name for name in ("run.json", "run.mp4", *(("run.gif",) if args.gif else ())))
+        extra = (("run.gif",) if args.gif else ()) + (("run.png",) if args.still is not None else ())
+        print_written(out / name for name in ("run.json", "run.mp4", *extra))
     return 0 if record["success"] else 1
 
 

@@ -452,16 +452,16 @@ def depth_at_color_pixels(
     colour-pixel-to-depth search of librealsense's ``rs2_project_color_pixel_to_depth_pixel``, done for a whole
     patch at once and with the same splat as the dense alignment.
 
-    ``search="window"`` (what ``sid.perception.lifting`` uses per frame; ~4x faster here) skips the search: from the
-    colour pixel's ray, ``_WINDOW_STEPS`` fixed-point steps (the first at infinite depth, then at the depth found)
+    ``search="window"`` (what ``sid.perception.lifting`` uses per frame; several times faster) skips the search: from
+    the colour pixel's ray, ``_WINDOW_STEPS`` fixed-point steps (the first at infinite depth, then at the depth found)
     find the depth pixel the ray meets, and the readings of the depth window about as wide as the colour patch
     around it (3x3 for a 5x5 patch and D435i intrinsics), as colour-frame z (``value``), are reduced as above.
-    What depends only on the calibration (each depth pixel's colour-frame z per metre of reading: ~5 ms to build at
-    848x480) is kept for the last few calibrations.
-    It reads the depth image's own pixels instead of the splatted patch, so it is not identical: on the synthetic
-    D435i frames of ``sid bench`` it is 8 mm from the exact search at the median, 30 mm at the 90th percentile
-    (docs/benchmarks.md; tests/perception/test_align.py bounds it against the dense alignment). ``mode`` only
-    applies to the exact search.
+    What depends only on the calibration (each depth pixel's colour-frame z per metre of reading) is kept for the
+    last few calibrations.
+    It reads the depth image's own pixels instead of the splatted patch, so it is not identical: ``sid bench``'s
+    ``align/window_4x17`` times both and reports their median difference (docs/benchmarks.md, "Depth at the
+    keypoints"); tests/perception/test_align.py bounds it against the dense alignment. ``mode`` only applies to
+    the exact search.
     """
     if search not in ("exact", "window"):
         raise ValueError(f"unknown depth search {search!r}; use 'exact' or 'window'")
@@ -515,7 +515,7 @@ def _window_geometry(calib: Calibration, patch: int) -> _WindowGeometry:
     return _cached_window_geometry(depth, (kc.fx, kc.fy), tuple(rotation[2].tolist()), patch)
 
 
-@lru_cache(maxsize=4)  # a few MB each at 848x480; ``ray_z`` takes ~5 ms to build
+@lru_cache(maxsize=4)  # a few MB each at 848x480, and ``ray_z`` is slow to build per frame
 def _cached_window_geometry(
     depth: tuple[int, int, float, float, float, float],
     color_focal: tuple[float, float],

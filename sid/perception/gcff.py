@@ -232,7 +232,7 @@ def _expansions(
     change = cost[:, alphas] - cost[rows, labels][:, None]  # (N, A); +inf: forbidden
     alone = (change < -tie) & (labels[:, None] != alphas[None, :])
     # Sums per used label over its members (people sorted by label; sums, not BLAS products: a 100 x 100 product
-    # can take milliseconds on a busy machine, the sums take microseconds).
+    # waits for BLAS's threads when other work keeps the cores busy, the sums do not).
     order = np.argsort(labels, kind="stable")
     used, starts = np.unique(labels[order], return_index=True)
     gain = np.add.reduceat(np.where(alone, change, 0.0)[order], starts, axis=0)  # (U, A) <= 0

@@ -79,10 +79,9 @@ class LiftParams:
     patch: side (pixels, odd) of the depth window read around each keypoint. 5, as the paper's authors did.
     depth_search: how keypoint depth is found in unregistered depth (``sid.perception.align.depth_at_color_pixels``'s
       ``search``). "window" (default): fixed-point steps to the depth pixel each keypoint sees and the depth window
-      around it, ~4x faster than "exact" here (0.64 against 2.6 ms median for 4 x 17 keypoints, busy machine) and within
-      8 mm (median; 30 mm at the 90th percentile) of it on sid bench's synthetic frames; the far outliers (a window
-      that reads the wall beside a silhouette) are what ``depth_gate`` drops. "exact": the splat search, equal to
-      aligning the whole frame. Measured in docs/benchmarks.md (issue 14).
+      around it, several times faster than "exact" and within millimetres of it at the median (docs/benchmarks.md,
+      "Depth at the keypoints"); the far outliers (a window that reads the wall beside a silhouette) are what
+      ``depth_gate`` drops. "exact": the splat search, equal to aligning the whole frame.
     min_range: keypoints nearer than this to the camera (m, optical z) are dropped. 0.2: a D435's minimum depth at
       848x480 is about 0.2 m, so a nearer reading is an artefact or a corrupt depth image (1 mm everywhere would
       otherwise place people 7 cm from the lens).
@@ -177,7 +176,7 @@ def lift_people(
         depth_m, keypoints[confident], calib, patch=params.patch, search=params.depth_search
     )
     usable = (depth >= params.min_range) & (depth <= params.max_range)  # NaN (not confident, no reading): False
-    # Median depth per person over its usable keypoints (unusable ones sort last as +inf; np.nanmedian is ~30x
+    # Median depth per person over its usable keypoints (unusable ones sort last as +inf; np.nanmedian is much
     # slower on arrays this small), picked from the sorted rows in Python (a few people: cheaper than numpy).
     ordered = np.sort(np.where(usable, depth, np.inf), axis=1).tolist()
     middle = [

@@ -59,28 +59,40 @@ def place_labels(
     boxes: Sequence[np.ndarray | Sequence[float]],
     shape: tuple[int, int],
     gap: int = 1,
+    avoid: np.ndarray | None = None,
+    prefer: Sequence[tuple[int, int]] | None = None,
 ) -> list[tuple[int, int]]:
     """Top-left corners (u, v) of label blocks of ``sizes`` (w, h) px, one per box (u0, v0, u1, v1), in an image of
     ``shape`` (h, w).
 
-    Each block goes, in the order given, to the free spot nearest (in u + v distance) to its preferred place, just
-    above its box's top-left corner: inside the image, centred over its box's columns, at least ``gap`` px from the
-    blocks already placed. When no spot is free, it goes where it overlaps the placed blocks least.
+    Each block goes, in the order given, to the free spot nearest (in u + v distance) to its preferred place (its
+    corner in ``prefer``; by default just above its box's top-left corner): inside the image, centred over its box's
+    columns or between them and the preferred place, at least ``gap`` px from the blocks already placed and covering
+    none of the ``avoid`` pixels (a boolean (h, w) mask of what is drawn already: arrows, markers, paths). When no
+    spot is free, it goes where it covers the least of both.
     """
     height, width = shape
+    if avoid is not None and avoid.shape != (height, width):
+        raise ValueError(f"place_labels: avoid mask of shape {avoid.shape} for an image of {(height, width)}")
+    drawn = None if avoid is None else cv2.integral(avoid.astype(np.uint8))  # (h + 1, w + 1) running sums
     placed: list[tuple[int, int, int, int]] = []
     corners = []
-    for (w, h), box in zip(sizes, boxes, strict=True):
+    for i, ((w, h), box) in enumerate(zip(sizes, boxes, strict=True)):
         u0, v0, u1 = (int(round(float(c))) for c in box[:3])
         hi_u, hi_v = max(0, width - w), max(0, height - h)
-        want_u, want_v = int(np.clip(u0, 0, hi_u)), int(np.clip(v0 - 2 - h, 0, hi_v))
-        us = np.union1d(np.arange(np.clip(u0 - w // 2, 0, hi_u), np.clip(u1 - w // 2, 0, hi_u) + 1), [want_u])
+        want = (u0, v0 - 2 - h) if prefer is None else prefer[i]
+        want_u, want_v = int(np.clip(want[0], 0, hi_u)), int(np.clip(want[1], 0, hi_v))
+        first, last = np.clip([min(u0 - w // 2, want_u), max(u1 - w // 2, want_u)], 0, hi_u)
+        us = np.union1d(np.arange(first, last + 1), [want_u])
         u, v = (grid.ravel() for grid in np.meshgrid(us, np.arange(hi_v + 1)))
         overlap = np.zeros(u.shape)
         for a0, b0, a1, b1 in placed:
             du = np.minimum(u + w, a1 + gap) - np.maximum(u, a0 - gap)
             dv = np.minimum(v + h, b1 + gap) - np.maximum(v, b0 - gap)
             overlap += np.clip(du, 0, None) * np.clip(dv, 0, None)
+        if drawn is not None:
+            u_end, v_end = np.minimum(u + w, width), np.minimum(v + h, height)
+            overlap += drawn[v_end, u_end] - drawn[v, u_end] - drawn[v_end, u] + drawn[v, u]
         best = int(np.lexsort((np.abs(u - want_u) + np.abs(v - want_v), overlap))[0])
         corners.append((int(u[best]), int(v[best])))
         placed.append((corners[-1][0], corners[-1][1], corners[-1][0] + w, corners[-1][1] + h))
@@ -129,13 +141,17 @@ def draw_detections(
             name, where = person_label(person)
             lines = [f"{name}  {lines[0]}", where]
         labels.append(lines)
+    arrows = np.zeros((h, w), np.uint8)  # the arrows' pixels, which the labels keep clear of
+    for det, person in zip(detections, people, strict=True):
+        if person is not None and person.theta is not None:
+            _draw_arrow(arrows, det, person.theta, _confident(det, keypoint_threshold), thick, 255)
     sizes = [_block_size(lines, font_scale) for lines in labels]
-    corners = place_labels(sizes, [det.box for det in detections], (h, w))
+    corners = place_labels(sizes, [det.box for det in detections], (h, w), avoid=arrows > 0)
     for lines, (left, top) in zip(labels, corners, strict=True):
         _draw_block(image, lines, left, top, font_scale)
     for det, person in zip(detections, people, strict=True):  # arrows last, over every label
         if person is not None and person.theta is not None:
-            _draw_arrow(image, det, person.theta, _confident(det, keypoint_threshold), thick)
+            _draw_arrow(image, det, person.theta, _confident(det, keypoint_threshold), thick, ARROW_COLOUR)
     return image
 
 
@@ -143,13 +159,15 @@ def _confident(det: PoseDetection, threshold: float) -> np.ndarray:
     return (det.scores >= threshold) & np.all(np.isfinite(det.keypoints), axis=1)
 
 
-def _draw_arrow(image: np.ndarray, det: PoseDetection, theta: float, ok: np.ndarray, thick: int) -> None:
-    """Facing arrow (world yaw ``theta``) from between the shoulders (or the top of the box), a quarter of the
-    box height long."""
+def _draw_arrow(
+    image: np.ndarray, det: PoseDetection, theta: float, ok: np.ndarray, thick: int, colour: int | tuple[int, int, int]
+) -> None:
+    """Facing arrow (world yaw ``theta``) in ``colour`` from between the shoulders (or the top of the box), a quarter
+    of the box height long."""
     box = det.box
     if ok[LEFT_SHOULDER] and ok[RIGHT_SHOULDER]:
         anchor = (det.keypoints[LEFT_SHOULDER] + det.keypoints[RIGHT_SHOULDER]) / 2
     else:
         anchor = np.array([(box[0] + box[2]) / 2, box[1]])
     tip = anchor + 0.25 * (box[3] - box[1]) * np.array([-np.sin(theta), -np.cos(theta)])
-    cv2.arrowedLine(image, _pt(anchor), _pt(tip), ARROW_COLOUR, thick + 1, cv2.LINE_AA, tipLength=0.3)
+    cv2.arrowedLine(image, _pt(anchor), _pt(tip), colour, thick + 1, cv2.LINE_AA, tipLength=0.3)

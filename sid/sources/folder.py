@@ -124,8 +124,8 @@ class _Reader:
     """Sequential iterator over a FolderSource that survives FrameReadError (it has already moved on).
 
     While the caller works on a frame, the next one is read in a background thread: OpenCV's PNG decoding releases
-    the GIL, so decoding overlaps the pose network and the rest of the frame (two PNG decodes are several
-    milliseconds a frame, docs/benchmarks.md). Frames still come in order, and a read error is raised for its own
+    the GIL, so decoding overlaps the pose network and the rest of the frame (docs/benchmarks.md, "Start-up and the
+    detect loop"). Frames still come in order, and a read error is raised for its own
     frame.
     """
 

@@ -7,9 +7,9 @@ the cost with every pair outside the gate priced above any matching of allowed p
 Most frames need no solver: when every row with an allowed pair has a single cheapest allowed column and no two
 rows share it, those pairs are the answer, and the only one (every row sits at its own lower bound, and no matching
 has more allowed pairs than rows that have one). The solver runs only otherwise, and ``scipy.optimize`` is imported
-on that first use: the import takes 0.7 s, most of SciPy, which was half of a `sid detect` start-up
-(docs/benchmarks.md, "Start-up"). ``load_solver()`` imports it ahead of time, for a long-running node that should not
-pause on its first crowded frame.
+on that first use: the import loads most of SciPy, about half of a `sid detect` start-up (docs/benchmarks.md,
+"Start-up and the detect loop"). ``load_solver()`` imports it ahead of time, for a long-running node that should
+not pause on its first crowded frame.
 """
 
 from __future__ import annotations

@@ -311,8 +311,9 @@ def _pair_distance(points: np.ndarray) -> np.ndarray:
 
 def connected_components(adjacent: np.ndarray) -> list[np.ndarray]:
     """The connected components of a symmetric (N, N) bool adjacency matrix, as index arrays ordered by their first
-    index. Union-find over the links (a few per walker), where ``scipy.sparse.csgraph`` would add 0.4 s of imports to
-    every start (docs/benchmarks.md, "Start-up") and squaring the reachability matrix costs O(N^3) per product."""
+    index. Union-find over the links (a few per walker), where ``scipy.sparse.csgraph`` would add its imports to
+    every start (docs/benchmarks.md, "Start-up and the detect loop") and squaring the reachability matrix costs
+    O(N^3) per product."""
     if not len(adjacent):
         return []
     parent = list(range(len(adjacent)))  # union-find over the links; a component's root is its first index

@@ -71,7 +71,7 @@ class ViewRegion:
         if polygon.ndim != 2 or polygon.shape[1] != 2 or len(polygon) < 3 or not np.isfinite(polygon).all():
             raise ValueError(f"view: a region needs 3 or more finite (x, y) corners, got shape {polygon.shape}")
         object.__setattr__(self, "polygon", polygon)
-        import shapely.prepared  # here, not at start-up: 80 ms that a camera's view cone never needs
+        import shapely.prepared  # here, not at start-up: an import a camera's view cone never needs
 
         object.__setattr__(self, "_shape", shapely.prepared.prep(shapely.Polygon(polygon)))
 

@@ -82,7 +82,7 @@ def test_detect_streams_json_lines_and_writes_pictures(tmp_path, capsys):
 
 
 def test_detect_top_view_shows_the_camera_and_only_what_it_draws(tmp_path):
-    from costmap.render import CAMERA, GOAL, INSCRIBED_COLOUR, PERSON, SCAN, START, world_to_image
+    from costmap.render import CAMERA, GOAL, GROUP_COLOURS, INSCRIBED_COLOUR, SCAN, START, world_to_image
     from sid.cli.detect import TOP_VIEW
 
     out = tmp_path / "out"
@@ -98,7 +98,7 @@ def test_detect_top_view_shows_the_camera_and_only_what_it_draws(tmp_path):
     assert at(6.0, 0.0) not in ((255, 255, 255), CAMERA)  # inside the field of view: shaded
     assert at(0.5, 3.0) == (255, 255, 255)  # behind the edge of the field of view: not shaded
     colours = {tuple(c) for c in np.unique(top.reshape(-1, 3), axis=0)}
-    assert PERSON in colours and CAMERA in colours
+    assert GROUP_COLOURS[0] in colours and CAMERA in colours  # S5's four people, in their group's colour
     for absent in (GOAL, START, SCAN, INSCRIBED_COLOUR):  # no robot, scan or costs drawn: none in the legend either
         assert absent not in colours, f"colour {absent} is drawn, yet nothing it stands for is on the map"
 

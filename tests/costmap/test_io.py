@@ -14,7 +14,7 @@ from costmap.layers.static import static_costs
 from costmap.mapfile import MapFileError, read_map, write_map
 from costmap.npz import load_npz, save_npz
 from costmap.occupancy import OccupancyGrid, cost_to_occupancy, costmap_to_occupancy, occupancy_to_cost
-from costmap.render import OBSTACLE, default_scale, render_costmap, world_to_image
+from costmap.render import GROUP_COLOURS, OBSTACLE, default_scale, render_costmap, world_to_image
 from costmap.rosbag import read_occupancy_grids, write_occupancy_mcap
 from sid.cli import main
 from sid.perception.groups import Group
@@ -222,7 +222,7 @@ def test_render_draws_costs_people_and_zones_where_the_world_says():
     img = render_costmap(layered, scale=3)
     assert img.dtype == np.uint8 and img.ndim == 3 and img.shape[2] == 3
     u, v = world_to_image([[4.0, 0.6]], layered.spec, 3)[0].astype(int)
-    assert tuple(img[v, u]) == (200, 110, 20)  # person 1's disc (BGR)
+    assert tuple(img[v, u]) == GROUP_COLOURS[0]  # person 1's disc, in its group's colour (BGR)
     plain = render_costmap(layered.master, scale=3)  # costs only
     lethal = layered.spec.cell_to_world(np.argwhere(layered.master.costs == 254)[:1])
     free = layered.spec.cell_to_world(np.argwhere(layered.master.costs == 0)[:1])

@@ -42,3 +42,15 @@ def test_compare_command_writes_summary_and_chart(tmp_path, capsys):
     assert (out / "planners.png").stat().st_size > 10_000
     assert main(["compare", str(scenario), "--planners", "prmstar", "--out", str(out)]) == 2
     assert "PRM* is not available" in capsys.readouterr().err
+
+
+def test_the_compare_example_is_the_demo_scenario_and_shows_the_layer(tmp_path, capsys):
+    """examples/goal_behind_group.json is the demo's scenario: without the layer the path crosses the group."""
+    from tests.conftest import REPO_ROOT
+
+    example = REPO_ROOT / "examples" / "goal_behind_group.json"
+    assert json.loads(example.read_text()) == json.loads(json.dumps(DEMO_SCENARIO))
+    assert main(["compare", str(example), "--planners", "grid", "--runs", "1", "--out", str(tmp_path)]) == 0
+    rows = {r["social_layer"]: r for r in json.loads((tmp_path / "summary.json").read_text())}
+    assert rows[False]["crossing_rate"] == 1.0 and rows[False]["median_intrusion_m"] > 1.0
+    assert rows[True]["crossing_rate"] == 0.0 and rows[True]["median_intrusion_m"] == 0.0

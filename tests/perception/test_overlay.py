@@ -124,3 +124,13 @@ def test_overlay_places_neighbouring_labels_apart(monkeypatch):
     draw_detections(np.zeros((500, 600, 3), np.uint8), [_standing(u) for u in (200, 260, 320)], people)
     assert len(drawn) == 3
     assert all(_disjoint(a, b) for i, a in enumerate(drawn) for b in drawn[i + 1 :]), drawn
+
+
+def test_labels_keep_clear_of_the_pixels_to_avoid_and_go_to_the_preferred_place():
+    avoid = np.zeros((200, 200), bool)
+    avoid[80:120, :] = True  # an arrow across the image, right where the label would go
+    (corner,) = place_labels([(40, 20)], [(60, 120, 100, 180)], (200, 200), avoid=avoid)
+    assert not avoid[corner[1] : corner[1] + 20, corner[0] : corner[0] + 40].any()
+    assert corner == (60, 120)  # the nearest free rows (just below the arrow), over its box
+    (corner,) = place_labels([(40, 20)], [(60, 120, 100, 180)], (200, 200), prefer=[(20, 185)])
+    assert corner == (20, 180)  # the preferred place, kept inside the image

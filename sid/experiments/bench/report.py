@@ -34,7 +34,8 @@ LIBRARIES = ("numpy", "scipy", "scikit-learn", "shapely", "opencv-python-headles
              "pyrealsense2")  # fmt: skip
 FIXED_FIELDS = ("median_ms", "min_ms", "max_ms", "runs")
 PAPER_COLUMN = "paper (Jetson Orin NX, another machine) ms"
-# A change beyond these ratios is flagged by ``format_comparison`` (timings of a busy machine move by ~10 %).
+# A change beyond these ratios is flagged by ``format_comparison``: timings on a shared machine move by about that
+# much between runs (docs/benchmarks.md, "Measuring a change side by side").
 SLOWER, FASTER = 1.10, 1 / 1.10
 
 

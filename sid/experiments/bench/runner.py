@@ -2,7 +2,7 @@
 
 A stage is timed by calling it repeatedly until ``max_runs`` calls or ``budget_s`` seconds have passed (but at
 least ``min_runs`` calls), after ``warmup`` untimed calls. Each call is timed on its own with
-``time.perf_counter_ns`` (its resolution, ~100 ns, is well below the fastest stage timed here, ~20 us), and the
+``time.perf_counter_ns`` (its resolution is well below the fastest stage's tens of microseconds), and the
 report keeps the median, the minimum, the maximum and the number of runs. The collector is switched off while a
 stage runs (after a collection) so that a collection triggered by an earlier stage's garbage does not land in a
 later stage's samples; this is how ``timeit`` measures too.

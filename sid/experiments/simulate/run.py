@@ -2,7 +2,8 @@
 
 ``run_record`` gives the JSON-ready record of ``run.json``: the scene, the options that made the run (replaying
 them gives the same run), the outcome and metrics of ``sid.experiments.simulate.metrics.run_metrics`` and the
-trajectory. ``write_run`` also writes ``run.mp4`` (and ``run.gif`` on request).
+trajectory. ``write_run`` also writes ``run.mp4`` (and on request ``run.gif``, and ``run.png``: the picture of one
+step).
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from collections.abc import Callable
 from dataclasses import asdict
 from pathlib import Path
 
+import cv2
 import numpy as np
 
 from sid.experiments.reproduce import write_json
@@ -48,8 +50,10 @@ def write_run(
     out_dir: Path | None,
     gif: bool = False,
     progress: StepProgress | None = None,
+    still_s: float | None = None,
 ) -> dict:
-    """Run once; with ``out_dir``, write ``run.json`` and ``run.mp4`` (and ``run.gif``) there. Returns the record."""
+    """Run once; with ``out_dir``, write ``run.json`` and ``run.mp4`` (and ``run.gif``; with ``still_s``, ``run.png``:
+    the picture of the first step at or after ``still_s`` seconds, or of the last step) there. Returns the record."""
     settings = world.settings
     total = int(math.ceil(settings.time_limit_s * settings.rate_hz))
     driven: list[tuple[float, float]] = []
@@ -57,6 +61,7 @@ def write_run(
     if out_dir is not None:
         out_dir.mkdir(parents=True, exist_ok=True)
         writer = VideoWriter(out_dir / "run.mp4", settings.rate_hz, out_dir / "run.gif" if gif else None)
+    still: list = []  # [t, picture] of the step run.png shows
     mode = "with" if options.social else "without"
     label = f"{world.scenario.name}, {mode} the social layer, seed {options.seed}"
 
@@ -67,7 +72,10 @@ def write_run(
             progress(step, total, f"t = {view.t:4.1f} s")
         if writer is not None:
             title = f"{label}: t = {view.t:5.1f} s, v = {view.robot.v:.2f} m/s"
-            writer.add(frame_picture(view, world, np.array(driven), title))
+            picture = frame_picture(view, world, np.array(driven), title)
+            writer.add(picture)
+            if still_s is not None and (not still or still[0] < still_s - 0.5 / settings.rate_hz):
+                still[:] = [view.t, picture]
 
     try:
         record = run_record(world, options, observe, color=writer is not None)
@@ -78,4 +86,6 @@ def write_run(
         progress(total, total, record["reason"])
     if out_dir is not None:
         write_json(out_dir / "run.json", record)
+        if still and not cv2.imwrite(str(out_dir / "run.png"), still[1]):
+            raise OSError(f"could not write {out_dir / 'run.png'}")
     return record

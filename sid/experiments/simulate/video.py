@@ -2,71 +2,138 @@
 
 A frame (BGR uint8) is ``costmap.render.render_costmap`` of the robot's costmap at that step (the costs, the known
 obstacles' outlines, the LiDAR hits, the people and groups the robot perceives, the camera's field of view), with the
-planned path (purple), the driven path (dark green), the robot's disc and heading, the goal, the true people as
-grey rings, the time in the title, and the camera's colour image in a column on the right.
+planned path (purple), the driven path (navy), the robot's disc and heading (navy), the goal, the true people as
+grey rings, a legend of all of it, the time in the title, and the camera's colour image in a column on the right.
 
 ``VideoWriter`` writes MP4 (H.264 through imageio-ffmpeg's bundled ffmpeg) and, on request, a GIF (Pillow) of every
-``gif_every``-th frame at half size.
+``gif_every``-th frame at full size.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Generator
+from collections.abc import Callable, Generator
 from pathlib import Path
 from types import TracebackType
 
 import cv2
 import numpy as np
 
-from costmap.render import CameraView, default_scale, render_costmap, world_to_image
-from planner.render import WITH_COLOUR, PathStyle, draw_path
+from costmap.grid import GridSpec
+from costmap.layers.social import SocialParams
+from costmap.render import (
+    LEGEND,
+    LEGEND_ROW,
+    MARGIN_BOTTOM,
+    MARGIN_LEFT,
+    MARGIN_TOP,
+    MAX_GROUP_ENTRIES,
+    CameraView,
+    Extra,
+    default_scale,
+    render_costmap,
+    world_to_image,
+)
+from planner.render import WITH_COLOUR, PathStyle, path_extra
 from sid.experiments.simulate.loop import StepView
 from sid.experiments.simulate.perception import FIELD_OF_VIEW
 from sid.experiments.simulate.world import SimWorld
 from sid.scenario.obstacles import outline
 
-DRIVEN = PathStyle("driven", (40, 110, 0))
-PLANNED = PathStyle("planned", WITH_COLOUR)
-ROBOT = (40, 110, 0)
+ROBOT = (90, 40, 0)  # BGR: navy, the robot and its driven path
+DRIVEN = PathStyle("driven path", ROBOT)
+PLANNED = PathStyle("planned path", WITH_COLOUR)
 TRUE_PERSON = (130, 130, 130)
 GOAL = (30, 30, 220)
 INSET_WIDTH = 320
+LEGEND_WIDTH = 260  # px right of the map: the colour scale and the legend
+
+
+def _true_person_swatch(img: np.ndarray, u: int, v: int) -> None:
+    cv2.circle(img, (u, v), 6, TRUE_PERSON, 2, cv2.LINE_AA)
+
+
+def _goal_swatch(img: np.ndarray, u: int, v: int) -> None:
+    cv2.drawMarker(img, (u, v), GOAL, cv2.MARKER_TILTED_CROSS, 12, 2, cv2.LINE_AA)
+
+
+def _robot_swatch(img: np.ndarray, u: int, v: int) -> None:
+    cv2.circle(img, (u, v), 7, ROBOT, 2, cv2.LINE_AA)
+    cv2.line(img, (u, v), (u + 7, v), ROBOT, 2, cv2.LINE_AA)
+
+
+def _robot_extras(view: StepView, world: SimWorld, driven: np.ndarray) -> list[Extra]:
+    """What a step's picture draws over the costmap, each with its legend entry: the true people, the planned and
+    driven paths, the goal and the robot."""
+    radius, body = world.settings.limits.radius, world.scenario.lidar.body_radius
+    robot, goal = view.robot, world.scenario.robot.goal
+
+    def ring(centre: tuple[float, float], r_m: float, colour: tuple[int, int, int]) -> Callable[..., None]:
+        def draw(img: np.ndarray, spec: GridSpec, scale: int) -> None:
+            u, v = world_to_image([centre], spec, scale)[0]
+            cv2.circle(img, (int(u), int(v)), int(round(r_m * scale / spec.resolution)), colour, 2, cv2.LINE_AA)
+
+        return draw
+
+    def true_people(img: np.ndarray, spec: GridSpec, scale: int) -> None:
+        for person in view.people:
+            ring((person.x, person.y), body, TRUE_PERSON)(img, spec, scale)
+
+    def robot_disc(img: np.ndarray, spec: GridSpec, scale: int) -> None:
+        ring((robot.x, robot.y), radius, ROBOT)(img, spec, scale)
+        nose = (robot.x + radius * math.cos(robot.yaw), robot.y + radius * math.sin(robot.yaw))
+        (u, v), (nu, nv) = world_to_image([[robot.x, robot.y], nose], spec, scale).astype(int)
+        cv2.line(img, (int(u), int(v)), (int(nu), int(nv)), ROBOT, 2, cv2.LINE_AA)
+
+    def goal_cross(img: np.ndarray, spec: GridSpec, scale: int) -> None:
+        gu, gv = world_to_image([goal[:2]], spec, scale)[0]
+        cv2.drawMarker(img, (int(gu), int(gv)), GOAL, cv2.MARKER_TILTED_CROSS, 16, 3, cv2.LINE_AA)
+
+    extras = []
+    if view.people:
+        extras.append(Extra("true people (simulation)", _true_person_swatch, true_people))
+    if view.path is not None:
+        extras.append(path_extra(view.path, PLANNED, 2))
+    if len(driven) >= 2:
+        extras.append(path_extra(driven, DRIVEN, 2))
+    return [*extras, Extra("goal", _goal_swatch, goal_cross), Extra("robot, heading", _robot_swatch, robot_disc)]
+
+
+def _map_picture_size(spec: GridSpec, people: int) -> tuple[int, int]:
+    """Height and width (px) of every step's costmap picture in a run: room for the map and for the longest legend
+    the run can have (every entry, one per possible group), so that the video's frames are all one size."""
+    groups = people // 2
+    rows = 1 + min(groups, MAX_GROUP_ENTRIES) + (groups > MAX_GROUP_ENTRIES) + len(LEGEND) - 2 + 5  # no robot task
+    scale = default_scale(spec)
+    height = max(MARGIN_TOP + spec.height * scale + MARGIN_BOTTOM, MARGIN_TOP + 10 + 224 + 74 + LEGEND_ROW * rows)
+    return height, MARGIN_LEFT + spec.width * scale + LEGEND_WIDTH
+
+
+def _pad(img: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    """``img`` on a white canvas of ``size`` (h, w), top-left aligned (cut where it is larger)."""
+    canvas = np.full((*size, 3), 255, dtype=np.uint8)
+    h, w = min(size[0], img.shape[0]), min(size[1], img.shape[1])
+    canvas[:h, :w] = img[:h, :w]
+    return canvas
 
 
 def frame_picture(view: StepView, world: SimWorld, driven: np.ndarray, title: str) -> np.ndarray:
     """The BGR picture of one step (see the module docstring); ``driven``: the trajectory so far (N, 2)."""
-    spec = view.costmap.spec
-    scale = default_scale(spec)
     robot = view.robot
     camera = CameraView(robot.x, robot.y, robot.yaw, FIELD_OF_VIEW) if view.image is not None else None
     img = render_costmap(
         view.costmap,
         view.seen,
         view.groups,
-        scale=scale,
+        scale=default_scale(view.costmap.spec),
         scan=view.scan,
         title=title,
         camera=camera,
         outlines=[outline(ob) for ob in world.scenario.obstacles],
+        zone_margin=SocialParams().group_margin,  # the tracked-people layer's (costmap.layers.tracked)
+        extras=_robot_extras(view, world, driven),
     )
-    px_per_m = scale / spec.resolution
-    for person in view.people:
-        u, v = world_to_image([[person.x, person.y]], spec, scale)[0]
-        r = world.scenario.lidar.body_radius * px_per_m
-        cv2.circle(img, (int(u), int(v)), int(round(r)), TRUE_PERSON, 2, cv2.LINE_AA)
-    if view.path is not None:
-        draw_path(img, view.path, spec, scale, PLANNED, 2)
-    draw_path(img, driven, spec, scale, DRIVEN, 2)
-    goal = world.scenario.robot.goal
-    gu, gv = world_to_image([goal[:2]], spec, scale)[0]
-    cv2.drawMarker(img, (int(gu), int(gv)), GOAL, cv2.MARKER_TILTED_CROSS, 16, 3, cv2.LINE_AA)
-    (u, v), (nu, nv) = world_to_image(
-        [[robot.x, robot.y], [robot.x + world.settings.limits.radius * math.cos(robot.yaw),
-                              robot.y + world.settings.limits.radius * math.sin(robot.yaw)]], spec, scale
-    )  # fmt: skip
-    cv2.circle(img, (int(u), int(v)), int(round(world.settings.limits.radius * px_per_m)), ROBOT, 2, cv2.LINE_AA)
-    cv2.line(img, (int(u), int(v)), (int(nu), int(nv)), ROBOT, 2, cv2.LINE_AA)
+    img = _pad(img, _map_picture_size(view.costmap.spec, len(world.scenario.people)))
     strip = np.full((img.shape[0], INSET_WIDTH + 16, 3), 255, dtype=np.uint8)
     if view.image is not None:
         inset = cv2.cvtColor(view.image, cv2.COLOR_RGB2BGR)
@@ -75,10 +142,12 @@ def frame_picture(view: StepView, world: SimWorld, driven: np.ndarray, title: st
             inset, (INSET_WIDTH, height), interpolation=cv2.INTER_AREA
         )
         cv2.rectangle(strip, (7, 33), (8 + INSET_WIDTH, 34 + height), (40, 40, 40), 1)
-    caption = "the robot's camera" if view.image is not None else "no camera image (no recognition, or exact people)"
-    cv2.putText(strip, caption, (8, 26), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (40, 40, 40), 1, cv2.LINE_AA)
+    captions = (
+        ["the robot's camera"] if view.image is not None else ["no camera image:", "no recognition, or exact people"]
+    )
+    for row, caption in enumerate(captions):
+        cv2.putText(strip, caption, (8, 26 + 22 * row), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (40, 40, 40), 1, cv2.LINE_AA)
     return np.hstack([img, strip])
-    return img
 
 
 class VideoWriter:
@@ -112,8 +181,7 @@ class VideoWriter:
             padded[: rgb.shape[0], : rgb.shape[1]] = rgb
             self._writer.send(padded)
         if self.gif is not None and self._count % self.gif_every == 0:
-            half = cv2.resize(rgb, (rgb.shape[1] // 2, rgb.shape[0] // 2), interpolation=cv2.INTER_AREA)
-            self._gif_frames.append(half)
+            self._gif_frames.append(rgb)  # full size: its text is as legible as the video's
         self._count += 1
 
     def close(self) -> None:

@@ -6,9 +6,8 @@ Choices (see docs/models.md):
   ``threads=`` overrides it (``sid detect --threads N``).
 - Thread pools do not spin (``session.intra_op.allow_spinning`` and ``session.inter_op.allow_spinning`` = 0):
   onnxruntime's workers busy-wait between operators by default, which on a loaded or small machine steals the cores
-  the other workers and the rest of the frame need (measured on 2 cores: YOLO11n-pose 34.5 ms per inference with 2
-  spinning threads against 20.0 ms without spinning; docs/parameters.md, "Pose sessions"). ``spinning=True``
-  restores onnxruntime's default.
+  the other workers and the rest of the frame need (docs/parameters.md, "Pose sessions", has the measurements).
+  ``spinning=True`` restores onnxruntime's default.
 - ``inter_op_num_threads`` = 1 with sequential execution: pose graphs are a single chain of layers, there is no
   parallel branch worth a second thread pool.
 - ``graph_optimization_level`` = ORT_ENABLE_ALL: constant folding, node fusions and layout optimisations; the

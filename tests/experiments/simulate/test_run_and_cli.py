@@ -67,3 +67,17 @@ def test_the_video_writer_pads_odd_frames(tmp_path):
     assert tuple(meta["size"]) == (42, 32)
     first = np.frombuffer(next(reader), np.uint8).reshape(32, 42, 3)
     assert first[15, 5, 0] > 200 and first[15, 5, 2] < 60  # RGB: red stays red
+
+
+def test_still_writes_the_picture_at_that_time_and_the_gif_is_full_size(scene, tmp_path):
+    import cv2
+    from PIL import Image
+
+    out = tmp_path / "out"
+    assert main(["simulate", scene, "--out", str(out), "--gif", "--still", "0.2"]) == 1
+    still = cv2.imread(str(out / "run.png"))
+    meta = next(imageio_ffmpeg.read_frames(str(out / "run.mp4")))
+    assert still is not None  # the video's frames are one size, padded to even sides for H.264
+    assert 0 <= meta["size"][0] - still.shape[1] <= 1 and 0 <= meta["size"][1] - still.shape[0] <= 1
+    with Image.open(out / "run.gif") as gif:
+        assert gif.size == (still.shape[1], still.shape[0])  # text as legible as the video's

@@ -1,0 +1,89 @@
+"""Costmap pictures: people coloured by group, each group's o-space as its record holds it, id labels clear of each
+other and of what is drawn, and a legend of exactly what is drawn."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import costmap.render as render
+from costmap.grid import Costmap2D, GridSpec
+from costmap.render import GROUP_COLOURS, PERSON, CameraView, render_costmap, world_to_image
+from sid.perception.groups import Group
+from sid.perception.people import Person
+
+SPEC = GridSpec.from_size(0.05, (-0.5, -3.0), (6.0, 6.0))
+PAIR = [Person(1, 2.0, 0.35, -np.pi / 2), Person(2, 2.0, -0.35, np.pi / 2)]  # face to face, 0.7 m apart
+POINT_GROUP = Group((1, 2), (2.0, 0.0), 0.0, np.array([[2.0, 0.0]]), 0.35)  # a pair's o-space: one point
+
+
+def _pixel(img: np.ndarray, xy: tuple[float, float], scale: int) -> tuple[int, ...]:
+    u, v = np.rint(world_to_image([xy], SPEC, scale)[0]).astype(int)
+    return tuple(int(c) for c in img[v, u])
+
+
+def _near(img: np.ndarray, xy: tuple[float, float], scale: int, colour: tuple[int, ...]) -> bool:
+    """Whether ``colour`` is drawn within a pixel of world point ``xy`` (anti-aliased lines blend at their edges)."""
+    u, v = np.rint(world_to_image([xy], SPEC, scale)[0]).astype(int)
+    return bool(np.any(np.all(img[v - 1 : v + 2, u - 1 : u + 2] == colour, axis=2)))
+
+
+@pytest.fixture
+def legend(monkeypatch) -> list[list[str]]:
+    """The legend rows of every picture drawn in the test, by name (a spy on the panel that draws them)."""
+    seen: list[list[str]] = []
+    panel = render._panel
+
+    def spy(img, spec, scale, costs, rows):  # type: ignore[no-untyped-def]
+        seen.append([name for name, _ in rows])
+        panel(img, spec, scale, costs, rows)
+
+    monkeypatch.setattr(render, "_panel", spy)
+    return seen
+
+
+def test_people_are_coloured_by_group_and_the_legend_names_each_group(legend) -> None:
+    people = [*PAIR, Person(3, 4.0, 2.0, 0.0), Person(4, 4.0, -2.0, np.pi), Person(5, 4.6, -2.0, 0.0)]
+    trio = Group((4, 5), (4.3, -2.0), 0.0, np.array([[4.3, -2.0]]), 0.3)
+    img = render_costmap(Costmap2D.filled(SPEC), people, [POINT_GROUP, trio], scale=4)
+    assert _pixel(img, (2.0, 0.35), 4) == _pixel(img, (2.0, -0.35), 4) == GROUP_COLOURS[0]
+    assert _pixel(img, (4.0, -2.0), 4) == GROUP_COLOURS[1] and _pixel(img, (4.0, 2.0), 4) == PERSON
+    assert legend[-1][:3] == ["person in no group, facing", "group of 1, 2", "group of 4, 5"]
+
+
+def test_a_zone_of_one_point_is_drawn_as_a_point_and_the_hull_only_with_a_margin(legend) -> None:
+    camera = CameraView(0.0, 0.0, 0.0, 1.5)
+    top = render_costmap(Costmap2D.filled(SPEC), PAIR, [POINT_GROUP], scale=4, camera=camera)
+    ring = (2.0 + 7 / 4 * SPEC.resolution, 0.0)  # the point's ring, 7 px out
+    hull = (2.0 + 0.3, 0.0)  # where the members' hull grown by 0.3 m crosses the x axis
+    assert _near(top, ring, 4, GROUP_COLOURS[0]) and not _near(top, hull, 4, GROUP_COLOURS[0])
+    assert legend[-1] == [
+        "group of 1, 2",
+        "o-space: one point, or under 10 px",
+        "interest point",
+        "camera, field of view",
+    ]
+    grown = render_costmap(Costmap2D.filled(SPEC), PAIR, [POINT_GROUP], scale=4, zone_margin=0.3)
+    columns = [_pixel(grown, (2.0 + 0.3 + dx, 0.0), 4) for dx in np.linspace(-0.03, 0.03, 7)]
+    assert GROUP_COLOURS[0] in columns and "interaction zone (costmap)" in legend[-1]
+
+
+def test_id_labels_keep_clear_of_each_other_and_of_what_is_drawn(monkeypatch) -> None:
+    """Five people shoulder to shoulder, each facing the next: every label on free map, none touching another."""
+    placed: list[tuple[list, list, np.ndarray]] = []
+    place = render.place_labels
+
+    def spy(sizes, boxes, shape, gap=1, avoid=None, prefer=None):  # type: ignore[no-untyped-def]
+        corners = place(sizes, boxes, shape, gap, avoid, prefer)
+        placed.append((list(sizes), corners, avoid))
+        return corners
+
+    monkeypatch.setattr(render, "place_labels", spy)
+    people = [Person(i, 2.0 + 0.45 * i, 0.1 * (i % 2), 0.0) for i in range(5)]
+    render_costmap(Costmap2D.filled(SPEC), people, [], scale=4)
+    ((sizes, corners, avoid),) = placed
+    blocks = [(u, v, u + w, v + h) for (u, v), (w, h) in zip(corners, sizes, strict=True)]
+    for i, (u0, v0, u1, v1) in enumerate(blocks):
+        assert not avoid[v0:v1, u0:u1].any(), f"label {i} covers a person or an arrow"
+        for a0, b0, a1, b1 in blocks[i + 1 :]:
+            assert u1 <= a0 or a1 <= u0 or v1 <= b0 or b1 <= v0, "two labels overlap"
