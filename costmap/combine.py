@@ -23,6 +23,19 @@ import numpy as np
 
 from costmap.grid import FREE_SPACE, INSCRIBED, NO_INFORMATION
 
+__all__ = [
+    "COMBINE",
+    "CombinationMethod",
+    "check_method",
+    "combine",
+    "update_with_addition",
+    "update_with_max",
+    "update_with_max_keep_unknown",
+    "update_with_max_nonzero",
+    "update_with_overwrite",
+    "update_with_true_overwrite",
+]
+
 CombinationMethod = Literal["max", "max_nonzero", "max_keep_unknown", "overwrite", "true_overwrite", "addition"]
 
 

@@ -25,6 +25,8 @@ from costmap.occupancy import OCC_OCCUPIED, OCC_UNKNOWN, OccupancyGrid, cost_to_
 from costmap.render import Outline, RobotTask, render_costmap
 from costmap.rosbag import write_occupancy_mcap
 
+__all__ = ["NAMES", "export_costmap", "filter_mask_cost", "keepout_mask"]
+
 NAMES = ("costmap.yaml", "costmap.pgm", "costmap.npz", "costmap.mcap", "costmap.png")
 
 

@@ -16,6 +16,21 @@ from numpy.typing import ArrayLike
 
 from sid.checks import check_limit, check_number, check_numbers
 
+__all__ = [
+    "Costmap2D",
+    "FREE_SPACE",
+    "GridSpec",
+    "INSCRIBED",
+    "LETHAL",
+    "MAX_NON_OBSTACLE",
+    "NO_INFORMATION",
+    "SEPARATE_WINDOW_CELLS",
+    "Window",
+    "disjoint",
+    "nonzero_cells",
+    "union",
+]
+
 FREE_SPACE = 0
 MAX_NON_OBSTACLE = 252
 INSCRIBED = 253

@@ -24,6 +24,8 @@ from sid.perception.groups import Group
 from sid.perception.people import Person
 from sid.tracking.records import Tracks
 
+__all__ = ["Layer", "LayerInputs"]
+
 
 @dataclass(frozen=True)
 class LayerInputs:

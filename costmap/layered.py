@@ -10,6 +10,8 @@ import numpy as np
 from costmap.grid import FREE_SPACE, Costmap2D, GridSpec, Window, disjoint, union
 from costmap.layer import Layer, LayerInputs
 
+__all__ = ["LayeredCostmap"]
+
 
 class LayeredCostmap:
     """A master grid and an ordered list of layers over the same grid.

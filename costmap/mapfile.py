@@ -28,6 +28,8 @@ from sid.checks import check_limit
 from sid.documents import is_number, load_document
 from sid.errors import SidError
 
+__all__ = ["MODES", "MapFileError", "read_map", "write_map"]
+
 MODES = ("trinary", "scale", "raw")
 
 

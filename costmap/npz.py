@@ -11,6 +11,8 @@ import numpy as np
 from costmap.grid import Costmap2D, GridSpec
 from costmap.layered import LayeredCostmap
 
+__all__ = ["SavedCostmap", "load_npz", "save_npz"]
+
 
 @dataclass
 class SavedCostmap:

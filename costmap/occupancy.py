@@ -15,6 +15,18 @@ import numpy as np
 
 from costmap.grid import FREE_SPACE, INSCRIBED, LETHAL, NO_INFORMATION, Costmap2D, GridSpec
 
+__all__ = [
+    "COST_TO_OCCUPANCY",
+    "OCC_FREE",
+    "OCC_INSCRIBED",
+    "OCC_OCCUPIED",
+    "OCC_UNKNOWN",
+    "OccupancyGrid",
+    "cost_to_occupancy",
+    "costmap_to_occupancy",
+    "occupancy_to_cost",
+]
+
 OCC_UNKNOWN = -1
 OCC_FREE = 0
 OCC_INSCRIBED = 99

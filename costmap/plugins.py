@@ -19,6 +19,8 @@ from costmap.layers.static import StaticLayer
 from costmap.layers.tracked import TrackedPeopleLayer, TrackedPeopleParams
 from costmap.occupancy import OccupancyGrid
 
+__all__ = ["CostmapParams", "Factory", "LayerContext", "PEOPLE_LAYERS", "PLUGINS", "layered_costmap"]
+
 
 @dataclass(frozen=True)
 class CostmapParams:

@@ -27,6 +27,32 @@ from sid.perception.groups import Group
 from sid.perception.overlay import place_labels
 from sid.perception.people import Person
 
+__all__ = [
+    "CAMERA",
+    "COST_COLOURS",
+    "CameraView",
+    "Extra",
+    "FONT",
+    "GOAL",
+    "GROUP_COLOURS",
+    "INSCRIBED_COLOUR",
+    "LEGEND",
+    "OBSTACLE",
+    "Outline",
+    "PERSON",
+    "RobotTask",
+    "SCAN",
+    "START",
+    "Swatch",
+    "TEXT",
+    "UNKNOWN_COLOUR",
+    "ZONE",
+    "default_scale",
+    "person_colours",
+    "render_costmap",
+    "world_to_image",
+]
+
 MARGIN_LEFT, MARGIN_TOP, MARGIN_BOTTOM, PANEL_WIDTH, PANEL_HEIGHT = 56, 40, 44, 190, 450
 
 

@@ -24,6 +24,8 @@ from rosbags.typesys.stores.ros2_humble import nav_msgs__msg__OccupancyGrid as O
 from costmap.grid import GridSpec
 from costmap.occupancy import OccupancyGrid
 
+__all__ = ["DISTROS", "MSGTYPE", "read_occupancy_grids", "write_occupancy_mcap"]
+
 MSGTYPE = "nav_msgs/msg/OccupancyGrid"
 DISTROS = {"humble": Stores.ROS2_HUMBLE, "jazzy": Stores.ROS2_JAZZY}
 _LATCHED = Qos(

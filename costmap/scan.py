@@ -12,6 +12,8 @@ import numpy as np
 
 from sid.checks import check_number, check_numbers
 
+__all__ = ["LaserScan"]
+
 
 @dataclass(frozen=True)
 class LaserScan:

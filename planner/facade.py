@@ -24,6 +24,19 @@ from planner.problem import CostField, PlanningError, PlanningProblem
 from planner.smoothing import smooth
 from planner.validity import check_path
 
+__all__ = [
+    "DEFAULT_PLANNER",
+    "DEFAULT_SETTLE_S",
+    "DEFAULT_SOFT_LIMIT_S",
+    "MAX_SEED",
+    "PLANNERS",
+    "PlanResult",
+    "UNAVAILABLE",
+    "check_endpoints",
+    "plan",
+    "resolve_planner",
+]
+
 PLANNERS: tuple[str, ...] = (*OMPL_PLANNERS, "grid")
 """Every planner ``plan`` offers: OMPL's (``planner.ompl_planners``) and the grid planner."""
 DEFAULT_PLANNER = "bitstar"

@@ -25,6 +25,8 @@ import numpy as np
 
 from sid.checks import check_numbers
 
+__all__ = ["Command", "FollowerParams", "follow", "nearest_arc_length", "point_at", "remaining"]
+
 
 @dataclass(frozen=True)
 class FollowerParams:

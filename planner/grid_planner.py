@@ -16,6 +16,8 @@ from scipy.sparse.csgraph import dijkstra
 
 from planner.problem import CostField, PlanningError
 
+__all__ = ["grid_graph", "grid_search"]
+
 _MOVES = ((0, 1), (1, 0), (1, 1), (1, -1))  # (drow, dcol); the graph is undirected
 
 

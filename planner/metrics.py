@@ -31,6 +31,19 @@ from sid.perception.people import Person
 if TYPE_CHECKING:
     from planner.facade import PlanResult
 
+__all__ = [
+    "FIXED_KEYS",
+    "HALL_BANDS",
+    "PERSONAL_DISTANCE_M",
+    "crosses_group",
+    "group_zones",
+    "heading_change",
+    "min_distance_to_points",
+    "path_length",
+    "path_metrics",
+    "result_metrics",
+]
+
 HALL_BANDS: dict[str, tuple[float, float]] = {"intimate": (0.0, 0.45), "personal": (0.45, 1.2), "social": (1.2, 3.6)}
 PERSONAL_DISTANCE_M = 1.2
 

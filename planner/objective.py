@@ -22,6 +22,8 @@ from ompl import base as ob
 
 from planner.problem import CostField
 
+__all__ = ["CostmapObjective"]
+
 
 class CostmapObjective(ob.PathLengthOptimizationObjective):
     """J = integral of (1 + w c / 252) ds over the motion, from ``CostField.segment_cost``; returns ``ob.Cost``."""

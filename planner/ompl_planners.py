@@ -30,6 +30,16 @@ from planner.objective import CostmapObjective
 from planner.problem import CostField
 from planner.validity import state_validity_checker
 
+__all__ = [
+    "FMT_SAMPLES_PER_SECOND",
+    "OMPL_PLANNERS",
+    "SETTLE_GAIN",
+    "SETTLE_POLL_S",
+    "SETTLING_PLANNERS",
+    "seed_ompl",
+    "solve_ompl",
+]
+
 ou.setLogLevel(ou.LOG_WARN)  # the default level prints OMPL's debug messages to stdout
 
 FMT_SAMPLES_PER_SECOND = 250

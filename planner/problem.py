@@ -34,6 +34,15 @@ from costmap.grid import INSCRIBED, LETHAL, MAX_NON_OBSTACLE, NO_INFORMATION, Co
 from sid.checks import check_number
 from sid.errors import SidError
 
+__all__ = [
+    "CostField",
+    "DEFAULT_COST_WEIGHT",
+    "MAX_COST_WEIGHT",
+    "PlanningError",
+    "PlanningProblem",
+    "SAMPLES_PER_CALL",
+]
+
 _LOOP_MAX = 20  # segment_cost sums this many samples or fewer in a Python loop, more with numpy (docs/parameters.md)
 SAMPLES_PER_CALL = 2**20
 """``CostField.segments`` prices at most about this many samples at once (a few arrays of 8 MB): a batch of long and

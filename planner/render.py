@@ -18,6 +18,21 @@ from costmap.render import Extra, Outline, RobotTask, default_scale, render_cost
 from planner.validity import interpolate
 from sid.perception.groups import Group
 
+__all__ = [
+    "FONT",
+    "HALO",
+    "PathStyle",
+    "ROW_HEIGHT",
+    "TEXT",
+    "WITHOUT_COLOUR",
+    "WITH_COLOUR",
+    "add_header",
+    "add_table",
+    "draw_path",
+    "path_extra",
+    "render_paths",
+]
+
 FONT = cv2.FONT_HERSHEY_SIMPLEX
 TEXT = (40, 40, 40)
 HALO = (255, 255, 255)

@@ -18,6 +18,8 @@ import numpy as np
 from planner.problem import CostField
 from planner.validity import interpolate
 
+__all__ = ["DP_REACH", "REFINE_MIN_STEP", "REFINE_SWEEPS", "dp_shortcut", "refine", "smooth"]
+
 _DIRECTIONS = np.array([[1, 0], [0, 1], [-1, 0], [0, -1], [1, 1], [-1, 1], [-1, -1], [1, -1]], float)
 _DIRECTIONS[4:] /= np.sqrt(2.0)
 _NEIGHBOURS = np.array([[-1], [0], [1]])  # (3, 1): before, the vertex, after

@@ -16,6 +16,8 @@ import numpy as np
 
 from planner.problem import CostField
 
+__all__ = ["PathCheck", "check_path", "interpolate", "state_validity_checker"]
+
 
 def state_validity_checker(field: CostField) -> Callable[[Any], bool]:
     """A callable for ``SpaceInformation.setStateValidityChecker``: state -> plannable (Python bool)."""

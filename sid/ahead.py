@@ -16,6 +16,8 @@ import threading
 from collections.abc import Iterable, Iterator
 from typing import TypeVar, cast
 
+__all__ = ["T", "run_ahead"]
+
 T = TypeVar("T")
 
 _END = object()  # the worker's last message: the iterator ended, with or without an exception

@@ -15,6 +15,8 @@ from typing import Any
 
 from sid.errors import SidError
 
+__all__ = ["LIMITS_ENV", "LimitError", "Limits", "check_limit", "check_number", "check_numbers", "limits"]
+
 LIMITS_ENV = "SID_LIMITS"
 """The environment variable that raises (or lowers) limits: ``SID_LIMITS="map_cells=16000000,people=300"``."""
 

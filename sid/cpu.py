@@ -7,6 +7,8 @@ import os
 from collections.abc import Iterable
 from pathlib import Path
 
+__all__ = ["keep_freed_memory", "physical_cores", "usable_cpus"]
+
 _TOPOLOGY = Path("/sys/devices/system/cpu")
 
 

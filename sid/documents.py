@@ -12,6 +12,16 @@ from typing import Any, TypeGuard
 
 import yaml
 
+__all__ = [
+    "InputWarning",
+    "TEMPORARY_PREFIX",
+    "decode_text",
+    "is_number",
+    "load_document",
+    "unique_keys",
+    "write_atomically",
+]
+
 
 class InputWarning(UserWarning):
     """An input sid accepts but changes (e.g. a map sampled onto other cells); ``sid`` prints it on one line."""

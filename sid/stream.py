@@ -30,6 +30,8 @@ from sid.tracking.records import TrackedGroup, TrackedPerson, Tracks
 from sid.tracking.session import TrackingParams, TrackingSession
 from sid.tracking.view import ViewCone, camera_view_cone
 
+__all__ = ["STREAM_PLUGINS", "SocialStream", "StreamUpdate"]
+
 STREAM_PLUGINS = ("static", "lidar", "tracked_people", "inflation")
 """The layers of the costmap a stream builds from a ``GridSpec``: the tracked-people layer instead of the social one."""
 

@@ -27,6 +27,8 @@ from costmap.grid import FREE_SPACE, INSCRIBED, LETHAL, MAX_NON_OBSTACLE, GridSp
 from costmap.layer import Layer, LayerInputs
 from sid.checks import check_number
 
+__all__ = ["DistanceMethod", "InflationLayer", "InflationParams", "distance_to_lethal_cells", "inflation_cost"]
+
 DistanceMethod = Literal["opencv", "scipy"]
 
 

@@ -32,6 +32,8 @@ from costmap.layer import Layer, LayerInputs
 from costmap.scan import LaserScan
 from sid.checks import check_number, check_numbers
 
+__all__ = ["ObstacleLayer", "ObstacleParams", "trace_cells"]
+
 
 @dataclass(frozen=True)
 class ObstacleParams:

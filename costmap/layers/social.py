@@ -39,6 +39,19 @@ from sid.checks import check_number, check_numbers
 from sid.perception.groups import Group
 from sid.perception.people import Person
 
+__all__ = [
+    "SocialLayer",
+    "SocialParams",
+    "group_zone_polygon",
+    "paint_bodies",
+    "paint_body",
+    "paint_group",
+    "paint_groups",
+    "paint_people",
+    "paint_person",
+    "zone_hull",
+]
+
 
 @dataclass(frozen=True)
 class SocialParams:

@@ -9,6 +9,8 @@ from costmap.grid import GridSpec, Window
 from costmap.layer import Layer, LayerInputs
 from costmap.occupancy import OccupancyGrid, occupancy_to_cost
 
+__all__ = ["StaticLayer", "static_costs"]
+
 
 def static_costs(grid: OccupancyGrid, spec: GridSpec, track_unknown_space: bool = True) -> np.ndarray:
     """A static map interpreted as Nav2's static layer does, sampled (nearest cell) onto ``spec``.

@@ -26,6 +26,8 @@ from costmap.layer import Layer, LayerInputs
 from costmap.layers.social import SocialParams, paint_bodies, paint_groups, paint_people, zone_hull
 from sid.checks import check_number
 
+__all__ = ["MAX_LOOKAHEAD", "TrackedPeopleLayer", "TrackedPeopleParams"]
+
 MAX_LOOKAHEAD = 10.0
 """The longest ``lookahead`` (s): a walker's cost stretched 14 m ahead at 1.4 m/s; beyond it the windows would grow
 without bound and say nothing about where a person will be."""

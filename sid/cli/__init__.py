@@ -17,6 +17,8 @@ from sid.cli.common import signals_as_interrupts
 from sid.cpu import keep_freed_memory
 from sid.documents import InputWarning
 
+__all__ = ["COMMANDS", "build_parser", "main"]
+
 # Each module provides ``add_parser(subparsers)``; the parser it adds sets ``func(args) -> int``.
 COMMANDS: tuple[str, ...] = (
     "detect",

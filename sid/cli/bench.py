@@ -26,6 +26,8 @@ from sid.experiments.bench import (
 from sid.experiments.bench.report import build_report
 from sid.perception.pose.session import PROVIDER_CHOICES, quiet_load_warnings
 
+__all__ = ["SHARED_ENV", "add_parser", "default_shared", "find_repository", "repository", "run"]
+
 PLAN_RUNS_FULL, PLAN_RUNS_QUICK = 5, 1
 SHARED_ENV = "SID_SHARED"
 """The environment variable naming the folder with models/ and data/ (``--shared``'s default when set)."""

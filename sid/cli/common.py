@@ -22,6 +22,24 @@ from typing import IO, Any, TextIO
 from sid.documents import TEMPORARY_PREFIX, unique_keys
 from sid.errors import SidError
 
+__all__ = [
+    "LineHandler",
+    "OutputFolderError",
+    "StagedOutput",
+    "Terminated",
+    "check_output_folder",
+    "clear_owned",
+    "fail",
+    "positive_int",
+    "print_written",
+    "process_json_lines",
+    "read_json_lines",
+    "run_json_lines",
+    "signals_as_interrupts",
+    "signals_deferred",
+    "staged_output",
+]
+
 
 class OutputFolderError(SidError, ValueError):
     """``--out`` names something that cannot be (or become) a writable folder."""

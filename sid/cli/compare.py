@@ -15,6 +15,8 @@ from sid.experiments.harness import prepare, run_matrix, summarise
 from sid.experiments.progress import ProgressBar
 from sid.scenario.loader import load_scenario
 
+__all__ = ["add_parser", "run"]
+
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(

@@ -12,6 +12,8 @@ from sid.scenario.build import build_costmap
 from sid.scenario.loader import ScenarioError, load_scenario
 from sid.scenario.obstacles import outline
 
+__all__ = ["add_parser", "run"]
+
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(

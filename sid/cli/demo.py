@@ -11,6 +11,8 @@ from sid.experiments.demo import DEMO_ITERATIONS, DEMO_SEED, run_demo
 from sid.experiments.plan_pictures import format_table
 from sid.scenario.loader import load_scenario
 
+__all__ = ["add_parser", "run"]
+
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(

@@ -41,6 +41,8 @@ from sid.tracking import SessionUpdate, TrackingError, TrackingSession, ViewCone
 if TYPE_CHECKING:  # costmap.render (the costmap layers, shapely) is imported only for --out: start-up time
     from costmap.render import CameraView
 
+__all__ = ["OUTPUTS", "PictureRecords", "TOP_VIEW", "add_parser", "camera_view", "picture_records", "run"]
+
 OUTPUTS = ("detections.jsonl", "overlay_*.png", "topview_*.png")
 """What ``sid detect --out`` writes (and clears there first, nothing else)."""
 TOP_VIEW = GridSpec.from_size(0.05, (-0.5, -3.5), (7.5, 7.0))  # world frame: 7 m ahead of the camera, 3.5 m each side

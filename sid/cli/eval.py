@@ -28,6 +28,8 @@ from sid.experiments.fformation import (
 )
 from sid.experiments.fformation import evaluate as evaluate_fformation
 
+__all__ = ["add_parser", "add_tracking_parser", "run", "run_tracking"]
+
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser("eval", help="score the detectors on benchmark datasets")

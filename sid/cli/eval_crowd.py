@@ -18,6 +18,8 @@ from sid.experiments.crowd import DEFAULT_GRID, CrowdSettings, cross_validate, e
 from sid.experiments.trajectories import ReplaySettings, TrajectoryError, TrajectorySet, load_trajectory_set
 from sid.tracking.view import ViewCone
 
+__all__ = ["FOV_DEGREES", "add_crowd_parser", "run_crowd"]
+
 FOV_DEGREES = 87.0
 """The RealSense D435i colour camera's horizontal opening (degrees), the default ``--fov``."""
 

@@ -9,6 +9,8 @@ import re
 
 from sid.perception.groups import GROUP_METHODS, GroupParams
 
+__all__ = ["add_group_params", "group_params_from"]
+
 
 def add_group_params(parser: argparse.ArgumentParser) -> None:
     """One option per GroupParams field (--method, --group-price, --eps, ...), defaulting to the record's defaults."""

@@ -23,6 +23,8 @@ from sid.documents import is_number
 from sid.perception.groups import Group, GroupParams, detect_groups
 from sid.perception.people import Person
 
+__all__ = ["add_parser", "group_to_json", "process", "run"]
+
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(

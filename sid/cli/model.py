@@ -16,6 +16,16 @@ from sid.perception.pose.contracts import PoseModelError
 from sid.perception.pose.quantize import FLOAT_LAYERS
 from sid.sources import FrameReadError, SourceError, open_source, skip_unreadable
 
+__all__ = [
+    "DEFAULT_FRAMES",
+    "INPUT_ERRORS",
+    "SYNTHETIC_FRAMES",
+    "add_parser",
+    "run_compare",
+    "run_quantize",
+    "run_simplify",
+]
+
 DEFAULT_FRAMES = 100
 """At most this many frames (all sources together) calibrate or are compared, unless --frames says otherwise."""
 SYNTHETIC_FRAMES = 30  # frames of a synthetic:SCENE source, as sid detect

@@ -16,6 +16,8 @@ from sid.cli.planning import (
 from sid.experiments.scenario_plan import plan_scenario, write_plan
 from sid.scenario.loader import load_scenario
 
+__all__ = ["add_parser", "run"]
+
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(

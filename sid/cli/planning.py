@@ -12,6 +12,15 @@ from planner.problem import DEFAULT_COST_WEIGHT, PlanningError
 from sid.experiments.harness import Comparison, goal_zone_warning
 from sid.scenario.loader import ScenarioError
 
+__all__ = [
+    "INPUT_ERRORS",
+    "add_planner_option",
+    "add_planning_options",
+    "add_scenario_arguments",
+    "seed_number",
+    "warn_goal_zone",
+]
+
 INPUT_ERRORS = (ScenarioError, MapFileError, PlanningError, ValueError)
 """What a command that loads a scenario and plans on it reports as bad input (exit code 2), not as a crash."""
 

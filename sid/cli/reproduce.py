@@ -16,6 +16,17 @@ from sid.experiments.progress import ProgressBar
 from sid.synthetic.layouts import LAYOUTS, VARIATIONS
 from sid.synthetic.noise import DepthNoise, KeypointNoise
 
+__all__ = [
+    "NAVIGATION_DEFAULTS",
+    "NavigationDefaults",
+    "QUICK_NAVIGATION",
+    "QUICK_TABLE1",
+    "TABLE1_DEFAULTS",
+    "add_parser",
+    "navigation_command",
+    "table1_command",
+]
+
 TABLE1_DEFAULTS = {"frames": 50, "variations": len(VARIATIONS)}
 QUICK_TABLE1 = {"frames": 2, "variations": 1}
 

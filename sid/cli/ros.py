@@ -14,6 +14,8 @@ from sid.perception.pipeline import PoseFn, image_pose
 from sid.perception.pose.contracts import PoseModelError
 from sid.sources import SourceError, open_source
 
+__all__ = ["INSTALL_HINT", "SHARE", "SYNTHETIC_FRAMES", "add_parser", "run"]
+
 INSTALL_HINT = (
     "sid ros needs ROS 2's rclpy, which cannot be imported here ({error}). Source a ROS 2 installation "
     "(`source /opt/ros/jazzy/setup.bash`), or install the Python wheels with `pip install 'sid[ros]'`; see "

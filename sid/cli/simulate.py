@@ -16,6 +16,8 @@ from sid.experiments.progress import ProgressBar
 from sid.experiments.simulate.loop import PERCEPTIONS, RunOptions
 from sid.experiments.simulate.scenes import SCENE_ORDER, load_scene, scene_list
 
+__all__ = ["RUN_FILES", "SUMMARY_KEYS", "SWEEP_FILES", "add_parser", "run"]
+
 RUN_FILES = ("run.json", "run.mp4", "run.gif", "run.png")
 """The files one run writes into --out (run.gif with --gif, run.png with --still): an earlier run's are replaced or
 removed."""

@@ -29,6 +29,8 @@ from sid.documents import is_number
 from sid.perception.people import Person
 from sid.tracking import TrackingSession
 
+__all__ = ["LINE_FIELDS", "PERSON_FIELDS", "add_parser", "run"]
+
 LINE_FIELDS = ("timestamp", "people")
 PERSON_FIELDS = ("id", "x", "y", "theta")
 

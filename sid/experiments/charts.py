@@ -14,6 +14,8 @@ from planner.render import WITH_COLOUR, WITHOUT_COLOUR
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
+__all__ = ["MODE_STYLE", "NAVIGATION_PANELS", "PLANNER_PANELS", "Panel", "bar_chart", "from_key"]
+
 
 @dataclass(frozen=True)
 class Panel:

@@ -17,6 +17,8 @@ from pathlib import Path
 from sid.experiments.charts import PLANNER_PANELS, bar_chart
 from sid.experiments.harness import Run, summarise
 
+__all__ = ["BY_SCENARIO", "CHART_NOTE", "format_summary", "write_comparison"]
+
 BY_SCENARIO = ("scenario", "time_limit_s", "planner")
 
 

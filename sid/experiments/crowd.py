@@ -44,14 +44,16 @@ from sid.tracking.tracker import TrackerParams
 from sid.tracking.view import scene_view
 
 __all__ = [
-    "DEFAULT_GRID",
     "CrowdSettings",
+    "DEFAULT_GRID",
+    "Progress",
     "TrackLog",
     "cross_validate",
     "evaluate_crowd",
     "find_coherent_groups",
     "find_groups",
     "record_tracks",
+    "require_motmetrics",
     "score_groups",
     "score_people",
 ]

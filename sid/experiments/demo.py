@@ -22,6 +22,8 @@ from sid.experiments.harness import LABELS, Comparison, Run, compare_with_withou
 from sid.experiments.plan_pictures import plan_picture
 from sid.scenario.loader import Scenario, scenario_from_dict
 
+__all__ = ["DEMO_ITERATIONS", "DEMO_SCENARIO", "DEMO_SEED", "comparison_picture", "demo_scenario", "run_demo"]
+
 
 def _circle(ids: tuple[int, ...], centre: tuple[float, float], radius: float, angles_deg: tuple[float, ...]) -> list:
     """People on a circle around ``centre``, each facing it (scenario-file dicts, world frame)."""

@@ -36,6 +36,35 @@ from sid.perception.gcff import GCFFParams
 from sid.perception.groups import GroupParams, detect_groups
 from sid.perception.people import Person
 
+__all__ = [
+    "DEFAULT_GRID",
+    "DEFAULT_THRESHOLDS",
+    "Fold",
+    "LabelledFrame",
+    "PLAUSIBLE_NEIGHBOUR_M",
+    "Score",
+    "UNIT_SCALES",
+    "YAW_LIMIT_RAD",
+    "cross_validate",
+    "evaluate",
+    "fitting_unit",
+    "format_threshold",
+    "frame_matches",
+    "frame_precision_recall",
+    "gcff_settings",
+    "load_dataset",
+    "load_dataset_in_metres",
+    "load_sequence",
+    "load_settings_gc",
+    "median_neighbour_distance",
+    "missing_members",
+    "parse_threshold",
+    "score",
+    "sequence_folders",
+    "unit_warning",
+    "with_facing_noise",
+]
+
 DEFAULT_THRESHOLDS: tuple[float, ...] = (2 / 3, 1.0)
 DEFAULT_GRID: dict[str, tuple[float, ...]] = {
     "alone_price": (0.5, 0.65, 0.8),

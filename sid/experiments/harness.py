@@ -32,6 +32,21 @@ from sid.perception.groups import Group, detect_groups
 from sid.scenario.build import build_costmap, planning_problem
 from sid.scenario.loader import Scenario
 
+__all__ = [
+    "Comparison",
+    "LABELS",
+    "MODES",
+    "MatrixProgress",
+    "Progress",
+    "Run",
+    "Task",
+    "compare_with_without",
+    "goal_zone_warning",
+    "prepare",
+    "run_matrix",
+    "summarise",
+]
+
 MODES: dict[str, bool] = {"without": False, "with": True}
 """The two costmap modes by name: whether the costmap has the social layer."""
 LABELS = {"without": "without recognition (map + LiDAR)", "with": "with recognition (social layer)"}

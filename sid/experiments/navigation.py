@@ -38,6 +38,25 @@ from sid.experiments.harness import Comparison, compare_with_without, prepare
 from sid.scenario.loader import Scenario, scenario_from_dict
 from sid.synthetic.layouts import LAYOUTS
 
+__all__ = [
+    "CENTRE_LATERAL_M",
+    "DIRECTIONS",
+    "ENDPOINT_LATERAL_M",
+    "GROUP_CENTRE_X",
+    "GroupLayout",
+    "JITTER_THETA_RAD",
+    "JITTER_XY_M",
+    "NAV_LAYOUTS",
+    "NavSettings",
+    "NavTask",
+    "NavigationResult",
+    "Progress",
+    "RUN_KEYS",
+    "navigation_tasks",
+    "run_navigation",
+    "task_scenario",
+]
+
 
 @dataclass(frozen=True)
 class GroupLayout:

@@ -9,6 +9,8 @@ from planner.render import WITH_COLOUR, WITHOUT_COLOUR, PathStyle, add_header, a
 from sid.experiments.harness import LABELS, Comparison
 from sid.scenario.obstacles import outline
 
+__all__ = ["HEADER", "STYLES", "format_table", "metric_cells", "plan_picture"]
+
 STYLES = {
     "without": PathStyle(LABELS["without"], WITHOUT_COLOUR, dashed=True),
     "with": PathStyle(LABELS["with"], WITH_COLOUR),

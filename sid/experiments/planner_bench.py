@@ -11,6 +11,8 @@ from __future__ import annotations
 from sid.experiments.demo import demo_scenario
 from sid.experiments.harness import Run, Task, prepare, run_matrix, summarise
 
+__all__ = ["TARGET_BUDGET_S", "TARGET_COST_RATIO", "bench_planner", "meets_target", "planner_task"]
+
 TARGET_BUDGET_S = 0.5
 TARGET_COST_RATIO = 1.03
 

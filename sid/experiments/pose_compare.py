@@ -27,6 +27,17 @@ from sid.perception.keypoints import PoseDetection
 from sid.perception.people import Person
 from sid.perception.pipeline import FrameResult, Pipeline
 
+__all__ = [
+    "COCO_SIGMAS",
+    "Criteria",
+    "FrameComparison",
+    "compare_pipelines",
+    "compare_results",
+    "format_comparisons",
+    "match_detections",
+    "oks",
+]
+
 COCO_SIGMAS = np.array(
     [0.026, 0.025, 0.025, 0.035, 0.035, 0.079, 0.079, 0.072, 0.072,
      0.062, 0.062, 0.107, 0.107, 0.087, 0.087, 0.089, 0.089]

@@ -7,6 +7,8 @@ import sys
 import time
 from typing import TextIO
 
+__all__ = ["ProgressBar"]
+
 
 class ProgressBar:
     """``progress(done, total, what)`` drawing a one-line bar with the elapsed time on ``stream`` (stderr), redrawn

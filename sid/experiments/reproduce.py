@@ -18,6 +18,19 @@ from sid.experiments.navigation import NAV_LAYOUTS, NavigationResult
 from sid.experiments.table1 import METRICS, PAPER_TABLE1, UNITS, Table1Result, table1_json
 from sid.synthetic.layouts import LAYOUTS, VARIATIONS
 
+__all__ = [
+    "cell",
+    "json_ready",
+    "markdown_table",
+    "navigation_json",
+    "navigation_markdown",
+    "percent",
+    "table1_markdown",
+    "write_json",
+    "write_navigation_report",
+    "write_table1_report",
+]
+
 
 def cell(value: float | None, spec: str = ".3f", unit: str = "") -> str:
     """A table cell: ``value`` formatted with ``spec`` (and a unit), or "-" when it is missing or not finite."""

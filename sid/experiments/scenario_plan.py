@@ -15,6 +15,8 @@ from sid.experiments.harness import Comparison, compare_with_without, prepare
 from sid.experiments.plan_pictures import plan_picture
 from sid.scenario.loader import Scenario
 
+__all__ = ["path_record", "plan_scenario", "write_plan"]
+
 
 def plan_scenario(
     scenario: Scenario,

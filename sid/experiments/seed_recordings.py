@@ -28,6 +28,19 @@ import numpy as np
 from sid.perception.groups import Group, GroupParams, detect_groups
 from sid.perception.people import Person
 
+__all__ = [
+    "Agreement",
+    "COLUMNS",
+    "LoggedFrame",
+    "LoggedGroup",
+    "authors_params",
+    "compare",
+    "frame_to_json",
+    "load_recording",
+    "load_recordings",
+    "main",
+]
+
 COLUMNS = (
     "Timestamp",
     "Group Index",

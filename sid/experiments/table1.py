@@ -42,6 +42,21 @@ from sid.synthetic.noise import DepthNoise, KeypointNoise
 from sid.synthetic.pose import TruthPose
 from sid.synthetic.sensor import FrameTruth
 
+__all__ = [
+    "ErrorLog",
+    "METRICS",
+    "PAPER_TABLE1",
+    "Progress",
+    "Table1Result",
+    "Table1Settings",
+    "UNITS",
+    "best_group",
+    "match_people",
+    "run_table1",
+    "table1_json",
+    "wrap_degrees",
+]
+
 METRICS = ("IZA", "IPX", "IPY", "HPX", "HPY", "HFD")
 UNITS = {"IZA": "m^2", "IPX": "m", "IPY": "m", "HPX": "m", "HPY": "m", "HFD": "deg"}
 

@@ -54,6 +54,17 @@ from sid.synthetic.sequence import SEQUENCES
 from sid.tracking.session import TrackingParams
 from sid.tracking.view import ViewCone
 
+__all__ = [
+    "MissingDependencyError",
+    "Progress",
+    "TrackingEvalSettings",
+    "as_truth_ids",
+    "evaluate_tracking",
+    "identify",
+    "measure_flicker",
+    "mot_scores",
+]
+
 Progress = Callable[[int, int, str], None]
 """progress(done, total, what) after each frame (``sid.experiments.progress.ProgressBar``)."""
 

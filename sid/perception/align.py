@@ -48,6 +48,16 @@ import numpy as np
 
 from sid.perception.camera import Calibration, Intrinsics
 
+__all__ = [
+    "Aligner",
+    "PatchMethod",
+    "Search",
+    "SplatMode",
+    "StoredValue",
+    "align_depth_to_color",
+    "depth_at_color_pixels",
+]
+
 SplatMode = Literal["rectangle", "point"]
 StoredValue = Literal["z", "depth"]
 PatchMethod = Literal["nearest", "min", "median"]

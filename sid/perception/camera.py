@@ -20,6 +20,8 @@ import numpy as np
 from sid.checks import check_number, check_numbers
 from sid.documents import is_number, load_document
 
+__all__ = ["Calibration", "Extrinsics", "Intrinsics", "MAX_FOCAL_PER_PIXEL", "MAX_IMAGE_SIDE", "deproject", "project"]
+
 MAX_IMAGE_SIDE = 100_000
 """The largest image width or height a calibration file may give (pixels)."""
 

@@ -26,6 +26,8 @@ import numpy as np
 
 from sid.checks import check_number
 
+__all__ = ["SMALL_N_MAX", "dbscan_labels"]
+
 # Above this many points scikit-learn is used: its neighbour index wins once the O(n^2) work grows (the two
 # cross between 128 and 256 points, docs/parameters.md).
 SMALL_N_MAX = 128

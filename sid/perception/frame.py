@@ -10,6 +10,8 @@ import numpy as np
 from sid.perception.camera import Calibration
 from sid.perception.robot_pose import RobotPose
 
+__all__ = ["Frame"]
+
 
 @dataclass
 class Frame:

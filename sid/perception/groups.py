@@ -56,6 +56,8 @@ from sid.perception.gcff import GCFFParams, gcff_labels
 from sid.perception.ospace import OSpaceModel, find_ospaces
 from sid.perception.people import Person
 
+__all__ = ["GROUP_METHODS", "Group", "GroupParams", "QUANTISED_STEPS", "detect_groups", "facing_step"]
+
 # |sin| of the angle between two rays below which they count as parallel (their crossing is rounding noise).
 _PARALLEL = 1e-9
 # |sin| of the angle between the rays of a face-to-face pair below which they meet at their midpoint, crossing or

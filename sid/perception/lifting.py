@@ -51,6 +51,8 @@ from sid.perception.mount import CameraMount
 from sid.perception.orientation import EAR_SEPARATION, HIP_SEPARATION, SHOULDER_SEPARATION, estimate_orientations
 from sid.perception.people import Person
 
+__all__ = ["LiftParams", "lift_people"]
+
 # Far-side completion. Root keypoints and their partner a fixed separation away, as (root, partner): shoulders,
 # hips, ears (``widths`` order), left roots then right ones.
 _ROOT_PAIRS = tuple(

@@ -16,6 +16,8 @@ import numpy as np
 
 from sid.checks import check_number, check_numbers
 
+__all__ = ["CameraMount", "MAX_MOUNT_M"]
+
 MAX_MOUNT_M = 10.0
 """The farthest (m) a robot's camera is taken to sit from ``base_footprint``'s origin, up or sideways."""
 

@@ -33,6 +33,16 @@ import numpy as np
 
 from sid.perception.keypoints import KP, NUM_KEYPOINTS
 
+__all__ = [
+    "EAR_SEPARATION",
+    "EYE_SEPARATION",
+    "HIP_SEPARATION",
+    "SHOULDER_SEPARATION",
+    "SIGN_PAIRS",
+    "estimate_orientation",
+    "estimate_orientations",
+]
+
 SHOULDER_SEPARATION = 0.34
 HIP_SEPARATION = 0.18
 EAR_SEPARATION = 0.15

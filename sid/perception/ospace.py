@@ -58,6 +58,8 @@ if TYPE_CHECKING:  # imported where a crowd needs it: scipy.spatial is ~0.3 s of
 
 from sid.checks import check_number
 
+__all__ = ["OSpace", "OSpaceModel", "TIE", "find_ospaces"]
+
 # Greedy assignment and refit rounds at most; the partition is stable after 2-4 on the benchmarks.
 _MAX_ROUNDS = 8
 TIE = 1e-9

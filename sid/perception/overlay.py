@@ -16,6 +16,18 @@ from sid.perception.keypoints import COCO_KEYPOINTS, LEFT_SHOULDER, RIGHT_SHOULD
 from sid.perception.people import Person
 from sid.perception.pose.base import check_color_image
 
+__all__ = [
+    "ARROW_COLOUR",
+    "BOX_COLOUR",
+    "CENTRE_COLOUR",
+    "FONT",
+    "LEFT_COLOUR",
+    "RIGHT_COLOUR",
+    "draw_detections",
+    "person_label",
+    "place_labels",
+]
+
 LEFT_COLOUR = (0, 140, 255)
 RIGHT_COLOUR = (255, 140, 0)
 CENTRE_COLOUR = (255, 255, 255)

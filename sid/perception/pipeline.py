@@ -24,6 +24,8 @@ from sid.perception.mount import CameraMount
 from sid.perception.people import Person
 from sid.perception.robot_pose import BASE_FRAME, MAP_FRAME, RobotPose
 
+__all__ = ["FrameResult", "Pipeline", "PoseFn", "PosedFrame", "group_json", "image_pose"]
+
 PoseFn = Callable[[Frame], list[PoseDetection]]
 
 

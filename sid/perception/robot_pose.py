@@ -16,6 +16,8 @@ import numpy as np
 from sid.checks import check_numbers
 from sid.perception.people import Person
 
+__all__ = ["BASE_FRAME", "MAP_FRAME", "RobotPose"]
+
 MAP_FRAME = "map"
 BASE_FRAME = "base_footprint"
 

@@ -10,6 +10,8 @@ import numpy as np
 
 from sid.perception.keypoints import COCO_KEYPOINTS
 
+__all__ = ["BODY_FRACTIONS", "skeleton_world"]
+
 # Joint centres of an upright person with arms hanging, as fractions of body height: (forward, left, up) in the
 # person's own frame, origin on the ground between the feet. Heights follow the anthropometric segment proportions
 # of Drillis & Contini as tabulated by Winter ("Biomechanics and Motor Control of Human Movement"): shoulder 0.818 h,

@@ -21,6 +21,20 @@ from costmap.grid import Costmap2D
 from sid.perception.pipeline import group_json
 from sid.tracking.records import TrackedGroup, TrackedPerson
 
+__all__ = [
+    "BODY_HEIGHT",
+    "BODY_RADIUS",
+    "GROUP_COLOR",
+    "GridFields",
+    "MarkerFields",
+    "PERSON_COLORS",
+    "grid_fields",
+    "groups_document",
+    "quaternion_from_yaw",
+    "scene_markers",
+    "yaw_from_quaternion",
+]
+
 BODY_RADIUS = 0.2
 """Radius (m) of the cylinder drawn for a person."""
 BODY_HEIGHT = 1.7

@@ -17,6 +17,18 @@ from visualization_msgs.msg import Marker, MarkerArray
 
 from sid.ros.convert import GridFields, MarkerFields
 
+__all__ = [
+    "KEEPOUT_FILTER",
+    "MARKER_TYPES",
+    "filter_info",
+    "filter_info_type",
+    "header",
+    "ids_list_type",
+    "marker_array",
+    "occupancy_grid",
+    "time_msg",
+]
+
 MARKER_TYPES = {
     "arrow": Marker.ARROW,
     "cylinder": Marker.CYLINDER,

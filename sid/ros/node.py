@@ -42,6 +42,8 @@ from sid.sources import FrameReadError, skip_unreadable
 from sid.sources.ros_messages import StampPairer, intrinsics_from_camera_info, rgbd_frame, stamp_seconds
 from sid.stream import SocialStream, StreamUpdate
 
+__all__ = ["COSTMAP_LAYERS", "LATCHED", "SPIN_WAIT", "SocialCostmapNode", "spin"]
+
 LATCHED = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
     depth=1,

@@ -14,6 +14,8 @@ from sid.perception.mount import CameraMount
 from sid.perception.robot_pose import BASE_FRAME, MAP_FRAME
 from sid.sources.rosbag2 import COLOR_TOPIC, DEPTH_TOPIC
 
+__all__ = ["DESCRIPTIONS", "NODE_NAME", "NodeParams", "PARAMETERS", "POSE_SOURCES", "ros_name"]
+
 NODE_NAME = "sid_social_costmap"
 POSE_SOURCES = ("auto", "tf", "odom", "none")
 

@@ -15,6 +15,8 @@ from sid.scenario.known_map import known_map
 from sid.scenario.lidar import simulate_scan
 from sid.scenario.loader import Scenario
 
+__all__ = ["build_costmap", "planning_problem"]
+
 
 def build_costmap(
     scenario: Scenario,

@@ -21,6 +21,8 @@ from costmap.grid import GridSpec
 from costmap.occupancy import OCC_OCCUPIED, OCC_UNKNOWN, OccupancyGrid
 from sid.scenario.obstacles import BoxObstacle, CircleObstacle, Obstacle, SegmentObstacle
 
+__all__ = ["known_map", "obstacle_mask"]
+
 
 def _mark_points(mask: np.ndarray, spec: GridSpec, xy: np.ndarray) -> None:
     cells = spec.world_to_cell(xy)

@@ -16,6 +16,8 @@ from sid.checks import check_number
 from sid.perception.people import Person
 from sid.scenario.obstacles import BoxObstacle, CircleObstacle, Obstacle, SegmentObstacle
 
+__all__ = ["simulate_scan"]
+
 
 def _segments(obstacles: Sequence[Obstacle]) -> tuple[np.ndarray, np.ndarray]:
     """Start and end points (S, 2) of every straight piece of walls and boxes."""

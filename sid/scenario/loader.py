@@ -39,11 +39,14 @@ __all__ = [
     "CostmapParams",
     "LidarSpec",
     "Obstacle",
+    "PERSON_FIELDS",
     "RobotSpec",
     "Scenario",
     "ScenarioError",
     "SegmentObstacle",
+    "TOP_LEVEL",
     "load_scenario",
+    "read_scenario_file",
     "scenario_from_dict",
 ]
 

@@ -14,6 +14,8 @@ from itertools import pairwise
 
 from sid.checks import check_number, check_numbers
 
+__all__ = ["MotionState", "Trajectory"]
+
 
 @dataclass(frozen=True)
 class MotionState:

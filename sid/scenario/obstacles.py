@@ -6,6 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+__all__ = ["BoxObstacle", "CircleObstacle", "Obstacle", "SegmentObstacle", "outline"]
+
 
 @dataclass(frozen=True)
 class SegmentObstacle:

@@ -24,6 +24,16 @@ from typing import Any
 from sid.errors import SidError
 from sid.perception.frame import Frame
 
+__all__ = [
+    "FrameReadError",
+    "RECORDING_SUFFIXES",
+    "ROSBAG2_METADATA",
+    "SourceError",
+    "frames_or_errors",
+    "open_source",
+    "skip_unreadable",
+]
+
 RECORDING_SUFFIXES = (".db3", ".bag", ".mcap")
 ROSBAG2_METADATA = "metadata.yaml"
 

@@ -25,6 +25,8 @@ from sid.perception.camera import Calibration
 from sid.perception.frame import Frame
 from sid.sources import FrameReadError, SourceError
 
+__all__ = ["CALIBRATION_NAMES", "COLOR_SUFFIXES", "FolderSource"]
+
 COLOR_SUFFIXES = (".png", ".jpg", ".jpeg")
 CALIBRATION_NAMES = ("intrinsics.json", "calibration.json")
 

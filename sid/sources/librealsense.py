@@ -24,6 +24,17 @@ import pyrealsense2 as rs
 
 from sid.perception.camera import Calibration, Extrinsics, Intrinsics
 
+__all__ = [
+    "RealSenseFrames",
+    "calibration_from_profile",
+    "calibration_from_profiles",
+    "make_frameset",
+    "read_frameset",
+    "record_synthetic",
+    "rs_extrinsics",
+    "rs_intrinsics",
+]
+
 _DISTORTIONS = {
     "none": rs.distortion.none,
     "brown_conrady": rs.distortion.brown_conrady,

@@ -48,6 +48,8 @@ from sid.sources.librealsense import (
     read_frameset,
 )
 
+__all__ = ["AlignMode", "IncompleteFrame", "RealSenseSource"]
+
 AlignMode = Literal["sid", "librealsense", "none"]
 _POLL_MS = 100
 

@@ -20,6 +20,17 @@ from sid.checks import check_number
 from sid.perception.camera import Calibration, Intrinsics
 from sid.perception.frame import Frame
 
+__all__ = [
+    "StampPairer",
+    "Stamped",
+    "T",
+    "color_rgb",
+    "depth_metres",
+    "intrinsics_from_camera_info",
+    "rgbd_frame",
+    "stamp_seconds",
+]
+
 # Colour encodings -> (channels, OpenCV conversion to RGB; None: already RGB).
 _COLOR = {
     "rgb8": (3, None),

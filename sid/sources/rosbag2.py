@@ -32,6 +32,16 @@ from sid.perception.frame import Frame
 from sid.sources import FrameReadError, SourceError
 from sid.sources.ros_messages import Stamped, StampPairer, intrinsics_from_camera_info, rgbd_frame, stamp_seconds
 
+__all__ = [
+    "BAG_SUFFIXES",
+    "CAMERA_INFO",
+    "COLOR_TOPIC",
+    "DEPTH_TOPIC",
+    "IMAGE",
+    "Rosbag2Source",
+    "is_librealsense_recording",
+]
+
 IMAGE = "sensor_msgs/msg/Image"
 CAMERA_INFO = "sensor_msgs/msg/CameraInfo"
 COLOR_TOPIC = "/camera/camera/color/image_raw"

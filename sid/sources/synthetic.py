@@ -26,6 +26,8 @@ from sid.synthetic.scene import Scene
 from sid.synthetic.sensor import SyntheticCamera
 from sid.synthetic.sequence import SEQUENCES, Sequence, builtin_sequence, load_scene_file
 
+__all__ = ["DEFAULT_FRAMES", "PREFIX", "SyntheticSource", "scene_from_spec", "synthetic_source"]
+
 PREFIX = "synthetic:"
 DEFAULT_FRAMES = 30  # frames of a static scene when none are asked for
 

@@ -14,6 +14,8 @@ from sid.checks import check_number
 from sid.perception.keypoints import KP, NUM_KEYPOINTS
 from sid.synthetic.render import Capsule
 
+__all__ = ["REFERENCE_HEIGHT", "body_capsules", "body_frame"]
+
 REFERENCE_HEIGHT = 1.70  # m: the body sizes below are for this height
 
 # (from keypoint, to keypoint, radius in m at the reference height)

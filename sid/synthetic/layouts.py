@@ -39,6 +39,8 @@ from sid.checks import check_numbers
 from sid.perception.mount import CameraMount
 from sid.synthetic.scene import Scene, ScenePerson
 
+__all__ = ["Formation", "LAYOUTS", "LayoutSpec", "VARIATIONS", "layout", "variations"]
+
 
 @dataclass(frozen=True)
 class LayoutSpec:

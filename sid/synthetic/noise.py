@@ -23,6 +23,8 @@ import numpy as np
 
 from sid.checks import check_number, check_numbers
 
+__all__ = ["DepthNoise", "KeypointNoise", "visible_to_right_imager"]
+
 
 @dataclass(frozen=True)
 class DepthNoise:

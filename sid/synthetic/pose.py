@@ -23,6 +23,8 @@ from sid.perception.frame import Frame
 from sid.perception.keypoints import KP, NUM_KEYPOINTS, PoseDetection
 from sid.synthetic.sensor import FrameTruth
 
+__all__ = ["TruthPose"]
+
 _FACE = np.isin(np.arange(NUM_KEYPOINTS), [KP["nose"], KP["left_eye"], KP["right_eye"]])
 
 

@@ -20,6 +20,8 @@ import numpy as np
 from sid.checks import check_number
 from sid.perception.camera import Extrinsics, Intrinsics
 
+__all__ = ["Background", "Capsule", "LABEL_GROUND", "LABEL_NONE", "LABEL_WALL", "RayCaster", "Rendering"]
+
 # Label image values that are not a body index.
 LABEL_NONE = -1  # nothing hit (sky / beyond every surface)
 LABEL_GROUND = -2

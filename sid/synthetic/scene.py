@@ -21,6 +21,8 @@ from sid.documents import load_document
 from sid.perception.mount import CameraMount
 from sid.perception.people import Person
 
+__all__ = ["Scene", "ScenePerson"]
+
 
 @dataclass(frozen=True)
 class ScenePerson:

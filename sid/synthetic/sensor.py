@@ -39,6 +39,17 @@ from sid.synthetic.scene import Scene, ScenePerson
 from sid.synthetic.sequence import Sequence
 from sid.synthetic.truth import TruthGroup, truth_groups
 
+__all__ = [
+    "D435I_COLOR",
+    "D435I_DEPTH",
+    "D435I_DEPTH_TO_COLOR",
+    "FrameTruth",
+    "PERSON_COLORS",
+    "SyntheticCamera",
+    "TruthPerson",
+    "d435i_calibration",
+]
+
 D435I_COLOR = Intrinsics(1280, 720, 910.0, 910.0, 639.5, 359.5)
 D435I_DEPTH = Intrinsics(848, 480, 420.0, 420.0, 423.5, 239.5)
 D435I_DEPTH_TO_COLOR = Extrinsics(np.eye(3), np.array([0.015, 0.0, 0.0]))

@@ -30,6 +30,8 @@ from sid.scenario.loader import Scenario, ScenarioError, scenario_from_dict
 from sid.scenario.motion import MotionState, Trajectory
 from sid.synthetic.scene import Scene, ScenePerson
 
+__all__ = ["Moment", "MovingPerson", "SEQUENCES", "SEQUENCES_DIR", "Sequence", "builtin_sequence", "load_scene_file"]
+
 SEQUENCES_DIR = Path(__file__).parent / "sequences"
 SEQUENCES = ("crossing_walkers", "drive_past_group", "walking_pairs", "file_behind_group", "close_crossing")
 

@@ -16,6 +16,8 @@ from dataclasses import dataclass
 from sid.perception.groups import GroupParams, detect_groups
 from sid.synthetic.scene import ScenePerson
 
+__all__ = ["TruthGroup", "truth_groups"]
+
 
 @dataclass(frozen=True)
 class TruthGroup:

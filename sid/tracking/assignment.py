@@ -20,6 +20,8 @@ from functools import cache
 
 import numpy as np
 
+__all__ = ["gated_assignment", "load_solver"]
+
 
 def gated_assignment(cost: np.ndarray, allowed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Rows and columns (int arrays, row order) of the best matching of allowed pairs of a (R, C) ``cost``.

@@ -34,6 +34,8 @@ from sid.perception.groups import GroupParams, detect_groups
 from sid.tracking.assignment import gated_assignment
 from sid.tracking.records import GroupKind, TrackedGroup, TrackedPerson
 
+__all__ = ["GroupTracker", "GroupTrackerParams", "connected_components"]
+
 _NO_ZONE = np.zeros((0, 2))
 
 

@@ -17,6 +17,8 @@ from sid.perception.groups import Group
 from sid.perception.people import Person
 from sid.perception.pipeline import group_json
 
+__all__ = ["GroupKind", "MotionState", "TrackedGroup", "TrackedPerson", "Tracks"]
+
 MotionState = Literal["standing", "walking"]
 GroupKind = Literal["conversation", "walking"]
 

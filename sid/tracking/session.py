@@ -25,6 +25,8 @@ from sid.tracking.records import TrackedGroup, TrackedPerson
 from sid.tracking.tracker import PeopleTracker, TrackerParams, TrackingError
 from sid.tracking.view import View
 
+__all__ = ["SessionUpdate", "TrackingParams", "TrackingSession"]
+
 
 @dataclass(frozen=True)
 class TrackingParams:

@@ -28,6 +28,8 @@ from sid.tracking.motion import MotionStates
 from sid.tracking.records import TrackedPerson
 from sid.tracking.view import View, ViewCone
 
+__all__ = ["OCCLUDER_RADIUS", "PeopleTracker", "TrackerParams", "TrackingError"]
+
 OCCLUDER_RADIUS = 0.2
 """A person's half-width (m) seen from above, to tell who is behind whom in the camera's view (``ViewCone.behind``)."""
 

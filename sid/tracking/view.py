@@ -18,6 +18,8 @@ from sid.perception.camera import Calibration
 from sid.perception.mount import CameraMount
 from sid.perception.robot_pose import RobotPose
 
+__all__ = ["View", "ViewCone", "ViewRegion", "camera_fov", "camera_view_cone", "scene_view"]
+
 
 @dataclass(frozen=True)
 class ViewCone:

@@ -37,6 +37,8 @@ from sklearn.cluster import DBSCAN
 
 from sid.perception.people import Person
 
+__all__ = ["BaselineGroup", "BaselineParams", "baseline_groups"]
+
 
 @dataclass(frozen=True)
 class BaselineParams:

@@ -19,6 +19,8 @@ from sid.experiments.bench.runner import RunSettings, measure_parts
 from sid.perception.pose import MoveNetSinglePose, load_pose_estimator
 from sid.perception.pose.base import check_boxes, check_color_image
 
+__all__ = ["WARMUP", "bench_pose", "timed_call"]
+
 WARMUP = 3
 
 

@@ -29,6 +29,19 @@ from typing import Any
 from sid.cpu import physical_cores, usable_cpus
 from sid.documents import is_number, load_document
 
+__all__ = [
+    "FIXED_FIELDS",
+    "FORMAT",
+    "LIBRARIES",
+    "PAPER_COLUMN",
+    "build_report",
+    "format_comparison",
+    "load_report",
+    "machine_info",
+    "markdown",
+    "write_report",
+]
+
 FORMAT = "sid-bench/1"
 LIBRARIES = ("numpy", "scipy", "scikit-learn", "shapely", "opencv-python-headless", "onnxruntime", "ompl",
              "pyrealsense2")  # fmt: skip

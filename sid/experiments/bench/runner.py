@@ -16,6 +16,8 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
+__all__ = ["FULL", "QUICK", "RunSettings", "Stats", "measure", "measure_parts"]
+
 
 @dataclass(frozen=True)
 class RunSettings:

@@ -8,6 +8,8 @@ from sid.perception.groups import Group
 from sid.perception.people import Person
 from sid.scenario.obstacles import BoxObstacle, CircleObstacle, Obstacle, SegmentObstacle
 
+__all__ = ["bench_scene"]
+
 
 def bench_scene(
     size_m: float = 20.0, group_sizes: tuple[int, ...] = (3, 4, 3), shift: float = 0.0

@@ -37,6 +37,37 @@ if TYPE_CHECKING:
     from sid.perception.pose import MoveNetMultiPose, MoveNetSinglePose, YoloPose
     from sid.synthetic import Scene
 
+__all__ = [
+    "ALIGN_MODES",
+    "Benchmark",
+    "CROWD_FPS",
+    "CROWD_RESOLUTION",
+    "CROWD_SETS",
+    "CROWD_SIZES",
+    "CROWD_SPACING",
+    "CROWD_TARGET_MS",
+    "CROWD_WARMUP_FRAMES",
+    "Context",
+    "DBSCAN_SIZES",
+    "FRAME_SIZES",
+    "GROUPING_THREADS",
+    "GROUP_SIZES",
+    "PAPER_GROUP_MAX",
+    "PAPER_GROUP_MS",
+    "PAPER_LIFT_MS",
+    "PAPER_POSE_MS",
+    "PAPER_TOTAL_MS",
+    "Records",
+    "TRACK_FPS",
+    "TRACK_SIZES",
+    "benchmarks",
+    "crowd_sets",
+    "grouping_scene",
+    "pose_models",
+    "real_rgbd_folders",
+    "record",
+]
+
 GROUP_SIZES = (2, 3, 4, 6, 20, 100)
 # The ray methods above this many people: the authors' approach and sid's `paper` method prune one crowd member by
 # member (minutes at 100 people), so their rows stop here.

@@ -11,6 +11,8 @@ from typing import Any
 
 from sid.experiments.bench.stages import Benchmark, Context
 
+__all__ = ["Progress", "SuiteResult", "run_suite", "select"]
+
 Progress = Callable[[int, int, str, str], None]
 """progress(index, total, benchmark name, status): called before each benchmark (status "") and after it."""
 

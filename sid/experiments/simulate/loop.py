@@ -60,6 +60,8 @@ from sid.stream import SocialStream
 from sid.synthetic.pose import TruthPose
 from sid.synthetic.sensor import SyntheticCamera
 
+__all__ = ["Observer", "PERCEPTIONS", "RunOptions", "RunTrace", "StepView", "make_sensing", "simulate"]
+
 PERCEPTIONS = ("camera", "exact")
 
 

@@ -19,6 +19,8 @@ from shapely.ops import unary_union
 from planner.metrics import PERSONAL_DISTANCE_M, crosses_group, group_zones, min_distance_to_points, path_length
 from sid.experiments.simulate.loop import RunTrace
 
+__all__ = ["run_metrics"]
+
 
 def run_metrics(trace: RunTrace, straight_m: float) -> dict:
     """The run's record (JSON-ready): outcome, social metrics, replans, planning time and the trajectory.

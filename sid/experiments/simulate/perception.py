@@ -42,6 +42,19 @@ from sid.synthetic.noise import DepthNoise
 from sid.synthetic.sensor import SyntheticCamera
 from sid.synthetic.sequence import Sequence
 
+__all__ = [
+    "CameraSensing",
+    "ExactSensing",
+    "FIELD_OF_VIEW",
+    "IMAGE_SIZE",
+    "LidarSensing",
+    "SIM_CALIBRATION",
+    "Seen",
+    "Sensing",
+    "in_view",
+    "sim_calibration",
+]
+
 FIELD_OF_VIEW = math.radians(87.0)
 """The D435i depth camera's horizontal field of view (rad)."""
 IMAGE_SIZE = (640, 360)

@@ -10,6 +10,8 @@ from sid.experiments.charts import Panel, bar_chart, from_key
 from sid.experiments.reproduce import cell, markdown_table, percent, write_json
 from sid.experiments.simulate.sweep import sweep_summary
 
+__all__ = ["HEADER", "SIMULATE_PANELS", "sweep_markdown", "write_sweep_report"]
+
 SIMULATE_PANELS = (
     Panel("success rate (goal, no collision)", from_key("success_rate")),
     Panel("o-space intrusion rate (share of runs entering a zone)", from_key("intrusion_rate")),

@@ -12,6 +12,8 @@ from dataclasses import dataclass
 
 from sid.checks import check_number, check_numbers
 
+__all__ = ["DriveLimits", "RobotState", "step"]
+
 
 @dataclass(frozen=True)
 class DriveLimits:

@@ -22,6 +22,8 @@ from sid.experiments.simulate.metrics import run_metrics
 from sid.experiments.simulate.video import VideoWriter, frame_picture
 from sid.experiments.simulate.world import SimWorld
 
+__all__ = ["StepProgress", "options_record", "run_record", "write_run"]
+
 StepProgress = Callable[[int, int, str], None]
 """progress(step, steps at the time limit, what)."""
 

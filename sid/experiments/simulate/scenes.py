@@ -8,6 +8,8 @@ from pathlib import Path
 
 from sid.experiments.simulate.world import SimWorld, load_world
 
+__all__ = ["SCENE_ORDER", "load_scene", "scene_list", "scene_path"]
+
 SCENE_ORDER = ("paper", "pair", "circle4", "circle5", "wall", "walkers", "forming")
 """The built-in scenes, in the order ``--list`` shows them."""
 

@@ -28,6 +28,8 @@ from sid.experiments.simulate.loop import RunOptions
 from sid.experiments.simulate.run import run_record
 from sid.experiments.simulate.scenes import load_scene
 
+__all__ = ["Job", "Progress", "run_job", "run_sweep", "sweep_jobs", "sweep_summary"]
+
 Progress = Callable[[int, int, str], None]
 
 

@@ -40,6 +40,18 @@ from sid.experiments.simulate.perception import FIELD_OF_VIEW
 from sid.experiments.simulate.world import SimWorld
 from sid.scenario.obstacles import outline
 
+__all__ = [
+    "DRIVEN",
+    "GOAL",
+    "INSET_WIDTH",
+    "LEGEND_WIDTH",
+    "PLANNED",
+    "ROBOT",
+    "TRUE_PERSON",
+    "VideoWriter",
+    "frame_picture",
+]
+
 ROBOT = (90, 40, 0)  # BGR: navy, the robot and its driven path
 DRIVEN = PathStyle("driven path", ROBOT)
 PLANNED = PathStyle("planned path", WITH_COLOUR)

@@ -30,6 +30,19 @@ from sid.perception.people import Person
 from sid.scenario.loader import Scenario, ScenarioError, read_scenario_file, scenario_from_dict
 from sid.scenario.obstacles import BoxObstacle, CircleObstacle, Obstacle
 
+__all__ = [
+    "JITTER_THETA_RAD",
+    "JITTER_XY_M",
+    "SIM_FIELDS",
+    "SimSettings",
+    "SimWorld",
+    "collision",
+    "jittered",
+    "load_world",
+    "obstacle_geometry",
+    "world_from_dict",
+]
+
 JITTER_XY_M = 0.05
 JITTER_THETA_RAD = math.radians(5.0)
 SIM_FIELDS = ("max_speed", "max_turn_rate", "max_accel", "time_limit_s", "rate_hz", "goal_tolerance_m", "description")

@@ -20,6 +20,8 @@ import numpy as np
 from sid.checks import check_number, check_numbers
 from sid.perception.keypoints import PoseDetection
 
+__all__ = ["Letterbox", "PoseEstimator", "check_boxes", "check_color_image", "clip_corners", "fit_letterbox"]
+
 
 @runtime_checkable
 class PoseEstimator(Protocol):

@@ -16,6 +16,21 @@ import numpy as np
 
 from sid.errors import SidError
 
+__all__ = [
+    "CONTRACTS",
+    "Contract",
+    "MOVENET_MULTIPOSE",
+    "MOVENET_SINGLEPOSE",
+    "ModelSignature",
+    "PoseModelError",
+    "TensorSpec",
+    "YOLO_POSE",
+    "detect_contract",
+    "fixed_hw",
+    "supported_contracts_text",
+    "yolo_layout",
+]
+
 MOVENET_MULTIPOSE = "movenet_multipose"
 MOVENET_SINGLEPOSE = "movenet_singlepose"
 YOLO_POSE = "yolo_pose"

@@ -16,6 +16,20 @@ from sid.perception.pose.base import Letterbox, check_boxes, check_color_image, 
 from sid.perception.pose.contracts import MOVENET_MULTIPOSE, MOVENET_SINGLEPOSE, fixed_hw
 from sid.perception.pose.session import OnnxModel
 
+__all__ = [
+    "CROP_EXPAND",
+    "CROP_MARGIN",
+    "MULTIPOSE_DEFAULT_THRESHOLD",
+    "MULTIPOSE_LONG_SIDE",
+    "MoveNetMultiPose",
+    "MoveNetSinglePose",
+    "MultiPoseSize",
+    "PAD_VALUE",
+    "PAPER_WIDTH",
+    "SINGLEPOSE_DEFAULT_THRESHOLD",
+    "multipose_input_size",
+]
+
 PAD_VALUE = 0  # tf.image.resize_with_pad pads with zeros
 MULTIPOSE_LONG_SIDE = 256  # default: 256 px on the long side (TF Hub's suggestion), the other side a multiple of 32
 PAPER_WIDTH = 128  # the paper authors' choice: 128 px wide, keeping the aspect ratio

@@ -37,6 +37,18 @@ from sid.perception.pose.contracts import PoseModelError
 if TYPE_CHECKING:
     import onnx
 
+__all__ = [
+    "FLOAT_LAYERS",
+    "ONNX_MISSING",
+    "QuantizeReport",
+    "WEIGHTED_OPS",
+    "check_paths",
+    "decoding_nodes",
+    "quantize_model",
+    "simplify_graph",
+    "simplify_model",
+]
+
 WEIGHTED_OPS = ("Conv", "ConvTranspose", "MatMul", "Gemm")
 """Operators whose int8 kernels make the speed-up; the graph after the last of them is the decoding, kept float."""
 FLOAT_LAYERS = 4

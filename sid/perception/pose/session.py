@@ -35,6 +35,22 @@ import onnxruntime as ort
 from sid.cpu import physical_cores, usable_cpus
 from sid.perception.pose.contracts import ModelSignature, PoseModelError, supported_contracts_text
 
+__all__ = [
+    "CPU_PROVIDER",
+    "OPENVINO_MISSING",
+    "OPENVINO_PROVIDER",
+    "OnnxModel",
+    "PREFERRED_PROVIDERS",
+    "PROVIDER_CHOICES",
+    "SPINNING_KEYS",
+    "THREADS_PER_CPU",
+    "check_threads",
+    "default_providers",
+    "quiet_load_warnings",
+    "resolve_providers",
+    "session_options",
+]
+
 CPU_PROVIDER = "CPUExecutionProvider"
 OPENVINO_PROVIDER = "OpenVINOExecutionProvider"
 PREFERRED_PROVIDERS: tuple[str, ...] = (

@@ -21,6 +21,8 @@ from sid.perception.pose.base import Letterbox, check_color_image, clip_corners,
 from sid.perception.pose.contracts import YOLO_POSE, fixed_hw, yolo_layout
 from sid.perception.pose.session import OnnxModel
 
+__all__ = ["DEFAULT_IOU", "DEFAULT_SIZE", "DEFAULT_THRESHOLD", "NORMALISED_LIMIT", "PAD_VALUE", "YoloPose"]
+
 PAD_VALUE = 114  # Ultralytics LetterBox fill
 DEFAULT_THRESHOLD = 0.25  # Ultralytics' default confidence for predict
 DEFAULT_IOU = 0.7  # Ultralytics' default NMS IoU for predict

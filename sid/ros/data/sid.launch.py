@@ -11,6 +11,8 @@ from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, ExecuteProcess
 from launch.substitutions import LaunchConfiguration
 
+__all__ = ["generate_launch_description"]
+
 
 def generate_launch_description() -> LaunchDescription:
     defaults = str(files("sid.ros") / "data" / "sid_params.yaml")
