@@ -20,7 +20,7 @@ from costmap.combine import CombinationMethod, check_method, combine
 from costmap.grid import FREE_SPACE, GridSpec, Window, union
 from costmap.scan import LaserScan
 from sid.checks import check_numbers
-from sid.perception.groups import Group
+from sid.perception.group import Group
 from sid.perception.people import Person
 from sid.tracking.records import Tracks
 

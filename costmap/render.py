@@ -23,8 +23,8 @@ from costmap.grid import INSCRIBED, LETHAL, MAX_NON_OBSTACLE, NO_INFORMATION, Co
 from costmap.layered import LayeredCostmap
 from costmap.layers.social import SocialLayer, SocialParams, group_zone_polygon
 from costmap.scan import LaserScan
-from sid.perception.groups import Group
-from sid.perception.overlay import place_labels
+from sid.labels import place_labels
+from sid.perception.group import Group
 from sid.perception.people import Person
 
 __all__ = [

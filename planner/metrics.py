@@ -25,7 +25,7 @@ from shapely.ops import unary_union
 from costmap.grid import LETHAL, MAX_NON_OBSTACLE, NO_INFORMATION, Costmap2D
 from costmap.layers.social import group_zone_polygon
 from planner.validity import interpolate
-from sid.perception.groups import Group
+from sid.perception.group import Group
 from sid.perception.people import Person
 
 if TYPE_CHECKING:

@@ -16,7 +16,7 @@ from costmap.grid import Costmap2D, GridSpec
 from costmap.layered import LayeredCostmap
 from costmap.render import Extra, Outline, RobotTask, default_scale, render_costmap, world_to_image
 from planner.validity import interpolate
-from sid.perception.groups import Group
+from sid.perception.group import Group
 
 __all__ = [
     "FONT",

@@ -32,7 +32,7 @@ _EXPORTS: dict[str, str] = {
     "CameraMount": "sid.perception.mount",
     "Calibration": "sid.perception.camera",
     "Person": "sid.perception.people",
-    "Group": "sid.perception.groups",
+    "Group": "sid.perception.group",
     "GroupParams": "sid.perception.groups",
     "detect_groups": "sid.perception.groups",
     "LayeredCostmap": "costmap.layered",
@@ -61,7 +61,7 @@ if TYPE_CHECKING:  # what type checkers see; ``as`` marks each as re-exported
     from planner.problem import PlanningProblem as PlanningProblem
     from sid.perception.camera import Calibration as Calibration
     from sid.perception.frame import Frame as Frame
-    from sid.perception.groups import Group as Group
+    from sid.perception.group import Group as Group
     from sid.perception.groups import GroupParams as GroupParams
     from sid.perception.groups import detect_groups as detect_groups
     from sid.perception.mount import CameraMount as CameraMount

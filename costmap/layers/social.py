@@ -36,7 +36,7 @@ from costmap.combine import CombinationMethod
 from costmap.grid import FREE_SPACE, LETHAL, MAX_NON_OBSTACLE, GridSpec, Window, disjoint, union
 from costmap.layer import Layer, LayerInputs
 from sid.checks import check_number, check_numbers
-from sid.perception.groups import Group
+from sid.perception.group import Group
 from sid.perception.people import Person
 
 __all__ = [

@@ -27,7 +27,8 @@ from sid.cli.common import (
 from sid.documents import write_atomically
 from sid.perception.camera import Calibration
 from sid.perception.frame import Frame
-from sid.perception.groups import GROUP_METHODS, Group, GroupParams
+from sid.perception.group import Group
+from sid.perception.groups import GROUP_METHODS, GroupParams
 from sid.perception.lifting import LiftParams
 from sid.perception.mount import CameraMount
 from sid.perception.overlay import draw_detections

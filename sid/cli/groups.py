@@ -20,7 +20,8 @@ from sid.checks import check_limit
 from sid.cli.common import fail, process_json_lines, run_json_lines
 from sid.cli.grouping import add_group_params, group_params_from
 from sid.documents import is_number
-from sid.perception.groups import Group, GroupParams, detect_groups
+from sid.perception.group import Group
+from sid.perception.groups import GroupParams, detect_groups
 from sid.perception.people import Person
 
 __all__ = ["add_parser", "group_to_json", "process", "run"]

@@ -28,7 +28,8 @@ from costmap.layers.social import group_zone_polygon
 from planner.facade import PlanResult, plan, resolve_planner
 from planner.metrics import result_metrics
 from planner.problem import DEFAULT_COST_WEIGHT, PlanningError, PlanningProblem
-from sid.perception.groups import Group, detect_groups
+from sid.perception.group import Group
+from sid.perception.groups import detect_groups
 from sid.scenario.build import build_costmap, planning_problem
 from sid.scenario.loader import Scenario
 

@@ -25,7 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
-from sid.perception.groups import Group, GroupParams, detect_groups
+from sid.perception.group import Group
+from sid.perception.groups import GroupParams, detect_groups
 from sid.perception.people import Person
 
 __all__ = [

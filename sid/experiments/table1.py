@@ -32,7 +32,8 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from sid.checks import check_number
-from sid.perception.groups import Group, GroupParams
+from sid.perception.group import Group
+from sid.perception.groups import GroupParams
 from sid.perception.lifting import LiftParams
 from sid.perception.people import Person
 from sid.perception.pipeline import Pipeline

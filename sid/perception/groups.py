@@ -53,10 +53,11 @@ import numpy as np
 from sid.checks import check_number, check_numbers
 from sid.perception.cluster import dbscan_labels
 from sid.perception.gcff import GCFFParams, gcff_labels
+from sid.perception.group import Group
 from sid.perception.ospace import OSpaceModel, find_ospaces
 from sid.perception.people import Person
 
-__all__ = ["GROUP_METHODS", "Group", "GroupParams", "QUANTISED_STEPS", "detect_groups", "facing_step"]
+__all__ = ["GROUP_METHODS", "GroupParams", "QUANTISED_STEPS", "detect_groups", "facing_step"]
 
 # |sin| of the angle between two rays below which they count as parallel (their crossing is rounding noise).
 _PARALLEL = 1e-9
@@ -213,22 +214,6 @@ class GroupParams:
             for old, new in names.items():
                 message = message.replace(f"groups: {old} ", f"groups: {new} ", 1)
             raise ValueError(message) from None
-
-
-@dataclass
-class Group:
-    """An interacting group.
-
-    members: person ids; interest_point: (x, y) of the o-space centre; area: interaction-zone area (m^2);
-    zone: (K, 2) polygon of ray crossings, counter-clockwise (one vertex for a pair); spread: D, the mean
-    member distance to the interest point (m).
-    """
-
-    members: tuple[int, ...]
-    interest_point: tuple[float, float]
-    area: float
-    zone: np.ndarray
-    spread: float
 
 
 @dataclass(frozen=True)

@@ -17,14 +17,15 @@ from typing import Any
 import numpy as np
 
 from sid.perception.frame import Frame
-from sid.perception.groups import Group, GroupParams, detect_groups
+from sid.perception.group import Group, group_json
+from sid.perception.groups import GroupParams, detect_groups
 from sid.perception.keypoints import PoseDetection
 from sid.perception.lifting import LiftParams, lift_people
 from sid.perception.mount import CameraMount
 from sid.perception.people import Person
 from sid.perception.robot_pose import BASE_FRAME, MAP_FRAME, RobotPose
 
-__all__ = ["FrameResult", "Pipeline", "PoseFn", "PosedFrame", "group_json", "image_pose"]
+__all__ = ["FrameResult", "Pipeline", "PoseFn", "PosedFrame", "image_pose"]
 
 PoseFn = Callable[[Frame], list[PoseDetection]]
 
@@ -69,17 +70,6 @@ class FrameResult:
             "groups": [group_json(g) for g in self.groups],
             "timing_ms": {k: round(v, 3) for k, v in self.timing_ms.items()},
         }
-
-
-def group_json(group: Group) -> dict:
-    """A group as plain JSON (the format of ``sid groups``)."""
-    return {
-        "members": [int(m) for m in group.members],
-        "interest_point": [float(v) for v in group.interest_point],
-        "area": float(group.area),
-        "spread": float(group.spread),
-        "zone": np.asarray(group.zone, dtype=float).round(4).tolist(),
-    }
 
 
 def _person_json(person: Person, keypoints: bool) -> dict:

@@ -18,7 +18,7 @@ import numpy as np
 
 from costmap.export import keepout_mask
 from costmap.grid import Costmap2D
-from sid.perception.pipeline import group_json
+from sid.perception.group import group_json
 from sid.tracking.records import TrackedGroup, TrackedPerson
 
 __all__ = [

@@ -10,7 +10,8 @@ from costmap.layers.static import static_costs
 from costmap.mapfile import read_map
 from costmap.plugins import CostmapParams, layered_costmap
 from planner.problem import DEFAULT_COST_WEIGHT, PlanningProblem
-from sid.perception.groups import Group, detect_groups
+from sid.perception.group import Group
+from sid.perception.groups import detect_groups
 from sid.scenario.known_map import known_map
 from sid.scenario.lidar import simulate_scan
 from sid.scenario.loader import Scenario

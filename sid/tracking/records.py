@@ -13,9 +13,8 @@ from typing import Any, Literal
 
 import numpy as np
 
-from sid.perception.groups import Group
+from sid.perception.group import Group, group_json
 from sid.perception.people import Person
-from sid.perception.pipeline import group_json
 
 __all__ = ["GroupKind", "MotionState", "TrackedGroup", "TrackedPerson", "Tracks"]
 

@@ -17,7 +17,7 @@ from costmap.occupancy import OccupancyGrid, cost_to_occupancy, costmap_to_occup
 from costmap.render import GROUP_COLOURS, OBSTACLE, default_scale, render_costmap, world_to_image
 from costmap.rosbag import read_occupancy_grids, write_occupancy_mcap
 from sid.cli import main
-from sid.perception.groups import Group
+from sid.perception.group import Group
 from sid.perception.people import Person
 from sid.scenario.build import build_costmap
 from sid.scenario.loader import load_scenario

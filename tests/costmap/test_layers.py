@@ -26,7 +26,7 @@ from costmap.layers.social import (
 )
 from costmap.plugins import CostmapParams, layered_costmap
 from costmap.scan import LaserScan
-from sid.perception.groups import Group
+from sid.perception.group import Group
 from sid.perception.people import Person
 from sid.scenario.lidar import simulate_scan
 from sid.scenario.obstacles import BoxObstacle, CircleObstacle, SegmentObstacle

@@ -9,7 +9,7 @@ import pytest
 import costmap.render as render
 from costmap.grid import Costmap2D, GridSpec
 from costmap.render import GROUP_COLOURS, PERSON, CameraView, render_costmap, world_to_image
-from sid.perception.groups import Group
+from sid.perception.group import Group
 from sid.perception.people import Person
 
 SPEC = GridSpec.from_size(0.05, (-0.5, -3.0), (6.0, 6.0))

@@ -12,7 +12,7 @@ from costmap.layer import LayerInputs
 from costmap.layers.social import SocialLayer, SocialParams
 from costmap.layers.tracked import TrackedPeopleLayer, TrackedPeopleParams
 from costmap.plugins import CostmapParams, layered_costmap
-from sid.perception.groups import Group
+from sid.perception.group import Group
 from sid.perception.people import Person
 from sid.tracking import TrackedGroup, TrackedPerson, Tracks
 

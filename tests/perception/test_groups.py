@@ -12,9 +12,9 @@ import shapely
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
+from sid.perception.group import Group
 from sid.perception.groups import (
     GROUP_METHODS,
-    Group,
     GroupParams,
     _convex_hull,
     _member_crossings,

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from sid.labels import place_labels
 from sid.perception.keypoints import KP, PoseDetection
 from sid.perception.overlay import (
     ARROW_COLOUR,
@@ -14,7 +15,6 @@ from sid.perception.overlay import (
     RIGHT_COLOUR,
     draw_detections,
     person_label,
-    place_labels,
 )
 from sid.perception.people import Person
 

@@ -20,7 +20,7 @@ from planner.metrics import (
     path_metrics,
     result_metrics,
 )
-from sid.perception.groups import Group
+from sid.perception.group import Group
 from sid.perception.people import Person
 
 TRIO = [Person(1, 4.0, 0.9, -math.pi / 2), Person(2, 3.2, -0.5, math.pi / 6), Person(3, 4.8, -0.5, 5 * math.pi / 6)]

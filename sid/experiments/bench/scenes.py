@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from sid.perception.groups import Group
+from sid.perception.group import Group
 from sid.perception.people import Person
 from sid.scenario.obstacles import BoxObstacle, CircleObstacle, Obstacle, SegmentObstacle
 

@@ -32,7 +32,7 @@ if TYPE_CHECKING:
     from sid.experiments.harness import Task
     from sid.perception.align import SplatMode
     from sid.perception.frame import Frame
-    from sid.perception.groups import Group
+    from sid.perception.group import Group
     from sid.perception.keypoints import PoseDetection
     from sid.perception.pose import MoveNetMultiPose, MoveNetSinglePose, YoloPose
     from sid.synthetic import Scene

@@ -50,7 +50,8 @@ from sid.experiments.simulate.perception import (
 )
 from sid.experiments.simulate.robot import RobotState, step
 from sid.experiments.simulate.world import SimWorld, collision, jittered, obstacle_geometry
-from sid.perception.groups import Group, detect_groups
+from sid.perception.group import Group
+from sid.perception.groups import detect_groups
 from sid.perception.people import Person
 from sid.perception.pipeline import Pipeline, PoseFn, image_pose
 from sid.perception.robot_pose import RobotPose

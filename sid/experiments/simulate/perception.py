@@ -30,7 +30,8 @@ from costmap.layer import LayerInputs
 from costmap.layered import LayeredCostmap
 from costmap.scan import LaserScan
 from sid.perception.camera import Calibration, Extrinsics, Intrinsics
-from sid.perception.groups import Group, GroupParams, detect_groups
+from sid.perception.group import Group
+from sid.perception.groups import GroupParams, detect_groups
 from sid.perception.people import Person
 from sid.perception.robot_pose import RobotPose
 from sid.scenario.lidar import simulate_scan
