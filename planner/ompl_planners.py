@@ -17,9 +17,10 @@ comparable. No other thread runs Python here: every planner below calls back int
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 
 import numpy as np
 from ompl import base as ob
@@ -39,8 +40,6 @@ __all__ = [
     "seed_ompl",
     "solve_ompl",
 ]
-
-ou.setLogLevel(ou.LOG_WARN)  # the default level prints OMPL's debug messages to stdout
 
 FMT_SAMPLES_PER_SECOND = 250
 """Samples of FMT* per second of time budget. FMT* is not anytime: it plans on a fixed sample set and returns nothing
@@ -75,16 +74,29 @@ OMPL_PLANNERS: dict[str, Callable[[ob.SpaceInformation, float, int | None], ob.P
 """Planner factories (space information, time budget in s, iteration cap or None) by name."""
 
 
+@contextlib.contextmanager
+def _ompl_log_level(level: int) -> Iterator[None]:
+    """OMPL's process-wide log level set to ``level`` for the block, then restored: planning sets it only while it
+    runs (OMPL's default prints its debug messages to stdout), so importing the planner changes nothing."""
+    before = ou.getLogLevel()
+    ou.setLogLevel(level)
+    try:
+        yield
+    finally:
+        ou.setLogLevel(before)
+
+
 def seed_ompl(seed: int) -> None:
+    """Seed OMPL's random number generator, which is process-wide (``ompl::RNG::setSeed``, OMPL's only way to seed):
+    every generator OMPL creates afterwards, in any planner of the process, draws from it."""
     # OMPL logs an error when reseeding after its first random number; reseeding still makes every generator
     # created afterwards deterministic (the seed tests in tests/planner check it), which is all a plan needs since
     # it creates its own.
-    level = ou.getLogLevel()
-    ou.setLogLevel(ou.LOG_NONE)
-    ou.RNG.setSeed(seed)
-    ou.setLogLevel(level)
+    with _ompl_log_level(ou.LOG_NONE):
+        ou.RNG.setSeed(seed)
 
 
+@_ompl_log_level(ou.LOG_WARN)  # OMPL's set-up and solve log at INFO level by default, on stdout
 def solve_ompl(
     field: CostField,
     name: str,

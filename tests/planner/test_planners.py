@@ -5,6 +5,8 @@ from __future__ import annotations
 import itertools
 import math
 import re
+import subprocess
+import sys
 from types import SimpleNamespace
 
 import numpy as np
@@ -435,3 +437,22 @@ def test_random_maps_give_a_valid_path_or_a_clear_refusal(discs, ends, name):
         assert independent_collisions(costmap, result.path) == 0
     else:
         assert len(result.path) == 0 and result.message
+
+
+def test_ompl_log_level_is_set_only_while_planning(walls, capfd):
+    """No process-global state changes at import; a plan runs quiet and leaves OMPL's log level as it found it."""
+    from ompl import util as ou
+
+    code = (
+        "from ompl import util as ou; a = ou.getLogLevel(); import planner.ompl_planners; print(a == ou.getLogLevel())"
+    )
+    assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout == "True\n"
+    before = ou.getLogLevel()
+    ou.setLogLevel(ou.LOG_INFO)
+    try:
+        capfd.readouterr()
+        assert plan(walls, "rrtconnect", time_limit=5.0, seed=1, max_iterations=CAPS["rrtconnect"]).success
+        assert ou.getLogLevel() == ou.LOG_INFO
+        assert capfd.readouterr().out == ""  # OMPL's INFO lines would land on stdout
+    finally:
+        ou.setLogLevel(before)
