@@ -24,7 +24,7 @@ from sid.synthetic.layouts import LAYOUTS, layout
 from sid.synthetic.noise import DepthNoise, KeypointNoise
 from sid.synthetic.scene import Scene
 from sid.synthetic.sensor import SyntheticCamera
-from sid.synthetic.sequence import SEQUENCES, Sequence, builtin_sequence, load_scene_file
+from sid.synthetic.sequence import SEQUENCES, SyntheticSequence, builtin_sequence, load_scene_file
 
 __all__ = ["DEFAULT_FRAMES", "PREFIX", "SyntheticSource", "scene_from_spec", "synthetic_source"]
 
@@ -32,7 +32,7 @@ PREFIX = "synthetic:"
 DEFAULT_FRAMES = 30  # frames of a static scene when none are asked for
 
 
-def scene_from_spec(spec: str) -> Scene | Sequence:
+def scene_from_spec(spec: str) -> Scene | SyntheticSequence:
     """A layout name (S1-S5, case-insensitive), a built-in sequence name or a scene/scenario file path, with or
     without ``synthetic:``.
 
@@ -57,39 +57,40 @@ def scene_from_spec(spec: str) -> Scene | Sequence:
 class SyntheticSource:
     """Iterable of ``frames`` synthetic ``Frame``s of one scene, ground truth in ``frame.truth``.
 
-    scene_or_spec: a static ``Scene``, a moving ``Sequence``, a ``sid.scenario.loader.Scenario`` (as a
-    ``Sequence``) or a spec string (see ``scene_from_spec``). frames: how many (None: ``DEFAULT_FRAMES`` of a static
-    scene, or a sequence until everyone has stopped, ``duration * fps + 1``). seed: noise seed. noise / keypoint_noise:
-    depth and 2D keypoint noise (defaults: ``DepthNoise()``, ``KeypointNoise()``; ``DepthNoise.exact()`` and
-    ``KeypointNoise(0, 0)`` for perfect data). Further keyword options go to ``SyntheticCamera`` (``registered``,
-    ``calibration``, ``shaded_color``, ``occlusion_margin``, ``self_occlusion_margin``, ``fps``, ``group_params``).
+    scene_or_spec: a static ``Scene``, a moving ``SyntheticSequence``, a ``sid.scenario.loader.Scenario`` (as a
+    ``SyntheticSequence``) or a spec string (see ``scene_from_spec``). frames: how many (None: ``DEFAULT_FRAMES`` of a
+    static scene, or a sequence until everyone has stopped, ``duration * fps + 1``). seed: noise seed. noise /
+    keypoint_noise: depth and 2D keypoint noise (defaults: ``DepthNoise()``, ``KeypointNoise()``;
+    ``DepthNoise.exact()`` and ``KeypointNoise(0, 0)`` for perfect data). Further keyword options go to
+    ``SyntheticCamera`` (``registered``, ``calibration``, ``shaded_color``, ``occlusion_margin``,
+    ``self_occlusion_margin``, ``fps``, ``group_params``).
     """
 
     def __init__(
         self,
-        scene_or_spec: Scene | Sequence | str | Any,
+        scene_or_spec: Scene | SyntheticSequence | str | Any,
         frames: int | None = None,
         seed: int = 0,
         noise: DepthNoise | None = None,
         keypoint_noise: KeypointNoise | None = None,
         **camera_options: Any,
     ):
-        self.scene: Scene | Sequence
-        if isinstance(scene_or_spec, (Scene, Sequence)):
+        self.scene: Scene | SyntheticSequence
+        if isinstance(scene_or_spec, (Scene, SyntheticSequence)):
             self.scene = scene_or_spec
         elif isinstance(scene_or_spec, (str, Path)):
             self.scene = scene_from_spec(str(scene_or_spec))
         elif isinstance(scene_or_spec, Scenario):
-            self.scene = Sequence.from_scenario(scene_or_spec)
+            self.scene = SyntheticSequence.from_scenario(scene_or_spec)
         else:
             raise TypeError(
-                "synthetic source: expected a Scene, a Sequence, a spec string or a scenario, got "
+                "synthetic source: expected a Scene, a SyntheticSequence, a spec string or a scenario, got "
                 f"{type(scene_or_spec).__name__}"
             )
         self.seed = int(seed)
         self.camera = SyntheticCamera(noise=noise, keypoint_noise=keypoint_noise, **camera_options)
         if frames is None:
-            duration = self.scene.duration if isinstance(self.scene, Sequence) else 0.0
+            duration = self.scene.duration if isinstance(self.scene, SyntheticSequence) else 0.0
             frames = round(duration * self.camera.fps) + 1 if duration > 0 else DEFAULT_FRAMES
         if int(frames) != frames or frames < 0:
             raise ValueError(f"synthetic source: frames must be a whole number >= 0, got {frames}")

@@ -12,8 +12,8 @@
 Modules, in the order data flows:
 
 - ``scene``: ``Scene`` / ``ScenePerson`` records of a static scene (robot frame) and scene files (JSON/YAML).
-- ``sequence``: ``Sequence``, a scene in motion read from a costmap scenario file (people walking along paths, the
-  robot driving, declared conversations; map frame), and the built-in sequences (``builtin_sequence``).
+- ``sequence``: ``SyntheticSequence``, a scene in motion read from a costmap scenario file (people walking along paths,
+  the robot driving, declared conversations; map frame), and the built-in sequences (``builtin_sequence``).
 - ``layouts``: the paper's S1-S5 as parameterised formations, and their documented variations.
 - ``body``: 15 capsules (torso, head, limbs) around each person's COCO skeleton (``sid.perception.skeleton``).
 - ``render``: exact depth / label / shading images by analytic ray-capsule intersection (ground, back wall).
@@ -28,7 +28,7 @@ from sid.synthetic.layouts import LAYOUTS, Formation, layout, variations
 from sid.synthetic.noise import DepthNoise, KeypointNoise
 from sid.synthetic.scene import Scene, ScenePerson
 from sid.synthetic.sensor import FrameTruth, SyntheticCamera, TruthPerson, d435i_calibration
-from sid.synthetic.sequence import SEQUENCES, Sequence, builtin_sequence
+from sid.synthetic.sequence import SEQUENCES, SyntheticSequence, builtin_sequence
 from sid.synthetic.truth import TruthGroup
 
 __all__ = [
@@ -40,7 +40,7 @@ __all__ = [
     "KeypointNoise",
     "Scene",
     "ScenePerson",
-    "Sequence",
+    "SyntheticSequence",
     "SyntheticCamera",
     "TruthGroup",
     "TruthPerson",

@@ -1,8 +1,8 @@
 """A virtual RealSense D435i: renders a scene into an RGB-D ``Frame`` with its ground truth attached.
 
 Scenes: a static ``Scene`` (people in the robot's frame, base_footprint; frames carry no robot pose) or a moving
-``Sequence`` (people and robot in the map frame; frame ``index`` shows time ``index / fps`` and carries the robot's
-pose). Ground truth is in the same frame as the scene (``FrameTruth.frame_id``).
+``SyntheticSequence`` (people and robot in the map frame; frame ``index`` shows time ``index / fps`` and carries the
+robot's pose). Ground truth is in the same frame as the scene (``FrameTruth.frame_id``).
 
 Cameras: the colour camera's optical frame is the one the mount places on the robot (the frame the pipeline
 lifts keypoints from); the depth camera sits ``depth_to_color`` away from it (p_color = R p_depth + t). Defaults are
@@ -36,7 +36,7 @@ from sid.synthetic.body import body_capsules
 from sid.synthetic.noise import DepthNoise, KeypointNoise
 from sid.synthetic.render import LABEL_GROUND, LABEL_NONE, LABEL_WALL, Background, Capsule, RayCaster, Rendering
 from sid.synthetic.scene import Scene, ScenePerson
-from sid.synthetic.sequence import Sequence
+from sid.synthetic.sequence import SyntheticSequence
 from sid.synthetic.truth import TruthGroup, truth_groups
 
 __all__ = [
@@ -98,7 +98,7 @@ class TruthPerson:
 @dataclass
 class FrameTruth:
     """What a synthetic frame shows: the scene's name, people and groups (the conversations that hold at the
-    frame's time), the camera mount used, and the frame of positions: ``"map"`` for a ``Sequence``,
+    frame's time), the camera mount used, and the frame of positions: ``"map"`` for a ``SyntheticSequence``,
     ``"base_footprint"`` for a static ``Scene``."""
 
     scene: str
@@ -259,13 +259,13 @@ class SyntheticCamera:
         rotation = d2c.rotation.T @ to_color.rotation
         return Extrinsics(rotation, d2c.rotation.T @ (to_color.translation - d2c.translation))
 
-    def capture(self, scene: Scene | Sequence, index: int = 0, seed: int = 0) -> Frame:
-        """Frame ``index`` of ``scene`` (a ``Sequence`` at time ``index / fps``): noisy depth (depth grid, float32
-        m), colour image, truth, and for a ``Sequence`` the robot's pose."""
+    def capture(self, scene: Scene | SyntheticSequence, index: int = 0, seed: int = 0) -> Frame:
+        """Frame ``index`` of ``scene`` (a ``SyntheticSequence`` at time ``index / fps``): noisy depth (depth grid,
+        float32 m), colour image, truth, and for a ``SyntheticSequence`` the robot's pose."""
         time = index / self.fps
         pose: RobotPose | None = None
         velocities: dict[int, tuple[float, float]] = {}
-        if isinstance(scene, Sequence):
+        if isinstance(scene, SyntheticSequence):
             moment = scene.at(time)
             pose, people, seen, groups = moment.robot_pose, moment.people, moment.seen_people, moment.groups
             velocities = {i: (m.vx, m.vy) for i, m in moment.states.items()}
@@ -329,7 +329,7 @@ class SyntheticCamera:
 
     def _render_scene(
         self,
-        scene: Scene | Sequence,
+        scene: Scene | SyntheticSequence,
         people: tuple[ScenePerson, ...],
         moving: tuple[bool, ...],
         pose: RobotPose | None,

@@ -1,10 +1,10 @@
 """Moving synthetic scenes: people and the robot carrying the camera follow scripted paths in the map frame.
 
-A ``Sequence`` is read from a costmap scenario file (``sid.scenario.loader``): its people (standing or walking along
-``people[i].path``), its robot (standing at ``robot.start`` or driving along ``robot.path``) and its declared
-``conversations``. ``Sequence.at(t)`` gives the ``Moment`` the camera renders at time t: the robot's pose, everyone's
-map-frame pose and velocity, and the conversations that hold then. A declared conversation holds while all its
-members stand (walkers are in no conversation). The scenario's obstacles are not rendered: the camera sees the
+A ``SyntheticSequence`` is read from a costmap scenario file (``sid.scenario.loader``): its people (standing or walking
+along ``people[i].path``), its robot (standing at ``robot.start`` or driving along ``robot.path``) and its declared
+``conversations``. ``SyntheticSequence.at(t)`` gives the ``Moment`` the camera renders at time t: the robot's pose,
+everyone's map-frame pose and velocity, and the conversations that hold then. A declared conversation holds while all
+its members stand (walkers are in no conversation). The scenario's obstacles are not rendered: the camera sees the
 people on open ground. Metres, radians, seconds.
 
 Built-in sequences (scenario files shipped in ``sid/synthetic/sequences``, loaded by name with ``builtin_sequence``
@@ -30,7 +30,15 @@ from sid.scenario.loader import Scenario, ScenarioError, scenario_from_dict
 from sid.scenario.motion import MotionState, Trajectory
 from sid.synthetic.scene import Scene, ScenePerson
 
-__all__ = ["Moment", "MovingPerson", "SEQUENCES", "SEQUENCES_DIR", "Sequence", "builtin_sequence", "load_scene_file"]
+__all__ = [
+    "Moment",
+    "MovingPerson",
+    "SEQUENCES",
+    "SEQUENCES_DIR",
+    "SyntheticSequence",
+    "builtin_sequence",
+    "load_scene_file",
+]
 
 SEQUENCES_DIR = Path(__file__).parent / "sequences"
 SEQUENCES = ("crossing_walkers", "drive_past_group", "walking_pairs", "file_behind_group", "close_crossing")
@@ -60,7 +68,7 @@ class Moment:
 
 
 @dataclass(frozen=True)
-class Sequence:
+class SyntheticSequence:
     """People and a camera-carrying robot moving in the map frame (module docstring).
 
     robot: the motion of base_footprint in the map. conversations: declared groups (person ids). mount: the camera
@@ -88,7 +96,7 @@ class Sequence:
                 raise ValueError(f"sequence {self.name}: conversation {group} names unknown people {sorted(missing)}")
 
     @classmethod
-    def from_scenario(cls, scenario: Scenario, mount: CameraMount | None = None) -> Sequence:
+    def from_scenario(cls, scenario: Scenario, mount: CameraMount | None = None) -> SyntheticSequence:
         """The people, robot motion and conversations of a ``sid.scenario.loader.Scenario``."""
         people = tuple(MovingPerson(p.id, scenario.trajectory(p)) for p in scenario.people)
         try:
@@ -118,17 +126,17 @@ class Sequence:
         return Moment(t, pose, states, tuple(people), tuple(seen), groups)
 
 
-def builtin_sequence(name: str) -> Sequence:
+def builtin_sequence(name: str) -> SyntheticSequence:
     """One of the built-in sequences (``SEQUENCES``) by name."""
     if name not in SEQUENCES:
         raise ValueError(f"unknown built-in sequence {name!r}; known: {', '.join(SEQUENCES)}")
     scene = load_scene_file(SEQUENCES_DIR / f"{name}.yaml")
-    assert isinstance(scene, Sequence)  # the shipped files are scenarios
+    assert isinstance(scene, SyntheticSequence)  # the shipped files are scenarios
     return scene
 
 
-def load_scene_file(path: str | Path) -> Scene | Sequence:
-    """A scene file as a static ``Scene``, or a costmap scenario file (it has a ``robot``) as a ``Sequence``.
+def load_scene_file(path: str | Path) -> Scene | SyntheticSequence:
+    """A scene file as a static ``Scene``, or a costmap scenario file (it has a ``robot``) as a ``SyntheticSequence``.
 
     Raises ValueError naming the file and the problem."""
     path = Path(path)
@@ -136,6 +144,6 @@ def load_scene_file(path: str | Path) -> Scene | Sequence:
     if not (isinstance(data, dict) and "robot" in data):
         return Scene.from_file(path)
     try:
-        return Sequence.from_scenario(scenario_from_dict(data, path.parent, path.stem))
+        return SyntheticSequence.from_scenario(scenario_from_dict(data, path.parent, path.stem))
     except (ScenarioError, ValueError) as exc:
         raise ValueError(f"{path}: {exc}") from None

@@ -21,7 +21,7 @@ from sid.synthetic.pose import TruthPose
 from sid.synthetic.render import LABEL_NONE
 from sid.synthetic.scene import Scene, ScenePerson
 from sid.synthetic.sensor import D435I_COLOR, FrameTruth, SyntheticCamera
-from sid.synthetic.sequence import Sequence
+from sid.synthetic.sequence import SyntheticSequence
 from tests.conftest import REPO_ROOT
 
 TORSO = [KP["left_shoulder"], KP["right_shoulder"], KP["left_hip"], KP["right_hip"]]
@@ -168,7 +168,11 @@ def test_specs_scenarios_and_errors(tmp_path: Path) -> None:
     path.write_text(json.dumps({"people": [{"x": 2.0, "y": 0.4, "theta": -1.5}, {"x": 2.0, "y": -0.4, "theta": 1.5}]}))
     source = synthetic_source(f"synthetic:{path}", frames=2, seed=1)
     assert len(source) == 2 and [p.id for p in source.scene.people] == [0, 1]
-    assert len(source.scene.people) == 2 and not isinstance(source.scene, Sequence) and source[0].robot_pose is None
+    assert (
+        len(source.scene.people) == 2
+        and not isinstance(source.scene, SyntheticSequence)
+        and source[0].robot_pose is None
+    )
     assert len(SyntheticSource("S1")) == 30  # a static scene: 30 frames unless asked
     with pytest.raises(SourceError, match="neither a built-in scene .*crossing_walkers"):
         synthetic_source("synthetic:S7")

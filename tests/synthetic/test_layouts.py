@@ -12,7 +12,7 @@ import yaml
 from sid.perception.people import Person
 from sid.synthetic.layouts import LAYOUTS, VARIATIONS, layout, variations
 from sid.synthetic.scene import Scene
-from sid.synthetic.sequence import Sequence, load_scene_file
+from sid.synthetic.sequence import SyntheticSequence, load_scene_file
 from tests.conftest import REPO_ROOT
 
 
@@ -122,7 +122,7 @@ def test_scenario_files_are_sequences_seen_from_the_robot(tmp_path: Path) -> Non
     with pytest.raises(ValueError, match="costmap scenario file"):
         Scene.from_file(path)
     sequence = load_scene_file(path)
-    assert isinstance(sequence, Sequence) and sequence.name == "turned" and sequence.duration == 0
+    assert isinstance(sequence, SyntheticSequence) and sequence.name == "turned" and sequence.duration == 0
     moment = sequence.at(0.0)
     # The robot at (1, 1) looks along +y: person 7 is 2 m straight ahead, facing the robot's right (-pi/2).
     seen = moment.seen_people[0]
@@ -136,7 +136,7 @@ def test_scenario_files_are_sequences_seen_from_the_robot(tmp_path: Path) -> Non
     examples = REPO_ROOT / "examples" / "conversation.json"
     if examples.is_file():  # the repository's example scenario renders as is
         example = load_scene_file(examples)
-        assert isinstance(example, Sequence) and len(example.people) == 4
+        assert isinstance(example, SyntheticSequence) and len(example.people) == 4
 
 
 @pytest.mark.parametrize(

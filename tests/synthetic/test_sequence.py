@@ -15,20 +15,20 @@ from sid.synthetic.noise import DepthNoise, KeypointNoise
 from sid.synthetic.pose import TruthPose
 from sid.synthetic.scene import Scene
 from sid.synthetic.sensor import SyntheticCamera
-from sid.synthetic.sequence import SEQUENCES, Sequence, builtin_sequence
+from sid.synthetic.sequence import SEQUENCES, SyntheticSequence, builtin_sequence
 
 
-def _sequence(people: list[dict], conversations: Any = (), robot: dict | None = None) -> Sequence:
+def _sequence(people: list[dict], conversations: Any = (), robot: dict | None = None) -> SyntheticSequence:
     data = {
         "map": {"resolution": 0.1, "origin": [-2.0, -6.0], "size": [12.0, 12.0]},
         "robot": robot or {"start": [0.0, 0.0, 0.0], "goal": [5.0, 0.0]},
         "people": people,
         "conversations": list(conversations),
     }
-    return Sequence.from_scenario(scenario_from_dict(data, default_name="test"))
+    return SyntheticSequence.from_scenario(scenario_from_dict(data, default_name="test"))
 
 
-def _exact(scene: Sequence | str, **options: Any) -> SyntheticSource:
+def _exact(scene: SyntheticSequence | str, **options: Any) -> SyntheticSource:
     return SyntheticSource(scene, noise=DepthNoise.exact(), keypoint_noise=KeypointNoise(0.0, 0.0), **options)
 
 
@@ -78,7 +78,7 @@ def test_a_walker_hides_a_standing_person_from_the_camera() -> None:
 def test_frames_carry_the_robot_pose_and_the_pipeline_reports_in_the_map() -> None:
     source = _exact("drive_past_group", shaded_color=False)
     sequence = source.scene
-    assert isinstance(sequence, Sequence) and len(source) == 421  # 14 s at 30 fps, both ends included
+    assert isinstance(sequence, SyntheticSequence) and len(source) == 421  # 14 s at 30 fps, both ends included
     pipeline = Pipeline(TruthPose())
     (true_group,) = builtin_sequence("drive_past_group").conversations
     for index in (0, 45, 90):  # the whole group in view (person 1 leaves it after about 3.5 s)

@@ -41,7 +41,7 @@ from sid.scenario.obstacles import Obstacle
 from sid.stream import SocialStream
 from sid.synthetic.noise import DepthNoise
 from sid.synthetic.sensor import SyntheticCamera
-from sid.synthetic.sequence import Sequence
+from sid.synthetic.sequence import SyntheticSequence
 
 __all__ = [
     "CameraSensing",
@@ -151,7 +151,7 @@ class CameraSensing:
         self.stream, self.camera, self.seed = stream, camera, seed
         self.costmap = stream.costmap
         self.sequence = (
-            Sequence.from_scenario(
+            SyntheticSequence.from_scenario(
                 dataclasses.replace(scenario, robot=dataclasses.replace(scenario.robot, path=())), stream.pipeline.mount
             )  # fmt: skip
             if scenario.people
