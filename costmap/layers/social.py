@@ -113,14 +113,22 @@ def group_zone_polygon(
     return grown
 
 
+_NO_AREA = 1e-12
+"""Twice the area (m^2) below which a hull's polygon counts as none (its vertices coincide or are collinear)."""
+
+
 def _hull_ring(hull: BaseGeometry) -> tuple[list[list[float]], bool]:
     """The vertices [x, y] (world frame, m) of a convex hull (Point, LineString or Polygon), a polygon's ring closed
-    and counter-clockwise (as shapely's ``orient(hull, 1.0)``), and whether it is a polygon. Python floats, read in
-    one call (``shapely.get_coordinates``): a handful of vertices, per group and frame."""
+    and counter-clockwise (as shapely's ``orient(hull, 1.0)``), and whether it bounds an area (a polygon of
+    vertices on one spot or one line does not). Python floats, read in one call (``shapely.get_coordinates``): a
+    handful of vertices, per group and frame."""
     ring = shapely.get_coordinates(hull).tolist()
     if not isinstance(hull, Polygon):
         return ring, False
-    twice_area = sum(ax * by - bx * ay for (ax, ay), (bx, by) in zip(ring[:-1], ring[1:], strict=True))  # shoelace
+    (ox, oy), edges = ring[0], zip(ring[:-1], ring[1:], strict=True)
+    twice_area = sum((ax - ox) * (by - oy) - (bx - ox) * (ay - oy) for (ax, ay), (bx, by) in edges)  # shoelace
+    if abs(twice_area) < _NO_AREA:  # vertices on one spot or one line, to rounding: painted as a polyline
+        return ring, False
     return (ring[::-1] if twice_area < 0 else ring), True
 
 
@@ -170,10 +178,10 @@ def _distance_to_hull(spec: GridSpec, window: Window, ring: list[list[float]], p
     of edges: numpy's call overhead would dominate).
     """
     ox, oy = ring[0]
-    if len(ring) == 1:
+    along, across, halves = _edge_fields(ring)
+    if not halves:  # a point: one vertex, or vertices that coincide (people on one spot)
         dx, dy = _polynomials(spec, window, ox, oy, _line(0.0, 0.0, 1.0, 0.0) + _line(0.0, 0.0, 0.0, 1.0))
         return cast(np.ndarray, cv2.magnitude(dx, dy))
-    along, across, halves = _edge_fields(ring)
     fields = _polynomials(spec, window, ox, oy, along + across)
     edges, cols = len(halves), fields.shape[2]
     # Every edge in each call (as one (edges x rows, cols) array for OpenCV): 5 calls whatever the number of edges.
