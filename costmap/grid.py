@@ -23,6 +23,7 @@ __all__ = [
     "INSCRIBED",
     "LETHAL",
     "MAX_NON_OBSTACLE",
+    "MAX_ORIGIN",
     "NO_INFORMATION",
     "SEPARATE_WINDOW_CELLS",
     "Window",
@@ -129,6 +130,11 @@ def nonzero_cells(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return rows, cols
 
 
+MAX_ORIGIN = 1e7
+"""The farthest (m, along x or y) a map's origin may lie from the world's: 10 000 km holds any UTM coordinate, and
+float64 still resolves nanometres there (at 1e300 m a person 4 m inside a map lands on its corner)."""
+
+
 @dataclass(frozen=True)
 class GridSpec:
     """Grid geometry: resolution (m/cell), origin (world x, y of the lower-left corner), size in cells."""
@@ -141,7 +147,7 @@ class GridSpec:
 
     def __post_init__(self) -> None:
         check_number("map", "resolution", self.resolution, low=0, low_open=True, unit="metres")
-        check_numbers("map", self, ("origin_x", "origin_y"), unit="metres")
+        check_numbers("map", self, ("origin_x", "origin_y"), low=-MAX_ORIGIN, high=MAX_ORIGIN, unit="metres")
         if self.width <= 0 or self.height <= 0:
             raise ValueError(f"map.size must give at least one cell, got {self.width}x{self.height} cells")
         _check_cells(self.width, self.height)

@@ -14,18 +14,17 @@ map_server loads exactly the values written. (map_saver's trinary output would k
 
 from __future__ import annotations
 
-import warnings
+import re
 from pathlib import Path
 
 import cv2
 import numpy as np
 import yaml
-from PIL import Image, UnidentifiedImageError
 
 from costmap.grid import GridSpec
 from costmap.occupancy import OCC_OCCUPIED, OCC_UNKNOWN, OccupancyGrid
 from sid.checks import check_limit
-from sid.documents import is_number, load_document
+from sid.documents import ImageHeader, is_number, load_document, read_image_header, summary
 from sid.errors import SidError
 
 __all__ = ["MODES", "MapFileError", "read_map", "write_map"]
@@ -42,7 +41,7 @@ def _number(doc: dict, key: str, path: Path) -> float:
         raise MapFileError(f"{path}: missing key '{key}'")
     value = doc[key]
     if not is_number(value):
-        raise MapFileError(f"{path}: '{key}' must be a finite number, got {value!r}")
+        raise MapFileError(f"{path}: '{key}' must be a finite number, got {summary(value)}")
     return float(value)
 
 
@@ -61,17 +60,17 @@ def _read_metadata(path: Path) -> dict:
         raise MapFileError(f"{path}: 'resolution' must be positive, got {resolution}")
     origin = doc.get("origin")
     if not isinstance(origin, list) or len(origin) != 3:
-        raise MapFileError(f"{path}: 'origin' must be [x, y, yaw], got {origin!r}")
+        raise MapFileError(f"{path}: 'origin' must be [x, y, yaw], got {summary(origin)}")
     origin = [_number({"origin": v}, "origin", path) for v in origin]
     mode = doc.get("mode", "trinary")
     if mode not in MODES:
-        raise MapFileError(f"{path}: 'mode' must be one of {MODES}, got {mode!r}")
+        raise MapFileError(f"{path}: 'mode' must be one of {MODES}, got {summary(mode)}")
     occupied, free = _number(doc, "occupied_thresh", path), _number(doc, "free_thresh", path)
     if mode != "raw" and not 0 <= free < occupied <= 1:
         raise MapFileError(f"{path}: need 0 <= free_thresh < occupied_thresh <= 1, got {free}, {occupied}")
     negate = doc.get("negate")
     if negate not in (0, 1, True, False):
-        raise MapFileError(f"{path}: 'negate' must be 0 or 1, got {negate!r}")
+        raise MapFileError(f"{path}: 'negate' must be 0 or 1, got {summary(negate)}")
     image_path = Path(image) if Path(image).is_absolute() else path.parent / image
     return dict(
         image=image_path,
@@ -84,22 +83,17 @@ def _read_metadata(path: Path) -> dict:
     )
 
 
-_NETPBM_MAGIC = (b"P2", b"P3", b"P5", b"P6")
-
-
-def _netpbm_maxval(image: Path) -> int | None:
-    """The maximum value declared in a PGM/PPM header (the value of white), None for other files or an unreadable
-    header. OpenCV returns the stored values unscaled and Pillow keeps the header's maximum private, so the four
-    header fields are read here (magic, width, height, maximum; ``#`` comments between them)."""
-    try:
-        with image.open("rb") as file:
-            head = file.read(1024)
-    except OSError:
+def _netpbm_maxval(image: Path, header: ImageHeader) -> int | None:
+    """The maximum value declared in a PGM/PPM header (the value of white), None for other formats. OpenCV returns
+    the stored values unscaled and Pillow keeps the header's maximum private, so the header's bytes (their length
+    known from Pillow, whatever its comments) are split into magic, width, height, maximum; ``#`` comments run to
+    the end of their line."""
+    if header.format != "PPM" or header.data_offset <= 0:
         return None
-    fields = b" ".join(line.split(b"#", 1)[0] for line in head.splitlines()).split()[:4]
-    if len(fields) < 4 or fields[0] not in _NETPBM_MAGIC or not fields[3].isdigit():
-        return None
-    return int(fields[3]) or None
+    with image.open("rb") as file:
+        head = file.read(header.data_offset)
+    fields = re.sub(rb"#[^\r\n]*", b" ", head).split()
+    return int(fields[3]) if len(fields) >= 4 and fields[3].isdigit() and int(fields[3]) > 0 else None
 
 
 def _shade(image: np.ndarray, mode: str, white: float) -> tuple[np.ndarray, np.ndarray]:
@@ -115,22 +109,19 @@ def _shade(image: np.ndarray, mode: str, white: float) -> tuple[np.ndarray, np.n
     return colour.mean(axis=2), opaque
 
 
-def _check_image_size(path: Path, image: Path) -> None:
-    """MapFileError when the image's header declares more pixels than ``Limits.map_cells``, read before any pixel
-    is decoded (Pillow reads headers lazily); formats Pillow does not know are left to OpenCV."""
+def _image_header(path: Path, image: Path) -> ImageHeader:
+    """The map image's header; MapFileError when it cannot be read before decoding or declares more pixels than
+    ``Limits.map_cells``."""
     try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", Image.DecompressionBombWarning)
-            with Image.open(image) as header:
-                width, height = header.size
-    except Image.DecompressionBombError as exc:  # Pillow's own bound, far above the default limit
-        raise MapFileError(f"{path}: map image {image}: {exc}") from None
-    except (OSError, UnidentifiedImageError, ValueError, SyntaxError):  # unreadable: OpenCV says so below
-        return
+        header = read_image_header(image, "map image")
+    except ValueError as exc:
+        raise MapFileError(f"{path}: {exc}") from None
     try:
-        check_limit("map image", width * height, "map_cells", "pixels", f"{width} x {height} = ")
+        detail = f"{header.width} x {header.height} = "
+        check_limit("map image", header.width * header.height, "map_cells", "pixels", detail)
     except ValueError as exc:
         raise MapFileError(f"{path}: {image}: {exc}") from None
+    return header
 
 
 def read_map(path: str | Path) -> OccupancyGrid:
@@ -140,13 +131,13 @@ def read_map(path: str | Path) -> OccupancyGrid:
     larger than ``sid.checks.Limits.map_cells`` pixels (refused from its header, before decoding)."""
     path = Path(path)
     meta = _read_metadata(path)
-    _check_image_size(path, meta["image"])
+    header = _image_header(path, meta["image"])
     image = cv2.imread(str(meta["image"]), cv2.IMREAD_UNCHANGED)
     if image is None or image.size == 0:
         raise MapFileError(f"{path}: cannot read map image {meta['image']} (missing or not an image)")
     if image.dtype not in (np.uint8, np.uint16):
         raise MapFileError(f"{path}: map image {meta['image']} must be 8 or 16 bit, got {image.dtype}")
-    white = _netpbm_maxval(meta["image"]) or (65535.0 if image.dtype == np.uint16 else 255.0)
+    white = _netpbm_maxval(meta["image"], header) or (65535.0 if image.dtype == np.uint16 else 255.0)
     shade, opaque = _shade(image, meta["mode"], white)
     occ = shade if meta["negate"] else 1.0 - shade
     free, occupied = meta["free"], meta["occupied"]
@@ -162,7 +153,10 @@ def read_map(path: str | Path) -> OccupancyGrid:
         if meta["mode"] == "scale":
             data = np.where(opaque, data, OCC_UNKNOWN)
     rows, cols = data.shape
-    spec = GridSpec(meta["resolution"], meta["origin"][0], meta["origin"][1], cols, rows)
+    try:
+        spec = GridSpec(meta["resolution"], meta["origin"][0], meta["origin"][1], cols, rows)
+    except ValueError as exc:  # e.g. an origin too far for its cells to be told apart
+        raise MapFileError(f"{path}: {exc}") from None
     return OccupancyGrid(spec, np.flipud(data).astype(np.int8), origin_yaw=meta["origin"][2])
 
 

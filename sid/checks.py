@@ -15,7 +15,16 @@ from typing import Any
 
 from sid.errors import SidError
 
-__all__ = ["LIMITS_ENV", "LimitError", "Limits", "check_limit", "check_number", "check_numbers", "limits"]
+__all__ = [
+    "LIMITS_ENV",
+    "LimitError",
+    "Limits",
+    "amount",
+    "check_limit",
+    "check_number",
+    "check_numbers",
+    "limits",
+]
 
 LIMITS_ENV = "SID_LIMITS"
 """The environment variable that raises (or lowers) limits: ``SID_LIMITS="map_cells=16000000,people=300"``."""
@@ -30,8 +39,12 @@ class Limits:
     lidar_beams: beams of a simulated scan (100000 beams: about 0.6 GB and 20 s for ``sid costmap``).
     scan_cells: beams x the longest LiDAR range in cells (``lidar.range_max`` or ``raytrace_max_range``), the
     samples a simulated scan and the LiDAR layer's ray tracing take (720 beams x 10 m at 5 cm: 144000).
-    people: people in one frame (a scenario, a ``sid groups`` or ``sid track`` line); grouping time grows faster
-    than the square.
+    people: people in one frame (a scenario, a ``sid groups`` or ``sid track`` line, a frame of an F-formation
+    dataset); grouping time grows faster than the square.
+    detections: people the pose model reports in one frame (the highest-scoring are kept, as Ultralytics'
+    ``max_det``); the same default as ``people``, whom they become.
+    obstacle_points: the points of a scenario's obstacles together (a wall's points, 4 per box, 1 per circle).
+    scan_edges: beams x (straight obstacle edges + circles + people), the ray tests of a simulated scan.
     Raise one with ``SID_LIMITS="NAME=VALUE,..."`` (an environment variable, read at each check).
     """
 
@@ -39,6 +52,9 @@ class Limits:
     lidar_beams: int = 100_000
     scan_cells: int = 20_000_000
     people: int = 100
+    detections: int = 100
+    obstacle_points: int = 100_000
+    scan_edges: int = 20_000_000
 
 
 class LimitError(SidError, ValueError):
@@ -125,6 +141,12 @@ def check_limit(field: str, count: float, limit: str, unit: str, detail: str = "
     allowed = getattr(limits(), limit)
     if not count <= allowed:
         raise LimitError(
-            f"{field}: {detail}{count:,.0f} {unit} is more than the limit of {allowed:,} {unit} ({limit}; raise it "
-            f"with {LIMITS_ENV}={limit}=N)"
+            f"{field}: {detail}{amount(count)} {unit} is more than the limit of {allowed:,} {unit} ({limit}; raise "
+            f"it with {LIMITS_ENV}={limit}=N)"
         )
+
+
+def amount(count: float) -> str:
+    """A count for a message: with thousands separators (``20,000,000``), in three digits past 10^15 (``2e+304``),
+    so that a number from a file cannot make the message long."""
+    return f"{count:,.0f}" if count < 1e15 else f"{count:.3g}"

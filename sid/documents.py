@@ -1,23 +1,32 @@
-"""Reading the project's JSON / YAML input files (scenarios, scenes) with one rule and one set of errors, and writing
-output files whole (a temporary file in the same folder, then a rename)."""
+"""Reading the project's JSON / YAML input files (scenarios, scenes) with one rule and one set of errors, the headers
+of image files before their pixels, and writing output files whole (a temporary file in the same folder, then a
+rename)."""
 
 from __future__ import annotations
 
 import json
 import math
 import os
+import re
+import reprlib
+import struct
 import tempfile
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TypeGuard
 
 import yaml
 
 __all__ = [
+    "IMAGE_FORMATS",
+    "ImageHeader",
     "InputWarning",
     "TEMPORARY_PREFIX",
     "decode_text",
     "is_number",
     "load_document",
+    "read_image_header",
+    "summary",
     "unique_keys",
     "write_atomically",
 ]
@@ -63,7 +72,9 @@ def unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
 
 class _UniqueKeyLoader(yaml.SafeLoader):
     """PyYAML's safe loader, refusing a mapping that gives a key twice (it would keep the last silently); keys
-    brought in by a ``<<`` merge may still be overridden, as YAML intends."""
+    brought in by a ``<<`` merge may still be overridden, as YAML intends. A number with an exponent and no point
+    (``5e-2``, ``1E3``) is a float, as in YAML 1.2 and in the yaml-cpp reader of Nav2's map_server (YAML 1.1, which
+    PyYAML follows, makes it a string)."""
 
     def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
         seen: set[Any] = set()
@@ -79,6 +90,53 @@ class _UniqueKeyLoader(yaml.SafeLoader):
                 raise yaml.constructor.ConstructorError(None, None, f"found duplicate key {key!r}", key_node.start_mark)
             seen.add(key)
         return super().construct_mapping(node, deep)
+
+
+_UniqueKeyLoader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9][0-9_]*)[eE][-+]?[0-9]+$"),
+    list("-+0123456789."),
+)
+
+
+def summary(value: Any, limit: int = 80) -> str:
+    """A parsed JSON / YAML value written as JSON (``null``, ``[525]``, ``"abc"``) for an error message, cut to
+    ``limit`` characters. Only as much of the value is visited as is written, so a value that is huge once expanded
+    (a YAML alias bomb: a few hundred bytes naming one list thousands of times over) stays short and cheap."""
+    parts: list[str] = []
+    room = limit + 1  # one past the limit: the text was cut
+
+    def put(text: str) -> None:
+        nonlocal room
+        parts.append(text[:room])
+        room -= len(text)
+
+    def walk(item: Any) -> None:
+        if room <= 0:
+            return
+        if isinstance(item, dict | list | tuple):
+            pairs = item.items() if isinstance(item, dict) else ((None, v) for v in item)
+            put("{" if isinstance(item, dict) else "[")
+            for i, (key, v) in enumerate(pairs):
+                if room <= 0:
+                    return
+                put(", " if i else "")
+                if isinstance(item, dict):
+                    walk(key if isinstance(key, str) else str(key))
+                    put(": ")
+                walk(v)
+            put("}" if isinstance(item, dict) else "]")
+        elif isinstance(item, str):
+            put(json.dumps(item[:room], ensure_ascii=False))
+        else:
+            try:
+                put(json.dumps(item))
+            except (TypeError, ValueError):  # not JSON (a YAML date, an int beyond str's digit limit)
+                put(reprlib.repr(item))
+
+    walk(value)
+    text = "".join(parts)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def decode_text(raw: bytes, what: str) -> str:
@@ -102,6 +160,54 @@ def is_number(value: Any) -> TypeGuard[int | float]:
         return math.isfinite(value)
     except OverflowError:  # an int beyond the float range
         return False
+
+
+IMAGE_FORMATS = ("PNG", "JPEG", "PPM", "BMP", "TIFF")
+"""Pillow's names of the image formats sid reads (PPM includes PGM): those whose size Pillow reads from the header
+without decoding a pixel, so it can be checked before OpenCV allocates the image."""
+
+
+@dataclass(frozen=True)
+class ImageHeader:
+    """What an image file's header declares: Pillow's format name, width and height (pixels), and the offset
+    (bytes) where its pixels start, the header's length (0 when the format stores them in several blocks)."""
+
+    format: str
+    width: int
+    height: int
+    data_offset: int
+
+
+def read_image_header(path: str | Path, what: str) -> ImageHeader:
+    """The header of an image file, read without decoding any pixel; ValueError ``"... what PATH ..."`` when the
+    file cannot be read or is not one of ``IMAGE_FORMATS`` (e.g. Radiance .hdr, PAM, OpenEXR: OpenCV would allocate
+    whatever their headers say before any size could be checked).
+
+    Pillow's parser of the format, found as ``Image.open`` finds it, reads the header; ``Image.open`` itself would
+    refuse a header above its own pixel bound with a message that hides the size."""
+    from PIL import Image  # Pillow's import only where an image is read
+
+    Image.init()
+    try:
+        with open(path, "rb") as file:
+            prefix = file.read(16)
+            for name in IMAGE_FORMATS:
+                factory, accept = Image.OPEN[name]
+                if accept is not None and not accept(prefix):
+                    continue
+                file.seek(0)
+                image = factory(file, str(path))
+                tiles = image.tile
+                offset = int(tiles[0][2]) if len(tiles) == 1 else 0
+                return ImageHeader(name, image.size[0], image.size[1], offset)
+    except OSError as exc:  # missing, unreadable, or truncated within its header
+        raise ValueError(f"cannot read {what} {path} ({str(exc.strerror or exc)[:120]})") from None
+    except (SyntaxError, ValueError, EOFError, struct.error) as exc:  # a header the format's parser refuses
+        raise ValueError(f"cannot read {what} {path}: bad header ({str(exc)[:120]})") from None
+    raise ValueError(
+        f"cannot read {what} {path}: not a PNG, JPEG, PGM/PPM, BMP or TIFF image (the formats whose size sid reads "
+        "before decoding)"
+    )
 
 
 TEMPORARY_PREFIX = ".sid-partial-"

@@ -40,6 +40,7 @@ from sid.perception.group import Group
 from sid.perception.people import Person
 
 __all__ = [
+    "SIGMA_RANGE",
     "SocialLayer",
     "SocialParams",
     "group_zone_polygon",
@@ -51,6 +52,10 @@ __all__ = [
     "paint_person",
     "zone_hull",
 ]
+
+SIGMA_RANGE = (1e-3, 1e3)
+"""The spreads (m) a Gaussian of the social layer may have: 1 mm to 1 km, whose exponents stay well inside float32
+(the layer's arithmetic) over the cells they reach; margins may be up to the same kilometre."""
 
 
 @dataclass(frozen=True)
@@ -70,8 +75,9 @@ class SocialParams:
     def __post_init__(self) -> None:
         check_numbers("social", self, ("amplitude", "group_cost"), low=0, high=MAX_NON_OBSTACLE)
         sigmas = ("sigma_front", "sigma_rear", "sigma_side", "sigma_unknown", "group_sigma")
-        check_numbers("social", self, sigmas, low=0, low_open=True, unit="metres")
-        check_numbers("social", self, ("group_margin", "people_clear_margin"), low=0, unit="metres")
+        check_numbers("social", self, sigmas, low=SIGMA_RANGE[0], high=SIGMA_RANGE[1], unit="metres")
+        margins = ("group_margin", "people_clear_margin")
+        check_numbers("social", self, margins, low=0, high=SIGMA_RANGE[1], unit="metres")
 
 
 @lru_cache(maxsize=64)

@@ -10,7 +10,6 @@ function here treats the camera as an ideal pinhole. Undistort images first if y
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -18,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from sid.checks import check_number, check_numbers
-from sid.documents import is_number, load_document
+from sid.documents import is_number, load_document, summary
 
 __all__ = ["Calibration", "Extrinsics", "Intrinsics", "MAX_FOCAL_PER_PIXEL", "MAX_IMAGE_SIDE", "deproject", "project"]
 
@@ -96,17 +95,17 @@ class Intrinsics:
         A missing or mistyped field is a ValueError naming ``where`` (e.g. ``color``), the field and its value.
         """
         if not isinstance(data, dict):
-            raise ValueError(f"{where}: expected an object with width, height, fx, fy, cx, cy, got {_shown(data)}")
+            raise ValueError(f"{where}: expected an object with width, height, fx, fy, cx, cy, got {summary(data)}")
         width, height = (_pixel_count(data, key, where) for key in ("width", "height"))
         fx, fy = (_number(data, key, where, low=0, low_open=True, unit="pixels") for key in ("fx", "fy"))
         cx = _number(data, "cx" if "cx" in data or "ppx" not in data else "ppx", where, unit="pixels")
         cy = _number(data, "cy" if "cy" in data or "ppy" not in data else "ppy", where, unit="pixels")
         model = data.get("model", "none")
         if not isinstance(model, str):
-            raise ValueError(f"{where}: model must be a distortion model name, got {_shown(model)}")
+            raise ValueError(f"{where}: model must be a distortion model name, got {summary(model)}")
         coeffs = data.get("coeffs", [0.0] * 5)
         if not (isinstance(coeffs, list) and all(is_number(c) for c in coeffs)):
-            raise ValueError(f"{where}: coeffs must be a list of numbers, got {_shown(coeffs)}")
+            raise ValueError(f"{where}: coeffs must be a list of numbers, got {summary(coeffs)}")
         return cls(width, height, fx, fy, cx, cy, model, tuple(float(c) for c in coeffs))
 
     def to_dict(self) -> dict[str, Any]:
@@ -155,7 +154,7 @@ class Extrinsics:
         A missing or mistyped field is a ValueError naming ``where`` (e.g. ``depth_to_color``), the field and its value.
         """
         if not isinstance(data, dict):
-            raise ValueError(f"{where}: expected an object with rotation and translation, got {_shown(data)}")
+            raise ValueError(f"{where}: expected an object with rotation and translation, got {summary(data)}")
         rotation = _numbers(data, "rotation", where, 9, "a 3x3 row-major matrix of numbers")
         translation = _numbers(data, "translation", where, 3, "[x, y, z] in metres")
         try:
@@ -194,7 +193,7 @@ class Calibration:
         path = Path(path)
         data = load_document(path, "calibration JSON")  # names the file itself
         if not isinstance(data, dict):
-            raise ValueError(f"calibration {path}: expected a JSON object, got {_shown(data)}")
+            raise ValueError(f"calibration {path}: expected a JSON object, got {summary(data)}")
         depth_scale = _depth_scale(data, f"calibration {path}")
         try:
             if "color" in data:
@@ -226,15 +225,6 @@ def _depth_scale(data: dict[str, Any], where: str) -> float:
     return _number({key: 0.001} | data, key, where, low=0, low_open=True, unit="metres per unit")
 
 
-def _shown(value: Any, limit: int = 80) -> str:
-    """A parsed JSON value as JSON (``null``, ``[525]``, ``"abc"``), shortened to ``limit`` characters."""
-    try:
-        text = json.dumps(value)
-    except (TypeError, ValueError):
-        text = repr(value)
-    return text if len(text) <= limit else text[: limit - 3] + "..."
-
-
 def _number(data: dict[str, Any], key: str, where: str, **bounds: Any) -> float:
     """``data[key]`` as a float: ValueError ``"where: key ..."`` when it is missing, not a number or out of bounds
     (``bounds`` as in ``sid.checks.check_number``)."""
@@ -242,7 +232,7 @@ def _number(data: dict[str, Any], key: str, where: str, **bounds: Any) -> float:
         raise ValueError(f"{where}: missing field {key!r}")
     value = data[key]
     if not is_number(value):
-        raise ValueError(f"{where}: {key} must be a number, got {_shown(value)}")
+        raise ValueError(f"{where}: {key} must be a number, got {summary(value)}")
     check_number(where, key, value, **bounds)
     return float(value)
 
@@ -251,7 +241,7 @@ def _pixel_count(data: dict[str, Any], key: str, where: str) -> int:
     """``data[key]`` as a whole number of pixels in [1, MAX_IMAGE_SIDE] (image width or height)."""
     value = _number(data, key, where, low=1, high=MAX_IMAGE_SIDE, unit="pixels")
     if not value.is_integer():
-        raise ValueError(f"{where}: {key} must be a whole number of pixels, got {_shown(data[key])}")
+        raise ValueError(f"{where}: {key} must be a whole number of pixels, got {summary(data[key])}")
     return int(value)
 
 
@@ -262,7 +252,7 @@ def _numbers(data: dict[str, Any], key: str, where: str, count: int, rule: str) 
     value = data[key]
     flat = [x for row in value for x in (row if isinstance(row, list) else [row])] if isinstance(value, list) else None
     if flat is None or len(flat) != count or not all(is_number(x) for x in flat):
-        raise ValueError(f"{where}: {key} must be {rule}, got {_shown(value)}")
+        raise ValueError(f"{where}: {key} must be {rule}, got {summary(value)}")
     return np.array(flat, dtype=float)
 
 

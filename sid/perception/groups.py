@@ -51,6 +51,7 @@ from functools import cached_property, lru_cache
 import numpy as np
 
 from sid.checks import check_number, check_numbers
+from sid.documents import summary
 from sid.perception.cluster import dbscan_labels
 from sid.perception.gcff import GCFFParams, gcff_labels
 from sid.perception.group import Group
@@ -170,7 +171,7 @@ class GroupParams:
 
     def __post_init__(self) -> None:
         if self.method not in GROUP_METHODS:
-            raise ValueError(f"groups: method must be one of {', '.join(GROUP_METHODS)}, got {self.method!r}")
+            raise ValueError(f"groups: method must be one of {', '.join(GROUP_METHODS)}, got {summary(self.method)}")
         self.ospace_model  # noqa: B018 - builds (and so checks) the o-space fields, once per record
         self.gcff_params  # noqa: B018 - likewise the graph-cut fields
         check_number("groups", "facing_weight_floor", self.facing_weight_floor, low=0, low_open=True, high=1)

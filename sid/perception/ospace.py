@@ -58,7 +58,7 @@ if TYPE_CHECKING:  # imported where a crowd needs it: scipy.spatial is ~0.3 s of
 
 from sid.checks import check_number
 
-__all__ = ["OSpace", "OSpaceModel", "TIE", "find_ospaces"]
+__all__ = ["MAX_LENGTH", "MAX_RADIUS_STEPS", "OSpace", "OSpaceModel", "TIE", "find_ospaces"]
 
 # Greedy assignment and refit rounds at most; the partition is stable after 2-4 on the benchmarks.
 _MAX_ROUNDS = 8
@@ -69,6 +69,12 @@ threshold: rounding after a rigid motion of the scene moves them by ~1e-15."""
 # candidates, and numpy's overhead per call outweighs the arithmetic. Above it, numpy arrays and a KD-tree finding
 # who is within reach of each candidate (the exclusivity test grows with the square of the people listed).
 _SMALL_PEOPLE_MAX = 16
+
+
+MAX_LENGTH = 1e3
+"""The longest length (m) an o-space constant may be, a kilometre: far beyond any conversation."""
+MAX_RADIUS_STEPS = 100
+"""The most proposals per person (one per centimetre over a metre of radii); the search's arrays grow with them."""
 
 
 @dataclass(frozen=True)
@@ -85,15 +91,17 @@ class OSpaceModel:
     angular_weight: float = 1.0
 
     def __post_init__(self) -> None:
-        check_number("ospace", "radius_min", self.radius_min, low=0, low_open=True, unit="metres")
-        check_number("ospace", "radius_max", self.radius_max, low=self.radius_min, unit="metres")
-        check_number("ospace", "price", self.price, low=0, low_open=True, unit="square metres")
-        check_number("ospace", "alone_price", self.alone_price, low=0, low_open=True, unit="square metres")
-        check_number("ospace", "unknown_cost", self.unknown_cost, low=0, unit="metres")
-        check_number("ospace", "body_radius", self.body_radius, low=0, unit="metres")
+        far, vast = MAX_LENGTH, MAX_LENGTH**2  # squared and summed downstream: bounded, they stay finite
+        check_number("ospace", "radius_min", self.radius_min, low=0, low_open=True, high=far, unit="metres")
+        check_number("ospace", "radius_max", self.radius_max, low=self.radius_min, high=far, unit="metres")
+        check_number("ospace", "price", self.price, low=0, low_open=True, high=vast, unit="square metres")
+        check_number("ospace", "alone_price", self.alone_price, low=0, low_open=True, high=vast, unit="square metres")
+        check_number("ospace", "unknown_cost", self.unknown_cost, low=0, high=far, unit="metres")
+        check_number("ospace", "body_radius", self.body_radius, low=0, high=far, unit="metres")
         check_number("ospace", "angular_weight", self.angular_weight, low=0, low_open=True)
-        if isinstance(self.radius_steps, bool) or int(self.radius_steps) != self.radius_steps or self.radius_steps < 1:
-            raise ValueError(f"ospace: radius_steps must be an integer >= 1, got {self.radius_steps}")
+        steps = self.radius_steps
+        if isinstance(steps, bool) or int(steps) != steps or not 1 <= steps <= MAX_RADIUS_STEPS:
+            raise ValueError(f"ospace: radius_steps must be an integer in [1, {MAX_RADIUS_STEPS}], got {steps}")
 
     @cached_property
     def radii(self) -> np.ndarray:

@@ -19,6 +19,11 @@ from sid.scenario.obstacles import BoxObstacle, CircleObstacle, Obstacle, Segmen
 __all__ = ["simulate_scan"]
 
 
+_TESTS_PER_BLOCK = 1_000_000
+"""Ray tests (beam x edge or circle) per block of beams: the arrays of one block stay tens of megabytes, whatever
+the number of walls (``Limits.scan_edges`` bounds the time)."""
+
+
 def _segments(obstacles: Sequence[Obstacle]) -> tuple[np.ndarray, np.ndarray]:
     """Start and end points (S, 2) of every straight piece of walls and boxes."""
     starts, ends = [], []
@@ -118,7 +123,13 @@ def simulate_scan(
         raise ValueError("simulate_scan: a circle obstacle or a person has a non-finite position")
     radii = np.array([r for _, r in circles], dtype=float)
 
-    ranges = np.minimum(_ray_segment_ranges(origin, dirs, a, b), _ray_circle_ranges(origin, dirs, centres, radii))
+    ranges = np.empty(beams)
+    block = max(1, _TESTS_PER_BLOCK // max(len(a) + len(radii), 1))  # beams per block: bounded (beams, edges) arrays
+    for k in range(0, beams, block):
+        d = dirs[k : k + block]
+        ranges[k : k + block] = np.minimum(
+            _ray_segment_ranges(origin, d, a, b), _ray_circle_ranges(origin, d, centres, radii)
+        )
     if static is not None:
         np.minimum(ranges, _grid_ranges(origin, dirs, static, range_max), out=ranges)
     ranges[ranges > range_max] = np.inf

@@ -25,8 +25,8 @@ from costmap.layers.tracked import TrackedPeopleParams
 from costmap.mapfile import MapFileError, read_map
 from costmap.occupancy import OccupancyGrid
 from costmap.plugins import PEOPLE_LAYERS, PLUGINS, CostmapParams
-from sid.checks import LimitError, check_limit
-from sid.documents import InputWarning, is_number, load_document
+from sid.checks import LimitError, amount, check_limit
+from sid.documents import InputWarning, is_number, load_document, summary
 from sid.errors import SidError
 from sid.perception.groups import GroupParams
 from sid.perception.people import Person
@@ -117,7 +117,7 @@ class ScenarioError(SidError, ValueError):
 
 
 def _fail(name: str, expected: str, value: Any) -> ScenarioError:
-    return ScenarioError(f"{name}: expected {expected}, got {value!r}")
+    return ScenarioError(f"{name}: expected {expected}, got {summary(value)}")
 
 
 def _number(value: Any, name: str, *, positive: bool = False, minimum: float | None = None) -> float:
@@ -128,6 +128,16 @@ def _number(value: Any, name: str, *, positive: bool = False, minimum: float | N
     if minimum is not None and value < minimum:
         raise _fail(name, f"a number >= {minimum}", value)
     return float(value)
+
+
+def _length(value: Any, name: str, grid: GridSpec) -> float:
+    """A positive length (m) at most the map's diagonal: a radius beyond it covers the whole map anyway, and the
+    drawing and ray arithmetic downstream need numbers of the map's size."""
+    length = _number(value, name, positive=True)
+    reach = math.hypot(*grid.size_m)
+    if length > reach:
+        raise ScenarioError(f"{name}: {length:g} m is more than the map's diagonal ({reach:g} m); use at most that")
+    return length
 
 
 def _integer(value: Any, name: str, minimum: int) -> int:
@@ -197,7 +207,7 @@ def _plugins(value: Any, name: str) -> tuple[str, ...]:
         raise _fail(name, "a list of layer names", value)
     for i, layer in enumerate(value):
         if layer not in PLUGINS:
-            raise ScenarioError(f"{name}[{i}]: unknown layer {layer!r}; known layers: {', '.join(PLUGINS)}")
+            raise ScenarioError(f"{name}[{i}]: unknown layer {summary(layer)}; known layers: {', '.join(PLUGINS)}")
     marking = ("lidar", *sorted(PEOPLE_LAYERS))
     if not set(value) & set(marking):
         raise ScenarioError(f"{name}: {value} has no layer that marks people; list one of {', '.join(marking)}")
@@ -365,13 +375,35 @@ def _near_map(grid: GridSpec, obstacle: Obstacle, name: str) -> None:
             )
 
 
-def _check_scan(grid: GridSpec, lidar: LidarSpec, layers: CostmapParams) -> None:
-    """The simulated scan's size: beams (Limits.lidar_beams), and beams x the longest range in cells
-    (Limits.scan_cells), the samples the scan and the LiDAR layer's ray tracing take."""
+def _point_count(value: Any) -> int:
+    """The points an obstacle's mapping gives, counted before it is read (``Limits.obstacle_points``): a wall's
+    points, 4 per box, 1 for anything else (a circle, or a mapping refused when read)."""
+    if not isinstance(value, dict):
+        return 1
+    if value.get("type") == "segment" and isinstance(value.get("points"), list):
+        return len(value["points"])
+    return 4 if value.get("type") == "box" else 1
+
+
+def _edge_count(obstacles: list[Obstacle], people: list[Person]) -> int:
+    """What each beam of the simulated scan is tested against: a wall's straight pieces, a box's 4 sides, a circle,
+    a person's body."""
+    pieces = (
+        len(o.points) - 1 if isinstance(o, SegmentObstacle) else 4 if isinstance(o, BoxObstacle) else 1
+        for o in obstacles
+    )
+    return sum(pieces) + len(people)
+
+
+def _check_scan(grid: GridSpec, lidar: LidarSpec, layers: CostmapParams, edges: int) -> None:
+    """The simulated scan's size: beams (Limits.lidar_beams), beams x the longest range in cells
+    (Limits.scan_cells), the samples the scan and the LiDAR layer's ray tracing take, and beams x ``edges``
+    (Limits.scan_edges), its ray tests against obstacles and people."""
     _limit("lidar.beams", lidar.beams, "lidar_beams", "beams")
+    _limit("lidar", lidar.beams * edges, "scan_edges", "ray tests", f"{lidar.beams} beams x {amount(edges)} edges = ")
     longest = max(lidar.range_max, layers.obstacle.raytrace_max_range)
     cells = math.ceil(longest / grid.resolution)
-    detail = f"{lidar.beams} beams x {cells:,} cells of range ({longest:g} m at {grid.resolution:g} m) = "
+    detail = f"{lidar.beams} beams x {amount(cells)} cells of range ({longest:g} m at {grid.resolution:g} m) = "
     _limit("lidar", lidar.beams * cells, "scan_cells", "beam cells", detail)
 
 
@@ -444,7 +476,9 @@ def scenario_from_dict(data: Any, base_dir: Path | None = None, default_name: st
     if static_map is not None and static_spec is not None:
         _warn_resampled(static_spec, grid, static_map)
 
-    obstacles = [_obstacle(o, f"obstacles[{i}]") for i, o in enumerate(_list(data.get("obstacles", []), "obstacles"))]
+    obstacles_data = _list(data.get("obstacles", []), "obstacles")
+    _limit("obstacles", sum(map(_point_count, obstacles_data)), "obstacle_points", "points")
+    obstacles = [_obstacle(o, f"obstacles[{i}]") for i, o in enumerate(obstacles_data)]
     for i, obstacle in enumerate(obstacles):
         _near_map(grid, obstacle, f"obstacles[{i}]")
     people_data = _list(data.get("people", []), "people")
@@ -468,7 +502,7 @@ def scenario_from_dict(data: Any, base_dir: Path | None = None, default_name: st
     robot = RobotSpec(
         start,
         _pose(robot_data["goal"], "robot.goal"),
-        _number(robot_data.get("radius", RobotSpec.radius), "robot.radius", positive=True),
+        _length(robot_data.get("radius", RobotSpec.radius), "robot.radius", grid),
         **_motion(robot_data, "robot", grid, (start[0], start[1]), RobotSpec.speed),
     )
     _inside(grid, robot.goal, "robot.goal")
@@ -479,7 +513,7 @@ def scenario_from_dict(data: Any, base_dir: Path | None = None, default_name: st
         _integer(lidar_data.get("beams", defaults.beams), "lidar.beams", 1),
         _number(lidar_data.get("range_max", defaults.range_max), "lidar.range_max", positive=True),
         _number(lidar_data.get("height", defaults.height), "lidar.height", minimum=0.0),
-        _number(lidar_data.get("body_radius", defaults.body_radius), "lidar.body_radius", positive=True),
+        _length(lidar_data.get("body_radius", defaults.body_radius), "lidar.body_radius", grid),
     )
 
     layer_sections: dict[str, Callable[[Any, str], Any]] = {
@@ -495,7 +529,7 @@ def scenario_from_dict(data: Any, base_dir: Path | None = None, default_name: st
         layers = CostmapParams(**sections)
     except ValueError as exc:
         raise ScenarioError(f"layers.{exc}") from exc
-    _check_scan(grid, lidar, layers)
+    _check_scan(grid, lidar, layers, _edge_count(obstacles, people))
     _check_inflation(grid, layers)
 
     return Scenario(

@@ -21,6 +21,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from sid.documents import read_image_header
 from sid.perception.camera import Calibration
 from sid.perception.frame import Frame
 from sid.sources import FrameReadError, SourceError
@@ -86,6 +87,10 @@ class FolderSource:
             raise FrameReadError(f"frame {name!r}: no colour image in {self.path / 'color'}", index, None)
         if depth_path is None:
             raise FrameReadError(f"frame {name!r}: no depth image {name}.png next to {color_path}", index, None)
+        calib = self.calibration
+        grid = calib.depth if calib.depth is not None else calib.color
+        _check_size(color_path, "colour image", calib.color.width, calib.color.height, index)  # before decoding
+        _check_size(depth_path, "depth image", grid.width, grid.height, index)
         rgb = cv2.imread(str(color_path), cv2.IMREAD_COLOR_RGB)  # decoded straight to RGB: no conversion pass
         if rgb is None:
             raise FrameReadError(f"cannot read colour image {color_path}", index, color_path)
@@ -99,7 +104,6 @@ class FolderSource:
                 index,
                 depth_path,
             )
-        calib = self.calibration
         expected_color = (calib.color.height, calib.color.width)
         if rgb.shape[:2] != expected_color:
             raise FrameReadError(
@@ -108,7 +112,6 @@ class FolderSource:
                 index,
                 color_path,
             )
-        grid = calib.depth if calib.depth is not None else calib.color
         if raw.shape != (grid.height, grid.width):
             raise FrameReadError(
                 f"depth image {depth_path} is {raw.shape[1]}x{raw.shape[0]}, expected {grid.width}x{grid.height}",
@@ -149,6 +152,19 @@ class _Reader:
         current = self._ahead or self._pool.submit(self.source.read, index)
         self._ahead = self._pool.submit(self.source.read, self.index) if self.index < len(self.source) else None
         return current.result()
+
+
+def _check_size(path: Path, what: str, width: int, height: int, index: int) -> None:
+    """FrameReadError unless the image's header declares the calibration's ``width`` x ``height`` pixels, read
+    before any pixel is decoded (a header of 20000 x 20000 would make OpenCV allocate gigabytes first)."""
+    try:
+        header = read_image_header(path, what)
+    except ValueError as exc:
+        raise FrameReadError(str(exc), index, path) from None
+    if (header.width, header.height) != (width, height):
+        raise FrameReadError(
+            f"{what} {path} is {header.width}x{header.height}, the calibration says {width}x{height}", index, path
+        )
 
 
 def _first_existing(folder: Path, stem: str) -> Path | None:

@@ -4,12 +4,21 @@ number safe to the end of the pipeline, degenerate geometry handled as geometry,
 from __future__ import annotations
 
 import json
+import os
+import struct
+import subprocess
+import sys
+import zlib
 from pathlib import Path
 
+import cv2
+import numpy as np
 import pytest
 
+from costmap.mapfile import read_map
 from sid.cli import main
 from tests.conftest import REPO_ROOT
+from tests.pose_models import build_yolo_pose_model
 
 EXAMPLE = REPO_ROOT / "examples" / "conversation.json"
 
@@ -52,3 +61,194 @@ def test_people_on_one_spot_are_geometry(tmp_path, capsys, command, method):
     extra = ["--planner", "grid"] if command == "plan" else []
     assert main([command, path, *extra, "--out", str(tmp_path / "out")]) == 0, capsys.readouterr().err
     assert (tmp_path / "out" / ("plan.png" if command == "plan" else "costmap.png")).is_file()
+
+
+# --- sizes read before they are allocated --------------------------------------------------------------------
+
+MEASURED = """
+import resource, sys
+from sid.cli import main
+code = main(sys.argv[1:])
+print(f"peak RSS {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss // 1024} MB", file=sys.stderr)
+sys.exit(code)
+"""
+
+
+def sid_measured(*args: str) -> tuple[int, list[str], float]:
+    """``sid ARGS`` in a fresh process: its exit code, its stderr lines and its peak memory (RSS, MB)."""
+    env = {**os.environ, "PYTHONPATH": str(REPO_ROOT)}
+    done = subprocess.run(
+        [sys.executable, "-c", MEASURED, *args], capture_output=True, text=True, env=env, cwd=REPO_ROOT, timeout=600
+    )
+    *lines, peak = done.stderr.strip().splitlines()
+    assert "Traceback" not in done.stderr, done.stderr
+    return done.returncode, lines, float(peak.split()[2])
+
+
+def black_png(width: int, height: int) -> bytes:
+    """A whole, valid PNG of ``width`` x ``height`` black pixels at 1 bit per pixel: a few hundred kilobytes that
+    decode to width x height x 3 bytes (OpenCV's colour image), or x 1 (its depth image)."""
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+    packer, row = zlib.compressobj(9), bytes(1 + (width + 7) // 8)  # filter byte 0, then the row's bits
+    pixels = b"".join(packer.compress(row) for _ in range(height)) + packer.flush()
+    header = struct.pack(">IIBBBBB", width, height, 1, 0, 0, 0, 0)
+    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", pixels) + chunk(b"IEND", b"")
+
+
+INTRINSICS = {"width": 64, "height": 48, "fx": 60.0, "fy": 60.0, "cx": 32.0, "cy": 24.0, "depth_scale": 0.001}
+
+
+@pytest.mark.parametrize("stream", ["color", "depth"])
+def test_a_frame_whose_header_says_20000_by_20000_is_refused_before_decoding(tmp_path, stream):
+    folder = tmp_path / "frames"
+    folder.mkdir()
+    (folder / "intrinsics.json").write_text(json.dumps(INTRINSICS))
+    cv2.imwrite(str(folder / "color.png"), np.zeros((48, 64, 3), np.uint8))
+    cv2.imwrite(str(folder / "depth.png"), np.full((48, 64), 1500, np.uint16))
+    (folder / f"{stream}.png").write_bytes(black_png(20000, 20000))
+    model = build_yolo_pose_model(tmp_path / "m.onnx", np.zeros((56, 8)), (64, 64))
+    code, lines, peak = sid_measured("detect", "--source", str(folder), "--model", str(model))
+    what = "colour" if stream == "color" else "depth"
+    assert f"{what} image {folder / f'{stream}.png'} is 20000x20000, the calibration says 64x48" in lines[0]
+    assert code == 0 and "0 frames with people, 1 skipped" in lines[-1]
+    assert peak < 1000  # decoded, the colour image alone is 1.2 GB
+
+
+MAP_YAML = "image: {image}\nresolution: {resolution}\norigin: [0.0, 0.0, 0.0]\nnegate: 0\noccupied_thresh: 0.65\n"
+MAP_YAML += "free_thresh: 0.25\n"
+
+
+def map_scenario(tmp_path: Path, image: str, content: bytes, resolution: str = "0.05") -> str:
+    (tmp_path / image).write_bytes(content)
+    (tmp_path / "room.yaml").write_text(MAP_YAML.format(image=image, resolution=resolution))
+    data = json.loads(EXAMPLE.read_text())
+    data["static_map"] = "room.yaml"
+    path = tmp_path / "s.json"
+    path.write_text(json.dumps(data))
+    return str(path)
+
+
+HEADERS_OPENCV_WOULD_TRUST = {
+    "room.hdr": b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 30000 +X 30000\n" + b"\0" * 64,
+    "room.pam": b"P7\nWIDTH 30000\nHEIGHT 30000\nDEPTH 1\nMAXVAL 255\nTUPLTYPE GRAYSCALE\nENDHDR\n",
+}
+
+
+@pytest.mark.parametrize("image", HEADERS_OPENCV_WOULD_TRUST)
+def test_a_map_image_whose_header_cannot_be_read_cheaply_is_refused(tmp_path, image):
+    path = map_scenario(tmp_path, image, HEADERS_OPENCV_WOULD_TRUST[image])
+    code, lines, peak = sid_measured("costmap", path, "--out", str(tmp_path / "out"))
+    assert code == 2 and len(lines) == 1
+    assert f"room.yaml: cannot read map image {tmp_path / image}: not a PNG, JPEG, PGM/PPM, BMP or TIFF" in lines[0]
+    assert peak < 1000
+
+
+def test_a_pgm_with_a_long_header_comment_keeps_its_maximum(tmp_path):
+    """The maximum (here 1: white) comes after a 2 KB comment; missed, every white (free) cell read as occupied."""
+    comment = b"# " + b"x" * 2000 + b"\n"
+    path = map_scenario(tmp_path, "room.pgm", b"P5\n" + comment + b"200 160\n1\n" + bytes([1]) * 32000)
+    assert read_map(tmp_path / "room.yaml").data.max() == 0  # every cell free
+    assert main(["costmap", path, "--out", str(tmp_path / "out")]) == 0
+
+
+def test_an_exponent_without_a_point_is_a_number_as_in_nav2(tmp_path):
+    map_scenario(tmp_path, "room.pgm", b"P5\n20 16\n255\n" + bytes([254] * 320), resolution="5e-2")
+    assert read_map(tmp_path / "room.yaml").spec.resolution == 0.05
+
+
+# --- numbers: a range each, said in the error ----------------------------------------------------------------
+
+OUT_OF_RANGE = [  # field, value, what the one-line error says
+    ("layers.social.sigma_front", 5e-324, "social: sigma_front must be a finite number of metres in [0.001, 1000]"),
+    ("layers.social.sigma_side", 1e300, "social: sigma_side must be a finite number of metres in [0.001, 1000]"),
+    ("layers.social.group_sigma", 1e-300, "social: group_sigma must be a finite number of metres in [0.001, 1000]"),
+    ("layers.social.people_clear_margin", 1e300, "people_clear_margin must be a finite number of metres in [0, 1000]"),
+    ("lidar.body_radius", 1e300, "lidar.body_radius: 1e+300 m is more than the map's diagonal (12.8062 m)"),
+    ("robot.radius", 1e300, "robot.radius: 1e+300 m is more than the map's diagonal (12.8062 m)"),
+    ("map.origin", [1e300, -4.0], "map: origin_x must be a finite number of metres in [-1e+07, 1e+07], got 1e+300"),
+    ("groups.radius_steps", 1000000, "groups: radius_steps must be an integer in [1, 100], got 1000000"),
+    ("groups.body_radius", 1e300, "groups: body_radius must be a finite number of metres in [0, 1000]"),
+    ("groups.unknown_facing_cost", 1e300, "groups: unknown_facing_cost must be a finite number of metres in [0, 1000]"),
+    ("layers.obstacle.raytrace_max_range", 1e300, "720 beams x 2e+301 cells of range (1e+300 m at 0.05 m) = 1.44e+304"),
+]
+
+
+@pytest.mark.parametrize(("field", "value", "message"), OUT_OF_RANGE)
+def test_a_number_downstream_code_cannot_take_is_refused_with_its_range(tmp_path, capsys, field, value, message):
+    assert main(["plan", scenario(tmp_path, {field: value}), "--planner", "grid", "--out", str(tmp_path)]) == 2
+    line = error_line(capsys)
+    assert message in line and len(line) < 300, line
+
+
+def test_the_numbers_at_the_ends_of_their_ranges_run_to_the_end(tmp_path, capsys):
+    """Each field at an end of its range still gives a costmap (no overflow, no drawing error), and a map at the
+    farthest origin the same plan as at home."""
+    ends = {f"layers.social.{name}": 1000.0 for name in ("sigma_front", "sigma_rear", "sigma_side", "sigma_unknown")}
+    ends |= {"layers.social.group_sigma": 1e-3, "groups.radius_steps": 100, "lidar.body_radius": 12.8}
+    ends |= {"robot.radius": 12.8, "layers.social.group_margin": 1000.0}
+    assert main(["costmap", scenario(tmp_path, ends), "--out", str(tmp_path / "a")]) == 0
+    # The farthest origin, people, robot and walls moved with the map: the same personal spaces as at home.
+    shift = np.array([-1e7 + 1.0, 1e7 - 4.0])
+    data = json.loads(EXAMPLE.read_text())
+    data["map"]["origin"] = (np.array(data["map"]["origin"]) + shift).tolist()
+    for person in data["people"]:
+        person["x"], person["y"] = (np.array([person["x"], person["y"]]) + shift).tolist()
+    for end in ("start", "goal"):
+        data["robot"][end][:2] = (np.array(data["robot"][end][:2]) + shift).tolist()
+    for obstacle in data["obstacles"]:
+        for key in ("points", "center", "min", "max"):
+            if key in obstacle:
+                obstacle[key] = (np.array(obstacle[key]) + shift).tolist()
+    (tmp_path / "far.json").write_text(json.dumps(data))
+    for name, path in (("far", tmp_path / "far.json"), ("home", EXAMPLE)):
+        assert main(["costmap", str(path), "--out", str(tmp_path / name)]) == 0
+    far, home = (np.load(tmp_path / name / "costmap.npz") for name in ("far", "home"))
+    assert far["origin"].tolist() == [-1e7, 1e7 - 8.0]
+    assert np.count_nonzero(home["layer_social"]) > 3000 and np.array_equal(far["layer_social"], home["layer_social"])
+    assert main(["plan", str(tmp_path / "far.json"), "--planner", "grid", "--out", str(tmp_path / "plan")]) == 0
+
+
+def test_obstacle_points_are_counted_before_they_are_read(tmp_path, capsys):
+    wall = [{"type": "segment", "points": [[0.0, 0.01 * (i % 2)] for i in range(200_000)]}]
+    code, lines, peak = sid_measured("costmap", scenario(tmp_path, obstacles=wall), "--out", str(tmp_path / "out"))
+    assert code == 2 and lines == [
+        f"sid costmap: {tmp_path / 's.json'}: obstacles: 200,000 points is more than the limit of 100,000 points "
+        "(obstacle_points; raise it with SID_LIMITS=obstacle_points=N)"
+    ]
+    assert peak < 1000
+    boxes = [{"type": "box", "min": [0.0, 0.0], "max": [0.1, 0.1]}] * 100_000
+    assert main(["costmap", scenario(tmp_path, obstacles=boxes), "--out", str(tmp_path / "out")]) == 2
+    assert "obstacles: 400,000 points is more than the limit" in error_line(capsys)
+
+
+def test_the_scan_bounds_its_ray_tests(tmp_path, capsys):
+    """Beams x edges is a limit of its own; below it the scan's arrays stay small whatever the walls."""
+    wall = [{"type": "segment", "points": [[-1.0 + 1e-4 * i, 0.01 * (i % 2)] for i in range(30_000)]}]
+    assert main(["costmap", scenario(tmp_path, obstacles=wall), "--out", str(tmp_path / "out")]) == 2
+    assert "lidar: 720 beams x 30,003 edges = 21,602,160 ray tests is more than the limit of 20,000,000" in (
+        error_line(capsys)
+    )
+    below = [{"type": "segment", "points": wall[0]["points"][:20_000]}]  # 720 x 20,003 = 14.4 million ray tests
+    code, lines, peak = sid_measured("costmap", scenario(tmp_path, obstacles=below), "--out", str(tmp_path / "o"))
+    assert code == 0 and peak < 1000
+
+
+LEVELS = "abcdefghi"
+ALIAS_BOMB = (
+    "[&a [x, x, x, x, x, x, x, x, x], "
+    + ", ".join(f"&{k} [{', '.join([f'*{p}'] * 9)}]" for p, k in zip(LEVELS, LEVELS[1:], strict=False))
+    + "]"
+)
+
+
+def test_an_alias_bomb_in_a_refused_field_is_not_expanded(tmp_path):
+    """Nine levels of nine aliases: 9^9 (387 million) items once expanded, about 400 bytes on disk."""
+    path = tmp_path / "bomb.yaml"
+    path.write_text(f"name: {ALIAS_BOMB}\nrobot: {{start: [0, 0], goal: [1, 0]}}\n")
+    code, lines, peak = sid_measured("costmap", str(path), "--out", str(tmp_path / "out"))
+    assert len(path.read_bytes()) < 500 and code == 2 and len(lines) == 1
+    assert lines[0].startswith(f'sid costmap: {path}: name: expected a non-empty string, got [["x", "x", "x"')
+    assert len(lines[0]) < 300 and peak < 1000

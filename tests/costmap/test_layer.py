@@ -332,7 +332,7 @@ def test_a_scenario_names_its_layers_in_order(tmp_path):
     assert list(layered.grids) == ["lidar", "inflation"]
     assert layered.master.cost_at([[2.0, 2.3]])[0] == FREE_SPACE  # no personal space: the person is a LiDAR mark
     for plugins, message in (
-        (["lidar", "sonar"], r"layers\.plugins\[1\]: unknown layer 'sonar'"),
+        (["lidar", "sonar"], r'layers\.plugins\[1\]: unknown layer "sonar"'),
         (["lidar", "lidar"], r"layers\.plugins: a layer is listed twice"),
         ("lidar", r"layers\.plugins: expected a list of layer names"),
         ([], r"layers\.plugins: \[\] has no layer that marks people; list one of lidar, social, tracked_people"),

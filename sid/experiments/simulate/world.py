@@ -24,7 +24,7 @@ import numpy as np
 from shapely.geometry import LineString, Point, Polygon
 from shapely.ops import unary_union
 
-from sid.documents import is_number
+from sid.documents import is_number, summary
 from sid.experiments.simulate.robot import DriveLimits
 from sid.perception.people import Person
 from sid.scenario.loader import Scenario, ScenarioError, read_scenario_file, scenario_from_dict
@@ -95,7 +95,7 @@ def jittered(world: SimWorld, seed: int) -> SimWorld:
 
 
 def _fail(name: str, expected: str, value: Any) -> ScenarioError:
-    return ScenarioError(f"{name}: expected {expected}, got {value!r}")
+    return ScenarioError(f"{name}: expected {expected}, got {summary(value)}")
 
 
 def _settings(data: Any) -> SimSettings:
