@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 import scipy.io
 
-from sid.checks import check_number
+from sid.checks import check_limit, check_number
 from sid.perception.gcff import GCFFParams
 from sid.perception.groups import GroupParams, detect_groups
 from sid.perception.people import Person
@@ -498,6 +498,7 @@ def _people(cell: np.ndarray, scale: float, degrees: bool, where: str) -> list[P
         return []
     if rows.ndim != 2 or rows.shape[1] < 4:
         raise ValueError(f"fformation: {where}: features must be N x 4 [id, x, y, theta], got shape {rows.shape}")
+    check_limit(f"fformation: {where}: features", len(rows), "people", "people")  # as sid groups, before grouping
     if not np.all(np.isfinite(rows[:, :3])):
         raise ValueError(f"fformation: {where}: non-finite id or position")
     ids = rows[:, 0]

@@ -135,6 +135,8 @@ class Extrinsics:
             raise ValueError("extrinsics: rotation and translation must be finite")
         if not np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-5):
             raise ValueError("extrinsics: rotation is not orthonormal")
+        if np.linalg.det(rotation) < 0:  # orthonormal, but a reflection: it would mirror the depth points
+            raise ValueError("extrinsics: rotation has determinant -1, a mirror rather than a rotation")
         object.__setattr__(self, "rotation", rotation)
         object.__setattr__(self, "translation", translation)
 

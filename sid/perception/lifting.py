@@ -43,7 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sid.checks import check_number, check_numbers
+from sid.checks import check_limit, check_number, check_numbers
 from sid.perception.align import Search, depth_at_color_pixels
 from sid.perception.camera import Calibration
 from sid.perception.keypoints import KP, NUM_KEYPOINTS, PoseDetection
@@ -169,6 +169,7 @@ def lift_people(
         raise ValueError(f"lift: {len(ids)} ids for {len(detections)} detections")
     if not detections:
         return []
+    check_limit("lift: detections", len(detections), "detections", "detections")  # (P, P, 17) arrays below
     # np.array of a list of equal-shape arrays stacks them, with less overhead than np.stack.
     keypoints = np.array([d.keypoints for d in detections])  # (P, 17, 2) colour pixels
     scores = np.array([d.scores for d in detections])  # (P, 17)

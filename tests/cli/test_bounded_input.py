@@ -16,9 +16,15 @@ import numpy as np
 import pytest
 
 from costmap.mapfile import read_map
+from sid.checks import LimitError
 from sid.cli import main
+from sid.perception.camera import Calibration, Intrinsics
+from sid.perception.keypoints import PoseDetection
+from sid.perception.lifting import lift_people
+from sid.perception.mount import CameraMount
 from tests.conftest import REPO_ROOT
-from tests.pose_models import build_yolo_pose_model
+from tests.experiments.test_fformation import write_sequence
+from tests.pose_models import build_yolo_pose_model, yolo_candidate
 
 EXAMPLE = REPO_ROOT / "examples" / "conversation.json"
 
@@ -252,3 +258,69 @@ def test_an_alias_bomb_in_a_refused_field_is_not_expanded(tmp_path):
     assert len(path.read_bytes()) < 500 and code == 2 and len(lines) == 1
     assert lines[0].startswith(f'sid costmap: {path}: name: expected a non-empty string, got [["x", "x", "x"')
     assert len(lines[0]) < 300 and peak < 1000
+
+
+# --- the pose model's answers ----------------------------------------------------------------------------------
+
+
+def one_frame_folder(tmp_path: Path) -> Path:
+    """A frame folder of one 64 x 48 frame, everything 1.5 m away."""
+    folder = tmp_path / "frames"
+    folder.mkdir()
+    (folder / "intrinsics.json").write_text(json.dumps(INTRINSICS))
+    cv2.imwrite(str(folder / "color.png"), np.full((48, 64, 3), 128, np.uint8))
+    cv2.imwrite(str(folder / "depth.png"), np.full((48, 64), 1500, np.uint16))
+    return folder
+
+
+def test_a_model_answering_20000_people_keeps_the_best_100(tmp_path):
+    """20,000 small boxes that NMS keeps apart (input pixels of a 256 x 256 model): the frame keeps the 100 best."""
+    side = np.arange(142) * 1.8 + 2.0
+    cx, cy = (a.ravel()[:20_000] for a in np.meshgrid(side, side))
+    spread = np.linspace(-0.4, 0.4, 17)
+    candidates = np.stack(
+        [
+            yolo_candidate((x, y, 1.0, 1.0), 0.5 + 0.4 * (k % 997) / 997, np.stack([x + spread, y + spread[::-1]], 1))
+            for k, (x, y) in enumerate(zip(cx, cy, strict=True))
+        ],
+        axis=1,
+    )
+    model = build_yolo_pose_model(tmp_path / "m.onnx", candidates, (256, 256))
+    code, lines, peak = sid_measured("detect", "--source", str(one_frame_folder(tmp_path)), "--model", str(model))
+    assert code == 0 and lines[0] == (
+        "sid detect: warning: pose: the model found 20,000 people in one frame, more than the limit of 100 "
+        "detections; the 100 highest-scoring kept (detections; raise it with SID_LIMITS=detections=N)"
+    )
+    assert peak < 1000
+
+
+def test_a_model_answering_no_candidates_is_refused_when_it_loads(tmp_path, capsys):
+    model = build_yolo_pose_model(tmp_path / "m.onnx", np.zeros((56, 0)), (64, 64))
+    assert main(["detect", "--source", str(one_frame_folder(tmp_path)), "--model", str(model)]) == 2
+    assert "the model answers no candidates (output [1, 56, 0])" in error_line(capsys)
+
+
+def test_lifting_refuses_more_detections_than_the_limit():
+    detection = PoseDetection(np.full((17, 2), 30.0), np.ones(17), np.array([28.0, 28, 32, 32]), 0.9)
+    calibration = Calibration(Intrinsics.from_dict(INTRINSICS))
+    with pytest.raises(LimitError, match="lift: detections: 101 detections is more than the limit of 100"):
+        lift_people([detection] * 101, np.full((48, 64), 1.5), calibration, CameraMount())
+
+
+def test_a_mirror_as_the_depth_to_colour_rotation_is_refused(tmp_path):
+    folder = one_frame_folder(tmp_path)
+    mirror = [[-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]  # orthonormal, determinant -1
+    extrinsics = {"rotation": mirror, "translation": [0.0, 0.0, 0.0]}
+    (folder / "intrinsics.json").write_text(
+        json.dumps({"color": INTRINSICS, "depth": INTRINSICS, "depth_to_color": extrinsics})
+    )
+    with pytest.raises(ValueError, match="depth_to_color: rotation has determinant -1, a mirror rather than a rota"):
+        Calibration.from_json(folder / "intrinsics.json")
+
+
+def test_eval_fformation_has_the_per_frame_people_limit_of_sid_groups(tmp_path, capsys):
+    crowd = np.array([[k + 1, 100.0 * (k % 60), 100.0 * (k // 60), 0.0] for k in range(3000)])
+    folder = write_sequence(tmp_path / "Crowd", [crowd], {1: [[1, 2]]})
+    assert main(["eval", "fformation", str(folder), "--method", "paper"]) == 2
+    line = error_line(capsys)
+    assert "frame at timestamp 1: features: 3,000 people is more than the limit of 100 people (people; raise" in line

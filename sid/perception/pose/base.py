@@ -9,6 +9,7 @@ continuous *edge* coordinates of their input (0 = the left edge of the first pix
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property, lru_cache
@@ -17,10 +18,19 @@ from typing import Protocol, runtime_checkable
 import cv2
 import numpy as np
 
-from sid.checks import check_number, check_numbers
+from sid.checks import LIMITS_ENV, amount, check_number, check_numbers, limits
+from sid.documents import InputWarning
 from sid.perception.keypoints import PoseDetection
 
-__all__ = ["Letterbox", "PoseEstimator", "check_boxes", "check_color_image", "clip_corners", "fit_letterbox"]
+__all__ = [
+    "Letterbox",
+    "PoseEstimator",
+    "check_boxes",
+    "check_color_image",
+    "clip_corners",
+    "fit_letterbox",
+    "most_detections",
+]
 
 
 @runtime_checkable
@@ -181,6 +191,21 @@ def _resize_plan(letterbox: Letterbox, h: int, w: int) -> tuple[int, int] | None
 def fit_letterbox(image_hw: tuple[int, ...], input_hw: tuple[int, ...]) -> Letterbox:
     """``Letterbox.fit``, built once per (image size, input size) pair: a camera's frames all share one."""
     return Letterbox.fit(image_hw, input_hw)
+
+
+def most_detections(found: int) -> int:
+    """How many of a frame's ``found`` detections (best first) to keep: at most ``Limits.detections``, as
+    Ultralytics' ``max_det`` keeps the best 300; an ``InputWarning`` says when some are dropped (a model answering
+    thousands of people would make the lifting and grouping stages allocate for each pair)."""
+    keep = limits().detections
+    if found > keep:
+        warnings.warn(
+            f"pose: the model found {amount(found)} people in one frame, more than the limit of {keep:,} detections; "
+            f"the {keep:,} highest-scoring kept (detections; raise it with {LIMITS_ENV}=detections=N)",
+            InputWarning,
+            stacklevel=3,
+        )
+    return min(found, keep)
 
 
 def check_color_image(color_rgb: np.ndarray) -> np.ndarray:

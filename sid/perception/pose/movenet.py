@@ -12,7 +12,14 @@ from collections.abc import Sequence
 import numpy as np
 
 from sid.perception.keypoints import NUM_KEYPOINTS, PoseDetection
-from sid.perception.pose.base import Letterbox, check_boxes, check_color_image, clip_corners, fit_letterbox
+from sid.perception.pose.base import (
+    Letterbox,
+    check_boxes,
+    check_color_image,
+    clip_corners,
+    fit_letterbox,
+    most_detections,
+)
 from sid.perception.pose.contracts import MOVENET_MULTIPOSE, MOVENET_SINGLEPOSE, fixed_hw
 from sid.perception.pose.session import OnnxModel
 
@@ -138,6 +145,7 @@ class MoveNetMultiPose:
         rows = output.reshape(-1, 56)
         rows = rows[rows[:, 55] >= self.score_threshold]
         rows = rows[np.argsort(-rows[:, 55], kind="stable")]
+        rows = rows[: most_detections(len(rows))]
         # Each person's 17 keypoints and two box corners go through one map to image pixels, all people at once.
         points = np.empty((len(rows), NUM_KEYPOINTS + 2, 2))
         points[:, :NUM_KEYPOINTS] = rows[:, :51].reshape(-1, NUM_KEYPOINTS, 3)[..., 1::-1]

@@ -17,8 +17,8 @@ import cv2
 import numpy as np
 
 from sid.perception.keypoints import NUM_KEYPOINTS, PoseDetection
-from sid.perception.pose.base import Letterbox, check_color_image, clip_corners, fit_letterbox
-from sid.perception.pose.contracts import YOLO_POSE, fixed_hw, yolo_layout
+from sid.perception.pose.base import Letterbox, check_color_image, clip_corners, fit_letterbox, most_detections
+from sid.perception.pose.contracts import YOLO_POSE, PoseModelError, fixed_hw, yolo_layout
 from sid.perception.pose.session import OnnxModel
 
 __all__ = ["DEFAULT_IOU", "DEFAULT_SIZE", "DEFAULT_THRESHOLD", "NORMALISED_LIMIT", "PAD_VALUE", "YoloPose"]
@@ -76,6 +76,11 @@ class YoloPose:
         h, w = self._size
         tensor, _ = self.preprocess(np.full((h, w, 3), PAD_VALUE, np.uint8))
         centres = self.infer(tensor).reshape(56, -1)[:2]
+        if centres.size == 0:
+            raise PoseModelError(
+                f"yolo: {self.model.path}: the model answers no candidates (output [1, 56, 0]); a YOLO pose export "
+                "answers one per anchor, e.g. 8400 at 640 x 640"
+            )
         return bool(np.nanmax(np.abs(centres)) <= NORMALISED_LIMIT)
 
     def preprocess(self, color_rgb: np.ndarray) -> tuple[np.ndarray, Letterbox]:
@@ -100,7 +105,8 @@ class YoloPose:
         rects = rows[:5].take(above, axis=1)  # the few candidates above the threshold: centre x, y, w, h, score
         rects[:2] -= rects[2:4] / 2  # centre -> top-left corner (edge coordinates), in float32 like the model
         keep = cv2.dnn.NMSBoxes(rects[:4].T.tolist(), rects[4].tolist(), self.score_threshold, self.iou_threshold)
-        kept = rows.take(above[np.asarray(keep, dtype=np.intp).reshape(-1)], axis=1).T  # (people, 56), best first
+        best = np.asarray(keep, dtype=np.intp).reshape(-1)  # best first
+        kept = rows.take(above[best[: most_detections(len(best))]], axis=1).T  # (people, 56)
         return self._detections(kept, letterbox, image_hw)
 
     def _detections(self, kept: np.ndarray, letterbox: Letterbox, image_hw: Sequence[int]) -> list[PoseDetection]:
