@@ -192,8 +192,10 @@ class GridSpec:
         return (cells[:, 0] >= 0) & (cells[:, 0] < self.height) & (cells[:, 1] >= 0) & (cells[:, 1] < self.width)
 
     def contains(self, xy: np.ndarray) -> np.ndarray:
-        """Boolean (N,) for world points (N, 2) inside the grid."""
-        return self.in_bounds(self.world_to_cell(xy))
+        """Boolean (N,) for world points (N, 2) inside the grid (False for any point far or not finite: compared as
+        floats, never cast to a cell)."""
+        m = self.world_to_map(xy)  # (col, row), cell k covering [k, k + 1)
+        return (m[:, 0] >= 0) & (m[:, 0] < self.width) & (m[:, 1] >= 0) & (m[:, 1] < self.height)
 
     @property
     def bounds(self) -> tuple[float, float, float, float]:

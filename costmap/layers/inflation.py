@@ -52,7 +52,8 @@ class InflationParams:
 def inflation_cost(distance_m: np.ndarray, inscribed_radius: float, cost_scaling_factor: float) -> np.ndarray:
     """Nav2's inflation cost (uint8) for distances (metres) to the nearest lethal cell; no radius cut-off here."""
     d = np.asarray(distance_m, dtype=float)
-    decay = np.floor(MAX_NON_OBSTACLE * np.exp(-cost_scaling_factor * (d - inscribed_radius)))
+    beyond = np.maximum(d - inscribed_radius, 0.0)  # cells within the radius are INSCRIBED below: no exp(+large)
+    decay = np.floor(MAX_NON_OBSTACLE * np.exp(-cost_scaling_factor * beyond))
     cost = np.where(d <= inscribed_radius, INSCRIBED, np.clip(decay, 0, MAX_NON_OBSTACLE))
     return np.where(d == 0, LETHAL, cost).astype(np.uint8)
 

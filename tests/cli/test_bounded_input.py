@@ -3,11 +3,13 @@ number safe to the end of the pipeline, degenerate geometry handled as geometry,
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import struct
 import subprocess
 import sys
+import warnings
 import zlib
 from pathlib import Path
 
@@ -15,13 +17,20 @@ import cv2
 import numpy as np
 import pytest
 
+from costmap.layers.inflation import InflationParams
+from costmap.layers.obstacle import ObstacleParams
+from costmap.layers.social import SocialParams
+from costmap.layers.tracked import TrackedPeopleParams
 from costmap.mapfile import read_map
 from sid.checks import LimitError
 from sid.cli import main
 from sid.perception.camera import Calibration, Intrinsics
+from sid.perception.groups import GroupParams
 from sid.perception.keypoints import PoseDetection
 from sid.perception.lifting import lift_people
 from sid.perception.mount import CameraMount
+from sid.scenario.build import build_costmap
+from sid.scenario.loader import LidarSpec, ScenarioError, scenario_from_dict
 from tests.conftest import REPO_ROOT
 from tests.experiments.test_fformation import write_sequence
 from tests.pose_models import build_yolo_pose_model, yolo_candidate
@@ -324,3 +333,55 @@ def test_eval_fformation_has_the_per_frame_people_limit_of_sid_groups(tmp_path, 
     assert main(["eval", "fformation", str(folder), "--method", "paper"]) == 2
     line = error_line(capsys)
     assert "frame at timestamp 1: features: 3,000 people is more than the limit of 100 people (people; raise" in line
+
+
+def _numeric_fields() -> list[str]:
+    """Every number a scenario file sets: each parameter record's numeric fields, the LiDAR's, and those of the
+    example's map, obstacles, people and robot."""
+    records = {
+        "layers.obstacle": ObstacleParams,
+        "layers.inflation": InflationParams,
+        "layers.social": SocialParams,
+        "layers.tracked_people": TrackedPeopleParams,
+        "groups": GroupParams,
+        "lidar": LidarSpec,
+    }
+    fields = [
+        f"{section}.{f.name}"
+        for section, record in records.items()
+        for f in dataclasses.fields(record)
+        if type(getattr(record(), f.name)) in (int, float)
+    ]
+    return fields + [
+        *("map.resolution", "map.origin.0", "map.size.1", "obstacles.3.radius", "obstacles.3.center.0"),
+        *(
+            "obstacles.0.points.1.0",
+            "obstacles.4.max.1",
+            "people.0.x",
+            "people.0.theta",
+            "people.1.orientation_quality",
+        ),
+        *("robot.radius", "robot.speed", "robot.start.2", "robot.goal.0"),
+    ]
+
+
+EXTREMES = [5e-324, 1e-300, 1e-9, 0, -1e300, 1e300, 1e6, 10**6, 100, 7]
+
+
+@pytest.mark.parametrize("field", _numeric_fields())
+def test_every_number_at_its_extremes_builds_a_costmap_or_names_the_field(field):
+    """The class, not the examples: each numeric field at each extreme loads and builds (no warning, no overflow) or
+    is refused in one short line naming the field."""
+    for value in EXTREMES:
+        data = json.loads(EXAMPLE.read_text())
+        *parents, last = field.split(".")
+        node = data
+        for key in parents:
+            node = node.setdefault(key, {}) if isinstance(node, dict) else node[int(key)]
+        node[last if isinstance(node, dict) else int(last)] = value
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # numpy's overflow and invalid-cast warnings included
+            try:
+                build_costmap(scenario_from_dict(data))
+            except ScenarioError as exc:
+                assert len(str(exc)) < 300 and "\n" not in str(exc), exc
