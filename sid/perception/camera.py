@@ -19,7 +19,17 @@ import numpy as np
 from sid.checks import check_number, check_numbers
 from sid.documents import is_number, load_document, summary
 
-__all__ = ["Calibration", "Extrinsics", "Intrinsics", "MAX_FOCAL_PER_PIXEL", "MAX_IMAGE_SIDE", "deproject", "project"]
+__all__ = [
+    "Calibration",
+    "Extrinsics",
+    "Intrinsics",
+    "MAX_BASELINE",
+    "MAX_FOCAL_PER_PIXEL",
+    "MAX_IMAGE_SIDE",
+    "MIN_FOCAL_PER_PIXEL",
+    "deproject",
+    "project",
+]
 
 MAX_IMAGE_SIDE = 100_000
 """The largest image width or height a calibration file may give (pixels)."""
@@ -28,6 +38,11 @@ MAX_IMAGE_SIDE = 100_000
 MAX_FOCAL_PER_PIXEL = 100.0
 """Largest focal length (pixels) per pixel of image width or height that ``Intrinsics`` accepts: a field of view of
 ~0.6 degrees; a larger one is a unit mistake (e.g. micrometres), not a camera."""
+MAX_BASELINE = 1.0
+"""Longest depth-to-colour translation (m) a calibration may have: an RGB-D camera's sensors sit centimetres apart."""
+MIN_FOCAL_PER_PIXEL = 0.01
+"""Smallest focal length (pixels) per pixel of image width or height: a field of view of ~178 degrees, as wide as a
+pinhole model goes; below it a viewing ray's slope (pixel offset / focal length) overflows to infinity."""
 
 
 @dataclass(frozen=True)
@@ -49,11 +64,12 @@ class Intrinsics:
         check_numbers("intrinsics", self, ("fx", "fy", "cx", "cy"), unit="pixels")
         if self.fx <= 0 or self.fy <= 0:
             raise ValueError(f"intrinsics: focal lengths must be positive, got fx={self.fx}, fy={self.fy}")
-        # A real camera's optical axis meets its own image, and its field of view spans more than half a degree.
+        # A real camera's optical axis meets its own image, and its field of view spans half a degree to 178 degrees.
         check_number("intrinsics", "cx", self.cx, low=0, high=self.width, unit="pixels")
         check_number("intrinsics", "cy", self.cy, low=0, high=self.height, unit="pixels")
-        check_number("intrinsics", "fx", self.fx, high=MAX_FOCAL_PER_PIXEL * self.width, unit="pixels")
-        check_number("intrinsics", "fy", self.fy, high=MAX_FOCAL_PER_PIXEL * self.height, unit="pixels")
+        for name, side in (("fx", self.width), ("fy", self.height)):
+            low, high = MIN_FOCAL_PER_PIXEL * side, MAX_FOCAL_PER_PIXEL * side
+            check_number("intrinsics", name, getattr(self, name), low=low, high=high, unit="pixels")
 
     @property
     def K(self) -> np.ndarray:  # noqa: N802 - K is the standard name of the camera matrix
@@ -182,6 +198,15 @@ class Calibration:
     depth_to_color: Extrinsics = field(default_factory=Extrinsics)
     depth_scale: float = 0.001
 
+    def __post_init__(self) -> None:
+        baseline = float(np.linalg.norm(self.depth_to_color.translation))
+        if baseline > MAX_BASELINE:
+            raise ValueError(
+                f"depth_to_color: translation {baseline:g} m is more than {MAX_BASELINE:g} m; the two sensors of an "
+                "RGB-D camera sit centimetres apart (metres expected, not millimetres)"
+            )
+        check_number("calibration", "depth_scale", self.depth_scale, low=0, low_open=True, high=1, unit="metres")
+
     @classmethod
     def from_json(cls, path: str | Path) -> Calibration:
         """Read a calibration JSON.
@@ -224,7 +249,7 @@ class Calibration:
 def _depth_scale(data: dict[str, Any], where: str) -> float:
     """``depth_scale`` (or ``depth_scale_m``), metres per depth unit; 0.001 when absent."""
     key = "depth_scale" if "depth_scale" in data or "depth_scale_m" not in data else "depth_scale_m"
-    return _number({key: 0.001} | data, key, where, low=0, low_open=True, unit="metres per unit")
+    return _number({key: 0.001} | data, key, where, low=0, low_open=True, high=1, unit="metres per unit")
 
 
 def _number(data: dict[str, Any], key: str, where: str, **bounds: Any) -> float:

@@ -316,7 +316,7 @@ def test_lifting_refuses_more_detections_than_the_limit():
         lift_people([detection] * 101, np.full((48, 64), 1.5), calibration, CameraMount())
 
 
-def test_a_mirror_as_the_depth_to_colour_rotation_is_refused(tmp_path):
+def test_a_mirror_or_a_baseline_in_millimetres_as_depth_to_colour_is_refused(tmp_path):
     folder = one_frame_folder(tmp_path)
     mirror = [[-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]  # orthonormal, determinant -1
     extrinsics = {"rotation": mirror, "translation": [0.0, 0.0, 0.0]}
@@ -324,6 +324,12 @@ def test_a_mirror_as_the_depth_to_colour_rotation_is_refused(tmp_path):
         json.dumps({"color": INTRINSICS, "depth": INTRINSICS, "depth_to_color": extrinsics})
     )
     with pytest.raises(ValueError, match="depth_to_color: rotation has determinant -1, a mirror rather than a rota"):
+        Calibration.from_json(folder / "intrinsics.json")
+    millimetres = {"rotation": np.eye(3).tolist(), "translation": [15.0, 0.0, 0.0]}  # 15 mm written as 15 m
+    (folder / "intrinsics.json").write_text(
+        json.dumps({"color": INTRINSICS, "depth": INTRINSICS, "depth_to_color": millimetres})
+    )
+    with pytest.raises(ValueError, match="depth_to_color: translation 15 m is more than 1 m; the two sensors"):
         Calibration.from_json(folder / "intrinsics.json")
 
 

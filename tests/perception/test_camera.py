@@ -45,7 +45,8 @@ def test_scaled_intrinsics_keep_pixel_centres():
         ("width", 0, "width"),
         ("cx", 1e6, r"cx must be a finite number of pixels in \[0, 1280\], got 1000000.0"),
         ("cy", -1e6, r"cy must be a finite number of pixels in \[0, 720\]"),
-        ("fx", 1e308, "fx must be a finite number of pixels <= 128000"),
+        ("fx", 1e308, r"fx must be a finite number of pixels in \[12.8, 128000\]"),
+        ("fy", 5e-324, r"fy must be a finite number of pixels in \[7.2, 72000\], got 5e-324"),  # rays of slope inf
     ],
 )
 def test_bad_intrinsics_are_named(field, value, message):
@@ -133,7 +134,8 @@ FULL = {"color": FLAT, "depth": FLAT, "depth_to_color": {"rotation": np.eye(3).t
         (FLAT | {"width": 1e300}, "intrinsics: width must be a finite number of pixels in [1, 100000], got 1e+300"),
         (FLAT | {"depth_scale_m": None}, "depth_scale_m must be a number, got null"),
         (FLAT | {"depth_scale_m": [0.001]}, "depth_scale_m must be a number, got [0.001]"),
-        (FLAT | {"depth_scale": 0}, "depth_scale must be a positive number of metres per unit, got 0"),
+        (FLAT | {"depth_scale": 0}, "depth_scale must be a finite number of metres per unit in (0, 1], got 0"),
+        (FLAT | {"depth_scale": 1e300}, "depth_scale must be a finite number of metres per unit in (0, 1], got 1e+300"),
         (FLAT | {"coeffs": 5}, "intrinsics: coeffs must be a list of numbers, got 5"),
         (FLAT | {"model": 5}, "intrinsics: model must be a distortion model name, got 5"),
         ({"color": "abc"}, 'color: expected an object with width, height, fx, fy, cx, cy, got "abc"'),
