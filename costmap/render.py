@@ -17,6 +17,7 @@ from typing import Protocol
 
 import cv2
 import numpy as np
+import shapely
 from numpy.typing import ArrayLike
 
 from costmap.grid import INSCRIBED, LETHAL, MAX_NON_OBSTACLE, NO_INFORMATION, Costmap2D, GridSpec
@@ -365,8 +366,9 @@ def _draw_groups(
     for i, group in enumerate(groups):
         colour = GROUP_COLOURS[i % len(GROUP_COLOURS)]
         if margin is not None and all(m in by_id for m in group.members):
-            ring = _px(np.asarray(group_zone_polygon(group, by_id, margin).exterior.coords), spec, scale)
-            cv2.polylines(img, [ring], True, colour, 2, cv2.LINE_AA, shift=4)
+            outline = group_zone_polygon(group, by_id, margin)  # a Point or LineString when it has no area
+            ring = _px(shapely.get_coordinates(outline.boundary if outline.area > 0 else outline), spec, scale)
+            cv2.polylines(img, [ring], outline.area > 0, colour, 2, cv2.LINE_AA, shift=4)
             drawn["interaction zone (costmap)"] = True
         zone = _px(np.asarray(group.zone, dtype=float).reshape(-1, 2), spec, scale)
         if len(zone) and np.ptp(zone, axis=0).max() >= 10 * 16:

@@ -105,18 +105,17 @@ def zone_hull(group: Group, people: Sequence[Person] | Mapping[int, Person]) -> 
 
 def group_zone_polygon(
     group: Group, people: Sequence[Person] | Mapping[int, Person], margin: float = SocialParams.group_margin
-) -> Polygon:
+) -> BaseGeometry:
     """The group's interaction zone as used by the social layer and by the planner's o-space metrics.
 
     The convex hull of the detector's o-space polygon (``group.zone``) and the members' positions, grown by
     ``margin`` metres: it covers the o-space, the members and the space between them (the p-space). ``people``
-    may be a list of persons or a mapping id -> person; every member must be there.
+    may be a list of persons or a mapping id -> person; every member must be there. A Polygon, except with margin
+    0 for members on one spot or one line: their hull, a Point or LineString (a zone of no area).
     """
     check_number("group zone", "margin", margin, low=0, unit="metres")
-    grown = zone_hull(group, people).buffer(margin, quad_segs=16) if margin > 0 else zone_hull(group, people)
-    if not isinstance(grown, Polygon) or grown.is_empty or grown.area == 0:
-        raise ValueError(f"group {group.members}: the zone is degenerate (collinear points); use a margin > 0")
-    return grown
+    hull = zone_hull(group, people)
+    return hull.buffer(margin, quad_segs=16) if margin > 0 else hull
 
 
 _NO_AREA = 1e-12

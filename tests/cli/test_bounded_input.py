@@ -69,13 +69,24 @@ ON_ONE_SPOT = [  # three people on one spot facing apart, a fourth nearby: the g
 ]
 
 
+PICTURE = {"costmap": "costmap.png", "plan": "plan.png", "demo": "comparison.png"}
+
+
 @pytest.mark.parametrize("method", ["ospace", "gcff", "rays", "paper"])
 @pytest.mark.parametrize("command", ["costmap", "plan"])
 def test_people_on_one_spot_are_geometry(tmp_path, capsys, command, method):
     path = scenario(tmp_path, people=ON_ONE_SPOT, groups={"method": method})
     extra = ["--planner", "grid"] if command == "plan" else []
     assert main([command, path, *extra, "--out", str(tmp_path / "out")]) == 0, capsys.readouterr().err
-    assert (tmp_path / "out" / ("plan.png" if command == "plan" else "costmap.png")).is_file()
+    assert (tmp_path / "out" / PICTURE[command]).is_file()
+
+
+@pytest.mark.parametrize("command", ["costmap", "plan", "demo"])
+def test_a_zone_of_no_area_without_a_margin_is_a_point_or_a_line(tmp_path, capsys, command):
+    path = scenario(tmp_path, {"layers.social.group_margin": 0.0}, people=ON_ONE_SPOT, groups={"method": "gcff"})
+    args = {"costmap": [path], "plan": [path, "--planner", "grid"], "demo": ["--scenario", path, "--planner", "grid"]}
+    assert main([command, *args[command], "--out", str(tmp_path / "out")]) == 0, capsys.readouterr().err
+    assert (tmp_path / "out" / PICTURE[command]).is_file()
 
 
 # --- sizes read before they are allocated --------------------------------------------------------------------
