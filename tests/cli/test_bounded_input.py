@@ -402,3 +402,11 @@ def test_every_number_at_its_extremes_builds_a_costmap_or_names_the_field(field)
                 build_costmap(scenario_from_dict(data))
             except ScenarioError as exc:
                 assert len(str(exc)) < 300 and "\n" not in str(exc), exc
+
+
+def test_a_simulation_of_too_many_steps_is_refused_before_it_runs(tmp_path, capsys):
+    path = scenario(tmp_path, simulation={"time_limit_s": 1e300, "rate_hz": 10})
+    assert main(["simulate", path, "--out", str(tmp_path / "out")]) == 2
+    assert "simulation: 1e+300 s x 10 Hz = 1e+301 steps is more than the limit of 6,000 steps (sim_steps; raise" in (
+        error_line(capsys)
+    )

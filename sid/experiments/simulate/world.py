@@ -24,6 +24,7 @@ import numpy as np
 from shapely.geometry import LineString, Point, Polygon
 from shapely.ops import unary_union
 
+from sid.checks import LimitError, check_limit
 from sid.documents import is_number, summary
 from sid.experiments.simulate.robot import DriveLimits
 from sid.perception.people import Person
@@ -112,7 +113,14 @@ def _settings(data: Any) -> SimSettings:
         raise _fail("simulation.description", "a string", description)
     limits = {k: float(data[k]) for k in ("max_speed", "max_turn_rate", "max_accel") if k in data}
     numbers = {k: float(data[k]) for k in ("time_limit_s", "rate_hz", "goal_tolerance_m") if k in data}
-    return SimSettings(limits=DriveLimits(**limits), description=description, **numbers)
+    settings = SimSettings(limits=DriveLimits(**limits), description=description, **numbers)
+    steps = settings.time_limit_s * settings.rate_hz  # the run keeps every step's people and pose
+    detail = f"{settings.time_limit_s:g} s x {settings.rate_hz:g} Hz = "
+    try:
+        check_limit("simulation", steps, "sim_steps", "steps", detail)
+    except LimitError as exc:
+        raise ScenarioError(str(exc)) from None
+    return settings
 
 
 def world_from_dict(data: Any, base_dir: Path | None = None, default_name: str = "scenario") -> SimWorld:
