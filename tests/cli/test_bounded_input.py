@@ -24,6 +24,7 @@ from costmap.layers.tracked import TrackedPeopleParams
 from costmap.mapfile import read_map
 from sid.checks import LimitError
 from sid.cli import main
+from sid.experiments.simulate.world import load_world
 from sid.perception.camera import Calibration, Intrinsics
 from sid.perception.groups import GroupParams
 from sid.perception.keypoints import PoseDetection
@@ -410,3 +411,19 @@ def test_a_simulation_of_too_many_steps_is_refused_before_it_runs(tmp_path, caps
     assert "simulation: 1e+300 s x 10 Hz = 1e+301 steps is more than the limit of 6,000 steps (sim_steps; raise" in (
         error_line(capsys)
     )
+
+
+def test_sid_limits_raises_the_new_limits(tmp_path, monkeypatch):
+    boxes = [{"type": "box", "min": [0.0, 0.0], "max": [0.1, 0.1]}] * 30
+    path = scenario(tmp_path, obstacles=boxes, simulation={"time_limit_s": 100, "rate_hz": 100})
+    refusals = {  # SID_LIMITS -> the refusal; each raised in turn
+        "sim_steps=5000": "simulation: 100 s x 100 Hz = 10,000 steps is more than the limit of 5,000",
+        "sim_steps=10000,obstacle_points=100": "obstacles: 120 points is more than the limit of 100 points",
+        "sim_steps=10000,obstacle_points=120,scan_edges=50000": "720 beams x 124 edges = 89,280 ray tests is more",
+    }
+    for setting, message in refusals.items():
+        monkeypatch.setenv("SID_LIMITS", setting)
+        with pytest.raises(ScenarioError, match=message):
+            load_world(path)
+    monkeypatch.setenv("SID_LIMITS", "sim_steps=10000,obstacle_points=120,scan_edges=90000")
+    assert len(load_world(path).scenario.obstacles) == 30
