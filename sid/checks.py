@@ -45,6 +45,8 @@ class Limits:
     ``max_det``); the same default as ``people``, whom they become.
     obstacle_points: the points of a scenario's obstacles together (a wall's points, 4 per box, 1 per circle).
     scan_edges: beams x (straight obstacle edges + circles + people), the ray tests of a simulated scan.
+    image_pixels: pixels of a camera's image (its calibration's width x height; 33 177 600 is 8K UHD), which every
+    frame is decoded at.
     sim_steps: steps of one ``sid simulate`` run, ``time_limit_s`` x ``rate_hz`` (each step's people are kept).
     Raise one with ``SID_LIMITS="NAME=VALUE,..."`` (an environment variable, read at each check).
     """
@@ -57,6 +59,7 @@ class Limits:
     obstacle_points: int = 100_000
     scan_edges: int = 20_000_000
     sim_steps: int = 6_000
+    image_pixels: int = 33_177_600
 
 
 class LimitError(SidError, ValueError):

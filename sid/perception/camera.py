@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from sid.checks import check_number, check_numbers
+from sid.checks import check_limit, check_number, check_numbers
 from sid.documents import is_number, load_document, summary
 
 __all__ = [
@@ -61,6 +61,8 @@ class Intrinsics:
     def __post_init__(self) -> None:
         if self.width <= 0 or self.height <= 0:
             raise ValueError(f"intrinsics: image size must be positive, got {self.width}x{self.height}")
+        detail = f"{self.width} x {self.height} = "  # every frame of this camera is decoded at this size
+        check_limit("intrinsics: image", self.width * self.height, "image_pixels", "pixels", detail)
         check_numbers("intrinsics", self, ("fx", "fy", "cx", "cy"), unit="pixels")
         if self.fx <= 0 or self.fy <= 0:
             raise ValueError(f"intrinsics: focal lengths must be positive, got fx={self.fx}, fy={self.fy}")

@@ -427,3 +427,14 @@ def test_sid_limits_raises_the_new_limits(tmp_path, monkeypatch):
             load_world(path)
     monkeypatch.setenv("SID_LIMITS", "sim_steps=10000,obstacle_points=120,scan_edges=90000")
     assert len(load_world(path).scenario.obstacles) == 30
+
+
+def test_a_calibration_larger_than_the_image_limit_is_refused_before_any_frame(tmp_path, capsys):
+    folder = one_frame_folder(tmp_path)
+    huge = INTRINSICS | {"width": 100_000, "height": 100_000, "cx": 50_000.0, "cy": 50_000.0, "fx": 50_000.0}
+    (folder / "intrinsics.json").write_text(json.dumps(huge | {"fy": 50_000.0}))
+    model = build_yolo_pose_model(tmp_path / "m.onnx", np.zeros((56, 8)), (64, 64))
+    assert main(["detect", "--source", str(folder), "--model", str(model)]) == 2
+    assert "intrinsics: image: 100000 x 100000 = 10,000,000,000 pixels is more than the limit of 33,177,600 pixels" in (
+        error_line(capsys)
+    )
