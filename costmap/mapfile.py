@@ -21,7 +21,7 @@ import cv2
 import numpy as np
 import yaml
 
-from costmap.grid import GridSpec
+from costmap.grid import MAX_ORIGIN, GridSpec
 from costmap.occupancy import OCC_OCCUPIED, OCC_UNKNOWN, OccupancyGrid
 from sid.checks import check_limit
 from sid.documents import ImageHeader, is_number, load_document, read_image_header, summary
@@ -62,6 +62,8 @@ def _read_metadata(path: Path) -> dict:
     if not isinstance(origin, list) or len(origin) != 3:
         raise MapFileError(f"{path}: 'origin' must be [x, y, yaw], got {summary(origin)}")
     origin = [_number({"origin": v}, "origin", path) for v in origin]
+    if max(abs(origin[0]), abs(origin[1])) > MAX_ORIGIN:  # before the image is decoded (GridSpec checks it too)
+        raise MapFileError(f"{path}: 'origin' x and y must lie within {MAX_ORIGIN:g} m, got {summary(origin)}")
     mode = doc.get("mode", "trinary")
     if mode not in MODES:
         raise MapFileError(f"{path}: 'mode' must be one of {MODES}, got {summary(mode)}")

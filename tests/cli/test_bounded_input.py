@@ -21,7 +21,7 @@ from costmap.layers.inflation import InflationParams
 from costmap.layers.obstacle import ObstacleParams
 from costmap.layers.social import SocialParams
 from costmap.layers.tracked import TrackedPeopleParams
-from costmap.mapfile import read_map
+from costmap.mapfile import MapFileError, read_map
 from sid.checks import LimitError
 from sid.cli import main
 from sid.experiments.simulate.world import load_world
@@ -438,3 +438,10 @@ def test_a_calibration_larger_than_the_image_limit_is_refused_before_any_frame(t
     assert "intrinsics: image: 100000 x 100000 = 10,000,000,000 pixels is more than the limit of 33,177,600 pixels" in (
         error_line(capsys)
     )
+
+
+def test_a_map_yaml_origin_too_far_is_refused_before_its_image_is_read(tmp_path):
+    map_scenario(tmp_path, "room.pgm", b"P5\n20 16\n255\n" + bytes([254] * 320))
+    (tmp_path / "room.yaml").write_text((tmp_path / "room.yaml").read_text().replace("[0.0, 0.0", "[1e300, 0.0"))
+    with pytest.raises(MapFileError, match=r"room.yaml: 'origin' x and y must lie within 1e\+07 m, got \[1e\+300, 0.0"):
+        read_map(tmp_path / "room.yaml")
