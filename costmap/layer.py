@@ -24,7 +24,7 @@ from sid.perception.group import Group
 from sid.perception.people import Person
 from sid.tracking.records import Tracks
 
-__all__ = ["Layer", "LayerInputs"]
+__all__ = ["Layer", "LayerInputs", "RepaintedLayer"]
 
 
 @dataclass(frozen=True)
@@ -84,3 +84,16 @@ class Layer(ABC):
         """Combine this layer's costs into ``master`` (the combined grid) over ``window``."""
         rows, cols = window.slices
         combine(master[rows, cols], self.costs[rows, cols], self.combination)
+
+
+class RepaintedLayer(Layer):
+    """A layer rebuilt at every update in windows that may lie far apart (people and their zones):
+    ``update_windows`` does the work, ``update`` returns the union of its windows."""
+
+    def update(self, inputs: LayerInputs, changed: Window | None) -> Window | None:
+        """``update_windows``' windows as one (None: nothing changed)."""
+        return union(*self.update_windows(inputs, [] if changed is None else [changed]))
+
+    @abstractmethod
+    def update_windows(self, inputs: LayerInputs, changed: Sequence[Window]) -> list[Window]:
+        """Repaint the layer for ``inputs``; the windows of the last update's paint (now cleared) and of this one's."""

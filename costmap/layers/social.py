@@ -33,8 +33,8 @@ from shapely.geometry import MultiPoint, Polygon
 from shapely.geometry.base import BaseGeometry
 
 from costmap.combine import CombinationMethod
-from costmap.grid import FREE_SPACE, LETHAL, MAX_NON_OBSTACLE, GridSpec, Window, disjoint, union
-from costmap.layer import Layer, LayerInputs
+from costmap.grid import FREE_SPACE, LETHAL, MAX_NON_OBSTACLE, GridSpec, Window, disjoint
+from costmap.layer import LayerInputs, RepaintedLayer
 from sid.checks import check_number, check_numbers
 from sid.perception.group import Group
 from sid.perception.people import Person
@@ -50,6 +50,7 @@ __all__ = [
     "paint_groups",
     "paint_people",
     "paint_person",
+    "repaint",
     "zone_hull",
 ]
 
@@ -513,7 +514,27 @@ def paint_bodies(
     return windows
 
 
-class SocialLayer(Layer):
+def repaint(
+    costs: np.ndarray,
+    spec: GridSpec,
+    previous: Sequence[Window],
+    hulls: Sequence[BaseGeometry],
+    people: Sequence[Person],
+    params: SocialParams,
+    body_radius: float,
+    sigma_fronts: Sequence[float] | None = None,
+) -> list[Window]:
+    """Clear the windows ``previous`` of ``costs``, then paint the group zones ``hulls``, the personal spaces of
+    ``people`` (``paint_people``'s ``sigma_fronts``) and their bodies; returns the windows painted, disjoint."""
+    for window in previous:
+        costs[window.slices] = FREE_SPACE
+    painted = paint_groups(costs, spec, hulls, params)
+    painted += paint_people(costs, spec, people, params, sigma_fronts)
+    painted += paint_bodies(costs, spec, people, body_radius)
+    return disjoint(painted)
+
+
+class SocialLayer(RepaintedLayer):
     """Rebuilt from the current people and groups at every update, so it never keeps stale marks.
 
     Combined by max with its free cells left out (``max_nonzero``): they carry no opinion, as cells outside a Nav2
@@ -530,21 +551,11 @@ class SocialLayer(Layer):
         self.body_radius = float(body_radius)
         self._painted: list[Window] = []  # windows holding the cells the last update may have painted
 
-    def update(self, inputs: LayerInputs, changed: Window | None) -> Window | None:
-        """Repaint the layer for the people (world frame) and groups of ``inputs``; returns the union of
-        ``update_windows``' windows."""
-        return union(*self.update_windows(inputs, [] if changed is None else [changed]))
-
     def update_windows(self, inputs: LayerInputs, changed: Sequence[Window]) -> list[Window]:
         """Repaint the layer for the people (world frame) and groups of ``inputs``; returns the windows of the last
         update's paint (now cleared) and of this one's."""
         by_id = _people_by_id(inputs.people)
         hulls = [zone_hull(group, by_id) for group in inputs.groups]  # raises on a bad group before any change
         previous = self._painted
-        for window in previous:
-            self.costs[window.slices] = FREE_SPACE
-        painted = paint_groups(self.costs, self.spec, hulls, self.params)
-        painted += paint_people(self.costs, self.spec, inputs.people, self.params)
-        painted += paint_bodies(self.costs, self.spec, inputs.people, self.body_radius)
-        self._painted = disjoint(painted)
+        self._painted = repaint(self.costs, self.spec, previous, hulls, inputs.people, self.params, self.body_radius)
         return [*previous, *self._painted]

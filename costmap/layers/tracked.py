@@ -21,9 +21,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from costmap.combine import CombinationMethod
-from costmap.grid import FREE_SPACE, GridSpec, Window, disjoint, union
-from costmap.layer import Layer, LayerInputs
-from costmap.layers.social import SocialParams, paint_bodies, paint_groups, paint_people, zone_hull
+from costmap.grid import GridSpec, Window
+from costmap.layer import LayerInputs, RepaintedLayer
+from costmap.layers.social import SocialParams, repaint, zone_hull
 from sid.checks import check_number
 
 __all__ = ["MAX_LOOKAHEAD", "TrackedPeopleLayer", "TrackedPeopleParams"]
@@ -45,7 +45,7 @@ class TrackedPeopleParams:
         check_number("tracked people layer", "lookahead", self.lookahead, low=0, high=MAX_LOOKAHEAD, unit="seconds")
 
 
-class TrackedPeopleLayer(Layer):
+class TrackedPeopleLayer(RepaintedLayer):
     """Rebuilt from the current tracks at every update (nothing stale is kept); no tracks given: an empty layer.
 
     ``social``: the costs of people and zones (as the social layer's); ``params``: the walkers' stretch."""
@@ -67,11 +67,6 @@ class TrackedPeopleLayer(Layer):
         self.body_radius = float(body_radius)
         self._painted: list[Window] = []  # windows holding the cells the last update may have painted
 
-    def update(self, inputs: LayerInputs, changed: Window | None) -> Window | None:
-        """Repaint the layer for the tracked people and groups of ``inputs.tracks``; returns the union of
-        ``update_windows``' windows."""
-        return union(*self.update_windows(inputs, [] if changed is None else [changed]))
-
     def update_windows(self, inputs: LayerInputs, changed: Sequence[Window]) -> list[Window]:
         """Repaint the layer for the tracked people and groups of ``inputs.tracks``; returns the windows of the last
         update's paint (now cleared) and of this one's."""
@@ -80,9 +75,6 @@ class TrackedPeopleLayer(Layer):
         by_id = {p.id: p for p in people}
         conversations = [] if tracks is None else [g.as_group() for g in tracks.groups if g.kind == "conversation"]
         hulls = [zone_hull(group, by_id) for group in conversations]  # raises on a bad group before any change
-        previous = self._painted
-        for window in previous:
-            self.costs[window.slices] = FREE_SPACE
         social = self.social
         fronts = []  # each person's sigma_front: a walker's personal space reaches further ahead
         for track in () if tracks is None else tracks.people:
@@ -91,8 +83,6 @@ class TrackedPeopleLayer(Layer):
                 by_id[track.id].theta = math.atan2(track.vy, track.vx)
                 front += self.params.lookahead * track.speed
             fronts.append(front)
-        painted = paint_groups(self.costs, self.spec, hulls, social)
-        painted += paint_people(self.costs, self.spec, people, social, fronts)
-        painted += paint_bodies(self.costs, self.spec, people, self.body_radius)
-        self._painted = disjoint(painted)
+        previous = self._painted
+        self._painted = repaint(self.costs, self.spec, previous, hulls, people, social, self.body_radius, fronts)
         return [*previous, *self._painted]
