@@ -5,6 +5,8 @@ import OMPL), the group detector's in ``sid.cli.grouping``."""
 from __future__ import annotations
 
 import argparse
+import contextlib
+import fcntl
 import fnmatch
 import json
 import os
@@ -17,23 +19,29 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import IO, Any, TextIO
+from typing import IO, Any, TextIO, cast
 
 from sid.documents import TEMPORARY_PREFIX, unique_keys
 from sid.errors import SidError
 
 __all__ = [
+    "LOCK_NAME",
     "LineHandler",
     "OutputFolderError",
+    "OutputFolderInUse",
     "StagedOutput",
+    "StandardOutputError",
     "Terminated",
     "check_output_folder",
     "clear_owned",
     "fail",
+    "guarded_standard_output",
+    "output_folder_lock",
     "positive_int",
     "print_written",
     "process_json_lines",
     "read_json_lines",
+    "report_standard_output",
     "run_json_lines",
     "signals_as_interrupts",
     "signals_deferred",
@@ -100,8 +108,7 @@ def run_json_lines(
     command: str, file: str, handle: LineHandler, *, strict: bool = False, refuse_duplicate_keys: bool = False
 ) -> int:
     """``process_json_lines`` on ``file`` read as bytes (``-``: stdin), writing to stdout; its exit code, or 2 when
-    ``file`` cannot be read. When the reader of stdout goes away (a broken pipe, e.g. ``| head``) the run stops
-    quietly with exit 0, as Unix tools do."""
+    ``file`` cannot be read. A failing stdout raises ``StandardOutputError`` (``sid.cli.main`` reports it)."""
     try:
         # Bytes, decoded line by line: a line that is not UTF-8 is reported and skipped like any malformed line.
         if file == "-":
@@ -122,10 +129,7 @@ def run_json_lines(
                 strict=strict,
                 refuse_duplicate_keys=refuse_duplicate_keys,
             )
-        except BrokenPipeError:
-            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error when Python exits
-            return 0
-        except OSError as exc:  # e.g. FILE is a directory, or the disk fails mid-read
+        except OSError as exc:  # e.g. FILE is a directory, or the disk fails mid-read (stdout: StandardOutputError)
             print(f"{command}: cannot read {file}: {exc.strerror or exc}", file=sys.stderr)
             return 2
 
@@ -206,6 +210,70 @@ def _reject_constant(name: str) -> float:
     raise ValueError(f"{name} is not a number")
 
 
+class StandardOutputError(SidError):
+    """Standard output cannot be written: it is closed, full (ENOSPC, e.g. ``> /dev/full``) or its reader went away
+    (a broken pipe, e.g. ``| head -1``). Not an OSError, so that a command's handler for its own files does not
+    take it for one of them; ``sid.cli.main`` reports it (``report_standard_output``)."""
+
+    def __init__(self, error: OSError | None) -> None:
+        super().__init__("it is closed" if error is None else (error.strerror or str(error)))
+        self.broken_pipe = isinstance(error, BrokenPipeError)
+
+
+class _GuardedOutput:
+    """Standard output (``stream``, None when the process started with it closed) whose write and flush errors
+    become ``StandardOutputError``; every other attribute is the stream's."""
+
+    def __init__(self, stream: TextIO | None) -> None:
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        if self._stream is None:
+            raise StandardOutputError(None)
+        try:
+            return self._stream.write(text)
+        except OSError as exc:
+            raise StandardOutputError(exc) from None
+
+    def flush(self) -> None:
+        if self._stream is None:
+            return
+        try:
+            self._stream.flush()
+        except OSError as exc:
+            raise StandardOutputError(exc) from None
+
+    def __getattr__(self, name: str) -> Any:
+        if self._stream is None:
+            raise StandardOutputError(None)
+        return getattr(self._stream, name)
+
+
+@contextmanager
+def guarded_standard_output() -> Iterator[None]:
+    """While a command runs, writing to ``sys.stdout`` raises ``StandardOutputError`` when it fails, whatever the
+    command was doing; the previous ``sys.stdout`` comes back afterwards."""
+    previous = sys.stdout
+    sys.stdout = cast(TextIO, _GuardedOutput(previous))
+    try:
+        yield
+    finally:
+        sys.stdout = previous
+
+
+def report_standard_output(command: str, error: StandardOutputError) -> int:
+    """The exit code of a run whose standard output failed: 0, quietly, when its reader went away (a broken pipe, as
+    Unix tools do), else 2 with ``COMMAND: cannot write standard output (REASON)``. Standard output is pointed at
+    /dev/null, so that Python's flush at exit does not fail a second time."""
+    if sys.__stdout__ is not None:  # None: closed from the start, then Python does not flush it
+        with contextlib.suppress(OSError, ValueError):  # not a file descriptor (e.g. a test's capture)
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.__stdout__.fileno())
+    if error.broken_pipe:
+        return 0
+    print(f"{command}: cannot write standard output ({error})", file=sys.stderr)
+    return 2
+
+
 def print_written(paths: Iterable[object]) -> None:
     """One ``wrote PATH`` line per file written."""
     for path in paths:
@@ -269,6 +337,52 @@ def clear_owned(folder: Path, owned: Sequence[str], keep: Iterable[str] = ()) ->
     return removed
 
 
+LOCK_NAME = ".sid-lock"
+"""The lock file a run holds in its output folder while it writes there (``output_folder_lock``)."""
+
+
+class OutputFolderInUse(SidError, OSError):
+    """Another sid run holds the output folder's lock; the message names the folder and that run's pid."""
+
+
+@contextmanager
+def output_folder_lock(folder: str | Path) -> Iterator[Path]:
+    """Hold ``folder``'s lock (``flock`` on ``LOCK_NAME`` in it; the folder is created if missing) while a run
+    writes there, so that two runs into one folder never delete or mix each other's files: a second run gets
+    ``OutputFolderInUse`` at once. The kernel releases the lock when the process ends, even on SIGKILL; the file is
+    deleted when the run ends. Yields the folder."""
+    out = Path(folder)
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / LOCK_NAME
+    while True:
+        handle = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = os.read(handle, 64).decode("ascii", "replace").strip() or "its pid unknown"
+            os.close(handle)
+            raise OutputFolderInUse(
+                f"{out}: another sid run is writing in this folder ({holder}); wait for it to end or choose another "
+                "folder"
+            ) from None
+        try:
+            current = os.stat(path).st_ino == os.fstat(handle).st_ino
+        except FileNotFoundError:
+            current = False
+        if current:
+            break
+        os.close(handle)  # the run that held it deleted it meanwhile: lock the file that is there now
+    try:
+        with contextlib.suppress(OSError):  # the pid only words a second run's message (a full disk may refuse it)
+            os.ftruncate(handle, 0)
+            os.write(handle, f"pid {os.getpid()}".encode())
+        yield out
+    finally:
+        with contextlib.suppress(OSError):
+            path.unlink()  # while still held: a run waiting on this file sees it is gone and locks a new one
+        os.close(handle)
+
+
 @dataclass(frozen=True)
 class StagedOutput:
     """A temporary folder (``path``) inside the output folder (``folder``) that a command writes its files into."""
@@ -287,18 +401,18 @@ def staged_output(folder: str | Path, owned: Sequence[str]) -> Iterator[StagedOu
     (created if missing); when it finishes, the files it wrote replace those of an earlier run (``os.replace``
     each, signals deferred), and files of ``owned`` patterns an earlier run left but this one did not write are
     deleted. When it fails or is interrupted, ``folder`` keeps the earlier run's files and the temporary folder goes.
+    The folder's lock is held throughout (``output_folder_lock``: OutputFolderInUse while another run writes there).
     """
-    out = Path(folder)
-    out.mkdir(parents=True, exist_ok=True)
-    staged = StagedOutput(out, Path(tempfile.mkdtemp(prefix=TEMPORARY_PREFIX, dir=out)))
-    try:
-        yield staged
-        written = sorted(p for p in staged.path.rglob("*") if p.is_file())
-        with signals_deferred():
-            for path in written:
-                target = staged.final(path)
-                target.parent.mkdir(parents=True, exist_ok=True)
-                os.replace(path, target)
-            clear_owned(out, owned, keep={p.name for p in written} | {staged.path.name})
-    finally:
-        shutil.rmtree(staged.path, ignore_errors=True)
+    with output_folder_lock(folder) as out:
+        staged = StagedOutput(out, Path(tempfile.mkdtemp(prefix=TEMPORARY_PREFIX, dir=out)))
+        try:
+            yield staged
+            written = sorted(p for p in staged.path.rglob("*") if p.is_file())
+            with signals_deferred():
+                for path in written:
+                    target = staged.final(path)
+                    target.parent.mkdir(parents=True, exist_ok=True)
+                    os.replace(path, target)
+                clear_owned(out, owned, keep={p.name for p in written} | {staged.path.name})
+        finally:
+            shutil.rmtree(staged.path, ignore_errors=True)
