@@ -25,7 +25,7 @@ from PIL import Image, UnidentifiedImageError
 from costmap.grid import GridSpec
 from costmap.occupancy import OCC_OCCUPIED, OCC_UNKNOWN, OccupancyGrid
 from sid.checks import check_limit
-from sid.documents import is_number, load_document
+from sid.documents import is_number, load_document, special_file
 from sid.errors import SidError
 
 __all__ = ["MODES", "MapFileError", "read_map", "write_map"]
@@ -140,6 +140,9 @@ def read_map(path: str | Path) -> OccupancyGrid:
     larger than ``sid.checks.Limits.map_cells`` pixels (refused from its header, before decoding)."""
     path = Path(path)
     meta = _read_metadata(path)
+    special = special_file(meta["image"])
+    if special:
+        raise MapFileError(f"{path}: cannot read map image {meta['image']}: {special}")
     _check_image_size(path, meta["image"])
     image = cv2.imread(str(meta["image"]), cv2.IMREAD_UNCHANGED)
     if image is None or image.size == 0:

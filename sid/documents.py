@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import stat
 import tempfile
 from pathlib import Path
 from typing import Any, TypeGuard
@@ -18,6 +19,7 @@ __all__ = [
     "decode_text",
     "is_number",
     "load_document",
+    "special_file",
     "unique_keys",
     "write_atomically",
 ]
@@ -34,6 +36,9 @@ def load_document(path: str | Path, kind: str = "file") -> Any:
     byte-order mark is allowed), not valid JSON / YAML, or nested too deeply to parse.
     """
     path = Path(path)
+    special = special_file(path)
+    if special:
+        raise ValueError(f"{path}: cannot read {kind}: {special}")
     try:
         raw = path.read_bytes()
     except OSError as exc:
@@ -49,6 +54,30 @@ def load_document(path: str | Path, kind: str = "file") -> Any:
         # PyYAML's messages span lines and name "<unicode string>": made one line here.
         reason = " ".join(str(exc).split()).replace(' in "<unicode string>",', " at")
         raise ValueError(f"{path}: not valid {'JSON' if is_json else 'YAML'} ({reason})") from None
+
+
+_SPECIAL_FILES = (
+    (stat.S_ISFIFO, "a FIFO (named pipe)"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISSOCK, "a socket"),
+    (stat.S_ISDIR, "a folder"),
+)
+
+
+def special_file(path: str | Path) -> str | None:
+    """``"it is a FIFO (named pipe), not a regular file"`` (or a device, a socket, a folder) when ``path`` exists and
+    is not a regular file or a link to one; None otherwise (a missing file is left to the reader's open). Readers
+    refuse these before opening them: opening a FIFO blocks until something writes to it, and a device such as
+    /dev/zero never ends."""
+    try:
+        mode = os.stat(path).st_mode
+    except (OSError, ValueError):  # missing, unreadable, or a name with a NUL byte: the open says so
+        return None
+    for test, name in _SPECIAL_FILES:
+        if test(mode):
+            return f"it is {name}, not a regular file"
+    return None
 
 
 def unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:

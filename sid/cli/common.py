@@ -8,6 +8,7 @@ import argparse
 import contextlib
 import fcntl
 import fnmatch
+import itertools
 import json
 import os
 import shutil
@@ -21,17 +22,20 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any, TextIO, cast
 
-from sid.documents import TEMPORARY_PREFIX, unique_keys
+from sid.documents import TEMPORARY_PREFIX, special_file, unique_keys
 from sid.errors import SidError
 
 __all__ = [
     "LOCK_NAME",
     "LineHandler",
+    "LineTooLong",
+    "MAX_LINE_BYTES",
     "OutputFolderError",
     "OutputFolderInUse",
     "StagedOutput",
     "StandardOutputError",
     "Terminated",
+    "bounded_lines",
     "check_output_folder",
     "clear_owned",
     "fail",
@@ -41,6 +45,7 @@ __all__ = [
     "print_written",
     "process_json_lines",
     "read_json_lines",
+    "refuse_unknown_fields",
     "report_standard_output",
     "run_json_lines",
     "signals_as_interrupts",
@@ -104,11 +109,37 @@ LineHandler = Callable[[Any], dict[str, Any]]
 """What a JSON-lines command does with one parsed line: the JSON object it writes for it; ValueError for a bad line."""
 
 
-def run_json_lines(
-    command: str, file: str, handle: LineHandler, *, strict: bool = False, refuse_duplicate_keys: bool = False
-) -> int:
+MAX_LINE_BYTES = 16 * 1024**2
+"""The longest line ``sid groups`` and ``sid track`` read (a line of 100 people with keypoints is about 100 kB):
+input with no newline in sight (``/dev/zero`` on stdin, a binary file) ends the run there, not in memory."""
+
+
+class LineTooLong(SidError, ValueError):
+    """A JSON-lines input whose line has no newline within ``MAX_LINE_BYTES``: the rest cannot be read as lines."""
+
+
+def bounded_lines(stream: IO[Any]) -> Iterator[str | bytes]:
+    """The lines of ``stream`` (bytes or text) as ``readline`` gives them, each read with a bound: LineTooLong for
+    one longer than ``MAX_LINE_BYTES``."""
+    for number in itertools.count(1):
+        line = stream.readline(MAX_LINE_BYTES + 1)
+        if not line:
+            return
+        if len(line) > MAX_LINE_BYTES and line[-1:] not in ("\n", b"\n"):
+            raise LineTooLong(
+                f"line {number} is longer than {MAX_LINE_BYTES:,} bytes (no newline): not JSON lines; stopped there"
+            )
+        yield line
+
+
+def run_json_lines(command: str, file: str, handle: LineHandler, *, strict: bool = False) -> int:
     """``process_json_lines`` on ``file`` read as bytes (``-``: stdin), writing to stdout; its exit code, or 2 when
-    ``file`` cannot be read. A failing stdout raises ``StandardOutputError`` (``sid.cli.main`` reports it)."""
+    ``file`` cannot be read: a device or a folder (a FIFO is read as a stream), a line longer than
+    ``MAX_LINE_BYTES``. A failing stdout raises ``StandardOutputError`` (``sid.cli.main`` reports it)."""
+    special = None if file == "-" else special_file(file)
+    if special and not special.startswith(("it is a FIFO", "it is a socket")):  # streams, read line by line
+        print(f"{command}: cannot read {file}: {special}", file=sys.stderr)
+        return 2
     try:
         # Bytes, decoded line by line: a line that is not UTF-8 is reported and skipped like any malformed line.
         if file == "-":
@@ -120,16 +151,11 @@ def run_json_lines(
         return 2
     with stream:
         try:
-            return process_json_lines(
-                command,
-                stream,
-                sys.stdout,
-                sys.stderr,
-                handle,
-                strict=strict,
-                refuse_duplicate_keys=refuse_duplicate_keys,
-            )
-        except OSError as exc:  # e.g. FILE is a directory, or the disk fails mid-read (stdout: StandardOutputError)
+            return process_json_lines(command, bounded_lines(stream), sys.stdout, sys.stderr, handle, strict=strict)
+        except LineTooLong as exc:
+            print(f"{command}: {'stdin' if file == '-' else file}: {exc}", file=sys.stderr)
+            return 2
+        except OSError as exc:  # e.g. the disk fails mid-read (stdout: StandardOutputError)
             print(f"{command}: cannot read {file}: {exc.strerror or exc}", file=sys.stderr)
             return 2
 
@@ -142,14 +168,13 @@ def process_json_lines(
     handle: LineHandler,
     *,
     strict: bool = False,
-    refuse_duplicate_keys: bool = False,
 ) -> int:
     """Write ``handle(value)`` on ``out`` as one JSON line, flushed, for each non-blank line of ``lines``
     (``read_json_lines``). A line that cannot be read, or that ``handle`` refuses (ValueError), is reported on ``err``
     as ``COMMAND: line N: problem`` and skipped, or, with ``strict``, ends the run: exit code 1. Returns the exit
     code."""
     skipped = 0
-    for number, value, problem in read_json_lines(lines, refuse_duplicate_keys=refuse_duplicate_keys):
+    for number, value, problem in read_json_lines(lines):
         if problem is None:
             try:
                 record = handle(value)
@@ -168,13 +193,10 @@ def process_json_lines(
     return 0
 
 
-def read_json_lines(
-    lines: Iterable[str | bytes], *, refuse_duplicate_keys: bool = False
-) -> Iterator[tuple[int, Any, str | None]]:
+def read_json_lines(lines: Iterable[str | bytes]) -> Iterator[tuple[int, Any, str | None]]:
     """(line number, parsed value, None) for each non-blank line, or (line number, None, problem) for one that is not
     UTF-8 text or not JSON. Bytes are decoded here line by line as UTF-8 (a byte-order mark before the first line is
-    dropped); NaN and Infinity are refused, and with ``refuse_duplicate_keys`` an object giving a key twice."""
-    hook = unique_keys if refuse_duplicate_keys else None
+    dropped); NaN and Infinity are refused, and an object giving a key twice (as scenario files refuse it)."""
     for number, raw in enumerate(lines, start=1):
         if isinstance(raw, bytes):
             try:
@@ -196,7 +218,7 @@ def read_json_lines(
         if not line.strip():
             continue
         try:
-            value = json.loads(line, parse_constant=_reject_constant, object_pairs_hook=hook)
+            value = json.loads(line, parse_constant=_reject_constant, object_pairs_hook=unique_keys)
         except ValueError as exc:  # json.JSONDecodeError, NaN or Infinity, a duplicate key
             yield number, None, f"not valid JSON ({exc})"
             continue
@@ -208,6 +230,14 @@ def read_json_lines(
 
 def _reject_constant(name: str) -> float:
     raise ValueError(f"{name} is not a number")
+
+
+def refuse_unknown_fields(data: dict[str, Any], known: tuple[str, ...], prefix: str = "") -> None:
+    """ValueError naming the first key of a JSON line's object ``data`` not in ``known``, as scenario files refuse
+    one (a misspelt ``thta`` would otherwise be read as an unknown facing)."""
+    unknown = [key for key in data if key not in known]
+    if unknown:
+        raise ValueError(f"{prefix}unknown field {unknown[0]!r} (the fields are {', '.join(known)})")
 
 
 class StandardOutputError(SidError):

@@ -23,7 +23,7 @@ import argparse
 from typing import Any
 
 from sid.checks import check_limit
-from sid.cli.common import fail, run_json_lines
+from sid.cli.common import fail, refuse_unknown_fields, run_json_lines
 from sid.cli.grouping import add_group_params, group_params_from
 from sid.documents import is_number
 from sid.perception.people import Person
@@ -53,9 +53,7 @@ def run(args: argparse.Namespace) -> int:
         session = TrackingSession(group_params=group_params_from(args))
     except ValueError as exc:
         return fail("sid track", exc)
-    return run_json_lines(
-        "sid track", args.file, lambda data: _track_line(data, session), strict=args.strict, refuse_duplicate_keys=True
-    )
+    return run_json_lines("sid track", args.file, lambda data: _track_line(data, session), strict=args.strict)
 
 
 def _track_line(data: Any, session: TrackingSession) -> dict[str, Any]:
@@ -75,7 +73,7 @@ def _parse_line(data: Any) -> tuple[int | float, list[Person]]:
     """The timestamp (s, as given) and people of a line."""
     if not isinstance(data, dict):
         raise ValueError("expected a JSON object with 'timestamp' and 'people'")
-    _refuse_unknown(data, LINE_FIELDS)
+    refuse_unknown_fields(data, LINE_FIELDS)
     for key in LINE_FIELDS:
         if key not in data:
             raise ValueError(f"missing {key!r}")
@@ -93,7 +91,7 @@ def _parse_person(data: Any, index: int) -> Person:
     where = f"people[{index}]"
     if not isinstance(data, dict):
         raise ValueError(f"{where} must be an object with x, y and optionally theta and id")
-    _refuse_unknown(data, PERSON_FIELDS, f"{where}: ")
+    refuse_unknown_fields(data, PERSON_FIELDS, f"{where}: ")
     person_id = data.get("id", index)
     if isinstance(person_id, bool) or not isinstance(person_id, int):
         raise ValueError(f"{where}: id must be an integer, got {person_id!r}")
@@ -108,10 +106,3 @@ def _parse_person(data: Any, index: int) -> Person:
     if theta is None:
         return Person(person_id, float(data["x"]), float(data["y"]))
     return Person(person_id, float(data["x"]), float(data["y"]), float(theta), 1.0)
-
-
-def _refuse_unknown(data: dict[str, Any], known: tuple[str, ...], prefix: str = "") -> None:
-    """ValueError naming the first key of ``data`` not in ``known`` (a misspelt field would otherwise be lost)."""
-    unknown = [key for key in data if key not in known]
-    if unknown:
-        raise ValueError(f"{prefix}unknown field {unknown[0]!r} (the fields are {', '.join(known)})")

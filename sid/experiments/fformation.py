@@ -32,6 +32,7 @@ import numpy as np
 import scipy.io
 
 from sid.checks import check_number
+from sid.documents import special_file
 from sid.perception.gcff import GCFFParams
 from sid.perception.groups import GroupParams, detect_groups
 from sid.perception.people import Person
@@ -462,6 +463,9 @@ def load_settings_gc(folder: str | Path, base: GCFFParams | None = None) -> GCFF
 def _load_mat(path: Path, keys: tuple[str, ...]) -> dict:
     if not path.exists():
         raise ValueError(f"fformation: {path} is missing")
+    special = special_file(path)
+    if special:
+        raise ValueError(f"fformation: cannot read {path}: {special}")
     try:
         data = scipy.io.loadmat(str(path))
     except Exception as exc:  # scipy raises ValueError, TypeError, MatReadError... for non-MAT input

@@ -21,6 +21,7 @@ from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
+from sid.documents import special_file
 from sid.errors import SidError
 from sid.perception.frame import Frame
 
@@ -68,6 +69,9 @@ def open_source(spec: str, **options: Any) -> Iterable[Frame]:
     if path.suffix.lower() in RECORDING_SUFFIXES:
         if not path.exists():
             raise SourceError(f"recording {path} does not exist")
+        special = special_file(path)
+        if special:
+            raise SourceError(f"recording {path}: {special}")
         if path.suffix.lower() == ".bag" or _librealsense_db3(path):
             return _realsense()(path, **options)
         return _rosbag2(path, options)
