@@ -35,6 +35,7 @@ __all__ = [
     "StagedOutput",
     "StandardOutputError",
     "Terminated",
+    "add_bag_topic_options",
     "bounded_lines",
     "check_output_folder",
     "clear_owned",
@@ -446,3 +447,18 @@ def staged_output(folder: str | Path, owned: Sequence[str]) -> Iterator[StagedOu
                 clear_owned(out, owned, keep={p.name for p in written} | {staged.path.name})
         finally:
             shutil.rmtree(staged.path, ignore_errors=True)
+
+
+def add_bag_topic_options(parser: argparse.ArgumentParser) -> None:
+    """``--color-topic``, ``--depth-topic`` and ``--info-topic``: the topics of a rosbag2 ``--source``
+    (``sid.sources.BAG_TOPICS``; default: realsense2_camera's names, found under any namespace)."""
+    for name, what in (
+        ("color", "colour sensor_msgs/Image"),
+        ("depth", "depth Image aligned to colour"),
+        ("info", "colour CameraInfo"),
+    ):
+        parser.add_argument(
+            f"--{name}-topic",
+            metavar="TOPIC",
+            help=f"rosbag2 sources: the {what} topic (default: realsense2_camera's, under any namespace)",
+        )

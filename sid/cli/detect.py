@@ -19,6 +19,7 @@ from costmap.grid import Costmap2D, GridSpec
 from sid.ahead import run_ahead
 from sid.cli.common import (
     OutputFolderError,
+    add_bag_topic_options,
     check_output_folder,
     clear_owned,
     fail,
@@ -38,7 +39,7 @@ from sid.perception.people import Person
 from sid.perception.pipeline import FrameResult, Pipeline, PosedFrame, PoseFn, image_pose
 from sid.perception.pose.contracts import PoseModelError
 from sid.perception.pose.session import PROVIDER_CHOICES
-from sid.sources import RECORDING_SUFFIXES, FrameReadError, SourceError, frames_or_errors, open_source
+from sid.sources import BAG_TOPICS, RECORDING_SUFFIXES, FrameReadError, SourceError, frames_or_errors, open_source
 from sid.tracking import SessionUpdate, TrackingError, TrackingSession, ViewCone, camera_fov, camera_view_cone
 
 if TYPE_CHECKING:  # costmap.render (the costmap layers, shapely) is imported only for --out: start-up time
@@ -60,6 +61,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "depth, and unreadable frames, are reported on stderr and skipped.",
     )
     parser.add_argument("--source", required=True, help="realsense | FILE.db3 | FILE.bag | DIR | synthetic:SCENE")
+    add_bag_topic_options(parser)
     parser.add_argument("--model", type=Path, help="pose model (.onnx); optional for synthetic sources")
     parser.add_argument("--contract", help="pose model contract, if it cannot be read from the model")
     parser.add_argument(
@@ -128,11 +130,12 @@ def _pose(args: argparse.Namespace) -> PoseFn:
 
 
 def _source_options(args: argparse.Namespace) -> dict:
+    topics = {name: getattr(args, name) for name in BAG_TOPICS}  # refused by open_source for a source without topics
     if args.source.startswith("synthetic:"):
-        return {"frames": args.frames or 30}
+        return {"frames": args.frames or 30} | topics
     if args.source == "realsense" or Path(args.source).suffix.lower() in RECORDING_SUFFIXES:
-        return {"align": args.align}
-    return {}
+        return {"align": args.align} | topics
+    return topics
 
 
 def _skip_reason(frame: Frame) -> str | None:
