@@ -20,16 +20,17 @@ run with their defaults; the group detector that finds conversations among the t
 from __future__ import annotations
 
 import argparse
-from typing import Any
+from collections.abc import Iterable
+from typing import Any, TextIO
 
 from sid.checks import check_limit
-from sid.cli.common import fail, refuse_unknown_fields, run_json_lines
+from sid.cli.common import fail, process_json_lines, refuse_unknown_fields, run_json_lines
 from sid.cli.grouping import add_group_params, group_params_from
 from sid.documents import is_number
 from sid.perception.people import Person
 from sid.tracking import TrackingSession
 
-__all__ = ["LINE_FIELDS", "PERSON_FIELDS", "add_parser", "run"]
+__all__ = ["LINE_FIELDS", "PERSON_FIELDS", "add_parser", "process", "run"]
 
 LINE_FIELDS = ("timestamp", "people")
 PERSON_FIELDS = ("id", "x", "y", "theta")
@@ -54,6 +55,14 @@ def run(args: argparse.Namespace) -> int:
     except ValueError as exc:
         return fail("sid track", exc)
     return run_json_lines("sid track", args.file, lambda data: _track_line(data, session), strict=args.strict)
+
+
+def process(
+    lines: Iterable[str | bytes], out: TextIO, err: TextIO, session: TrackingSession, strict: bool = False
+) -> int:
+    """Track ``lines`` (text, or bytes decoded line by line) into ``session``, writing one JSON line per good line on
+    ``out`` and each problem on ``err``; the exit code (1 when ``strict`` stopped at a bad line)."""
+    return process_json_lines("sid track", lines, out, err, lambda data: _track_line(data, session), strict=strict)
 
 
 def _track_line(data: Any, session: TrackingSession) -> dict[str, Any]:
