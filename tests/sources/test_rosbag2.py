@@ -258,3 +258,28 @@ def test_a_file_damaged_inside_stops_the_source_naming_it(tmp_path: Path, mcap: 
     with pytest.raises(SourceError, match=f"rosbag2 recording {bag} is damaged after its first \\d colour image"):
         frames.extend(skip_unreadable(open_source(str(bag)), lambda error: None))
     assert 0 < len(frames) < 6 and [f.index for f in frames] == list(range(len(frames)))  # the frames before it
+
+
+def test_sid_detect_reports_each_bad_frame_of_a_bag_and_goes_on(tmp_path: Path, capsys) -> None:
+    from tests.pose_models import build_yolo_pose_model
+
+    pairs, synthetic = synthetic_pairs(5)
+    stamps = [100.0, 100.1, 100.1, 100.3, 100.4]  # frame 2 repeats frame 1's stamp
+    messages = camera_messages(pairs, synthetic[0].calibration.color, namespace="/camera", stamps=stamps)
+    colour = [k for k, m in enumerate(messages) if m[0] == "/camera/color/image_raw"]
+    topic, msgtype, time_ns, raw = messages[colour[3]]
+    messages[colour[3]] = (topic, msgtype, time_ns, raw[:100])  # frame 3's colour message cut short
+    bag = write_messages(tmp_path / "bag", messages)
+    model = build_yolo_pose_model(tmp_path / "yolo.onnx", np.zeros((56, 10)))  # answers nobody: "no people"
+    assert main(["detect", "--source", str(bag), "--model", str(model), "--no-tracking"]) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert (
+        f"detect: frame 2: skipped, {bag}: frame 2: its colour image has the stamp of an earlier one (100.100000 s)"
+        in err
+    )
+    assert any(
+        line.startswith(f"detect: frame 3: skipped, {bag}: frame 3: /camera/color/image_raw: the message")
+        for line in err
+    )
+    assert sorted(line.split()[2] for line in err if " skipped, " in line) == ["0:", "1:", "2:", "3:", "4:"]
+    assert err[-1].startswith("detect: 0 frames with people, 5 skipped")
