@@ -65,14 +65,16 @@ _SPECIAL_FILES = (
 )
 
 
-def special_file(path: str | Path) -> str | None:
+def special_file(path: str | Path, *, streams: bool = False) -> str | None:
     """``"it is a FIFO (named pipe), not a regular file"`` (or a device, a socket, a folder) when ``path`` exists and
     is not a regular file or a link to one; None otherwise (a missing file is left to the reader's open). Readers
     refuse these before opening them: opening a FIFO blocks until something writes to it, and a device such as
-    /dev/zero never ends."""
+    /dev/zero never ends. ``streams``: FIFOs and sockets pass, for a reader that reads a stream with a bound."""
     try:
         mode = os.stat(path).st_mode
     except (OSError, ValueError):  # missing, unreadable, or a name with a NUL byte: the open says so
+        return None
+    if streams and (stat.S_ISFIFO(mode) or stat.S_ISSOCK(mode)):
         return None
     for test, name in _SPECIAL_FILES:
         if test(mode):

@@ -137,8 +137,8 @@ def run_json_lines(command: str, file: str, handle: LineHandler, *, strict: bool
     """``process_json_lines`` on ``file`` read as bytes (``-``: stdin), writing to stdout; its exit code, or 2 when
     ``file`` cannot be read: a device or a folder (a FIFO is read as a stream), a line longer than
     ``MAX_LINE_BYTES``. A failing stdout raises ``StandardOutputError`` (``sid.cli.main`` reports it)."""
-    special = None if file == "-" else special_file(file)
-    if special and not special.startswith(("it is a FIFO", "it is a socket")):  # streams, read line by line
+    special = None if file == "-" else special_file(file, streams=True)  # a FIFO is read line by line
+    if special:
         print(f"{command}: cannot read {file}: {special}", file=sys.stderr)
         return 2
     try:
