@@ -162,6 +162,7 @@ def _kinds() -> dict[str, tuple[str, Callable[[Any], str], Any]]:
         "pgm": ("PGM maps (comments, any maximum)", kinds.check_pgm, kinds.PGM_CASES),
         "fformation": (".mat files of any cells (F-formation)", kinds.check_fformation, kinds.fformation_sets()),
         "folder": ("frame folders (names, suffixes, pixels)", kinds.check_frame_folder, kinds.frame_folders()),
+        "bag": ("rosbag2 recordings (fields, cut messages)", kinds.check_camera_bag, kinds.camera_bags()),
     }
 
 
