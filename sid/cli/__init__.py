@@ -58,7 +58,14 @@ def main(argv: list[str] | None = None) -> int:
     written ends it the same way in every command (``report_standard_output``)."""
     argv = sys.argv[1:] if argv is None else argv
     known = argv[0] if argv and argv[0] in COMMANDS else None  # else: help, or an error listing every command
-    args = build_parser(known).parse_args(argv)
+    with guarded_standard_output():  # --help writes there too
+        try:
+            try:
+                args = build_parser(known).parse_args(argv)
+            finally:  # after --help (SystemExit) as well: a failure is reported here, not at exit
+                sys.stdout.flush()
+        except StandardOutputError as exc:
+            return report_standard_output(f"sid {known}" if known else "sid", exc)
     command = f"sid {args.command}"
     try:
         limits()  # a malformed $SID_LIMITS is said once, before any work

@@ -70,3 +70,19 @@ def test_a_closed_standard_output_is_named_as_such(tmp_path, command):
     assert done.returncode == 2
     assert f"sid {command}: cannot write standard output (it is closed)" in done.stderr.decode()
     assert "Traceback" not in done.stderr.decode()
+
+
+def test_help_is_written_under_the_same_rules():
+    with open("/dev/full", "wb") as full:
+        done = _run(["groups", "--help"], full.fileno())
+    assert (done.returncode, done.stderr.decode()) == (
+        2,
+        "sid groups: cannot write standard output (No space left on device)\n",
+    )
+    read, write = os.pipe()
+    os.close(read)
+    try:
+        done = _run(["--help"], write)
+    finally:
+        os.close(write)
+    assert (done.returncode, done.stderr.decode()) == (0, "")
