@@ -24,7 +24,7 @@ import yaml
 from costmap.grid import MAX_ORIGIN, GridSpec
 from costmap.occupancy import OCC_OCCUPIED, OCC_UNKNOWN, OccupancyGrid
 from sid.checks import check_limit
-from sid.documents import ImageHeader, is_number, load_document, read_image_header, summary
+from sid.documents import ImageHeader, is_number, load_document, read_image_header, special_file, summary
 from sid.errors import SidError
 
 __all__ = ["MODES", "MapFileError", "read_map", "write_map"]
@@ -133,6 +133,9 @@ def read_map(path: str | Path) -> OccupancyGrid:
     larger than ``sid.checks.Limits.map_cells`` pixels (refused from its header, before decoding)."""
     path = Path(path)
     meta = _read_metadata(path)
+    special = special_file(meta["image"])
+    if special:
+        raise MapFileError(f"{path}: cannot read map image {meta['image']}: {special}")
     header = _image_header(path, meta["image"])
     image = cv2.imread(str(meta["image"]), cv2.IMREAD_UNCHANGED)
     if image is None or image.size == 0:

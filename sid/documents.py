@@ -9,6 +9,7 @@ import math
 import os
 import re
 import reprlib
+import stat
 import struct
 import tempfile
 from dataclasses import dataclass
@@ -26,6 +27,7 @@ __all__ = [
     "is_number",
     "load_document",
     "read_image_header",
+    "special_file",
     "summary",
     "unique_keys",
     "write_atomically",
@@ -43,6 +45,9 @@ def load_document(path: str | Path, kind: str = "file") -> Any:
     byte-order mark is allowed), not valid JSON / YAML, or nested too deeply to parse.
     """
     path = Path(path)
+    special = special_file(path)
+    if special:
+        raise ValueError(f"{path}: cannot read {kind}: {special}")
     try:
         raw = path.read_bytes()
     except OSError as exc:
@@ -58,6 +63,32 @@ def load_document(path: str | Path, kind: str = "file") -> Any:
         # PyYAML's messages span lines and name "<unicode string>": made one line here.
         reason = " ".join(str(exc).split()).replace(' in "<unicode string>",', " at")
         raise ValueError(f"{path}: not valid {'JSON' if is_json else 'YAML'} ({reason})") from None
+
+
+_SPECIAL_FILES = (
+    (stat.S_ISFIFO, "a FIFO (named pipe)"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISSOCK, "a socket"),
+    (stat.S_ISDIR, "a folder"),
+)
+
+
+def special_file(path: str | Path, *, streams: bool = False) -> str | None:
+    """``"it is a FIFO (named pipe), not a regular file"`` (or a device, a socket, a folder) when ``path`` exists and
+    is not a regular file or a link to one; None otherwise (a missing file is left to the reader's open). Readers
+    refuse these before opening them: opening a FIFO blocks until something writes to it, and a device such as
+    /dev/zero never ends. ``streams``: FIFOs and sockets pass, for a reader that reads a stream with a bound."""
+    try:
+        mode = os.stat(path).st_mode
+    except (OSError, ValueError):  # missing, unreadable, or a name with a NUL byte: the open says so
+        return None
+    if streams and (stat.S_ISFIFO(mode) or stat.S_ISSOCK(mode)):
+        return None
+    for test, name in _SPECIAL_FILES:
+        if test(mode):
+            return f"it is {name}, not a regular file"
+    return None
 
 
 def unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:

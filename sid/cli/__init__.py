@@ -13,7 +13,12 @@ import warnings
 from typing import TextIO
 
 from sid.checks import limits
-from sid.cli.common import signals_as_interrupts
+from sid.cli.common import (
+    StandardOutputError,
+    guarded_standard_output,
+    report_standard_output,
+    signals_as_interrupts,
+)
 from sid.cpu import keep_freed_memory
 from sid.documents import InputWarning
 
@@ -49,10 +54,18 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Run one command; its exit code. SIGINT and SIGTERM stop it cleanly (exit 130 / 143: every file it wrote is
-    whole), and ``InputWarning``s print as one ``sid COMMAND: warning: ...`` line."""
+    whole), ``InputWarning``s print as one ``sid COMMAND: warning: ...`` line, and a standard output that cannot be
+    written ends it the same way in every command (``report_standard_output``)."""
     argv = sys.argv[1:] if argv is None else argv
     known = argv[0] if argv and argv[0] in COMMANDS else None  # else: help, or an error listing every command
-    args = build_parser(known).parse_args(argv)
+    with guarded_standard_output():  # --help writes there too
+        try:
+            try:
+                args = build_parser(known).parse_args(argv)
+            finally:  # after --help (SystemExit) as well: a failure is reported here, not at exit
+                sys.stdout.flush()
+        except StandardOutputError as exc:
+            return report_standard_output(f"sid {known}" if known else "sid", exc)
     command = f"sid {args.command}"
     try:
         limits()  # a malformed $SID_LIMITS is said once, before any work
@@ -75,13 +88,17 @@ def main(argv: list[str] | None = None) -> int:
             default_show(message, category, filename, lineno, file, line)
 
     keep_freed_memory()  # numpy's image-sized temporaries reuse heap memory instead of new mappings (sid.cpu)
-    with warnings.catch_warnings(), signals_as_interrupts():
+    with warnings.catch_warnings(), signals_as_interrupts(), guarded_standard_output():
         warnings.showwarning = show
         try:
-            return int(args.func(args) or 0)
+            code = int(args.func(args) or 0)
+            sys.stdout.flush()  # here, where a failure is reported, not at exit
+            return code
         except KeyboardInterrupt as exc:
             print(f"{command}: interrupted", file=sys.stderr)
             return 128 + int(getattr(exc, "signal_number", 2))
+        except StandardOutputError as exc:  # closed, full, or a reader that went away (| head)
+            return report_standard_output(command, exc)
 
 
 if __name__ == "__main__":

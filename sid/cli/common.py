@@ -5,7 +5,10 @@ import OMPL), the group detector's in ``sid.cli.grouping``."""
 from __future__ import annotations
 
 import argparse
+import contextlib
+import fcntl
 import fnmatch
+import itertools
 import json
 import os
 import shutil
@@ -17,23 +20,34 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import IO, Any, TextIO
+from typing import IO, Any, TextIO, cast
 
-from sid.documents import TEMPORARY_PREFIX, unique_keys
+from sid.documents import TEMPORARY_PREFIX, special_file, unique_keys
 from sid.errors import SidError
 
 __all__ = [
+    "LOCK_NAME",
     "LineHandler",
+    "LineTooLong",
+    "MAX_LINE_BYTES",
     "OutputFolderError",
+    "OutputFolderInUse",
     "StagedOutput",
+    "StandardOutputError",
     "Terminated",
+    "add_bag_topic_options",
+    "bounded_lines",
     "check_output_folder",
     "clear_owned",
     "fail",
+    "guarded_standard_output",
+    "output_folder_lock",
     "positive_int",
     "print_written",
     "process_json_lines",
     "read_json_lines",
+    "refuse_unknown_fields",
+    "report_standard_output",
     "run_json_lines",
     "signals_as_interrupts",
     "signals_deferred",
@@ -96,12 +110,37 @@ LineHandler = Callable[[Any], dict[str, Any]]
 """What a JSON-lines command does with one parsed line: the JSON object it writes for it; ValueError for a bad line."""
 
 
-def run_json_lines(
-    command: str, file: str, handle: LineHandler, *, strict: bool = False, refuse_duplicate_keys: bool = False
-) -> int:
+MAX_LINE_BYTES = 16 * 1024**2
+"""The longest line ``sid groups`` and ``sid track`` read (a line of 100 people with keypoints is about 100 kB):
+input with no newline in sight (``/dev/zero`` on stdin, a binary file) ends the run there, not in memory."""
+
+
+class LineTooLong(SidError, ValueError):
+    """A JSON-lines input whose line has no newline within ``MAX_LINE_BYTES``: the rest cannot be read as lines."""
+
+
+def bounded_lines(stream: IO[Any]) -> Iterator[str | bytes]:
+    """The lines of ``stream`` (bytes or text) as ``readline`` gives them, each read with a bound: LineTooLong for
+    one longer than ``MAX_LINE_BYTES``."""
+    for number in itertools.count(1):
+        line = stream.readline(MAX_LINE_BYTES + 1)
+        if not line:
+            return
+        if len(line) > MAX_LINE_BYTES and line[-1:] not in ("\n", b"\n"):
+            raise LineTooLong(
+                f"line {number} is longer than {MAX_LINE_BYTES:,} bytes (no newline): not JSON lines; stopped there"
+            )
+        yield line
+
+
+def run_json_lines(command: str, file: str, handle: LineHandler, *, strict: bool = False) -> int:
     """``process_json_lines`` on ``file`` read as bytes (``-``: stdin), writing to stdout; its exit code, or 2 when
-    ``file`` cannot be read. When the reader of stdout goes away (a broken pipe, e.g. ``| head``) the run stops
-    quietly with exit 0, as Unix tools do."""
+    ``file`` cannot be read: a device or a folder (a FIFO is read as a stream), a line longer than
+    ``MAX_LINE_BYTES``. A failing stdout raises ``StandardOutputError`` (``sid.cli.main`` reports it)."""
+    special = None if file == "-" else special_file(file, streams=True)  # a FIFO is read line by line
+    if special:
+        print(f"{command}: cannot read {file}: {special}", file=sys.stderr)
+        return 2
     try:
         # Bytes, decoded line by line: a line that is not UTF-8 is reported and skipped like any malformed line.
         if file == "-":
@@ -113,19 +152,11 @@ def run_json_lines(
         return 2
     with stream:
         try:
-            return process_json_lines(
-                command,
-                stream,
-                sys.stdout,
-                sys.stderr,
-                handle,
-                strict=strict,
-                refuse_duplicate_keys=refuse_duplicate_keys,
-            )
-        except BrokenPipeError:
-            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error when Python exits
-            return 0
-        except OSError as exc:  # e.g. FILE is a directory, or the disk fails mid-read
+            return process_json_lines(command, bounded_lines(stream), sys.stdout, sys.stderr, handle, strict=strict)
+        except LineTooLong as exc:
+            print(f"{command}: {'stdin' if file == '-' else file}: {exc}", file=sys.stderr)
+            return 2
+        except OSError as exc:  # e.g. the disk fails mid-read (stdout: StandardOutputError)
             print(f"{command}: cannot read {file}: {exc.strerror or exc}", file=sys.stderr)
             return 2
 
@@ -138,14 +169,13 @@ def process_json_lines(
     handle: LineHandler,
     *,
     strict: bool = False,
-    refuse_duplicate_keys: bool = False,
 ) -> int:
     """Write ``handle(value)`` on ``out`` as one JSON line, flushed, for each non-blank line of ``lines``
     (``read_json_lines``). A line that cannot be read, or that ``handle`` refuses (ValueError), is reported on ``err``
     as ``COMMAND: line N: problem`` and skipped, or, with ``strict``, ends the run: exit code 1. Returns the exit
     code."""
     skipped = 0
-    for number, value, problem in read_json_lines(lines, refuse_duplicate_keys=refuse_duplicate_keys):
+    for number, value, problem in read_json_lines(lines):
         if problem is None:
             try:
                 record = handle(value)
@@ -164,13 +194,10 @@ def process_json_lines(
     return 0
 
 
-def read_json_lines(
-    lines: Iterable[str | bytes], *, refuse_duplicate_keys: bool = False
-) -> Iterator[tuple[int, Any, str | None]]:
+def read_json_lines(lines: Iterable[str | bytes]) -> Iterator[tuple[int, Any, str | None]]:
     """(line number, parsed value, None) for each non-blank line, or (line number, None, problem) for one that is not
     UTF-8 text or not JSON. Bytes are decoded here line by line as UTF-8 (a byte-order mark before the first line is
-    dropped); NaN and Infinity are refused, and with ``refuse_duplicate_keys`` an object giving a key twice."""
-    hook = unique_keys if refuse_duplicate_keys else None
+    dropped); NaN and Infinity are refused, and an object giving a key twice (as scenario files refuse it)."""
     for number, raw in enumerate(lines, start=1):
         if isinstance(raw, bytes):
             try:
@@ -192,7 +219,7 @@ def read_json_lines(
         if not line.strip():
             continue
         try:
-            value = json.loads(line, parse_constant=_reject_constant, object_pairs_hook=hook)
+            value = json.loads(line, parse_constant=_reject_constant, object_pairs_hook=unique_keys)
         except ValueError as exc:  # json.JSONDecodeError, NaN or Infinity, a duplicate key
             yield number, None, f"not valid JSON ({exc})"
             continue
@@ -204,6 +231,78 @@ def read_json_lines(
 
 def _reject_constant(name: str) -> float:
     raise ValueError(f"{name} is not a number")
+
+
+def refuse_unknown_fields(data: dict[str, Any], known: tuple[str, ...], prefix: str = "") -> None:
+    """ValueError naming the first key of a JSON line's object ``data`` not in ``known``, as scenario files refuse
+    one (a misspelt ``thta`` would otherwise be read as an unknown facing)."""
+    unknown = [key for key in data if key not in known]
+    if unknown:
+        raise ValueError(f"{prefix}unknown field {unknown[0]!r} (the fields are {', '.join(known)})")
+
+
+class StandardOutputError(SidError):
+    """Standard output cannot be written: it is closed, full (ENOSPC, e.g. ``> /dev/full``) or its reader went away
+    (a broken pipe, e.g. ``| head -1``). Not an OSError, so that a command's handler for its own files does not
+    take it for one of them; ``sid.cli.main`` reports it (``report_standard_output``)."""
+
+    def __init__(self, error: OSError | None) -> None:
+        super().__init__("it is closed" if error is None else (error.strerror or str(error)))
+        self.broken_pipe = isinstance(error, BrokenPipeError)
+
+
+class _GuardedOutput:
+    """Standard output (``stream``, None when the process started with it closed) whose write and flush errors
+    become ``StandardOutputError``; every other attribute is the stream's."""
+
+    def __init__(self, stream: TextIO | None) -> None:
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        if self._stream is None:
+            raise StandardOutputError(None)
+        try:
+            return self._stream.write(text)
+        except OSError as exc:
+            raise StandardOutputError(exc) from None
+
+    def flush(self) -> None:
+        if self._stream is None:
+            return
+        try:
+            self._stream.flush()
+        except OSError as exc:
+            raise StandardOutputError(exc) from None
+
+    def __getattr__(self, name: str) -> Any:
+        if self._stream is None:
+            raise StandardOutputError(None)
+        return getattr(self._stream, name)
+
+
+@contextmanager
+def guarded_standard_output() -> Iterator[None]:
+    """While a command runs, writing to ``sys.stdout`` raises ``StandardOutputError`` when it fails, whatever the
+    command was doing; the previous ``sys.stdout`` comes back afterwards."""
+    previous = sys.stdout
+    sys.stdout = cast(TextIO, _GuardedOutput(previous))
+    try:
+        yield
+    finally:
+        sys.stdout = previous
+
+
+def report_standard_output(command: str, error: StandardOutputError) -> int:
+    """The exit code of a run whose standard output failed: 0, quietly, when its reader went away (a broken pipe, as
+    Unix tools do), else 2 with ``COMMAND: cannot write standard output (REASON)``. Standard output is pointed at
+    /dev/null, so that Python's flush at exit does not fail a second time."""
+    if sys.__stdout__ is not None:  # None: closed from the start, then Python does not flush it
+        with contextlib.suppress(OSError, ValueError):  # not a file descriptor (e.g. a test's capture)
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.__stdout__.fileno())
+    if error.broken_pipe:
+        return 0
+    print(f"{command}: cannot write standard output ({error})", file=sys.stderr)
+    return 2
 
 
 def print_written(paths: Iterable[object]) -> None:
@@ -269,6 +368,52 @@ def clear_owned(folder: Path, owned: Sequence[str], keep: Iterable[str] = ()) ->
     return removed
 
 
+LOCK_NAME = ".sid-lock"
+"""The lock file a run holds in its output folder while it writes there (``output_folder_lock``)."""
+
+
+class OutputFolderInUse(SidError, OSError):
+    """Another sid run holds the output folder's lock; the message names the folder and that run's pid."""
+
+
+@contextmanager
+def output_folder_lock(folder: str | Path) -> Iterator[Path]:
+    """Hold ``folder``'s lock (``flock`` on ``LOCK_NAME`` in it; the folder is created if missing) while a run
+    writes there, so that two runs into one folder never delete or mix each other's files: a second run gets
+    ``OutputFolderInUse`` at once. The kernel releases the lock when the process ends, even on SIGKILL; the file is
+    deleted when the run ends. Yields the folder."""
+    out = Path(folder)
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / LOCK_NAME
+    while True:
+        handle = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = os.read(handle, 64).decode("ascii", "replace").strip() or "its pid unknown"
+            os.close(handle)
+            raise OutputFolderInUse(
+                f"{out}: another sid run is writing in this folder ({holder}); wait for it to end or choose another "
+                "folder"
+            ) from None
+        try:
+            current = os.stat(path).st_ino == os.fstat(handle).st_ino
+        except FileNotFoundError:
+            current = False
+        if current:
+            break
+        os.close(handle)  # the run that held it deleted it meanwhile: lock the file that is there now
+    try:
+        with contextlib.suppress(OSError):  # the pid only words a second run's message (a full disk may refuse it)
+            os.ftruncate(handle, 0)
+            os.write(handle, f"pid {os.getpid()}".encode())
+        yield out
+    finally:
+        with contextlib.suppress(OSError):
+            path.unlink()  # while still held: a run waiting on this file sees it is gone and locks a new one
+        os.close(handle)
+
+
 @dataclass(frozen=True)
 class StagedOutput:
     """A temporary folder (``path``) inside the output folder (``folder``) that a command writes its files into."""
@@ -287,18 +432,33 @@ def staged_output(folder: str | Path, owned: Sequence[str]) -> Iterator[StagedOu
     (created if missing); when it finishes, the files it wrote replace those of an earlier run (``os.replace``
     each, signals deferred), and files of ``owned`` patterns an earlier run left but this one did not write are
     deleted. When it fails or is interrupted, ``folder`` keeps the earlier run's files and the temporary folder goes.
+    The folder's lock is held throughout (``output_folder_lock``: OutputFolderInUse while another run writes there).
     """
-    out = Path(folder)
-    out.mkdir(parents=True, exist_ok=True)
-    staged = StagedOutput(out, Path(tempfile.mkdtemp(prefix=TEMPORARY_PREFIX, dir=out)))
-    try:
-        yield staged
-        written = sorted(p for p in staged.path.rglob("*") if p.is_file())
-        with signals_deferred():
-            for path in written:
-                target = staged.final(path)
-                target.parent.mkdir(parents=True, exist_ok=True)
-                os.replace(path, target)
-            clear_owned(out, owned, keep={p.name for p in written} | {staged.path.name})
-    finally:
-        shutil.rmtree(staged.path, ignore_errors=True)
+    with output_folder_lock(folder) as out:
+        staged = StagedOutput(out, Path(tempfile.mkdtemp(prefix=TEMPORARY_PREFIX, dir=out)))
+        try:
+            yield staged
+            written = sorted(p for p in staged.path.rglob("*") if p.is_file())
+            with signals_deferred():
+                for path in written:
+                    target = staged.final(path)
+                    target.parent.mkdir(parents=True, exist_ok=True)
+                    os.replace(path, target)
+                clear_owned(out, owned, keep={p.name for p in written} | {staged.path.name})
+        finally:
+            shutil.rmtree(staged.path, ignore_errors=True)
+
+
+def add_bag_topic_options(parser: argparse.ArgumentParser) -> None:
+    """``--color-topic``, ``--depth-topic`` and ``--info-topic``: the topics of a rosbag2 ``--source``
+    (``sid.sources.BAG_TOPICS``; default: realsense2_camera's names, found under any namespace)."""
+    for name, what in (
+        ("color", "colour sensor_msgs/Image"),
+        ("depth", "depth Image aligned to colour"),
+        ("info", "colour CameraInfo"),
+    ):
+        parser.add_argument(
+            f"--{name}-topic",
+            metavar="TOPIC",
+            help=f"rosbag2 sources: the {what} topic (default: realsense2_camera's, under any namespace)",
+        )

@@ -5,11 +5,12 @@ from __future__ import annotations
 import argparse
 import contextlib
 import json
+import os
 import sys
 import time
 from collections.abc import Iterable, Iterator, Sized
 from pathlib import Path
-from typing import TYPE_CHECKING, NamedTuple, TextIO
+from typing import TYPE_CHECKING, NamedTuple
 
 import cv2
 import numpy as np
@@ -18,9 +19,11 @@ from costmap.grid import Costmap2D, GridSpec
 from sid.ahead import run_ahead
 from sid.cli.common import (
     OutputFolderError,
+    add_bag_topic_options,
     check_output_folder,
     clear_owned,
     fail,
+    output_folder_lock,
     positive_int,
     signals_deferred,
 )
@@ -36,7 +39,7 @@ from sid.perception.people import Person
 from sid.perception.pipeline import FrameResult, Pipeline, PosedFrame, PoseFn, image_pose
 from sid.perception.pose.contracts import PoseModelError
 from sid.perception.pose.session import PROVIDER_CHOICES
-from sid.sources import RECORDING_SUFFIXES, FrameReadError, SourceError, frames_or_errors, open_source
+from sid.sources import BAG_TOPICS, RECORDING_SUFFIXES, FrameReadError, SourceError, frames_or_errors, open_source
 from sid.tracking import SessionUpdate, TrackingError, TrackingSession, ViewCone, camera_fov, camera_view_cone
 
 if TYPE_CHECKING:  # costmap.render (the costmap layers, shapely) is imported only for --out: start-up time
@@ -58,6 +61,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "depth, and unreadable frames, are reported on stderr and skipped.",
     )
     parser.add_argument("--source", required=True, help="realsense | FILE.db3 | FILE.bag | DIR | synthetic:SCENE")
+    add_bag_topic_options(parser)
     parser.add_argument("--model", type=Path, help="pose model (.onnx); optional for synthetic sources")
     parser.add_argument("--contract", help="pose model contract, if it cannot be read from the model")
     parser.add_argument(
@@ -126,11 +130,12 @@ def _pose(args: argparse.Namespace) -> PoseFn:
 
 
 def _source_options(args: argparse.Namespace) -> dict:
+    topics = {name: getattr(args, name) for name in BAG_TOPICS}  # refused by open_source for a source without topics
     if args.source.startswith("synthetic:"):
-        return {"frames": args.frames or 30}
+        return {"frames": args.frames or 30} | topics
     if args.source == "realsense" or Path(args.source).suffix.lower() in RECORDING_SUFFIXES:
-        return {"align": args.align}
-    return {}
+        return {"align": args.align} | topics
+    return topics
 
 
 def _skip_reason(frame: Frame) -> str | None:
@@ -217,11 +222,52 @@ def _count(n: int, one: str, many: str) -> str:
     return f"{n} {one if n == 1 else many}"
 
 
-def _emit(record: dict, streams: list[TextIO]) -> None:
-    line = json.dumps(record)
-    for stream in streams:
-        stream.write(line + "\n")
-        stream.flush()
+class _OutFolder:
+    """``sid detect --out``: the folder held with its lock (``output_folder_lock``, entered by the caller), an
+    earlier run's files cleared, and each frame's line of detections.jsonl written with its pictures, or none."""
+
+    def __init__(self, folder: Path) -> None:
+        self.folder = folder
+        cleared = clear_owned(folder, OUTPUTS)  # an earlier run's files, so none is mistaken for this run's
+        if cleared:
+            print(f"detect: removed {len(cleared)} file(s) of an earlier run from {folder}", file=sys.stderr)
+        # Unbuffered: a line that fails half-written is cut off below, and no buffer writes it again at close.
+        self._lines = os.open(folder / "detections.jsonl", os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
+
+    def write(self, line: str, pictures: dict[str, bytes]) -> None:
+        """The frame's pictures, then its line; when any of it fails (a full disk) what was written of the frame
+        is removed again and the error raised, so detections.jsonl never holds a line whose pictures are missing."""
+        written: list[Path] = []
+        end = os.lseek(self._lines, 0, os.SEEK_CUR)
+        target = self.folder / "detections.jsonl"
+        try:
+            for name, png in pictures.items():
+                target = self.folder / name
+                written.append(write_atomically(target, png))
+            target = self.folder / "detections.jsonl"
+            data = memoryview((line + "\n").encode())
+            while data:
+                data = data[os.write(self._lines, data) :]
+        except BaseException as exc:
+            with contextlib.suppress(OSError):
+                os.ftruncate(self._lines, end)
+                os.lseek(self._lines, end, os.SEEK_SET)
+            for path in written:
+                path.unlink(missing_ok=True)
+            if isinstance(exc, OSError):
+                reason = exc.strerror or exc
+                raise OSError(f"cannot write {target} ({reason}); the frame's line and pictures are left out") from None
+            raise
+
+    def close(self) -> None:
+        os.close(self._lines)
+
+
+def _close_source(source: Iterable[Frame]) -> None:
+    """Close ``source`` when it has a ``close`` (cameras, recordings)."""
+    close = getattr(source, "close", None)
+    if close is not None:
+        close()
 
 
 def _view(frame: Frame, pipeline: Pipeline) -> ViewCone:
@@ -270,13 +316,13 @@ def run(args: argparse.Namespace) -> int:
         print(f"detect: {exc}", file=sys.stderr)
         return 2
 
-    streams: list[TextIO] = [sys.stdout]
-    if args.out is not None:
-        args.out.mkdir(parents=True, exist_ok=True)
-        cleared = clear_owned(args.out, OUTPUTS)  # an earlier run's files, so none is mistaken for this run's
-        if cleared:
-            print(f"detect: removed {len(cleared)} file(s) of an earlier run from {args.out}", file=sys.stderr)
-        streams.append((args.out / "detections.jsonl").open("w"))
+    held = contextlib.ExitStack()  # --out's lock, held until the run ends
+    try:
+        out = None if args.out is None else _OutFolder(held.enter_context(output_folder_lock(args.out)))
+    except OSError as exc:  # another run holds the folder (OutputFolderInUse), or it cannot be written
+        held.close()
+        _close_source(source)
+        return fail("sid detect", exc)
 
     done = skipped = 0
 
@@ -321,10 +367,11 @@ def run(args: argparse.Namespace) -> int:
                 record = _tracked_json(record, tracked)
             records = picture_records(result, tracked)
             pictures = _pictures(frame, result, records, mount) if args.out is not None else {}
+            line = json.dumps(record)
             with signals_deferred():  # a frame's line and both its pictures, or none of them
-                _emit(record, streams)
-                for name, png in pictures.items():
-                    write_atomically(args.out / name, png)
+                if out is not None:
+                    out.write(line, pictures)
+                print(line, flush=True)
             done += 1
             totals.append(result.timing_ms["total"])
     except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (sid.cli.common.Terminated)
@@ -336,11 +383,10 @@ def run(args: argparse.Namespace) -> int:
         print(f"detect: source stopped: {exc}", file=sys.stderr)
         return 1
     finally:
-        for stream in streams[1:]:
-            stream.close()
-        close = getattr(source, "close", None)
-        if close is not None:
-            close()
+        if out is not None:
+            out.close()
+        held.close()
+        _close_source(source)
     seconds = time.perf_counter() - started  # the frames' wall-clock time, start-up (imports, model load) aside
     rate = f" in {seconds:.1f} s ({(done + skipped) / seconds:.1f} frames/s)" if done + skipped else ""
     median = f", median {np.median(totals):.2f} ms per frame" if totals else ""

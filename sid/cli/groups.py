@@ -6,8 +6,9 @@ orientation_quality in [0, 1] weighs the facing, default 1 when theta is given):
 Output, one line per good input line, flushed as it is written:
     {"frame": 0, "groups": [{"members": [1, 2], "interest_point": [x, y], "area": a, "spread": d,
                              "zone": [[x, y], ...]}]}
-A malformed line (including one that is not UTF-8 text) is reported on stderr with its line number and skipped,
-or ends the run with --strict (exit 1); everything written before it stays written.
+A malformed line (one that is not UTF-8 JSON, gives a key twice or has a field not named above) is reported on
+stderr with its line number and skipped, or ends the run with --strict (exit 1); everything written before it stays
+written.
 """
 
 from __future__ import annotations
@@ -17,14 +18,17 @@ from collections.abc import Iterable
 from typing import Any, TextIO
 
 from sid.checks import check_limit
-from sid.cli.common import fail, process_json_lines, run_json_lines
+from sid.cli.common import fail, process_json_lines, refuse_unknown_fields, run_json_lines
 from sid.cli.grouping import add_group_params, group_params_from
 from sid.documents import is_number
 from sid.perception.group import Group
 from sid.perception.groups import GroupParams, detect_groups
 from sid.perception.people import Person
 
-__all__ = ["add_parser", "group_to_json", "process", "run"]
+__all__ = ["LINE_FIELDS", "PERSON_FIELDS", "add_parser", "group_to_json", "process", "run"]
+
+LINE_FIELDS = ("frame", "people")
+PERSON_FIELDS = ("id", "x", "y", "theta", "orientation_quality")
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -75,6 +79,7 @@ def group_to_json(group: Group) -> dict[str, Any]:
 def _parse_frame(data: Any) -> dict[str, Any]:
     if not isinstance(data, dict):
         raise ValueError("expected a JSON object with 'frame' and 'people'")
+    refuse_unknown_fields(data, LINE_FIELDS)
     if "people" not in data:
         raise ValueError("missing 'people'")
     if not isinstance(data["people"], list):
@@ -90,6 +95,7 @@ def _parse_person(data: Any, index: int) -> Person:
     where = f"people[{index}]"
     if not isinstance(data, dict):
         raise ValueError(f"{where} must be an object with id, x, y, theta")
+    refuse_unknown_fields(data, PERSON_FIELDS, f"{where}: ")
     for key in ("id", "x", "y"):
         if key not in data:
             raise ValueError(f"{where} is missing {key!r}")

@@ -10,11 +10,11 @@ import sys
 from collections.abc import Iterator
 from pathlib import Path
 
-from sid.cli.common import fail, positive_int
+from sid.cli.common import add_bag_topic_options, fail, positive_int
 from sid.perception.frame import Frame
 from sid.perception.pose.contracts import PoseModelError
 from sid.perception.pose.quantize import FLOAT_LAYERS
-from sid.sources import FrameReadError, SourceError, open_source, skip_unreadable
+from sid.sources import BAG_TOPICS, FrameReadError, SourceError, open_source, skip_unreadable
 
 __all__ = [
     "DEFAULT_FRAMES",
@@ -103,6 +103,7 @@ def _add_sources(parser: argparse.ArgumentParser, option: str, what: str) -> Non
         metavar="SOURCE",
         help=f"{what}: any sid detect --source (DIR, FILE.db3, FILE.bag, synthetic:SCENE); several may follow",
     )
+    add_bag_topic_options(parser)
     parser.add_argument(
         "--frames",
         type=positive_int,
@@ -118,7 +119,7 @@ def _frames(args: argparse.Namespace, command: str) -> Iterator[tuple[str, Frame
     count = 0
     for spec in args.sources:
         options = {"frames": SYNTHETIC_FRAMES} if spec.startswith("synthetic:") else {}
-        source = open_source(spec, **options)
+        source = open_source(spec, **options, **{name: getattr(args, name) for name in BAG_TOPICS})
 
         def report(error: FrameReadError, spec: str = spec) -> None:
             print(f"{command}: {spec}: skipped, {error}", file=sys.stderr)

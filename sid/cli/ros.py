@@ -8,11 +8,11 @@ import sys
 from collections.abc import Iterable
 from pathlib import Path
 
-from sid.cli.common import positive_int
+from sid.cli.common import add_bag_topic_options, positive_int
 from sid.perception.frame import Frame
 from sid.perception.pipeline import PoseFn, image_pose
 from sid.perception.pose.contracts import PoseModelError
-from sid.sources import SourceError, open_source
+from sid.sources import BAG_TOPICS, SourceError, open_source
 
 __all__ = ["INSTALL_HINT", "SHARE", "SYNTHETIC_FRAMES", "add_parser", "run"]
 
@@ -38,6 +38,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--source", help="read frames from a sid source instead of topics: realsense | FILE | DIR | synthetic:SCENE"
     )
+    add_bag_topic_options(parser)
     parser.add_argument("--model", type=Path, help="pose model (.onnx); optional only for a synthetic --source")
     parser.add_argument(
         "--frames", type=positive_int, help=f"stop the --source after this many frames (synthetic: {SYNTHETIC_FRAMES})"
@@ -84,7 +85,10 @@ def run(args: argparse.Namespace) -> int:
         node = SocialCostmapNode(pose, camera_topics=args.source is None)
         frames: Iterable[Frame] | None = None
         if args.source is not None:
-            frames = open_source(args.source, **({"frames": args.frames or SYNTHETIC_FRAMES} if synthetic else {}))
+            topics = {name: getattr(args, name) for name in BAG_TOPICS}
+            frames = open_source(
+                args.source, **({"frames": args.frames or SYNTHETIC_FRAMES} if synthetic else {}), **topics
+            )
             if args.frames is not None and not synthetic:
                 frames = itertools.islice(frames, args.frames)
         spin(node, frames, args.rate)

@@ -12,6 +12,7 @@ from pathlib import Path
 
 from sid.cli.common import check_output_folder, fail, print_written, staged_output
 from sid.cli.planning import INPUT_ERRORS, add_planner_option
+from sid.documents import special_file
 from sid.experiments.progress import ProgressBar
 from sid.experiments.simulate.loop import PERCEPTIONS, RunOptions
 from sid.experiments.simulate.scenes import SCENE_ORDER, load_scene, scene_list
@@ -111,7 +112,7 @@ def run(args: argparse.Namespace) -> int:
         options = _options(args)
         if args.model is not None:
             if not Path(args.model).is_file():
-                raise ValueError(f"--model {args.model}: no such file")
+                raise ValueError(f"--model {args.model}: {special_file(args.model) or 'no such file'}")
             from sid.perception.pose.session import quiet_load_warnings
 
             quiet_load_warnings()

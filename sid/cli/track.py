@@ -20,16 +20,17 @@ run with their defaults; the group detector that finds conversations among the t
 from __future__ import annotations
 
 import argparse
-from typing import Any
+from collections.abc import Iterable
+from typing import Any, TextIO
 
 from sid.checks import check_limit
-from sid.cli.common import fail, run_json_lines
+from sid.cli.common import fail, process_json_lines, refuse_unknown_fields, run_json_lines
 from sid.cli.grouping import add_group_params, group_params_from
 from sid.documents import is_number
 from sid.perception.people import Person
 from sid.tracking import TrackingSession
 
-__all__ = ["LINE_FIELDS", "PERSON_FIELDS", "add_parser", "run"]
+__all__ = ["LINE_FIELDS", "PERSON_FIELDS", "add_parser", "process", "run"]
 
 LINE_FIELDS = ("timestamp", "people")
 PERSON_FIELDS = ("id", "x", "y", "theta")
@@ -53,9 +54,15 @@ def run(args: argparse.Namespace) -> int:
         session = TrackingSession(group_params=group_params_from(args))
     except ValueError as exc:
         return fail("sid track", exc)
-    return run_json_lines(
-        "sid track", args.file, lambda data: _track_line(data, session), strict=args.strict, refuse_duplicate_keys=True
-    )
+    return run_json_lines("sid track", args.file, lambda data: _track_line(data, session), strict=args.strict)
+
+
+def process(
+    lines: Iterable[str | bytes], out: TextIO, err: TextIO, session: TrackingSession, strict: bool = False
+) -> int:
+    """Track ``lines`` (text, or bytes decoded line by line) into ``session``, writing one JSON line per good line on
+    ``out`` and each problem on ``err``; the exit code (1 when ``strict`` stopped at a bad line)."""
+    return process_json_lines("sid track", lines, out, err, lambda data: _track_line(data, session), strict=strict)
 
 
 def _track_line(data: Any, session: TrackingSession) -> dict[str, Any]:
@@ -75,7 +82,7 @@ def _parse_line(data: Any) -> tuple[int | float, list[Person]]:
     """The timestamp (s, as given) and people of a line."""
     if not isinstance(data, dict):
         raise ValueError("expected a JSON object with 'timestamp' and 'people'")
-    _refuse_unknown(data, LINE_FIELDS)
+    refuse_unknown_fields(data, LINE_FIELDS)
     for key in LINE_FIELDS:
         if key not in data:
             raise ValueError(f"missing {key!r}")
@@ -93,7 +100,7 @@ def _parse_person(data: Any, index: int) -> Person:
     where = f"people[{index}]"
     if not isinstance(data, dict):
         raise ValueError(f"{where} must be an object with x, y and optionally theta and id")
-    _refuse_unknown(data, PERSON_FIELDS, f"{where}: ")
+    refuse_unknown_fields(data, PERSON_FIELDS, f"{where}: ")
     person_id = data.get("id", index)
     if isinstance(person_id, bool) or not isinstance(person_id, int):
         raise ValueError(f"{where}: id must be an integer, got {person_id!r}")
@@ -108,10 +115,3 @@ def _parse_person(data: Any, index: int) -> Person:
     if theta is None:
         return Person(person_id, float(data["x"]), float(data["y"]))
     return Person(person_id, float(data["x"]), float(data["y"]), float(theta), 1.0)
-
-
-def _refuse_unknown(data: dict[str, Any], known: tuple[str, ...], prefix: str = "") -> None:
-    """ValueError naming the first key of ``data`` not in ``known`` (a misspelt field would otherwise be lost)."""
-    unknown = [key for key in data if key not in known]
-    if unknown:
-        raise ValueError(f"{prefix}unknown field {unknown[0]!r} (the fields are {', '.join(known)})")

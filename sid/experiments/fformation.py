@@ -32,6 +32,7 @@ import numpy as np
 import scipy.io
 
 from sid.checks import check_limit, check_number
+from sid.documents import special_file
 from sid.perception.gcff import GCFFParams
 from sid.perception.groups import GroupParams, detect_groups
 from sid.perception.people import Person
@@ -122,17 +123,22 @@ def load_sequence(folder: str | Path, scale: float = 1.0, degrees: bool = False)
     truth_groups = _cells(truth["GTgroups"], truth_path, "GTgroups")
     truth_timestamps = _numbers(truth["GTtimestamp"], truth_path, "GTtimestamp")
     if len(frames_people) != len(timestamps):
-        raise ValueError(f"{features_path}: {len(frames_people)} feature frames but {len(timestamps)} timestamps")
+        raise ValueError(
+            f"fformation: {features_path}: {len(frames_people)} feature frames but {len(timestamps)} timestamps"
+        )
     if len(truth_groups) != len(truth_timestamps):
-        raise ValueError(f"{truth_path}: {len(truth_groups)} GTgroups frames but {len(truth_timestamps)} GTtimestamps")
+        raise ValueError(
+            f"fformation: {truth_path}: {len(truth_groups)} GTgroups frames but {len(truth_timestamps)} GTtimestamps"
+        )
     _check_unique(timestamps, features_path, "timestamp")
     _check_unique(truth_timestamps, truth_path, "GTtimestamp")
     index = _frame_index(timestamps)
     frames = []
     for groups_cell, stamp in zip(truth_groups, truth_timestamps, strict=True):
-        k = index.get(float(stamp), index.get(float(np.float32(stamp))))
+        with np.errstate(over="ignore"):  # a stamp beyond single precision's range rounds to inf: no frame
+            k = index.get(float(stamp), index.get(float(np.float32(stamp))))
         if k is None:
-            raise ValueError(f"{truth_path}: GTtimestamp {stamp} has no frame in {features_path.name}")
+            raise ValueError(f"fformation: {truth_path}: GTtimestamp {stamp} has no frame in {features_path.name}")
         where = f"{features_path} frame at timestamp {timestamps[k]:g}"
         people = _people(frames_people[k], scale, degrees, where)
         groups = [g for g in _groups(groups_cell, f"{truth_path} at timestamp {stamp:g}") if len(g) > 1]
@@ -151,7 +157,8 @@ def _frame_index(timestamps: np.ndarray) -> dict[float, int]:
     """Frame position by timestamp, and by the timestamp rounded to single precision where that is still unique
     (a ground-truth file saved in single precision then finds its frames)."""
     index = {float(t): k for k, t in enumerate(timestamps)}
-    single = timestamps.astype(np.float32).astype(float)
+    with np.errstate(over="ignore"):  # beyond single precision's range: inf, never unique when repeated
+        single = timestamps.astype(np.float32).astype(float)
     values, counts = np.unique(single, return_counts=True)
     unique = set(values[counts == 1].tolist())
     return {float(s): k for k, s in enumerate(single) if s in unique and s not in index} | index
@@ -462,6 +469,9 @@ def load_settings_gc(folder: str | Path, base: GCFFParams | None = None) -> GCFF
 def _load_mat(path: Path, keys: tuple[str, ...]) -> dict:
     if not path.exists():
         raise ValueError(f"fformation: {path} is missing")
+    special = special_file(path)
+    if special:
+        raise ValueError(f"fformation: cannot read {path}: {special}")
     try:
         data = scipy.io.loadmat(str(path))
     except Exception as exc:  # scipy raises ValueError, TypeError, MatReadError... for non-MAT input

@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from sid.documents import special_file
 from sid.perception.group import Group
 from sid.perception.groups import GroupParams, detect_groups
 from sid.perception.people import Person
@@ -113,6 +114,9 @@ class Agreement:
 def load_recording(path: str | Path) -> list[LoggedFrame]:
     """The logged messages of one CSV, as frames. Raises ValueError naming the file and line when malformed."""
     path = Path(path)
+    special = special_file(path)
+    if special:
+        raise ValueError(f"cannot read {path}: {special}")
     try:
         with path.open(newline="", encoding="utf-8") as handle:
             reader = csv.DictReader(handle)

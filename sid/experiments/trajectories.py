@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from sid.checks import check_number
+from sid.documents import special_file
 from sid.errors import SidError
 from sid.perception.people import Person
 from sid.tracking.view import View
@@ -102,7 +103,7 @@ def load_trajectory_set(folder: str | Path, interval: float = 0.4) -> Trajectory
     check_number("trajectories", "interval", interval, low=0, low_open=True, unit="seconds")
     obsmat, groups_file = folder / "obsmat.txt", folder / "groups.txt"
     for path in (obsmat, groups_file):
-        if not path.is_file():
+        if not path.exists():
             raise TrajectoryError(f"{folder}: no {path.name} (a trajectory set holds obsmat.txt and groups.txt)")
     rows = _read_obsmat(obsmat)
     frames = rows[:, 0].astype(np.int64)
@@ -226,6 +227,9 @@ _LARGEST_ID = 2**53  # frame numbers and ids are read as floats: whole numbers b
 
 def _lines(path: Path) -> Iterator[tuple[int, str]]:
     """(line number, line) for the non-blank lines of a UTF-8 text file; TrajectoryError naming a line that is not."""
+    special = special_file(path)
+    if special:
+        raise TrajectoryError(f"{path}: cannot read it: {special}")
     with path.open("rb") as handle:
         for number, raw in enumerate(handle, 1):
             try:

@@ -145,7 +145,10 @@ class SocialCostmapNode:
         pair = self.pairer.add(stream, stamp_seconds(msg.header), msg)
         for dropped in self.pairer.dropped_colors:
             self.node.get_logger().warning(f"colour image at {dropped.stamp:.3f} s has no depth image; skipped")
+        for dropped in self.pairer.duplicate_colors:
+            self.node.get_logger().warning(f"colour image at {dropped.stamp:.3f} s repeats another's stamp; skipped")
         self.pairer.dropped_colors.clear()
+        self.pairer.duplicate_colors.clear()
         if pair is None:
             return
         index, self.frames = self.frames, self.frames + 1

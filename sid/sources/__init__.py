@@ -21,10 +21,12 @@ from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
+from sid.documents import special_file
 from sid.errors import SidError
 from sid.perception.frame import Frame
 
 __all__ = [
+    "BAG_TOPICS",
     "FrameReadError",
     "RECORDING_SUFFIXES",
     "ROSBAG2_METADATA",
@@ -36,6 +38,8 @@ __all__ = [
 
 RECORDING_SUFFIXES = (".db3", ".bag", ".mcap")
 ROSBAG2_METADATA = "metadata.yaml"
+BAG_TOPICS = ("color_topic", "depth_topic", "info_topic")
+"""The options of a rosbag2 source that choose its topics (``sid.sources.rosbag2.Rosbag2Source``)."""
 
 
 class SourceError(SidError, RuntimeError):
@@ -55,9 +59,16 @@ class FrameReadError(SourceError):
 
 
 def open_source(spec: str, **options: Any) -> Iterable[Frame]:
-    """The source named by ``spec`` (see the module docstring); ``options`` go to that source's constructor."""
+    """The source named by ``spec`` (see the module docstring); ``options`` go to that source's constructor. The
+    topic options of ``BAG_TOPICS`` (None: not given) are for rosbag2 recordings; SourceError for another source."""
     if not isinstance(spec, str) or not spec:
         raise SourceError("source: empty spec; use realsense, FILE.db3, FILE.bag, FILE.mcap, DIR or synthetic:SCENARIO")
+    given = {name: options.pop(name, None) for name in BAG_TOPICS}
+    topics = {name: topic for name, topic in given.items() if topic is not None}
+    if topics and not _is_rosbag2(Path(spec)):
+        named = ", ".join(f"--{name.replace('_', '-')}" for name in topics)
+        raise SourceError(f"{named}: only rosbag2 recordings have topics to choose, and {spec} is not one")
+    options |= topics
     if spec.startswith("synthetic:"):
         from sid.sources.synthetic import synthetic_source
 
@@ -68,12 +79,16 @@ def open_source(spec: str, **options: Any) -> Iterable[Frame]:
     if path.suffix.lower() in RECORDING_SUFFIXES:
         if not path.exists():
             raise SourceError(f"recording {path} does not exist")
+        special = special_file(path)
+        if special:
+            raise SourceError(f"recording {path}: {special}")
         if path.suffix.lower() == ".bag" or _librealsense_db3(path):
             return _realsense()(path, **options)
         return _rosbag2(path, options)
-    if (path / ROSBAG2_METADATA).is_file():
+    if (path / ROSBAG2_METADATA).exists():
         return _rosbag2(path, options)
     if path.is_dir():
+        _refuse_bare_bag_folder(path)
         from sid.sources.folder import FolderSource
 
         return FolderSource(path, **options)
@@ -82,14 +97,41 @@ def open_source(spec: str, **options: Any) -> Iterable[Frame]:
     raise SourceError(f"source {spec!r}: not a recording (.db3/.bag/.mcap), a rosbag2 folder or a folder of frames")
 
 
+def _is_rosbag2(path: Path) -> bool:
+    """Whether ``open_source`` reads ``path`` as a rosbag2 recording."""
+    if (path / ROSBAG2_METADATA).exists():
+        return True
+    suffix = path.suffix.lower()
+    return suffix in RECORDING_SUFFIXES and suffix != ".bag" and path.is_file() and not _librealsense_db3(path)
+
+
 def _librealsense_db3(path: Path) -> bool:
-    """A .db3 written by librealsense, or one rosbags cannot read (librealsense then has the last word)."""
-    from sid.sources.rosbag2 import is_librealsense_recording
+    """A .db3 written by librealsense, or one rosbags cannot read (librealsense then has the last word); a file
+    that is not a readable SQLite database at all (cut short, overwritten) is refused here, naming the problem."""
+    from sid.sources.rosbag2 import is_librealsense_recording, sqlite_problem
 
     try:
         return path.suffix.lower() == ".db3" and is_librealsense_recording(path)
     except SourceError:
+        problem = sqlite_problem(path)
+        if problem:
+            raise SourceError(
+                f"recording {path}: not a readable SQLite database ({problem}); the file is damaged or incomplete"
+            ) from None
         return True
+
+
+def _refuse_bare_bag_folder(path: Path) -> None:
+    """SourceError for a folder holding rosbag2 storage files but no metadata.yaml (not a frame folder either)."""
+    if any((path / name).exists() for name in ("color", "depth", "color.png", "depth.png")):
+        return
+    bags = sorted(p.name for p in path.iterdir() if p.suffix.lower() in (".db3", ".mcap"))
+    if bags:
+        raise SourceError(
+            f"{path}: holds {', '.join(bags[:3])}{' ...' if len(bags) > 3 else ''} but no {ROSBAG2_METADATA}, so it "
+            f"is not a rosbag2 folder (nor a folder of frames); give the file itself (--source {path / bags[0]}) "
+            f"or rebuild the metadata with `ros2 bag reindex {path}`"
+        )
 
 
 def _rosbag2(path: Path, options: dict[str, Any]) -> Iterable[Frame]:

@@ -14,6 +14,7 @@ raises ``FrameReadError`` naming the file, and iteration goes on with the next f
 
 from __future__ import annotations
 
+import itertools
 import re
 from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
@@ -21,7 +22,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from sid.documents import read_image_header
+from sid.documents import read_image_header, special_file
 from sid.perception.camera import Calibration
 from sid.perception.frame import Frame
 from sid.sources import FrameReadError, SourceError
@@ -52,41 +53,57 @@ class FolderSource:
     def _read_calibration(self) -> Calibration:
         for name in CALIBRATION_NAMES:
             candidate = self.path / name
-            if candidate.is_file():
+            if candidate.exists():  # a FIFO or a device too: Calibration.from_json refuses it by name
                 try:
                     return Calibration.from_json(candidate)
                 except ValueError as exc:
                     raise SourceError(str(exc)) from None
         raise SourceError(f"frame folder {self.path}: no {' or '.join(CALIBRATION_NAMES)} with the intrinsics")
 
-    def _find_pairs(self) -> list[tuple[str, Path | None, Path | None]]:
-        """(name, colour file, depth file) per frame; a missing file is None (that frame fails when read)."""
-        single_color = _first_existing(self.path, "color")
-        if single_color is not None or (self.path / "depth.png").exists():
+    def _find_pairs(self) -> list[tuple[str, list[Path], list[Path]]]:
+        """(name, colour files, depth files) per frame: one of each, else that frame fails when read (a file
+        missing, or two with one name, e.g. ``a.png`` and ``a.jpg``)."""
+        single_color = [self.path / f"color{suffix}" for suffix in COLOR_SUFFIXES]
+        single_color = [p for p in single_color if p.exists()]
+        if single_color or (self.path / "depth.png").exists():
             depth = self.path / "depth.png"
-            return [("color", single_color, depth if depth.exists() else None)]
+            return [("color", single_color, [depth] if depth.exists() else [])]
         color_dir, depth_dir = self.path / "color", self.path / "depth"
         if not (color_dir.is_dir() and depth_dir.is_dir()):
             raise SourceError(
                 f"frame folder {self.path}: expected color.png + depth.png, or color/ and depth/ subfolders"
             )
-        colors = {p.stem: p for p in sorted(color_dir.iterdir()) if p.suffix.lower() in COLOR_SUFFIXES}
-        depths = {p.stem: p for p in depth_dir.iterdir() if p.suffix.lower() == ".png"}
+        colors: dict[str, list[Path]] = {}
+        for path in sorted(color_dir.iterdir()):
+            if path.suffix.lower() in COLOR_SUFFIXES:
+                colors.setdefault(path.stem, []).append(path)
+        depths: dict[str, list[Path]] = {}
+        for path in sorted(depth_dir.iterdir()):
+            if path.suffix.lower() == ".png":
+                depths.setdefault(path.stem, []).append(path)
         names = sorted(colors.keys() | depths.keys(), key=_natural_key)
         if not names:
             raise SourceError(f"frame folder {self.path}: color/ and depth/ hold no images")
-        return [(name, colors.get(name), depths.get(name)) for name in names]
+        return [(name, colors.get(name, []), depths.get(name, [])) for name in names]
 
     def __len__(self) -> int:
         return len(self.pairs)
 
     def read(self, index: int) -> Frame:
         """Frame ``index`` (0-based). Raises FrameReadError naming the file when it cannot be used."""
-        name, color_path, depth_path = self.pairs[index]
-        if color_path is None:
+        name, colors, depths = self.pairs[index]
+        if not colors:
             raise FrameReadError(f"frame {name!r}: no colour image in {self.path / 'color'}", index, None)
-        if depth_path is None:
-            raise FrameReadError(f"frame {name!r}: no depth image {name}.png next to {color_path}", index, None)
+        if not depths:
+            raise FrameReadError(f"frame {name!r}: no depth image {name}.png next to {colors[0]}", index, None)
+        for kind, paths in (("colour", colors), ("depth", depths)):
+            if len(paths) > 1:
+                names = " and ".join(str(p) for p in paths)
+                raise FrameReadError(f"frame {name!r}: {len(paths)} {kind} images, {names}; keep one", index, None)
+            special = special_file(paths[0])
+            if special:
+                raise FrameReadError(f"{kind} image {paths[0]}: {special}", index, paths[0])
+        color_path, depth_path = colors[0], depths[0]
         calib = self.calibration
         grid = calib.depth if calib.depth is not None else calib.color
         _check_size(color_path, "colour image", calib.color.width, calib.color.height, index)  # before decoding
@@ -167,13 +184,9 @@ def _check_size(path: Path, what: str, width: int, height: int, index: int) -> N
         )
 
 
-def _first_existing(folder: Path, stem: str) -> Path | None:
-    for suffix in COLOR_SUFFIXES:
-        candidate = folder / f"{stem}{suffix}"
-        if candidate.is_file():
-            return candidate
-    return None
-
-
 def _natural_key(name: str) -> list[int | str]:
-    return [int(part) if part.isdigit() else part.lower() for part in re.split(r"(\d+)", name)]
+    """``name`` split into text and runs of ASCII digits (read as numbers): any name sorts, ``².png`` too."""
+    return [int(part) if odd else part.lower() for odd, part in zip(itertools.cycle((0, 1)), _DIGITS.split(name))]
+
+
+_DIGITS = re.compile("([0-9]+)")  # ASCII only: str.isdigit also accepts "²", which int() refuses

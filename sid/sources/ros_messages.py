@@ -149,7 +149,9 @@ class StampPairer(Generic[T]):
 
     Feed each message as it comes (``add("color" | "depth", stamp, item)``); a message that completes a pair
     returns it as (colour, depth). Messages of one stream older than a paired one can never pair; they are dropped
-    and, for colour, kept in ``dropped_colors`` (the caller reports them). At most ``keep`` messages wait per stream.
+    and, for colour, kept in ``dropped_colors`` (the caller reports them). A colour message whose stamp is that of
+    one already waiting or paired is dropped at once into ``duplicate_colors`` (reported too: one stamp, one frame).
+    At most ``keep`` messages wait per stream.
     """
 
     def __init__(self, tolerance: float, keep: int = 30) -> None:
@@ -157,10 +159,15 @@ class StampPairer(Generic[T]):
         self.tolerance = float(tolerance)
         self.waiting: dict[str, deque[Stamped[T]]] = {"color": deque(maxlen=keep), "depth": deque(maxlen=keep)}
         self.dropped_colors: list[Stamped[T]] = []
+        self.duplicate_colors: list[Stamped[T]] = []
+        self._paired_color: float | None = None  # the stamp of the last colour message paired
 
     def add(self, stream: str, stamp: float, item: T) -> tuple[Stamped[T], Stamped[T]] | None:
         if stream not in self.waiting:
             raise ValueError(f"stamp pairing: stream must be 'color' or 'depth', got {stream!r}")
+        if stream == "color" and (stamp == self._paired_color or any(m.stamp == stamp for m in self.waiting["color"])):
+            self.duplicate_colors.append(Stamped(stamp, item))
+            return None
         other = self.waiting["depth" if stream == "color" else "color"]
         match = min(other, key=lambda m: abs(m.stamp - stamp), default=None)
         new = Stamped(stamp, item)
@@ -172,6 +179,7 @@ class StampPairer(Generic[T]):
             return None
         color, depth = (new, match) if stream == "color" else (match, new)
         self._forget_until(color.stamp, depth.stamp)
+        self._paired_color = color.stamp
         return color, depth
 
     def _forget_until(self, color_stamp: float, depth_stamp: float) -> None:

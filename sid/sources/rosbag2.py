@@ -6,17 +6,23 @@
 What is read: the colour ``sensor_msgs/Image`` (rgb8 or bgr8), the depth aligned to colour (16UC1 in depth units,
 or 32FC1 metres) and the colour ``sensor_msgs/CameraInfo`` (the intrinsics of both, since the depth is aligned).
 Topics default to realsense2_camera's names (``/camera/camera/...``, its 4.54+ default namespace); when those are
-absent the one Image topic ending in ``color/image_raw`` and the one ending in ``aligned_depth_to_color/image_raw``
-are used, with the colour topic's ``camera_info``. Colour and depth images are paired by header stamp.
+absent the one Image topic whose last names are ``color/image_raw`` and the one ending in
+``aligned_depth_to_color/image_raw`` are used, under any namespace, with the colour topic's ``camera_info``. Colour
+and depth images are paired by header stamp.
 
-Frames are numbered by colour image (0-based). A colour image with no depth image within ``sync_tolerance``, or
-whose pixels cannot be used, raises ``FrameReadError`` and the source moves on. librealsense's own .db3
-recordings (topics under ``/device_0/``) are a different layout: ``is_librealsense_recording`` tells them apart
-and ``sid.sources.open_source`` sends them to ``sid.sources.realsense``.
+Frames are numbered by colour image (0-based). A colour image with no depth image within ``sync_tolerance``, one
+whose message is damaged or whose stamp repeats an earlier colour image's, or whose pixels cannot be used, raises
+``FrameReadError`` and the source moves on; a file damaged further in ends it with ``SourceError``.
+librealsense's own .db3 recordings (topics under ``/device_0/``) are a different layout:
+``is_librealsense_recording`` tells them apart and ``sid.sources.open_source`` sends them to
+``sid.sources.realsense``.
 """
 
 from __future__ import annotations
 
+import contextlib
+import sqlite3
+import warnings
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import Any
@@ -27,9 +33,10 @@ from rosbags.rosbag2 import ReaderError
 from rosbags.typesys import Stores, get_typestore
 
 from sid.checks import check_number
+from sid.documents import InputWarning, decode_text, special_file
 from sid.perception.camera import Intrinsics
 from sid.perception.frame import Frame
-from sid.sources import FrameReadError, SourceError
+from sid.sources import ROSBAG2_METADATA, FrameReadError, SourceError
 from sid.sources.ros_messages import Stamped, StampPairer, intrinsics_from_camera_info, rgbd_frame, stamp_seconds
 
 __all__ = [
@@ -40,6 +47,7 @@ __all__ = [
     "IMAGE",
     "Rosbag2Source",
     "is_librealsense_recording",
+    "sqlite_problem",
 ]
 
 IMAGE = "sensor_msgs/msg/Image"
@@ -51,13 +59,37 @@ _LIBREALSENSE_PREFIX = "/device_"
 
 
 def _reader(path: Path) -> AnyReader:
-    """An opened rosbags reader; bags without embedded message definitions (.db3) use ROS 2 Humble's types."""
+    """An opened rosbags reader; bags without embedded message definitions (.db3) use ROS 2 Humble's types.
+    SourceError naming the file and what is wrong with it (a damaged file, a metadata.yaml that is not text)."""
+    metadata = path / ROSBAG2_METADATA
+    if path.is_dir() and metadata.exists():
+        special = special_file(metadata)
+        if special:
+            raise SourceError(f"rosbag2 metadata {metadata}: {special}")
+        try:
+            decode_text(metadata.read_bytes(), f"rosbag2 metadata {metadata}")
+        except OSError as exc:
+            raise SourceError(f"cannot read rosbag2 metadata {metadata}: {exc.strerror or exc}") from None
+        except ValueError as exc:  # a binary file, e.g. the storage file saved under the wrong name
+            raise SourceError(str(exc)) from None
     reader = AnyReader([path], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
     try:
         reader.open()
-    except (AnyReaderError, ReaderError, OSError) as exc:
-        raise SourceError(f"cannot read rosbag2 recording {path}: {exc}") from None
+    except (AnyReaderError, ReaderError, OSError, ValueError) as exc:
+        where = metadata if path.is_dir() else path
+        raise SourceError(f"cannot read rosbag2 recording {where}: {exc}") from None
     return reader
+
+
+def sqlite_problem(path: Path) -> str | None:
+    """Why ``path`` is not a readable SQLite database (e.g. "database disk image is malformed" for a .db3 cut
+    short), or None when its schema reads."""
+    try:
+        with contextlib.closing(sqlite3.connect(f"file:{path}?mode=ro", uri=True)) as database:
+            database.execute("SELECT name FROM sqlite_master").fetchall()
+    except sqlite3.Error as exc:
+        return str(exc)
+    return None
 
 
 def is_librealsense_recording(path: str | Path) -> bool:
@@ -69,19 +101,26 @@ def is_librealsense_recording(path: str | Path) -> bool:
         reader.close()
 
 
-def _pick(connections: list[Connection], msgtype: str, wanted: str | None, default: str, ending: str) -> Connection:
-    """The connection of topic ``wanted``; else ``default``; else the only ``msgtype`` topic ending in ``ending``."""
+def _pick(
+    connections: list[Connection], msgtype: str, wanted: str | None, default: str, ending: str, option: str
+) -> Connection:
+    """The connection of topic ``wanted``; else ``default``; else the only ``msgtype`` topic whose last names are
+    ``ending`` (whole names: ``aligned_depth_to_color/image_raw`` does not end in ``color/image_raw``). ``option``
+    names the setting that chooses the topic (e.g. ``color_topic``), for the error."""
     typed = [c for c in connections if c.msgtype == msgtype]
     if wanted is not None:
         named = [c for c in typed if c.topic == wanted]
         if not named:
             raise SourceError(f"no {msgtype} topic {wanted!r} in the bag; it has {_topics(typed, msgtype)}")
         return named[0]
-    named = [c for c in typed if c.topic == default] or [c for c in typed if c.topic.endswith(ending)]
+    named = [c for c in typed if c.topic == default] or [
+        c for c in typed if f"/{c.topic.strip('/')}".endswith(f"/{ending}")
+    ]
     if len({c.topic for c in named}) != 1:
         found = "none" if not named else "several"
         raise SourceError(
-            f"{found} of the bag's {msgtype} topics end in {ending!r} ({_topics(typed, msgtype)}); name the topic"
+            f"{found} of the bag's {msgtype} topics end in {ending!r} ({_topics(typed, msgtype)}); name the topic "
+            f"with {option} (sid detect --{option.replace('_', '-')})"
         )
     return named[0]
 
@@ -92,13 +131,27 @@ def _topics(connections: list[Connection], msgtype: str) -> str:
 
 
 def _first_camera_info(reader: AnyReader, info: Connection) -> Intrinsics:
-    """The intrinsics of the first CameraInfo on ``info`` (the calibration of the whole recording)."""
-    for connection, _, raw in reader.messages(connections=[info]):
+    """The intrinsics of the first usable CameraInfo on ``info`` (the calibration of the whole recording); each
+    one before it that cannot be read or used is skipped with an ``InputWarning``."""
+    problems = []
+    for connection, time_ns, raw in reader.messages(connections=[info]):
         try:
-            return intrinsics_from_camera_info(reader.deserialize(raw, connection.msgtype))
-        except ValueError as exc:
-            raise SourceError(f"{connection.topic}: {exc}") from None
+            intrinsics = intrinsics_from_camera_info(reader.deserialize(raw, connection.msgtype))
+        except (AnyReaderError, ValueError) as exc:
+            problems.append(f"the message at {time_ns * 1e-9:.3f} s (bag time) {_unreadable(exc)}")
+            warnings.warn(f"{connection.topic}: {problems[-1]}; skipped", InputWarning, stacklevel=2)
+            continue
+        return intrinsics
+    if problems:
+        raise SourceError(f"{info.topic}: none of its {len(problems)} message(s) can be used; {problems[0]}")
     raise SourceError(f"{info.topic} holds no message")
+
+
+def _unreadable(exc: Exception) -> str:
+    """Why a message cannot be used, for a sentence about it."""
+    if isinstance(exc, AnyReaderError):
+        return f"cannot be read (a damaged message: {exc})"
+    return f"cannot be used ({exc})"
 
 
 class Rosbag2Source:
@@ -129,12 +182,13 @@ class Rosbag2Source:
         self._reader: AnyReader | None = reader
         connections = list(reader.connections)
         try:
-            self.color = _pick(connections, IMAGE, color_topic, COLOR_TOPIC, "color/image_raw")
-            self.depth = _pick(connections, IMAGE, depth_topic, DEPTH_TOPIC, "aligned_depth_to_color/image_raw")
-            namespace = self.color.topic.rsplit("/", 1)[0]
-            self.info = _pick(
-                connections, CAMERA_INFO, info_topic, f"{namespace}/camera_info", f"{namespace}/camera_info"
+            self.color = _pick(connections, IMAGE, color_topic, COLOR_TOPIC, "color/image_raw", "color_topic")
+            self.depth = _pick(
+                connections, IMAGE, depth_topic, DEPTH_TOPIC, "aligned_depth_to_color/image_raw", "depth_topic"
             )
+            namespace = self.color.topic.rsplit("/", 1)[0]
+            info = f"{namespace}/camera_info"
+            self.info = _pick(connections, CAMERA_INFO, info_topic, info, info.strip("/"), "info_topic")
             self.intrinsics = _first_camera_info(reader, self.info)
         except SourceError as exc:
             self.close()
@@ -151,28 +205,52 @@ class Rosbag2Source:
             if self._reader is None:
                 raise StopIteration
             try:
-                connection, _, raw = next(self._messages)
+                connection, time_ns, raw = next(self._messages)
             except StopIteration:
                 self._ready.extend(self._unpaired(self._pairer.waiting["color"]))
                 self.close()
                 continue
-            self._add(connection, raw)
+            except Exception as exc:  # a damaged file: rosbags, sqlite and mcap raise many types (OverflowError...)
+                self.close()
+                raise SourceError(
+                    f"rosbag2 recording {self.path} is damaged after its first {self._colors} colour image(s) "
+                    f"({type(exc).__name__}: {str(exc)[:200]})"
+                ) from None
+            self._add(connection, time_ns, raw)
         item = self._ready.pop(0)
         if isinstance(item, FrameReadError):
             raise item
         return item
 
-    def _add(self, connection: Connection, raw: bytes) -> None:
-        """Deserialize one image and queue the frames and errors it completes, in frame order."""
+    def _add(self, connection: Connection, time_ns: int, raw: bytes) -> None:
+        """Deserialize one image and queue the frames and errors it completes, in frame order. A colour message
+        that cannot be read is its frame's FrameReadError; a depth one an ``InputWarning`` (its colour image is then
+        reported as having no depth)."""
         assert self._reader is not None  # only called while the bag is open
-        msg: Any = self._reader.deserialize(raw, connection.msgtype)
         stream = "color" if connection.topic == self.color.topic else "depth"
-        item: Any = msg
-        if stream == "color":
-            item = (self._colors, msg)
-            self._colors += 1
-        pair = self._pairer.add(stream, stamp_seconds(msg.header), item)
+        index = self._colors
+        self._colors += stream == "color"
+        try:
+            msg: Any = self._reader.deserialize(raw, connection.msgtype)
+            stamp = stamp_seconds(msg.header)
+        except AnyReaderError as exc:  # rosbags' deserializer failed: a damaged message
+            problem = f"{connection.topic}: the message at {time_ns * 1e-9:.3f} s (bag time) {_unreadable(exc)}"
+            if stream == "depth":
+                warnings.warn(f"{self.path}: {problem}; skipped", InputWarning, stacklevel=2)
+            else:
+                self._ready.append(FrameReadError(f"{self.path}: frame {index}: {problem}", index, self.path))
+            return
+        pair = self._pairer.add(stream, stamp, (index, msg) if stream == "color" else msg)
         dropped, self._pairer.dropped_colors = self._pairer.dropped_colors, []
+        duplicates, self._pairer.duplicate_colors = self._pairer.duplicate_colors, []
+        self._ready.extend(
+            FrameReadError(
+                f"{self.path}: frame {m.item[0]}: its colour image has the stamp of an earlier one ({m.stamp:.6f} s)",
+                m.item[0],
+                self.path,
+            )
+            for m in duplicates
+        )
         self._ready.extend(self._unpaired(dropped))
         if pair is None:
             return

@@ -303,3 +303,28 @@ def test_eval_fformation_scores_gcff_with_each_sequences_own_settings(tmp_path, 
     (tmp_path / "Set" / "Seq2" / "settings_gc.mat").unlink()
     code, _, err = run_sid(["eval", "fformation", str(tmp_path / "Set"), "--gcff-settings"], capsys)
     assert code == 2 and "settings_gc.mat is missing" in err
+
+
+def test_keys_given_twice_and_unknown_fields_are_malformed_lines_as_in_scenario_files(tmp_path, capsys):
+    lines = [
+        '{"frame": 0, "frame": 1, "people": []}',
+        json.dumps({"frame": 1, "people": [{"id": 1, "x": 0.0, "y": 0.0, "thta": 3.1}]}),  # a misspelt facing
+        json.dumps({"frame": 2, "people": [], "stamp": 4.0}),
+        '{"frame": 3, "people": [{"id": 1, "x": 0.0, "x": 5.0, "y": 0.0}]}',
+        json.dumps(PAIR),
+    ]
+    source = tmp_path / "frames.jsonl"
+    source.write_text("\n".join(lines) + "\n")
+    code, out, err = run_sid(["groups", str(source)], capsys)
+    assert code == 0 and [json.loads(line)["frame"] for line in out] == [0]
+    assert err.splitlines() == [
+        "sid groups: line 1: not valid JSON (duplicate key 'frame')",
+        "sid groups: line 2: people[0]: unknown field 'thta' (the fields are id, x, y, theta, orientation_quality)",
+        "sid groups: line 3: unknown field 'stamp' (the fields are frame, people)",
+        "sid groups: line 4: not valid JSON (duplicate key 'x')",
+        "sid groups: skipped 4 malformed line(s)",
+    ]
+    code, out, err = run_sid(["groups", "--strict", str(source)], capsys)
+    assert (
+        code == 1 and out == [] and err.splitlines() == ["sid groups: line 1: not valid JSON (duplicate key 'frame')"]
+    )

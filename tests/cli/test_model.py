@@ -95,3 +95,12 @@ def test_quantize_then_compare_the_real_yolo_model(tmp_path, capsys):
     table = capsys.readouterr().out
     assert code in (0, 1) and "| five_people#0 |" not in table and f"| {frames[0]}#0 | 5 / 5 | 5 / 5 |" in table
     assert load_pose_estimator(out).contract == "yolo_pose"
+
+
+def test_bag_topics_are_options_here_too_and_refused_for_a_source_without_topics(tmp_path, capsys):
+    model = build_yolo_pose_model(tmp_path / "yolo.onnx", np.zeros((56, 10)))
+    code = main(["model", "compare", str(model), str(model), "--source", "synthetic:S1", "--color-topic", "/x/image"])
+    assert code == 2
+    assert _error(capsys) == (
+        "sid model compare: --color-topic: only rosbag2 recordings have topics to choose, and synthetic:S1 is not one"
+    )

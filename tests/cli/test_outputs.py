@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import resource
 import signal
 import subprocess
 import sys
@@ -15,7 +16,7 @@ import cv2
 import pytest
 
 from sid.cli import main
-from sid.cli.common import clear_owned, staged_output
+from sid.cli.common import LOCK_NAME, OutputFolderInUse, clear_owned, output_folder_lock, staged_output
 from sid.documents import TEMPORARY_PREFIX
 from tests.conftest import REPO_ROOT
 
@@ -120,3 +121,99 @@ def test_an_interrupted_detect_leaves_every_file_whole(tmp_path, sig, code):
     assert all(cv2.imread(str(p)) is not None for p in overlays + tops)
     assert not [p for p in out.iterdir() if p.name.startswith(TEMPORARY_PREFIX)]
     assert os.path.getsize(out / "detections.jsonl") > 0
+
+
+def _sid(*argv: str, **options) -> subprocess.Popen:
+    """``python -m sid ARGV`` started in the repository, stderr piped."""
+    return subprocess.Popen([sys.executable, "-m", "sid", *argv], cwd=REPO_ROOT, stderr=subprocess.PIPE, **options)
+
+
+def test_a_second_run_on_a_held_folder_is_refused_and_leaves_the_first_runs_files(tmp_path):
+    out = tmp_path / "out"
+    with output_folder_lock(out):  # as a running `sid detect --out` or `sid demo --out` holds it
+        (out / "overlay_000000.png").write_bytes(b"the first run's")
+        for argv in (
+            ["detect", "--source", "synthetic:S1", "--frames", "1", "--out", str(out)],
+            ["costmap", SCENARIO, "--out", str(out)],
+        ):
+            second = _sid(*argv, stdout=subprocess.DEVNULL)
+            _, err = second.communicate(timeout=300)
+            assert second.returncode == 2
+            assert f"{out}: another sid run is writing in this folder (pid {os.getpid()})" in err.decode()
+        assert (out / "overlay_000000.png").read_bytes() == b"the first run's"
+        assert sorted(p.name for p in out.iterdir()) == [LOCK_NAME, "overlay_000000.png"]
+    assert not (out / LOCK_NAME).exists()  # released and removed at the end of the run
+    with output_folder_lock(out):  # and free for the next one
+        pass
+
+
+def test_the_lock_of_a_killed_run_is_released(tmp_path):
+    out = tmp_path / "out"
+    holder = _sid("detect", "--source", "synthetic:S1", "--frames", "100000", "--out", str(out), stdout=subprocess.PIPE)
+    assert holder.stdout is not None
+    holder.stdout.readline()  # the first frame is out: the folder is held
+    with pytest.raises(OutputFolderInUse, match=f"pid {holder.pid}"), output_folder_lock(out):
+        pass
+    holder.kill()
+    holder.wait(timeout=60)
+    with output_folder_lock(out):  # SIGKILL left the file, but the kernel released the lock
+        assert (out / LOCK_NAME).read_text() == f"pid {os.getpid()}"
+
+
+def test_two_demos_into_one_folder_the_second_is_refused_and_the_first_finishes(tmp_path):
+    out = tmp_path / "demo"
+    argv = ("demo", "--out", str(out), "--planner", "grid")
+    first = _sid(*argv, stdout=subprocess.PIPE)
+    assert first.stdout is not None
+    first.stdout.readline()  # its first progress line: it is staging in the folder
+    first.send_signal(signal.SIGSTOP)  # paused there, whatever the machine's speed
+    try:
+        second = _sid(*argv, stdout=subprocess.DEVNULL)
+        _, second_err = second.communicate(timeout=300)
+    finally:
+        first.send_signal(signal.SIGCONT)
+    first_out, first_err = first.communicate(timeout=300)
+    assert second.returncode == 2 and "another sid run is writing in this folder" in second_err.decode()
+    assert first.returncode in (0, 1), first_err.decode()  # 1: a planner failed to reach the goal, still written
+    assert {"comparison.png", "metrics.json", "scenario.json"} <= {p.name for p in out.iterdir()}
+    assert not [p for p in out.iterdir() if p.name.startswith((TEMPORARY_PREFIX, LOCK_NAME))]
+
+
+def test_a_frame_whose_line_cannot_be_written_keeps_none_of_its_pictures(tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "detections.jsonl").symlink_to("/dev/full")  # every write of a line fails: ENOSPC, a full disk
+    run = _sid("detect", "--source", "synthetic:S1", "--frames", "2", "--out", str(out), stdout=subprocess.PIPE)
+    stdout, err = run.communicate(timeout=300)
+    assert run.returncode == 2
+    assert f"sid detect: cannot write {out / 'detections.jsonl'} (No space left on device)" in err.decode()
+    assert stdout == b""  # the frame was not reported as written either
+    assert sorted(p.name for p in out.iterdir()) == ["detections.jsonl"]  # no picture without its line
+
+
+def test_a_frame_whose_picture_cannot_be_written_gets_no_line(tmp_path):
+    out = tmp_path / "out"
+
+    def small_files() -> None:  # a file may not pass 100 kB (an overlay is larger): its write fails as on a full disk
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (100_000, 100_000))
+
+    run = _sid(
+        "detect",
+        "--source",
+        "synthetic:S1",
+        "--frames",
+        "2",
+        "--out",
+        str(out),
+        stdout=subprocess.PIPE,
+        preexec_fn=small_files,
+    )
+    stdout, err = run.communicate(timeout=300)
+    assert (
+        run.returncode == 2
+        and f"sid detect: cannot write {out / 'overlay_000000.png'} (File too large)" in err.decode()
+    )
+    assert stdout == b""
+    assert sorted(p.name for p in out.iterdir()) == ["detections.jsonl"]
+    assert (out / "detections.jsonl").read_bytes() == b""

@@ -196,7 +196,7 @@ def test_unreadable_input_is_one_line(tmp_path, capsys):
         and err == [f"sid track: cannot read {tmp_path / 'missing.jsonl'}: No such file or directory"]
     )
     code, out, err = run_sid(["track", str(tmp_path)], capsys)
-    assert code == 2 and out == [] and err == [f"sid track: cannot read {tmp_path}: Is a directory"]
+    assert code == 2 and out == [] and err == [f"sid track: cannot read {tmp_path}: it is a folder, not a regular file"]
 
 
 def test_stdin_is_read_as_bytes_line_by_line():

@@ -325,3 +325,28 @@ def test_median_neighbour_distance_is_in_the_input_units(tiny):
     assert centimetres == pytest.approx(100 * metres)
     assert centimetres > PLAUSIBLE_NEIGHBOUR_M[1] > metres > PLAUSIBLE_NEIGHBOUR_M[0]
     assert median_neighbour_distance([]) is None
+
+
+def test_files_that_disagree_are_named_with_the_fformation_prefix(tmp_path):
+    # Found by tests/fuzz/test_input_kinds.py: these three messages lacked the prefix every other one has.
+    folder = write_sequence(tmp_path / "Odd", tiny_frames(), {1: [[1, 2]]})
+    scipy.io.savemat(folder / "features.mat", {"features": cells(tiny_frames()), "timestamp": np.array([[1.0, 2.0]])})
+    with pytest.raises(ValueError, match=r"^fformation: .*features.mat: 4 feature frames but 2 timestamps$"):
+        load_sequence(folder)
+    write_sequence(folder, tiny_frames(), {9: [[1, 2]]})
+    with pytest.raises(
+        ValueError, match=r"^fformation: .*groundtruth.mat: GTtimestamp 9.0 has no frame in features.mat$"
+    ):
+        load_sequence(folder)
+
+
+def test_stamps_beyond_single_precision_load_without_a_numpy_warning(tmp_path, recwarn):
+    # Found by tests/fuzz/test_input_kinds.py: casting 1e300 to single precision printed an overflow RuntimeWarning.
+    folder = write_sequence(tmp_path / "Far", tiny_frames()[:2], {1: [[1, 2]]})
+    stamps = np.array([[1.0, 1e300]])
+    scipy.io.savemat(folder / "features.mat", {"features": cells(tiny_frames()[:2]), "timestamp": stamps})
+    scipy.io.savemat(
+        folder / "groundtruth.mat", {"GTgroups": cells([cells([np.array([[1.0, 2.0]])])] * 2), "GTtimestamp": stamps}
+    )
+    assert [f.timestamp for f in load_sequence(folder, scale=0.01)] == [1.0, 1e300]
+    assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]

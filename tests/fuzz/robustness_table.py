@@ -19,6 +19,7 @@ import resource
 import subprocess
 import sys
 import tempfile
+import time
 from collections import Counter
 from collections.abc import Callable
 from pathlib import Path
@@ -120,6 +121,7 @@ def _arguments(argv: list[str]) -> str:
 
 def _kinds() -> dict[str, tuple[str, Callable[[Any], str], Any]]:
     from tests.fuzz import test_arguments as arguments
+    from tests.fuzz import test_input_kinds as kinds
     from tests.fuzz import test_readers as readers
 
     return {
@@ -146,6 +148,21 @@ def _kinds() -> dict[str, tuple[str, Callable[[Any], str], Any]]:
             st.tuples(st.binary(max_size=300), st.sampled_from(["features.mat", "groundtruth.mat"])),
         ),  # fmt: skip
         "arguments": ("command lines (every command)", _arguments, arguments.command_lines()),
+        "keyed_groups": (
+            "JSON lines, keys repeated / misspelt (sid groups)",
+            kinds.check_groups_lines,
+            kinds.groups_lines(),
+        ),
+        "keyed_track": (
+            "JSON lines, keys repeated / misspelt (sid track)",
+            kinds.check_track_lines,
+            kinds.track_lines(),
+        ),
+        "scenario_yaml": ("scenario YAML edited as text", kinds.check_scenario_yaml, kinds.scenario_yaml()),
+        "pgm": ("PGM maps (comments, any maximum)", kinds.check_pgm, kinds.PGM_CASES),
+        "fformation": (".mat files of any cells (F-formation)", kinds.check_fformation, kinds.fformation_sets()),
+        "folder": ("frame folders (names, suffixes, pixels)", kinds.check_frame_folder, kinds.frame_folders()),
+        "bag": ("rosbag2 recordings (fields, cut messages)", kinds.check_camera_bag, kinds.camera_bags()),
     }
 
 
@@ -170,9 +187,11 @@ def run_kind(name: str, cases: int) -> dict[str, Any]:
             examples.setdefault(outcome, f"{type(exc).__name__}: {exc}"[:200])
         counts[outcome] += 1
 
+    started = time.perf_counter()
     fuzz()
+    seconds = time.perf_counter() - started
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-    return {"kind": name, "counts": dict(counts), "examples": examples, "peak_mb": peak}
+    return {"kind": name, "counts": dict(counts), "examples": examples, "peak_mb": peak, "seconds": seconds}
 
 
 def run_fixtures() -> dict[str, Any]:
@@ -181,6 +200,7 @@ def run_fixtures() -> dict[str, Any]:
     runs += [["groups", str(p)] for p in sorted((MALFORMED / "groups").iterdir())]
     counts: Counter[str] = Counter()
     peak = 0.0
+    started = time.perf_counter()
     code = "import sys; from sid.cli import main; sys.exit(main(sys.argv[1:]))"
     for argv in runs:
         with tempfile.TemporaryDirectory() as folder:
@@ -206,7 +226,8 @@ def run_fixtures() -> dict[str, Any]:
             counts["clear"] += 1
         else:
             counts["unclear"] += 1
-    return {"kind": "fixtures", "counts": dict(counts), "examples": {}, "peak_mb": peak}
+    seconds = time.perf_counter() - started
+    return {"kind": "fixtures", "counts": dict(counts), "examples": {}, "peak_mb": peak, "seconds": seconds}
 
 
 TITLES = {"fixtures": "malformed fixtures via `sid costmap` / `sid groups`"}
@@ -215,28 +236,31 @@ TITLES = {"fixtures": "malformed fixtures via `sid costmap` / `sid groups`"}
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--cases", type=int, default=300, help="cases per fuzzed kind (default %(default)s)")
+    parser.add_argument("--only", nargs="+", metavar="KIND", help=f"these kinds alone: {', '.join(_kinds())}")
     parser.add_argument("--kind", help=argparse.SUPPRESS)  # internal: run one kind in this process
     args = parser.parse_args()
     if args.kind:
         print(json.dumps(run_kind(args.kind, args.cases)))
         return
     rows = []
-    for name in _kinds():
+    for name in args.only or _kinds():
         out = subprocess.run(
             [sys.executable, "-m", "tests.fuzz.robustness_table", "--kind", name, "--cases", str(args.cases)],
             cwd=REPO_ROOT, capture_output=True, text=True, check=True, env=os.environ | {"PYTHONPATH": str(REPO_ROOT)},
         )  # fmt: skip
         rows.append(json.loads(out.stdout.splitlines()[-1]))
-    rows.append(run_fixtures())
+    if not args.only:
+        rows.append(run_fixtures())
     titles = {name: title for name, (title, _, _) in _kinds().items()} | TITLES
-    print("| input kind | cases | accepted | clear errors | tracebacks | hangs | peak memory (RSS) |")
-    print("|---|---|---|---|---|---|---|")
+    print("| input kind | cases | accepted | clear errors | tracebacks | hangs | peak memory (RSS) | time |")
+    print("|---|---|---|---|---|---|---|---|")
     for row in rows:
         c = row["counts"]
         tried = sum(c.values())
         print(
             f"| {titles[row['kind']]} | {tried} | {c.get('accepted', 0)} | {c.get('clear', 0)} | "
-            f"{c.get('traceback', 0) + c.get('unclear', 0)} | {c.get('hang', 0)} | {row['peak_mb']:.0f} MB |"
+            f"{c.get('traceback', 0) + c.get('unclear', 0)} | {c.get('hang', 0)} | {row['peak_mb']:.0f} MB | "
+            f"{row['seconds']:.0f} s |"
         )
         for outcome, example in row["examples"].items():
             print(f"<!-- {row['kind']} {outcome}: {example} -->")

@@ -61,6 +61,53 @@ def camera_info(stamp_s: float, intr: Intrinsics):
     )
 
 
+Message = tuple[str, str, int, bytes]
+"""One recorded message: topic, message type, bag time (ns) and its CDR bytes."""
+
+
+def camera_messages(
+    frames: Iterable[tuple[np.ndarray, np.ndarray]],
+    intr: Intrinsics,
+    *,
+    namespace: str = NAMESPACE,
+    encoding: str = "rgb8",
+    fps: float = 30.0,
+    skip_depth: Iterable[int] = (),
+    stamps: Iterable[float] | None = None,
+) -> list[Message]:
+    """The camera_info, colour and aligned depth messages of (RGB uint8, depth uint16 mm) frames under
+    realsense2_camera's topic names in ``namespace``. encoding: the colour encoding (rgb8 or bgr8). skip_depth:
+    frame numbers recorded without their depth image. stamps: each frame's header stamp (s; default 100 s +
+    number / fps)."""
+    skipped = set(skip_depth)
+    frames = list(frames)
+    times = list(stamps) if stamps is not None else [100.0 + number / fps for number in range(len(frames))]
+    out: list[Message] = []
+    for number, ((rgb, depth), stamp) in enumerate(zip(frames, times, strict=True)):
+        time_ns = round((100.0 + number / fps) * 1e9)
+        pixels = cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR) if encoding == "bgr8" else rgb
+        info = TYPES.serialize_cdr(camera_info(stamp, intr), "sensor_msgs/msg/CameraInfo")
+        out.append((f"{namespace}/color/camera_info", "sensor_msgs/msg/CameraInfo", time_ns, info))
+        color = TYPES.serialize_cdr(image(stamp, pixels, encoding), "sensor_msgs/msg/Image")
+        out.append((f"{namespace}/color/image_raw", "sensor_msgs/msg/Image", time_ns, color))
+        if number not in skipped:
+            aligned = TYPES.serialize_cdr(image(stamp + 0.002, depth, "16UC1"), "sensor_msgs/msg/Image")
+            out.append((f"{namespace}/aligned_depth_to_color/image_raw", "sensor_msgs/msg/Image", time_ns, aligned))
+    return out
+
+
+def write_messages(path: Path, messages: Iterable[Message], *, mcap: bool = True) -> Path:
+    """A rosbag2 folder ``path`` of ``messages`` written by rosbags, one connection per topic; returns the folder."""
+    plugin = StoragePlugin.MCAP if mcap else StoragePlugin.SQLITE3
+    connections = {}
+    with Writer(path, version=8, storage_plugin=plugin) as writer:
+        for topic, msgtype, time_ns, raw in messages:
+            if topic not in connections:
+                connections[topic] = writer.add_connection(topic, msgtype, typestore=TYPES)
+            writer.write(connections[topic], time_ns, raw)
+    return path
+
+
 def write_camera_bag(
     path: Path,
     frames: Iterable[tuple[np.ndarray, np.ndarray]],
@@ -71,24 +118,6 @@ def write_camera_bag(
     fps: float = 30.0,
     skip_depth: Iterable[int] = (),
 ) -> Path:
-    """Write (RGB uint8, depth uint16 mm) frames to a rosbag2 folder ``path``; returns the folder.
-
-    encoding: the colour encoding (rgb8 or bgr8). skip_depth: frame numbers recorded without their depth image.
-    """
-    skipped = set(skip_depth)
-    plugin = StoragePlugin.MCAP if mcap else StoragePlugin.SQLITE3
-    with Writer(path, version=8, storage_plugin=plugin) as writer:
-        color_c = writer.add_connection(COLOR, "sensor_msgs/msg/Image", typestore=TYPES)
-        depth_c = writer.add_connection(DEPTH, "sensor_msgs/msg/Image", typestore=TYPES)
-        info_c = writer.add_connection(INFO, "sensor_msgs/msg/CameraInfo", typestore=TYPES)
-        for number, (rgb, depth) in enumerate(frames):
-            stamp = 100.0 + number / fps
-            time_ns = round(stamp * 1e9)
-            pixels = cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR) if encoding == "bgr8" else rgb
-            messages = [(info_c, camera_info(stamp, intr), "sensor_msgs/msg/CameraInfo")]
-            messages.append((color_c, image(stamp, pixels, encoding), "sensor_msgs/msg/Image"))
-            if number not in skipped:
-                messages.append((depth_c, image(stamp + 0.002, depth, "16UC1"), "sensor_msgs/msg/Image"))
-            for connection, message, msgtype in messages:
-                writer.write(connection, time_ns, TYPES.serialize_cdr(message, msgtype))
-    return path
+    """Write (RGB uint8, depth uint16 mm) frames to a rosbag2 folder ``path`` (``camera_messages``); returns it."""
+    messages = camera_messages(frames, intr, encoding=encoding, fps=fps, skip_depth=skip_depth)
+    return write_messages(path, messages, mcap=mcap)

@@ -176,3 +176,31 @@ def test_live_camera_absent_gives_a_clear_error() -> None:
         pytest.skip("a RealSense camera is connected")
     with pytest.raises(SourceError, match="no RealSense camera is connected"):
         open_source("realsense")
+
+
+def test_frames_of_one_name_in_two_files_are_reported_not_dropped(tmp_path: Path) -> None:
+    write_pair(tmp_path / "color" / "a.png", tmp_path / "depth" / "a.png", 1000)
+    write_pair(tmp_path / "color" / "a.jpg", tmp_path / "other" / "x.png", 1000)  # a second colour image of frame a
+    write_pair(tmp_path / "color" / "b.png", tmp_path / "depth" / "b.png", 2000)
+    (tmp_path / "intrinsics.json").write_text(json.dumps(INTR))
+    errors: list[FrameReadError] = []
+    frames = list(skip_unreadable(FolderSource(tmp_path), errors.append))
+    assert [f.index for f in frames] == [1]
+    assert [str(e) for e in errors] == [
+        f"frame 'a': 2 colour images, {tmp_path / 'color' / 'a.jpg'} and {tmp_path / 'color' / 'a.png'}; keep one"
+    ]
+    single = tmp_path / "single"
+    write_pair(single / "color.png", single / "depth.png", 1000)
+    write_pair(single / "color.jpg", single / "x" / "depth.png", 1000)
+    (single / "intrinsics.json").write_text(json.dumps(INTR))
+    with pytest.raises(FrameReadError, match="frame 'color': 2 colour images, .*color.png and .*color.jpg; keep one"):
+        list(FolderSource(single))
+
+
+def test_frame_names_that_are_not_plain_numbers_sort_and_play(tmp_path: Path) -> None:
+    for name in ("2", "10", "²", "x٣", "frame1"):  # "²": str.isdigit() says yes, int() refuses it
+        write_pair(tmp_path / "color" / f"{name}.png", tmp_path / "depth" / f"{name}.png", 1000)
+    (tmp_path / "intrinsics.json").write_text(json.dumps(INTR))
+    source = FolderSource(tmp_path)
+    assert [name for name, _, _ in source.pairs] == ["2", "10", "frame1", "x٣", "²"]
+    assert len(list(source)) == 5

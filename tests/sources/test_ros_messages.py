@@ -78,3 +78,14 @@ def test_pairing_by_stamp() -> None:
     assert pairer.add("depth", 1.100, "d3") is None and pairer.add("color", 1.095, "c3") is not None
     with pytest.raises(ValueError, match="'color' or 'depth'"):
         pairer.add("ir", 1.0, "x")
+
+
+def test_a_colour_stamp_given_twice_is_a_duplicate_not_a_second_frame() -> None:
+    pairer: StampPairer[str] = StampPairer(0.01)
+    assert pairer.add("color", 1.0, "c1") is None
+    assert pairer.add("color", 1.0, "c1 again") is None  # waiting with the same stamp
+    pair = pairer.add("depth", 1.002, "d1")
+    assert pair is not None and pair[0].item == "c1"
+    assert pairer.add("color", 1.0, "c1 a third time") is None  # the stamp of the colour image just paired
+    assert [m.item for m in pairer.duplicate_colors] == ["c1 again", "c1 a third time"]
+    assert pairer.dropped_colors == []

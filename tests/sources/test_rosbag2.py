@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from sid.cli import main
+from sid.documents import InputWarning
 from sid.perception.frame import Frame
 from sid.perception.pipeline import Pipeline
 from sid.sources import FrameReadError, SourceError, open_source, skip_unreadable
@@ -17,7 +18,7 @@ from sid.sources.rosbag2 import Rosbag2Source, is_librealsense_recording
 from sid.sources.synthetic import SyntheticSource
 from sid.synthetic.pose import TruthPose
 from tests.conftest import realsense, shared_path
-from tests.sources.camera_bags import COLOR, write_camera_bag
+from tests.sources.camera_bags import COLOR, INFO, camera_messages, write_camera_bag, write_messages
 
 
 def synthetic_pairs(count: int) -> tuple[list[tuple[np.ndarray, np.ndarray]], list[Frame]]:
@@ -131,3 +132,154 @@ def test_librealsense_db3_still_goes_to_the_realsense_source(tmp_path: Path) -> 
         tmp_path / "bag", synthetic_pairs(1)[0], synthetic_pairs(1)[1][0].calibration.color, mcap=False
     )
     assert not is_librealsense_recording(next(bag.glob("*.db3")))
+
+
+def _frames_and_errors(spec: Path, **options: str) -> tuple[list[int], list[FrameReadError]]:
+    errors: list[FrameReadError] = []
+    frames = [f.index for f in skip_unreadable(open_source(str(spec), **options), errors.append)]
+    return frames, errors
+
+
+def test_colour_images_sharing_a_stamp_are_reported_as_skipped(tmp_path: Path) -> None:
+    pairs, synthetic = synthetic_pairs(5)
+    stamps = [100.0, 100.1, 100.1, 100.1, 100.3]  # frames 1 to 3 share one stamp: one is paired, two are reported
+    bag = write_messages(tmp_path / "bag", camera_messages(pairs, synthetic[0].calibration.color, stamps=stamps))
+    frames, errors = _frames_and_errors(bag)
+    assert frames == [0, 1, 4]
+    assert sorted(e.index for e in errors) == [2, 3]
+    assert all("its colour image has the stamp of an earlier one (100.100000 s)" in str(e) for e in errors)
+    assert len(frames) + len(errors) == 5  # every colour image is a frame or a line
+
+
+def test_a_damaged_message_skips_its_frame_with_a_line(tmp_path: Path) -> None:
+    pairs, synthetic = synthetic_pairs(3)
+    messages = camera_messages(pairs, synthetic[0].calibration.color)
+    topic, msgtype, time_ns, raw = messages[4]  # frame 1's colour image, cut in half
+    assert topic == COLOR
+    messages[4] = (topic, msgtype, time_ns, raw[: len(raw) // 2])
+    bag = write_messages(tmp_path / "bag", messages)
+    frames, errors = _frames_and_errors(bag)
+    assert frames == [0, 2] and [e.index for e in errors] == [1]
+    assert f"frame 1: {COLOR}: the message at 100.033 s (bag time) cannot be read (a damaged message:" in str(errors[0])
+
+
+def test_an_empty_camera_info_is_skipped_with_a_warning_and_the_next_one_used(tmp_path: Path) -> None:
+    pairs, synthetic = synthetic_pairs(2)
+    messages = camera_messages(pairs, synthetic[0].calibration.color)
+    topic, msgtype, time_ns, _ = messages[0]
+    assert topic == INFO
+    messages[0] = (topic, msgtype, time_ns, b"")
+    bag = write_messages(tmp_path / "bag", messages)
+    with pytest.warns(InputWarning, match=f"{INFO}: the message at 100.000 s .*cannot be read.*; skipped"):
+        frames, errors = _frames_and_errors(bag)
+    assert frames == [0, 1] and errors == []
+    only_empty = write_messages(tmp_path / "empty", [m if m[0] != INFO else (*m[:3], b"") for m in messages])
+    with (
+        pytest.raises(
+            SourceError, match=f"empty: {INFO}: none of its 2 message\\(s\\) can be used; the message at 100.000 s"
+        ),
+        pytest.warns(InputWarning),
+    ):
+        open_source(str(only_empty))
+
+
+@pytest.mark.parametrize("namespace", ["/camera", "/robot/front", ""])
+def test_realsense_topics_are_found_under_any_namespace(tmp_path: Path, namespace: str) -> None:
+    pairs, synthetic = synthetic_pairs(2)
+    bag = write_messages(tmp_path / "bag", camera_messages(pairs, synthetic[0].calibration.color, namespace=namespace))
+    source = open_source(str(bag))
+    assert isinstance(source, Rosbag2Source)
+    assert (source.color.topic, source.depth.topic, source.info.topic) == (
+        f"{namespace}/color/image_raw",
+        f"{namespace}/aligned_depth_to_color/image_raw",
+        f"{namespace}/color/camera_info",
+    )
+    assert [f.index for f in source] == [0, 1]
+
+
+def test_topics_are_chosen_by_name_and_two_cameras_ask_for_the_option(tmp_path: Path, capsys) -> None:
+    pairs, synthetic = synthetic_pairs(2)
+    intr = synthetic[0].calibration.color
+    messages = camera_messages(pairs, intr, namespace="/front") + camera_messages(pairs, intr, namespace="/back")
+    bag = write_messages(tmp_path / "bag", messages)
+    with pytest.raises(SourceError, match="several of the bag's .* topics end in 'color/image_raw'.*--color-topic"):
+        open_source(str(bag))
+    back = {"color_topic": "/back/color/image_raw", "depth_topic": "/back/aligned_depth_to_color/image_raw"}
+    source = open_source(str(bag), **back)
+    assert isinstance(source, Rosbag2Source) and source.info.topic == "/back/color/camera_info"
+    argv = ["detect", "--source", str(bag), "--color-topic", back["color_topic"], "--depth-topic", back["depth_topic"]]
+    assert main([*argv, "--info-topic", "/back/color/camera_info", "--frames", "1", "--no-tracking"]) == 2
+    assert "a real source needs a pose model" in capsys.readouterr().err  # the topics were accepted; no model given
+    folder = write_folder(tmp_path / "frames", pairs, intr.to_dict())
+    with pytest.raises(
+        SourceError, match=f"--color-topic: only rosbag2 recordings have topics to choose, and {folder}"
+    ):
+        open_source(str(folder), color_topic="/front/color/image_raw")
+
+
+def test_damaged_files_are_named_with_what_is_wrong(tmp_path: Path) -> None:
+    pairs, synthetic = synthetic_pairs(3)
+    intr = synthetic[0].calibration.color
+    db3 = next(write_camera_bag(tmp_path / "sqlite", pairs, intr, mcap=False).glob("*.db3"))
+    half = tmp_path / "half.db3"
+    half.write_bytes(db3.read_bytes()[: db3.stat().st_size // 2])
+    with pytest.raises(SourceError, match=f"recording {half}: not a readable SQLite database \\(database disk image "):
+        open_source(str(half))
+    binary = write_camera_bag(tmp_path / "binary", pairs, intr)
+    (binary / "metadata.yaml").write_bytes(b"\x89PNG\r\n\x1a\n\x00\x00")
+    with pytest.raises(
+        SourceError, match=f"rosbag2 metadata {binary / 'metadata.yaml'}: byte 0x89 at offset 0 .*UTF-8"
+    ):
+        open_source(str(binary))
+    mcap = next(write_camera_bag(tmp_path / "mcap", pairs, intr).glob("*.mcap"))
+    bare = tmp_path / "bare"
+    bare.mkdir()
+    (bare / "walk.mcap").write_bytes(mcap.read_bytes())
+    with pytest.raises(
+        SourceError, match=f"{bare}: holds walk.mcap but no metadata.yaml.*--source {bare / 'walk.mcap'}"
+    ):
+        open_source(str(bare))
+    assert [f.index for f in open_source(str(bare / "walk.mcap"))] == [0, 1, 2]  # the file itself reads
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(mcap.read_bytes()[: mcap.stat().st_size // 2])
+    with pytest.raises(SourceError, match=f"cannot read rosbag2 recording {cut}: "):
+        open_source(str(cut))
+
+
+@pytest.mark.parametrize("mcap", [True, False])
+def test_a_file_damaged_inside_stops_the_source_naming_it(tmp_path: Path, mcap: bool) -> None:
+    pairs, synthetic = synthetic_pairs(6)
+    bag = write_camera_bag(tmp_path / "bag", pairs, synthetic[0].calibration.color, mcap=mcap)
+    storage = next(bag.glob("*.mcap" if mcap else "*.db3"))
+    raw = bytearray(storage.read_bytes())
+    raw[len(raw) // 3 : len(raw) // 3 + 5000] = b"\xab" * 5000  # overwritten in the middle
+    storage.write_bytes(bytes(raw))
+    frames: list[Frame] = []
+    with pytest.raises(SourceError, match=f"rosbag2 recording {bag} is damaged after its first \\d colour image"):
+        frames.extend(skip_unreadable(open_source(str(bag)), lambda error: None))
+    assert 0 < len(frames) < 6 and [f.index for f in frames] == list(range(len(frames)))  # the frames before it
+
+
+def test_sid_detect_reports_each_bad_frame_of_a_bag_and_goes_on(tmp_path: Path, capsys) -> None:
+    from tests.pose_models import build_yolo_pose_model
+
+    pairs, synthetic = synthetic_pairs(5)
+    stamps = [100.0, 100.1, 100.1, 100.3, 100.4]  # frame 2 repeats frame 1's stamp
+    messages = camera_messages(pairs, synthetic[0].calibration.color, namespace="/camera", stamps=stamps)
+    colour = [k for k, m in enumerate(messages) if m[0] == "/camera/color/image_raw"]
+    topic, msgtype, time_ns, raw = messages[colour[3]]
+    messages[colour[3]] = (topic, msgtype, time_ns, raw[:100])  # frame 3's colour message cut short
+    bag = write_messages(tmp_path / "bag", messages)
+    model = build_yolo_pose_model(tmp_path / "yolo.onnx", np.zeros((56, 10)))  # answers nobody: "no people"
+    assert main(["detect", "--source", str(bag), "--model", str(model), "--no-tracking"]) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert (
+        f"detect: frame 2: skipped, {bag}: frame 2: its colour image has the stamp of an earlier one (100.100000 s)"
+        in err
+    )
+    assert any(
+        line.startswith(f"detect: frame 3: skipped, {bag}: frame 3: /camera/color/image_raw: the message")
+        for line in err
+    )
+    assert sorted(line.split()[2] for line in err if " skipped, " in line) == ["0:", "1:", "2:", "3:", "4:"]
+    assert err[-1].startswith("detect: 0 frames with people, 5 skipped")

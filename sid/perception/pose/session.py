@@ -33,6 +33,7 @@ import numpy as np
 import onnxruntime as ort
 
 from sid.cpu import physical_cores, usable_cpus
+from sid.documents import special_file
 from sid.perception.pose.contracts import ModelSignature, PoseModelError, supported_contracts_text
 
 __all__ = [
@@ -164,6 +165,9 @@ class OnnxModel:
         self.threads = check_threads(threads) or physical_cores()
         self.spinning = spinning
         chosen = resolve_providers(providers)
+        special = special_file(self.path)
+        if special:
+            raise PoseModelError(f"pose model {self.path}: {special}")
         if not self.path.is_file():
             hint = "" if self.path.suffix == ".onnx" else " (expected an .onnx file)"
             raise PoseModelError(f"pose model file not found: {self.path}{hint}\n" + supported_contracts_text())
