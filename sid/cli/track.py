@@ -26,7 +26,7 @@ from typing import Any, TextIO
 from sid.checks import check_limit
 from sid.cli.common import fail, process_json_lines, refuse_unknown_fields, run_json_lines
 from sid.cli.grouping import add_group_params, group_params_from
-from sid.documents import is_number
+from sid.documents import is_number, summary
 from sid.perception.people import Person
 from sid.tracking import TrackingSession
 
@@ -88,7 +88,7 @@ def _parse_line(data: Any) -> tuple[int | float, list[Person]]:
             raise ValueError(f"missing {key!r}")
     timestamp = data["timestamp"]
     if not is_number(timestamp):
-        raise ValueError(f"'timestamp' must be a finite number of seconds, got {timestamp!r}")
+        raise ValueError(f"'timestamp' must be a finite number of seconds, got {summary(timestamp)}")
     if not isinstance(data["people"], list):
         raise ValueError("'people' must be a list")
     check_limit("people", len(data["people"]), "people", "people")  # before any work on them (sid.checks.Limits)
@@ -103,15 +103,17 @@ def _parse_person(data: Any, index: int) -> Person:
     refuse_unknown_fields(data, PERSON_FIELDS, f"{where}: ")
     person_id = data.get("id", index)
     if isinstance(person_id, bool) or not isinstance(person_id, int):
-        raise ValueError(f"{where}: id must be an integer, got {person_id!r}")
+        raise ValueError(f"{where}: id must be an integer, got {summary(person_id)}")
     for key in ("x", "y"):
         if key not in data:
             raise ValueError(f"{where} is missing {key!r}")
         if not is_number(data[key]):
-            raise ValueError(f"{where}: {key} must be a finite number of metres, got {data[key]!r}")
+            raise ValueError(f"{where}: {key} must be a finite number of metres, got {summary(data[key])}")
     theta = data.get("theta")
     if theta is not None and not is_number(theta):
-        raise ValueError(f"{where}: theta must be a finite number of radians, or null when unknown, got {theta!r}")
+        raise ValueError(
+            f"{where}: theta must be a finite number of radians, or null when unknown, got {summary(theta)}"
+        )
     if theta is None:
         return Person(person_id, float(data["x"]), float(data["y"]))
     return Person(person_id, float(data["x"]), float(data["y"]), float(theta), 1.0)

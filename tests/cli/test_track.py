@@ -104,20 +104,20 @@ BAD_LINES = [
     ("{not json", "not valid JSON (Expecting property name enclosed in double quotes: line 1 column 2 (char 1))"),
     ("[1, 2]", "expected a JSON object with 'timestamp' and 'people'"),
     ('{"people": []}', "missing 'timestamp'"),
-    ('{"timestamp": "0.5", "people": []}', "'timestamp' must be a finite number of seconds, got '0.5'"),
-    ('{"timestamp": 1e400, "people": []}', "'timestamp' must be a finite number of seconds, got inf"),
+    ('{"timestamp": "0.5", "people": []}', "'timestamp' must be a finite number of seconds, got \"0.5\""),
+    ('{"timestamp": 1e400, "people": []}', "'timestamp' must be a finite number of seconds, got Infinity"),
     ('{"timestamp": NaN, "people": []}', "not valid JSON (NaN is not a number)"),
     ('{"timestamp": 0.5, "people": {}}', "'people' must be a list"),
     ('{"timestamp": 0.5, "people": [3]}', "people[0] must be an object with x, y and optionally theta and id"),
     ('{"timestamp": 0.5, "people": [{"y": 0}]}', "people[0] is missing 'x'"),
-    ('{"timestamp": 0.5, "people": [{"x": 0, "y": null}]}', "people[0]: y must be a finite number of metres, got None"),
+    ('{"timestamp": 0.5, "people": [{"x": 0, "y": null}]}', "people[0]: y must be a finite number of metres, got null"),
     (
         '{"timestamp": 0.5, "people": [{"x": 0, "y": 1' + "0" * 400 + "}]}",  # an int no float can hold
-        "people[0]: y must be a finite number of metres, got 1" + "0" * 400,
+        "people[0]: y must be a finite number of metres, got 1" + "0" * 76 + "...",  # its summary, 80 characters
     ),
     (
         '{"timestamp": 0.5, "people": [{"x": 0, "y": 0, "theta": "north"}]}',
-        "people[0]: theta must be a finite number of radians, or null when unknown, got 'north'",
+        'people[0]: theta must be a finite number of radians, or null when unknown, got "north"',
     ),
     (
         '{"timestamp": 0.5, "people": [{"x": 0, "y": 0, "thta": 1.0}]}',
