@@ -149,8 +149,9 @@ class StampPairer(Generic[T]):
 
     Feed each message as it comes (``add("color" | "depth", stamp, item)``); a message that completes a pair
     returns it as (colour, depth). Messages of one stream older than a paired one can never pair; they are dropped
-    and, for colour, kept in ``dropped_colors`` (the caller reports them). A colour message whose stamp is that of
-    one already waiting or paired is dropped at once into ``duplicate_colors`` (reported too: one stamp, one frame).
+    (a colour one at once, when it arrives) and, for colour, kept in ``dropped_colors`` (the caller reports them). A
+    colour message whose stamp is that of one already waiting or paired is dropped at once into ``duplicate_colors``
+    (reported too: one stamp, one frame).
     At most ``keep`` messages wait per stream.
     """
 
@@ -167,6 +168,9 @@ class StampPairer(Generic[T]):
             raise ValueError(f"stamp pairing: stream must be 'color' or 'depth', got {stream!r}")
         if stream == "color" and (stamp == self._paired_color or any(m.stamp == stamp for m in self.waiting["color"])):
             self.duplicate_colors.append(Stamped(stamp, item))
+            return None
+        if stream == "color" and self._paired_color is not None and stamp < self._paired_color:
+            self.dropped_colors.append(Stamped(stamp, item))  # older than a frame already given: out of order
             return None
         other = self.waiting["depth" if stream == "color" else "color"]
         match = min(other, key=lambda m: abs(m.stamp - stamp), default=None)
