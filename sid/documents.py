@@ -9,9 +9,9 @@ import math
 import os
 import re
 import reprlib
+import secrets
 import stat
 import struct
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TypeGuard
@@ -247,14 +247,21 @@ TEMPORARY_PREFIX = ".sid-partial-"
 
 def write_atomically(path: str | Path, data: bytes) -> Path:
     """Write ``data`` to ``path`` whole or not at all: into a temporary file in the same folder, then
-    ``os.replace`` (atomic on POSIX and Windows), so a reader never sees a half-written file, even after a kill."""
+    ``os.replace`` (atomic on POSIX and Windows), so a reader never sees a half-written file, even after a kill.
+    The file gets the permissions the user's umask gives a new file, as ``open`` would (not mkstemp's 0600)."""
     path = Path(path)
-    handle, temporary = tempfile.mkstemp(prefix=TEMPORARY_PREFIX, dir=path.parent)
+    while True:
+        temporary = path.parent / f"{TEMPORARY_PREFIX}{secrets.token_hex(6)}"
+        try:
+            handle = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
+            break
+        except FileExistsError:  # another writer's temporary file of the same name: draw again
+            continue
     try:
         with os.fdopen(handle, "wb") as file:
             file.write(data)
         os.replace(temporary, path)
     except BaseException:
-        Path(temporary).unlink(missing_ok=True)
+        temporary.unlink(missing_ok=True)
         raise
     return path

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import os
+import stat
+
 import pytest
 
 from sid.documents import load_document
@@ -127,3 +130,17 @@ def test_write_atomically_into_a_missing_folder_fails_and_writes_nothing(tmp_pat
     with pytest.raises(OSError):
         write_atomically(tmp_path / "missing" / "a.png", b"x")
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("umask", [0o022, 0o077, 0o002])
+def test_write_atomically_gives_the_permissions_of_the_users_umask(tmp_path, umask):
+    from sid.documents import write_atomically
+
+    previous = os.umask(umask)
+    try:
+        write_atomically(tmp_path / "a.png", b"x")
+        (tmp_path / "b.txt").write_bytes(b"x")  # what open() gives under the same umask
+    finally:
+        os.umask(previous)
+    assert stat.S_IMODE((tmp_path / "a.png").stat().st_mode) == 0o666 & ~umask
+    assert (tmp_path / "a.png").stat().st_mode == (tmp_path / "b.txt").stat().st_mode

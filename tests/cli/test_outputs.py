@@ -7,6 +7,7 @@ import json
 import os
 import resource
 import signal
+import stat
 import subprocess
 import sys
 import time
@@ -77,6 +78,18 @@ def test_detect_rerun_clears_the_earlier_runs_pictures(tmp_path, capsys):
         "topview_000000.png",
     ]
     assert "removed 7 file(s) of an earlier run" in capsys.readouterr().err
+
+
+def test_every_file_detect_writes_has_the_permissions_of_the_users_umask(tmp_path, capsys):
+    out = tmp_path / "out"
+    previous = os.umask(0o027)
+    try:
+        assert main(["detect", "--source", "synthetic:S1", "--frames", "2", "--out", str(out)]) == 0
+    finally:
+        os.umask(previous)
+    modes = {p.name: stat.S_IMODE(p.stat().st_mode) for p in out.iterdir()}
+    assert "overlay_000000.png" in modes and "detections.jsonl" in modes
+    assert set(modes.values()) == {0o640}, modes
 
 
 def _detect_until_interrupted(out: Path, sig: signal.Signals) -> int:
