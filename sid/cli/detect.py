@@ -27,6 +27,7 @@ from sid.cli.common import (
     positive_int,
     signals_deferred,
 )
+from sid.distribution import install_hint
 from sid.documents import write_atomically
 from sid.perception.camera import Calibration
 from sid.perception.frame import Frame
@@ -76,7 +77,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         choices=PROVIDER_CHOICES,
         default="auto",
         help="onnxruntime execution provider for the pose model: 'auto' (default) uses OpenVINO when "
-        "onnxruntime-openvino is installed (pip install 'sid[openvino]'), else CPU",
+        f"onnxruntime-openvino is installed ({install_hint('openvino')}), else CPU",
     )
     parser.add_argument("--frames", type=positive_int, help="stop after this many frames (default: all; synthetic: 30)")
     parser.add_argument("--out", type=Path, help="also write detections.jsonl, overlay and top-view PNGs here")

@@ -9,6 +9,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from sid.cli.common import add_bag_topic_options, positive_int
+from sid.distribution import install_hint
 from sid.perception.frame import Frame
 from sid.perception.pipeline import PoseFn, image_pose
 from sid.perception.pose.contracts import PoseModelError
@@ -18,7 +19,7 @@ __all__ = ["INSTALL_HINT", "SHARE", "SYNTHETIC_FRAMES", "add_parser", "run"]
 
 INSTALL_HINT = (
     "sid ros needs ROS 2's rclpy, which cannot be imported here ({error}). Source a ROS 2 installation "
-    "(`source /opt/ros/jazzy/setup.bash`), or install the Python wheels with `pip install 'sid[ros]'`; see "
+    f"(`source /opt/ros/jazzy/setup.bash`), or install the Python wheels with `{install_hint('ros')}`; see "
     "docs/ros2.md"
 )
 SYNTHETIC_FRAMES = 300

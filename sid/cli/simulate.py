@@ -81,7 +81,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     sweep.add_argument("--workers", type=int, default=1, metavar="N", help="parallel worker processes (1)")
     sweep.add_argument(
         "--ray", default=None, metavar="ADDRESS",
-        help="run on a Ray cluster ('local' starts one here, 'auto' joins a running head); needs sid[cluster]",
+        help="run on a Ray cluster ('local' starts one here, 'auto' joins a running head); needs sid-social[cluster]",
     )  # fmt: skip
     parser.set_defaults(func=run)
 

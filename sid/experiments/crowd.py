@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from sid.distribution import install_hint
 from sid.experiments.fformation import format_threshold, frame_matches
 from sid.experiments.gmitre import LinkCounts, gmitre_counts
 from sid.experiments.tracking import MissingDependencyError, as_truth_ids, identify, mot_scores
@@ -322,5 +323,5 @@ def _settings_json(settings: CrowdSettings) -> dict[str, Any]:
 def require_motmetrics() -> None:
     if importlib.util.find_spec("motmetrics") is None:
         raise MissingDependencyError(
-            "the crowd evaluation needs py-motmetrics: pip install 'sid[eval]' (or pip install motmetrics)"
+            f"the crowd evaluation needs py-motmetrics: {install_hint('eval')} (or pip install motmetrics)"
         )

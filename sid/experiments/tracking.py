@@ -41,6 +41,7 @@ from costmap.grid import GridSpec
 from costmap.layer import LayerInputs
 from costmap.plugins import CostmapParams, layered_costmap
 from sid.checks import check_number
+from sid.distribution import install_hint
 from sid.errors import SidError
 from sid.experiments.fformation import LabelledFrame, format_threshold, score
 from sid.perception.frame import Frame
@@ -126,7 +127,7 @@ def evaluate_tracking(settings: TrackingEvalSettings | None = None, progress: Pr
     "settings": {...}}``."""
     if importlib.util.find_spec("motmetrics") is None:  # fail before any rendering
         raise MissingDependencyError(
-            "the tracking evaluation needs py-motmetrics: pip install 'sid[eval]' (or pip install motmetrics)"
+            f"the tracking evaluation needs py-motmetrics: {install_hint('eval')} (or pip install motmetrics)"
         )
     settings = settings or TrackingEvalSettings()
     per_sequence: dict[str, Any] = {}

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from sid.cli import main
+from sid.distribution import install_hint
 from sid.perception.frame import Frame
 from sid.perception.pipeline import Pipeline
 from sid.sources.synthetic import SyntheticSource
@@ -251,7 +252,7 @@ def test_missing_openvino_provider_is_explained(tmp_path, capsys):
     model = build_yolo_pose_model(tmp_path / "yolo.onnx", np.zeros((56, 10)))
     assert main(["detect", "--source", "synthetic:S1", "--model", str(model), "--provider", "openvino"]) == 2
     err = capsys.readouterr().err
-    assert "openvino provider is not available" in err and "pip install 'sid[openvino]'" in err
+    assert "openvino provider is not available" in err and install_hint("openvino") in err
 
 
 def test_summary_counts_every_skipped_frame(tmp_path, capsys):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import importlib.util
 import math
+import re
 from collections import Counter
 from dataclasses import dataclass, field
 from typing import Any
@@ -11,6 +12,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+from sid.distribution import install_hint
 from sid.experiments import tracking
 from sid.experiments.tracking import (
     MissingDependencyError,
@@ -58,7 +60,7 @@ def test_people_are_identified_by_nearest_position_within_the_gate() -> None:
 
 def test_a_missing_motmetrics_is_explained(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(tracking.importlib.util, "find_spec", lambda name: None)
-    with pytest.raises(MissingDependencyError, match=r"pip install 'sid\[eval\]'"):
+    with pytest.raises(MissingDependencyError, match=re.escape(install_hint("eval"))):
         evaluate_tracking(TrackingEvalSettings(sequences=("walking_pairs",), frames=2))
 
 

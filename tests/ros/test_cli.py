@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 
 from sid.cli import main
+from sid.distribution import install_hint
 
 
 def test_without_rclpy_it_says_how_to_install_it(
@@ -16,7 +17,7 @@ def test_without_rclpy_it_says_how_to_install_it(
     monkeypatch.setitem(sys.modules, "rclpy", None)  # import rclpy now raises ImportError
     assert main(["ros", "--source", "synthetic:S4"]) == 2
     err = capsys.readouterr().err
-    assert "rclpy" in err and "pip install 'sid[ros]'" in err and "docs/ros2.md" in err
+    assert "rclpy" in err and install_hint("ros") in err and "docs/ros2.md" in err
 
 
 def test_share_prints_the_folder_of_the_launch_and_yaml_files(capsys: pytest.CaptureFixture[str]) -> None:
@@ -26,13 +27,13 @@ def test_share_prints_the_folder_of_the_launch_and_yaml_files(capsys: pytest.Cap
 
 
 def test_camera_topics_need_a_pose_model(capsys: pytest.CaptureFixture[str]) -> None:
-    pytest.importorskip("rclpy", reason="rclpy is not installed (pip install 'sid[ros]' or source ROS 2)")
+    pytest.importorskip("rclpy", reason="rclpy is not installed (pip install 'sid-social[ros]' or source ROS 2)")
     assert main(["ros"]) == 2
     assert "--model FILE.onnx" in capsys.readouterr().err
 
 
 def test_bad_parameter_is_reported(capsys: pytest.CaptureFixture[str]) -> None:
-    pytest.importorskip("rclpy", reason="rclpy is not installed (pip install 'sid[ros]' or source ROS 2)")
+    pytest.importorskip("rclpy", reason="rclpy is not installed (pip install 'sid-social[ros]' or source ROS 2)")
     code = main(["ros", "--source", "synthetic:S4", "--ros-args", "-p", "pose_source:=gps"])
     assert code == 2
     assert "pose_source must be one of auto, tf, odom, none, got 'gps'" in capsys.readouterr().err

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-pytest.importorskip("rclpy", reason="rclpy is not installed (pip install 'sid[ros]' or source ROS 2)")
+pytest.importorskip("rclpy", reason="rclpy is not installed (pip install 'sid-social[ros]' or source ROS 2)")
 
 from costmap.grid import Costmap2D, GridSpec  # noqa: E402
 from sid.ros import messages  # noqa: E402

@@ -30,7 +30,7 @@ from sid.synthetic.pose import TruthPose
 from sid.synthetic.sensor import D435I_COLOR
 from tests.conftest import REPO_ROOT
 
-rclpy = pytest.importorskip("rclpy", reason="rclpy is not installed (pip install 'sid[ros]' or source ROS 2)")
+rclpy = pytest.importorskip("rclpy", reason="rclpy is not installed (pip install 'sid-social[ros]' or source ROS 2)")
 from nav_msgs.msg import OccupancyGrid, Odometry  # noqa: E402
 from rclpy.executors import SingleThreadedExecutor  # noqa: E402
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy  # noqa: E402

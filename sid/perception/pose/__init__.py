@@ -62,7 +62,7 @@ def load_pose_estimator(
     differ from the originals, so tune it per model file). input_size: only for models with dynamic height and
     width (MultiPose: long side in px, (h, w) or "paper"; SinglePose: side; YOLO: side or (h, w)).
     iou_threshold: YOLO NMS overlap (default 0.7). providers: ``"auto"`` (default: TensorRT, CUDA, OpenVINO when
-    this onnxruntime offers them, then CPU), ``"cpu"``, ``"openvino"`` (needs ``pip install 'sid[openvino]'``) or
+    this onnxruntime offers them, then CPU), ``"cpu"``, ``"openvino"`` (needs ``pip install 'sid-social[openvino]'``) or
     a list of onnxruntime provider names; ``estimator.model.providers`` says what the session uses.
 
     Raises PoseModelError (missing file, not ONNX, unsupported signature; the message lists the contracts and

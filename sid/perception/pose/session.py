@@ -14,9 +14,9 @@ Choices (see docs/models.md):
   one-off cost is paid once at load time.
 - Providers (``providers="auto"``): TensorRT, then CUDA, when this onnxruntime build offers them (the
   ``onnxruntime-gpu`` package on a Jetson or desktop GPU), then OpenVINO (the ``onnxruntime-openvino`` package,
-  ``pip install 'sid[openvino]'``; it gives the CPU provider's keypoints, usually in less ``session.run`` time, but
-  on a heavily loaded machine a whole ``sid detect`` ran slower with it: docs/parameters.md, "Pose sessions"), else
-  CPU.
+  ``pip install 'sid-social[openvino]'``; it gives the CPU provider's keypoints, usually in less ``session.run``
+  time, but on a heavily loaded machine a whole ``sid detect`` ran slower with it: docs/parameters.md, "Pose
+  sessions"), else CPU.
   ``"cpu"`` and ``"openvino"`` ask for one; asking for OpenVINO where it is not installed is an error. An explicit
   list of onnxruntime provider names is passed through as it is.
 - Session log level = errors only; converter warnings about deprecated attributes are noise to a user. Those
@@ -33,6 +33,7 @@ import numpy as np
 import onnxruntime as ort
 
 from sid.cpu import physical_cores, usable_cpus
+from sid.distribution import install_hint
 from sid.documents import special_file
 from sid.perception.pose.contracts import ModelSignature, PoseModelError, supported_contracts_text
 
@@ -64,7 +65,7 @@ PROVIDER_CHOICES: tuple[str, ...] = ("auto", "cpu", "openvino")
 SPINNING_KEYS: tuple[str, ...] = ("session.intra_op.allow_spinning", "session.inter_op.allow_spinning")
 OPENVINO_MISSING = (
     "pose: the openvino provider is not available in this onnxruntime (available: {available}). Install it with "
-    "`pip install 'sid[openvino]'` (the onnxruntime-openvino package; it replaces the files of the plain "
+    f"`{install_hint('openvino')}` (the onnxruntime-openvino package; it replaces the files of the plain "
     "onnxruntime package, so install it in its own environment or uninstall onnxruntime first), or use "
     "--provider auto or cpu"
 )

@@ -3,12 +3,15 @@ provider gives the CPU provider's keypoints (run only where onnxruntime-openvino
 
 from __future__ import annotations
 
+import re
+
 import cv2
 import numpy as np
 import onnxruntime as ort
 import pytest
 
 from sid.cpu import physical_cores
+from sid.distribution import install_hint
 from sid.perception.pose import load_pose_estimator
 from sid.perception.pose.session import (
     CPU_PROVIDER,
@@ -24,7 +27,7 @@ from tests.pose_models import build_multipose_model
 HAS_OPENVINO = OPENVINO_PROVIDER in ort.get_available_providers()
 needs_openvino = pytest.mark.skipif(
     not HAS_OPENVINO,
-    reason="onnxruntime-openvino is not installed (pip install 'sid[openvino]' in its own environment)",
+    reason="onnxruntime-openvino is not installed (pip install 'sid-social[openvino]' in its own environment)",
 )
 
 
@@ -85,7 +88,7 @@ def test_unknown_provider_is_refused_before_loading(tmp_path):
 
 @pytest.mark.skipif(HAS_OPENVINO, reason="the openvino provider is installed here")
 def test_missing_openvino_says_how_to_install_it(tmp_path):
-    with pytest.raises(ValueError, match=r"openvino provider is not available.*pip install 'sid\[openvino\]'"):
+    with pytest.raises(ValueError, match="openvino provider is not available.*" + re.escape(install_hint("openvino"))):
         load_pose_estimator(build_multipose_model(tmp_path / "m.onnx"), providers="openvino")
 
 
