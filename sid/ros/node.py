@@ -7,8 +7,11 @@ the publications: the mask on ``costmap_topic`` (reliable, transient local, dept
 as JSON on ``groups_topic`` (plus REP-155's ``/humans/groups/tracked`` when hri_msgs is importable).
 
 Frames come from the camera topics (colour, aligned depth, camera_info; paired by stamp) or, with ``source``, from
-any sid source read in a thread. A frame that fails (bad image, no pose yet, out of time order) is logged and
-skipped; the node keeps running. Per-stage timing is logged at debug level.
+any sid source read in a thread. With ``pose_source`` auto, a frame that carries its own robot pose (a recording
+with odometry, a synthetic sequence) uses it; else the TF or odometry pose; while neither has arrived, the robot is
+taken as fixed at ``global_frame``'s origin (one warning says how to set ``pose_source``). A frame that fails (bad
+image, no pose yet with pose_source tf or odom, out of time order) is logged and skipped; the node keeps running.
+Per-stage timing is logged at debug level.
 """
 
 from __future__ import annotations
@@ -75,8 +78,10 @@ class SocialCostmapNode:
             )
         values = {name: _typed(self.node.get_parameter(name).value, default) for name, default, _ in PARAMETERS}
         self.params = p = NodeParams(**{f.name: values[ros_name(f.name)] for f in fields(NodeParams)})
-        costmap = CostmapParams(plugins=COSTMAP_LAYERS)
-        self.stream = SocialStream(Pipeline(pose, p.mount, group=False), p.grid, costmap)
+        self.pose = pose
+        self.stream = self._new_stream()
+        self.fixed_robot = False
+        """Whether frames are placed with the robot fixed at the origin (pose_source auto, no pose arrived yet)."""
         self.frames = 0
         self.costmap_pub = self.node.create_publisher(OccupancyGrid, p.costmap_topic, LATCHED)
         self.markers_pub = self.node.create_publisher(MarkerArray, p.markers_topic, 10)
@@ -119,6 +124,10 @@ class SocialCostmapNode:
             f"{p.grid.resolution} m); robot pose from {self.pose_source}; filter info: "
             f"{'on ' + p.filter_info_topic if info_type else 'off (nav2_msgs not importable)'}"
         )
+
+    def _new_stream(self) -> SocialStream:
+        costmap = CostmapParams(plugins=COSTMAP_LAYERS)
+        return SocialStream(Pipeline(self.pose, self.params.mount, group=False), self.params.grid, costmap)
 
     def _pose_source(self) -> str:
         chosen = self.params.pose_source
@@ -163,9 +172,9 @@ class SocialCostmapNode:
             return
         self.on_frame(frame, color.item.header.stamp)
 
-    def robot_pose(self, stamp: Any | None) -> RobotPose | None:
+    def robot_pose(self, stamp: Any | None, wait: bool = True) -> RobotPose | None:
         """base_frame's pose in global_frame at ``stamp`` (a builtin_interfaces/Time; None: the latest), or None
-        when it is not known yet."""
+        when it is not known yet. ``wait``: wait up to ``transform_timeout`` for the transform (pose source tf)."""
         if self.pose_source == "none":
             return RobotPose(0.0, 0.0, 0.0)
         if self.pose_source == "odom":
@@ -184,10 +193,11 @@ class SocialCostmapNode:
                 self.params.global_frame,
                 self.params.base_frame,
                 when,
-                timeout=Duration(seconds=self.params.transform_timeout),
+                timeout=Duration(seconds=self.params.transform_timeout if wait else 0.0),
             )
         except tf2_ros.TransformException as exc:
-            self.node.get_logger().warning(f"no transform: {exc}", throttle_duration_sec=5.0)
+            if wait:
+                self.node.get_logger().warning(f"no transform: {exc}", throttle_duration_sec=5.0)
             return None
         q = t.transform.rotation
         return RobotPose(t.transform.translation.x, t.transform.translation.y, yaw_from_quaternion(q.x, q.y, q.z, q.w))
@@ -196,7 +206,7 @@ class SocialCostmapNode:
         """The per-frame work: pose, stream update, publications. ``stamp``: the images' header stamp (None: now,
         for frames read from a source). A failing frame is logged and skipped."""
         try:
-            pose = self.robot_pose(stamp)
+            pose = self.frame_pose(frame, stamp)
             if pose is None:
                 self.node.get_logger().warning(
                     f"frame {frame.index}: skipped, no robot pose yet ({self.pose_source})", throttle_duration_sec=5.0
@@ -211,6 +221,28 @@ class SocialCostmapNode:
         self.node.get_logger().debug(
             f"frame {frame.index}: {len(update.people)} people, {len(update.groups)} groups; ms: {timing}"
         )
+
+    def frame_pose(self, frame: Frame, stamp: Any | None) -> RobotPose | None:
+        """The robot pose ``frame`` is placed with (see the module docstring), or None: skip it."""
+        if self.params.pose_source != "auto":
+            return self.robot_pose(stamp)
+        if frame.robot_pose is not None:
+            return frame.robot_pose
+        pose = self.robot_pose(stamp, wait=not self.fixed_robot)
+        log = self.node.get_logger()
+        if pose is None and not self.fixed_robot:
+            self.fixed_robot = True
+            source = f"odometry on {self.params.odom_topic}" if self.pose_source == "odom" else "a TF transform"
+            log.warning(
+                f"frame {frame.index}: no robot pose ({source}, pose_source auto) and none in the frames: the robot "
+                f"is taken as fixed at the origin of {self.params.global_frame} until one arrives. Set pose_source: "
+                "-p pose_source:=none for a fixed camera, odom or tf to wait for the robot's pose"
+            )
+        elif pose is not None and self.fixed_robot:
+            self.fixed_robot = False
+            log.info(f"frame {frame.index}: robot pose from {self.pose_source} from now on; tracking starts afresh")
+            self.stream = self._new_stream()
+        return pose if pose is not None else RobotPose(0.0, 0.0, 0.0)
 
     def publish(self, update: StreamUpdate, stamp: Any) -> None:
         """The mask, the markers and the groups of one update, stamped ``stamp``."""

@@ -87,7 +87,8 @@ DESCRIPTIONS: dict[str, str] = {
     "camera_y": "camera optical centre left of base_frame's origin (m)",
     "camera_yaw": "heading of the camera's optical axis from base_frame's x axis (rad, counter-clockwise)",
     "pose_source": "robot pose from 'tf' (tf2_ros), 'odom' (odom_topic), 'none' (robot fixed at the global "
-    "frame's origin) or 'auto' (tf when tf2_ros is importable, else odom)",
+    "frame's origin) or 'auto' (a source frame's own pose; else tf when tf2_ros is importable, else odom; until one "
+    "arrives, the robot fixed at the origin, with a warning)",
     "odom_topic": "nav_msgs/Odometry topic giving base_frame's pose in global_frame (pose_source odom)",
     "global_frame": "frame of the published costmap and markers (Nav2's global_frame)",
     "base_frame": "the robot's ground frame below the camera (REP-105 base_footprint)",

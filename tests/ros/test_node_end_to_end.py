@@ -1,6 +1,7 @@
 """``sid ros`` end to end over real ROS 2 topics: the node runs in its own process (``python -m sid ros``), this
 test publishes a synthetic realsense2_camera (colour, aligned depth, camera_info) and odometry, and subscribes to
-what the node publishes: the KeepoutFilter mask, the markers and the groups.
+what the node publishes: the KeepoutFilter mask, the markers and the groups. A second test runs
+``sid ros --source synthetic:S4`` with every parameter at its default: no pose arrives, the robot is fixed.
 
 The scene is layout S4 (four people in a conversation, 1.9 m ahead of the camera), rendered once at 640x360 with
 exact depth. The pose model is a crafted YOLO-pose ONNX model that answers the scene's true keypoints (the scene
@@ -200,3 +201,53 @@ def test_node_publishes_the_group_zone_for_nav2(tmp_path: Path, monkeypatch: pyt
     latencies = [received - (g.header.stamp.sec + g.header.stamp.nanosec * 1e-9) for received, g in grids[-WANTED:]]
     median_ms = 1000 * float(np.median(latencies))
     print(f"\nsid ros: image publish -> costmap received, median {median_ms:.1f} ms over {len(latencies)} frames")
+
+
+@pytest.mark.slow
+def test_a_source_without_a_robot_pose_publishes_with_default_parameters(tmp_path: Path) -> None:
+    domain = 100 + (os.getpid() + 50) % 100
+    env = os.environ | {"ROS_DOMAIN_ID": str(domain), "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
+    log_path = tmp_path / "node.log"
+    with log_path.open("w") as node_log:
+        node_process = subprocess.Popen(
+            [sys.executable, "-m", "sid", "ros", "--source", "synthetic:S4"],
+            cwd=REPO_ROOT,
+            env=env,
+            stdout=node_log,
+            stderr=subprocess.STDOUT,
+        )
+        context = rclpy.Context()
+        rclpy.init(context=context, domain_id=domain)
+        test_node = rclpy.create_node("sid_test_listener", context=context)
+        executor = SingleThreadedExecutor(context=context)
+        executor.add_node(test_node)
+        grids: list[OccupancyGrid] = []
+        groups: list[dict] = []
+        latched = QoSProfile(
+            depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
+        )
+        test_node.create_subscription(OccupancyGrid, "/social_costmap", grids.append, latched)
+        test_node.create_subscription(String, "/social_groups", lambda m: groups.append(json.loads(m.data)), 10)
+        try:
+            deadline = time.monotonic() + 180  # a hang bound, not a speed check
+            while time.monotonic() < deadline and node_process.poll() is None:
+                executor.spin_once(timeout_sec=0.05)
+                if sum(1 for g in groups if g["groups"]) >= 5 and grids:
+                    break
+        finally:
+            node_process.terminate()
+            node_process.wait(timeout=30)
+            executor.shutdown()
+            test_node.destroy_node()
+            rclpy.shutdown(context=context)
+    log = log_path.read_text()
+    assert sum(1 for g in groups if g["groups"]) >= 5 and grids, f"no group published; node log:\n{log[-3000:]}"
+    # One warning, saying how to choose: the robot is fixed at the map's origin, the camera looking along +x.
+    assert log.count("pose_source:=none") == 1 and "skipped, no robot pose" not in log, log[-3000:]
+    last = groups[-1]
+    assert last["frame_id"] == "map" and len(last["groups"][0]["members"]) == 4
+    assert np.linalg.norm(np.array(last["groups"][0]["interest_point"]) - [FORMATION_DISTANCE, 0.0]) < 0.15
+    grid = grids[-1]
+    costs = filter_mask_cost(np.array(grid.data, dtype=np.int8).reshape(grid.info.height, grid.info.width))
+    row, col = int((0.0 + 10.0) / 0.05), int((FORMATION_DISTANCE + 10.0) / 0.05)
+    assert costs[row, col] >= 230 and costs[200, 200] == 0  # the group zone; the robot's own cell free
