@@ -14,7 +14,7 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from planner.problem import CostField, PlanningError
+from planner.problem import CostField, NoPathError, PlanningError
 
 __all__ = ["grid_graph", "grid_search"]
 
@@ -57,7 +57,7 @@ def grid_search(field: CostField) -> np.ndarray:
         raise PlanningError("start or goal is not in a plannable cell (check_endpoints should have caught this)")
     dist, previous = dijkstra(graph.tocsr(), directed=False, indices=s, return_predecessors=True)
     if not np.isfinite(dist[g]):
-        raise PlanningError("no collision-free path: the goal is not reachable from the start on this costmap")
+        raise NoPathError("no path: the goal is not reachable from the start on this costmap")
     chain = [g]
     while chain[-1] != s:
         chain.append(previous[chain[-1]])

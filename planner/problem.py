@@ -41,6 +41,7 @@ __all__ = [
     "PlanningError",
     "PlanningProblem",
     "SAMPLES_PER_CALL",
+    "NoPathError",
 ]
 
 _LOOP_MAX = 20  # segment_cost sums this many samples or fewer in a Python loop, more with numpy (docs/parameters.md)
@@ -60,6 +61,11 @@ a larger w only overflows the cost sums (1e308 did)."""
 class PlanningError(SidError, ValueError):
     """A problem that cannot be planned (start or goal outside the map or in collision, no free path); the message
     names the reason."""
+
+
+class NoPathError(PlanningError):
+    """A well-formed task without a solution: the start or goal in collision, or the two walled off from each other;
+    the message starts with "no path: "."""
 
 
 @dataclass(frozen=True)

@@ -12,8 +12,10 @@ import sys
 import warnings
 from typing import TextIO
 
+from sid import __version__
 from sid.checks import limits
 from sid.cli.common import (
+    ExitCode,
     StandardOutputError,
     guarded_standard_output,
     report_standard_output,
@@ -22,7 +24,13 @@ from sid.cli.common import (
 from sid.cpu import keep_freed_memory
 from sid.documents import InputWarning
 
-__all__ = ["COMMANDS", "build_parser", "main"]
+__all__ = [
+    "COMMANDS",
+    "build_parser",
+    "main",
+    "DESCRIPTION",
+    "EXIT_CODES",
+]
 
 # Each module provides ``add_parser(subparsers)``; the parser it adds sets ``func(args) -> int``.
 COMMANDS: tuple[str, ...] = (
@@ -42,10 +50,31 @@ COMMANDS: tuple[str, ...] = (
 )
 
 
+DESCRIPTION = (
+    "sid: social interaction detection for robot navigation. See conversational groups with one RGB-D camera, build "
+    "a social costmap and plan around them. 'sid COMMAND --help' describes each command."
+)
+EXIT_CODES = (
+    "exit codes: "
+    + ", ".join(
+        f"{code.value} {text}"
+        for code, text in (
+            (ExitCode.OK, "done"),
+            (ExitCode.FAILURE, "the run failed (e.g. a file could not be written)"),
+            (ExitCode.USAGE, "bad command line or input"),
+            (ExitCode.NO_PATH, "no path / goal not reached (plan, demo, simulate, reproduce navigation)"),
+            (ExitCode.MISSING_DEPENDENCY, "an optional package is missing (the message says how to install it)"),
+        )
+    )
+    + "; 130 / 143 interrupted by Ctrl-C / SIGTERM."
+)
+
+
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     """The parser of every subcommand, or of ``command`` alone: each subcommand's module imports what it runs
     (onnxruntime, OMPL, the costmap, ...), so ``sid detect`` does not pay for the planners' imports at start-up."""
-    parser = argparse.ArgumentParser(prog="sid", description=__doc__.split("\n")[0].strip('"` '))
+    parser = argparse.ArgumentParser(prog="sid", description=DESCRIPTION, epilog=EXIT_CODES)
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name in COMMANDS if command is None else (command,):
         importlib.import_module(f"sid.cli.{name}").add_parser(subparsers)
@@ -71,7 +100,7 @@ def main(argv: list[str] | None = None) -> int:
         limits()  # a malformed $SID_LIMITS is said once, before any work
     except ValueError as exc:
         print(f"{command}: {exc}", file=sys.stderr)
-        return 2
+        return ExitCode.USAGE
     default_show = warnings.showwarning
 
     def show(

@@ -9,7 +9,15 @@ import sys
 from dataclasses import asdict
 from pathlib import Path
 
-from sid.cli.common import check_output_folder, fail, positive_int, staged_output
+from sid.cli.common import (
+    ExitCode,
+    add_output_option,
+    check_output_folder,
+    fail,
+    plain_text,
+    positive_int,
+    staged_output,
+)
 from sid.experiments.bench import (
     FULL,
     QUICK,
@@ -60,11 +68,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "bench",
         help="time grouping, alignment, lifting, pose models, the per-frame pipeline, costmap and planners",
-        description=__doc__.replace("``", ""),
+        description=plain_text(__doc__),
     )
-    parser.add_argument(
-        "--out", default="out/bench", help="output folder for bench.json and bench.md (default %(default)s)"
-    )
+    add_output_option(parser, "bench", "bench.json and bench.md")
     parser.add_argument(
         "--quick", action="store_true", help="few repeats (~0.15 s per stage, 1 planner seed): a smoke run"
     )
@@ -150,5 +156,5 @@ def run(args: argparse.Namespace) -> int:
     print(f"wrote {json_path} and {md_path}", file=sys.stderr)
     if result.failures:
         print(f"sid bench: {len(result.failures)} benchmark(s) failed: {', '.join(result.failures)}", file=sys.stderr)
-        return 1
+        return ExitCode.FAILURE
     return 0

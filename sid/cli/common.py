@@ -19,9 +19,11 @@ import threading
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
+from enum import IntEnum
 from pathlib import Path
 from typing import IO, Any, TextIO, cast
 
+from sid.distribution import MissingDependencyError
 from sid.documents import TEMPORARY_PREFIX, special_file, unique_keys
 from sid.errors import SidError
 
@@ -52,7 +54,40 @@ __all__ = [
     "signals_as_interrupts",
     "signals_deferred",
     "staged_output",
+    "ExitCode",
+    "exit_code",
+    "add_output_option",
+    "plain_text",
 ]
+
+
+class ExitCode(IntEnum):
+    """What a ``sid`` command's exit status means (README, "Exit codes"); 128 + N after signal N (130 Ctrl-C, 143
+    SIGTERM)."""
+
+    OK = 0
+    FAILURE = 1
+    """The run failed: a file could not be written, a source stopped, a benchmark failed."""
+    USAGE = 2
+    """Bad command line or bad input (a file, a line, a value); the message names the problem."""
+    NO_PATH = 3
+    """The robot's task was not done: no path (an impossible task, or none found in the budget), or in ``sid
+    simulate`` the goal not reached (run.json's ``reason`` says why)."""
+    MISSING_DEPENDENCY = 4
+    """An optional package the command needs is not installed; the message gives the install command."""
+
+
+def exit_code(error: Exception) -> ExitCode:
+    """The exit code of a command stopped by ``error``: writing failed (OSError), no path (planner.problem's
+    NoPathError), a missing optional dependency, else bad input."""
+    if isinstance(error, MissingDependencyError):
+        return ExitCode.MISSING_DEPENDENCY
+    problem = sys.modules.get("planner.problem")  # not imported here: commands that do not plan never load it
+    if problem is not None and isinstance(error, problem.NoPathError):
+        return ExitCode.NO_PATH
+    if isinstance(error, OSError):
+        return ExitCode.FAILURE
+    return ExitCode.USAGE
 
 
 class OutputFolderError(SidError, ValueError):
@@ -89,6 +124,21 @@ def check_output_folder(path: str | Path, option: str = "--out") -> Path:
     return folder
 
 
+def add_output_option(parser: argparse.ArgumentParser, command: str, what: str) -> None:
+    """``--out DIR``, by default ``./sid-COMMAND`` (every command that writes files has one), for ``what``."""
+    parser.add_argument(
+        "--out",
+        default=f"sid-{command}",
+        metavar="DIR",
+        help=f"output folder for {what}, created if missing (default: ./%(default)s)",
+    )
+
+
+def plain_text(doc: str) -> str:
+    """A docstring as ``--help`` text: without the backquotes of its literals (reStructuredText or Markdown)."""
+    return doc.replace("`", "")
+
+
 def positive_int(text: str) -> int:
     """argparse type: a whole number >= 1."""
     try:
@@ -101,9 +151,9 @@ def positive_int(text: str) -> int:
 
 
 def fail(command: str, error: Exception) -> int:
-    """Print ``command: error`` on stderr; the exit code of bad input (2)."""
+    """Print ``command: error`` on stderr; its ``exit_code``."""
     print(f"{command}: {error}", file=sys.stderr)
-    return 2
+    return exit_code(error)
 
 
 LineHandler = Callable[[Any], dict[str, Any]]
@@ -172,8 +222,8 @@ def process_json_lines(
 ) -> int:
     """Write ``handle(value)`` on ``out`` as one JSON line, flushed, for each non-blank line of ``lines``
     (``read_json_lines``). A line that cannot be read, or that ``handle`` refuses (ValueError), is reported on ``err``
-    as ``COMMAND: line N: problem`` and skipped, or, with ``strict``, ends the run: exit code 1. Returns the exit
-    code."""
+    as ``COMMAND: line N: problem`` and skipped, or, with ``strict``, ends the run: exit code 2 (bad input). Returns
+    the exit code."""
     skipped = 0
     for number, value, problem in read_json_lines(lines):
         if problem is None:
@@ -184,7 +234,7 @@ def process_json_lines(
         if problem is not None:
             print(f"{command}: line {number}: {problem}", file=err, flush=True)
             if strict:
-                return 1
+                return ExitCode.USAGE
             skipped += 1
             continue
         out.write(json.dumps(record) + "\n")

@@ -8,7 +8,7 @@ import sys
 
 from planner.facade import PLANNERS
 from planner.problem import DEFAULT_COST_WEIGHT
-from sid.cli.common import check_output_folder, fail, print_written, staged_output
+from sid.cli.common import add_output_option, check_output_folder, fail, plain_text, print_written, staged_output
 from sid.cli.planning import INPUT_ERRORS
 from sid.experiments.compare import BY_SCENARIO, format_summary, write_comparison
 from sid.experiments.harness import prepare, run_matrix, summarise
@@ -22,16 +22,20 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "compare",
         help="compare the planners on scenarios, with and without the social layer (table and chart)",
-        description=__doc__.replace("``", ""),
+        description=plain_text(__doc__),
     )
     parser.add_argument("scenarios", nargs="+", metavar="SCENARIO", help="scenario files (.json or .yaml)")
     parser.add_argument("--planners", nargs="+", default=list(PLANNERS), help=f"default: {' '.join(PLANNERS)}")
-    parser.add_argument("--runs", type=int, default=3, metavar="K", help="seeds 1..K per planner (default 3)")
-    parser.add_argument("--time", type=float, default=0.5, metavar="S", help="time budget per run in s (0.5)")
+    parser.add_argument(
+        "--runs", type=int, default=3, metavar="K", help="seeds 1..K per planner (default: %(default)s)"
+    )
+    parser.add_argument(
+        "--time", type=float, default=0.5, metavar="S", help="time budget per run in s (default: %(default)s)"
+    )
     parser.add_argument(
         "--cost-weight", type=float, default=DEFAULT_COST_WEIGHT, metavar="W", help="w of the cost (see sid plan)"
     )
-    parser.add_argument("--out", default="sid-compare", help="output folder for summary.json and planners.png")
+    add_output_option(parser, "compare", "summary.json and planners.png")
     parser.set_defaults(func=run)
 
 

@@ -1,4 +1,4 @@
-"""``sid costmap SCENARIO --out DIR``: build a scenario's layered costmap and export it for navigation stacks."""
+"""``sid costmap SCENARIO [--out DIR]``: build a scenario's layered costmap and export it for navigation stacks."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import argparse
 
 from costmap.export import export_costmap
 from costmap.mapfile import MapFileError
-from sid.cli.common import OutputFolderError, check_output_folder, fail, print_written, staged_output
+from sid.cli.common import OutputFolderError, check_output_folder, fail, plain_text, print_written, staged_output
 from sid.cli.planning import add_scenario_arguments
 from sid.scenario.build import build_costmap
 from sid.scenario.loader import ScenarioError, load_scenario
@@ -19,9 +19,14 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "costmap",
         help="build a scenario's costmap and write map_server YAML/PGM, .npz, .mcap and a picture",
-        description=__doc__.replace("``", ""),
+        description=plain_text(__doc__),
     )
-    add_scenario_arguments(parser, "leave out the social layer (the 'without recognition' baseline)")
+    add_scenario_arguments(
+        parser,
+        "costmap",
+        "costmap.yaml + .pgm, .npz, .mcap and .png",
+        "leave out the social layer (the 'without recognition' baseline)",
+    )
     parser.set_defaults(func=run)
 
 

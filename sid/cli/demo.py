@@ -5,7 +5,15 @@ from __future__ import annotations
 
 import argparse
 
-from sid.cli.common import check_output_folder, fail, print_written, staged_output
+from sid.cli.common import (
+    ExitCode,
+    add_output_option,
+    check_output_folder,
+    fail,
+    plain_text,
+    print_written,
+    staged_output,
+)
 from sid.cli.planning import INPUT_ERRORS, add_planner_option, add_planning_options, warn_goal_zone
 from sid.experiments.demo import DEMO_ITERATIONS, DEMO_SEED, run_demo
 from sid.experiments.plan_pictures import format_table
@@ -18,13 +26,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "demo",
         help="the main result: plan past a conversation without and with group recognition (no input needed)",
-        description=__doc__.replace("``", ""),
+        description=plain_text(__doc__),
     )
-    parser.add_argument("--out", default="sid-demo", help="output folder (default ./sid-demo)")
+    add_output_option(parser, "demo", "comparison.png, metrics.json and scenario.json")
     parser.add_argument("--scenario", default=None, help="a scenario file to use instead of the built-in one")
     add_planner_option(parser)
-    add_planning_options(parser, time_default=5.0)
-    parser.set_defaults(func=run, seed=DEMO_SEED, iterations=DEMO_ITERATIONS)
+    add_planning_options(parser, time_default=5.0, seed=DEMO_SEED, iterations=DEMO_ITERATIONS)
+    parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -50,4 +58,4 @@ def run(args: argparse.Namespace) -> int:
     print()
     names = ("comparison.png", "metrics.json") + (() if args.scenario else ("scenario.json",))
     print_written(staged.folder / name for name in names)
-    return 0 if all(run.result.success for run in comparison.runs.values()) else 1
+    return ExitCode.OK if all(run.result.success for run in comparison.runs.values()) else ExitCode.NO_PATH

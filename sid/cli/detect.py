@@ -18,6 +18,7 @@ import numpy as np
 from costmap.grid import Costmap2D, GridSpec
 from sid.ahead import run_ahead
 from sid.cli.common import (
+    ExitCode,
     OutputFolderError,
     add_bag_topic_options,
     check_output_folder,
@@ -27,7 +28,7 @@ from sid.cli.common import (
     positive_int,
     signals_deferred,
 )
-from sid.distribution import install_hint
+from sid.distribution import MissingDependencyError, install_hint
 from sid.documents import write_atomically
 from sid.perception.camera import Calibration
 from sid.perception.frame import Frame
@@ -313,9 +314,11 @@ def run(args: argparse.Namespace) -> int:
         pipeline = Pipeline(_pose(args), mount, lift, GroupParams(method=args.group_method))
         options = _source_options(args)
         source = open_source(args.source, **options)
+    except MissingDependencyError as exc:  # --provider openvino without it
+        return fail("sid detect", exc)
     except (SourceError, PoseModelError, ValueError, OSError) as exc:
         print(f"detect: {exc}", file=sys.stderr)
-        return 2
+        return ExitCode.USAGE
 
     held = contextlib.ExitStack()  # --out's lock, held until the run ends
     try:
@@ -382,7 +385,7 @@ def run(args: argparse.Namespace) -> int:
         return fail("sid detect", exc)
     except SourceError as exc:
         print(f"detect: source stopped: {exc}", file=sys.stderr)
-        return 1
+        return ExitCode.FAILURE
     finally:
         if out is not None:
             out.close()

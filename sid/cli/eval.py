@@ -10,8 +10,10 @@ import math
 import sys
 from pathlib import Path
 
+from sid.cli.common import fail
 from sid.cli.eval_crowd import add_crowd_parser
 from sid.cli.grouping import add_group_params, group_params_from
+from sid.distribution import MissingDependencyError
 from sid.experiments.fformation import (
     DEFAULT_GRID,
     DEFAULT_THRESHOLDS,
@@ -262,7 +264,7 @@ def add_tracking_parser(tasks: argparse._SubParsersAction) -> None:
 
 def run_tracking(args: argparse.Namespace) -> int:
     from sid.experiments.progress import ProgressBar
-    from sid.experiments.tracking import MissingDependencyError, TrackingEvalSettings, evaluate_tracking
+    from sid.experiments.tracking import TrackingEvalSettings, evaluate_tracking
 
     try:
         settings = TrackingEvalSettings(
@@ -271,8 +273,7 @@ def run_tracking(args: argparse.Namespace) -> int:
         )  # fmt: skip
         result = evaluate_tracking(settings, ProgressBar("tracking"))
     except (ValueError, MissingDependencyError) as exc:
-        print(f"sid eval tracking: {exc}", file=sys.stderr)
-        return 2
+        return fail("sid eval tracking", exc)
     print(_tracking_table(result) if args.table else json.dumps(result, indent=2))
     return 0
 

@@ -14,6 +14,8 @@ import math
 import sys
 from typing import Any
 
+from sid.cli.common import fail, plain_text
+from sid.distribution import MissingDependencyError
 from sid.experiments.crowd import DEFAULT_GRID, CrowdSettings, cross_validate, evaluate_crowd
 from sid.experiments.trajectories import ReplaySettings, TrajectoryError, TrajectorySet, load_trajectory_set
 from sid.tracking.view import ViewCone
@@ -30,7 +32,8 @@ def add_crowd_parser(tasks: argparse._SubParsersAction) -> None:
     parser = tasks.add_parser(
         "crowd",
         help="people and walking-group tracking on real pedestrian trajectories (MOTA, IDF1, G-MITRE, group F1)",
-        description=(__doc__ or "").split("\n\n", 1)[1].strip() + " Takes a few seconds per set; progress on stderr.",
+        description=plain_text((__doc__ or "").split("\n\n", 1)[1].strip())
+        + " Takes a few seconds per set; progress on stderr.",
     )
     parser.add_argument("folders", nargs="+", metavar="DIR", help="trajectory sets (obsmat.txt + groups.txt each)")
     parser.add_argument(
@@ -66,7 +69,6 @@ def add_crowd_parser(tasks: argparse._SubParsersAction) -> None:
 
 def run_crowd(args: argparse.Namespace) -> int:
     from sid.experiments.progress import ProgressBar
-    from sid.experiments.tracking import MissingDependencyError
 
     try:
         view = None
@@ -81,8 +83,7 @@ def run_crowd(args: argparse.Namespace) -> int:
         else:
             result = evaluate_crowd(sets, settings, ProgressBar("crowd"))
     except (ValueError, MissingDependencyError) as exc:  # TrajectoryError and bad settings are ValueErrors
-        print(f"sid eval crowd: {exc}", file=sys.stderr)
-        return 2
+        return fail("sid eval crowd", exc)
     except OSError as exc:
         print(f"sid eval crowd: cannot read {exc.filename}: {exc.strerror}", file=sys.stderr)
         return 2

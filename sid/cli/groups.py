@@ -7,7 +7,7 @@ Output, one line per good input line, flushed as it is written:
     {"frame": 0, "groups": [{"members": [1, 2], "interest_point": [x, y], "area": a, "spread": d,
                              "zone": [[x, y], ...]}]}
 A malformed line (one that is not UTF-8 JSON, gives a key twice or has a field not named above) is reported on
-stderr with its line number and skipped, or ends the run with --strict (exit 1); everything written before it stays
+stderr with its line number and skipped, or ends the run with --strict (exit 2); everything written before it stays
 written.
 """
 
@@ -18,7 +18,7 @@ from collections.abc import Iterable
 from typing import Any, TextIO
 
 from sid.checks import check_limit
-from sid.cli.common import fail, process_json_lines, refuse_unknown_fields, run_json_lines
+from sid.cli.common import fail, plain_text, process_json_lines, refuse_unknown_fields, run_json_lines
 from sid.cli.grouping import add_group_params, group_params_from
 from sid.documents import is_number, summary
 from sid.perception.group import Group
@@ -35,11 +35,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "groups",
         help="detect conversational groups in JSON-lines frames of people",
-        description=__doc__.split("\n\n", 1)[1].split("\n\n")[0] if __doc__ else None,
+        description=plain_text(__doc__.split("\n\n", 1)[1].split("\n\n")[0]) if __doc__ else None,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("file", metavar="FILE", help="JSON-lines input, or - for stdin")
-    parser.add_argument("--strict", action="store_true", help="stop at the first malformed line (exit 1)")
+    parser.add_argument("--strict", action="store_true", help="stop at the first malformed line (exit 2)")
     add_group_params(parser)
     parser.set_defaults(func=run)
 
@@ -53,7 +53,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def process(lines: Iterable[str | bytes], out: TextIO, err: TextIO, params: GroupParams, strict: bool = False) -> int:
-    """Detect groups frame by frame; returns the exit code (1 when --strict stopped at a bad line).
+    """Detect groups frame by frame; returns the exit code (2 when --strict stopped at a bad line).
 
     ``lines`` are text, or bytes decoded here line by line as UTF-8 (a byte-order mark before the first is dropped).
     """

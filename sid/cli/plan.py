@@ -1,11 +1,11 @@
-"""``sid plan SCENARIO --out DIR``: plan the scenario's robot task on its costmap; write path.json and plan.png."""
+"""``sid plan SCENARIO [--out DIR]``: plan the scenario's robot task on its costmap; write path.json and plan.png."""
 
 from __future__ import annotations
 
 import argparse
 
 from planner.facade import resolve_planner
-from sid.cli.common import check_output_folder, fail, print_written, staged_output
+from sid.cli.common import ExitCode, check_output_folder, fail, plain_text, print_written, staged_output
 from sid.cli.planning import (
     INPUT_ERRORS,
     add_planner_option,
@@ -23,9 +23,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "plan",
         help="plan a scenario's robot task on its costmap (OMPL or grid planner); write path.json and plan.png",
-        description=__doc__.replace("``", ""),
+        description=plain_text(__doc__),
     )
-    add_scenario_arguments(parser, "plan without the social layer (the 'without recognition' robot)")
+    add_scenario_arguments(
+        parser, "plan", "path.json and plan.png", "plan without the social layer (the 'without recognition' robot)"
+    )
     add_planner_option(parser)
     add_planning_options(parser, time_default=0.5)
     parser.set_defaults(func=run)
@@ -68,4 +70,4 @@ def run(args: argparse.Namespace) -> int:
     if r.seed is not None and r.iterations > 0:  # no iteration ran within --time: nothing to repeat
         print(f"repeat exactly: --seed {r.seed} --iterations {r.iterations} --time {max(10.0, 4 * args.time):g}")
     print_written(files.values())
-    return 0 if r.success else 1
+    return ExitCode.OK if r.success else ExitCode.NO_PATH

@@ -9,6 +9,7 @@ import sys
 from costmap.mapfile import MapFileError
 from planner.facade import DEFAULT_PLANNER, DEFAULT_SOFT_LIMIT_S, MAX_SEED, PLANNERS
 from planner.problem import DEFAULT_COST_WEIGHT, PlanningError
+from sid.cli.common import add_output_option
 from sid.experiments.harness import Comparison, goal_zone_warning
 from sid.scenario.loader import ScenarioError
 
@@ -22,20 +23,21 @@ __all__ = [
 ]
 
 INPUT_ERRORS = (ScenarioError, MapFileError, PlanningError, ValueError)
-"""What a command that loads a scenario and plans on it reports as bad input (exit code 2), not as a crash."""
+"""What a command that loads a scenario and plans on it reports as bad input (exit code 2; NoPathError, a task without
+a solution: 3), not as a crash."""
 
 
-def add_scenario_arguments(parser: argparse.ArgumentParser, no_social_help: str) -> None:
-    """The scenario file, the output folder and ``--no-social`` (``sid costmap``, ``sid plan``)."""
+def add_scenario_arguments(parser: argparse.ArgumentParser, command: str, writes: str, no_social_help: str) -> None:
+    """The scenario file, the output folder (for ``writes``) and ``--no-social`` (``sid costmap``, ``sid plan``)."""
     parser.add_argument("scenario", help="scenario file (.json or .yaml); see docs/scenario.md")
-    parser.add_argument("--out", required=True, help="output folder (created if missing)")
+    add_output_option(parser, command, writes)
     parser.add_argument("--no-social", action="store_true", help=no_social_help)
 
 
-def add_planner_option(parser: argparse.ArgumentParser) -> None:
-    """``--planner NAME`` (``sid plan``, ``sid demo``)."""
+def add_planner_option(parser: argparse.ArgumentParser, default: str = DEFAULT_PLANNER) -> None:
+    """``--planner NAME`` (``sid plan``, ``sid demo``, ``sid simulate``)."""
     parser.add_argument(
-        "--planner", default=DEFAULT_PLANNER, help=f"one of {', '.join(PLANNERS)} (default {DEFAULT_PLANNER})"
+        "--planner", default=default, metavar="NAME", help=f"one of {', '.join(PLANNERS)} (default: %(default)s)"
     )
 
 
@@ -50,32 +52,40 @@ def seed_number(text: str) -> int:
     return value
 
 
-def add_planning_options(parser: argparse.ArgumentParser, time_default: float) -> None:
-    """The planner budget options ``sid plan`` and ``sid demo`` share."""
+def add_planning_options(
+    parser: argparse.ArgumentParser, time_default: float, seed: int | None = None, iterations: int | None = None
+) -> None:
+    """The planner budget options ``sid plan`` and ``sid demo`` share, with the command's defaults (None: no seed,
+    from the clock; no cap on iterations)."""
     parser.add_argument(
         "--time",
         type=float,
         default=time_default,
         metavar="S",
-        help=f"planner time budget in seconds ({time_default}); without --iterations BIT* stops earlier once it has a "
-        f"path, when its cost settles or after {DEFAULT_SOFT_LIMIT_S} s",
+        help="planner time budget in seconds (default: %(default)s); without --iterations BIT* stops earlier once it "
+        f"has a path, when its cost settles or after {DEFAULT_SOFT_LIMIT_S} s",
     )
     parser.add_argument(
-        "--seed", type=seed_number, default=None, metavar="N", help=f"random seed for OMPL, 1 to {MAX_SEED}"
+        "--seed",
+        type=seed_number,
+        default=seed,
+        metavar="N",
+        help=f"random seed for OMPL, 1 to {MAX_SEED} (default: {'%(default)s' if seed is not None else 'random'})",
     )
     parser.add_argument(
         "--iterations",
         type=int,
-        default=None,
+        default=iterations,
         metavar="K",
-        help="cap on the planner's iterations; with --seed, a run that stops on the cap repeats exactly",
+        help="cap on the planner's iterations; with --seed, a run that stops on the cap repeats exactly (default: "
+        f"{'%(default)s' if iterations is not None else 'none'})",
     )
     parser.add_argument(
         "--cost-weight",
         type=float,
         default=DEFAULT_COST_WEIGHT,
         metavar="W",
-        help=f"w in cost = integral of (1 + w c/252) ds ({DEFAULT_COST_WEIGHT:g}; 0 = shortest path)",
+        help="w in cost = integral of (1 + w c/252) ds (default: %(default)s; 0 = shortest path)",
     )
 
 

@@ -10,7 +10,15 @@ from dataclasses import dataclass
 
 from planner.facade import PLANNERS
 from planner.problem import DEFAULT_COST_WEIGHT
-from sid.cli.common import check_output_folder, fail, print_written, staged_output
+from sid.cli.common import (
+    ExitCode,
+    add_output_option,
+    check_output_folder,
+    fail,
+    plain_text,
+    print_written,
+    staged_output,
+)
 from sid.experiments.navigation import NAV_LAYOUTS, NavSettings, navigation_tasks, run_navigation
 from sid.experiments.progress import ProgressBar
 from sid.synthetic.layouts import LAYOUTS, VARIATIONS
@@ -49,7 +57,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "reproduce",
         help="reproduce the paper: Table 1 accuracy on synthetic S1-S5, and the navigation with/without study",
-        description=__doc__.replace("``", ""),
+        description=plain_text(__doc__),
     )
     studies = parser.add_subparsers(dest="study", required=True, metavar="STUDY")
     _add_table1(studies)
@@ -59,7 +67,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 def _add_study(studies: argparse._SubParsersAction, name: str, help: str, description: str) -> argparse.ArgumentParser:
     """A study's parser, with the option every study has (``--out``)."""
     parser = studies.add_parser(name, help=help, description=description)
-    parser.add_argument("--out", default="sid-reproduce", help="output folder (default ./sid-reproduce)")
+    add_output_option(parser, "reproduce", f"the {name} report")
     return parser
 
 
@@ -199,4 +207,4 @@ def navigation_command(args: argparse.Namespace) -> int:
         return fail("sid reproduce", exc)
     print(navigation_markdown(result, seeds, _command()))
     print_written(paths.values())
-    return 0 if not result.impossible else 1
+    return ExitCode.OK if not result.impossible else ExitCode.NO_PATH

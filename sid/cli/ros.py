@@ -8,7 +8,7 @@ import sys
 from collections.abc import Iterable
 from pathlib import Path
 
-from sid.cli.common import add_bag_topic_options, positive_int
+from sid.cli.common import ExitCode, add_bag_topic_options, positive_int
 from sid.distribution import install_hint
 from sid.perception.frame import Frame
 from sid.perception.pipeline import PoseFn, image_pose
@@ -75,7 +75,7 @@ def run(args: argparse.Namespace) -> int:
         from sid.ros.node import SocialCostmapNode, spin
     except ImportError as exc:
         print(INSTALL_HINT.format(error=exc), file=sys.stderr)
-        return 2
+        return ExitCode.MISSING_DEPENDENCY
     ros_args = ["--ros-args", *args.ros_args] if args.ros_args is not None else []
     # sid's own handlers turn SIGINT and SIGTERM into KeyboardInterrupt (sid.cli.main); rclpy's would not.
     rclpy.init(args=["sid", *ros_args], signal_handler_options=SignalHandlerOptions.NO)
@@ -95,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
         spin(node, frames, args.rate)
     except (SourceError, PoseModelError, ValueError, OSError) as exc:
         print(f"sid ros: {exc}", file=sys.stderr)
-        return 2
+        return ExitCode.USAGE
     finally:
         if node is not None:
             node.node.destroy_node()

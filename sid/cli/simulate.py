@@ -10,8 +10,17 @@ import sys
 import time
 from pathlib import Path
 
-from sid.cli.common import check_output_folder, fail, print_written, staged_output
+from sid.cli.common import (
+    ExitCode,
+    add_output_option,
+    check_output_folder,
+    fail,
+    plain_text,
+    print_written,
+    staged_output,
+)
 from sid.cli.planning import INPUT_ERRORS, add_planner_option
+from sid.distribution import MissingDependencyError
 from sid.documents import special_file
 from sid.experiments.progress import ProgressBar
 from sid.experiments.simulate.loop import PERCEPTIONS, RunOptions
@@ -52,13 +61,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "simulate",
         help="drive a simulated robot past people with perception in the loop, with or without the social layer",
-        description=__doc__.replace("``", ""),
+        description=plain_text(__doc__),
     )
     parser.add_argument("scene", nargs="?", help=f"a built-in scene ({', '.join(SCENE_ORDER)}) or a scenario file")
-    parser.add_argument("--out", default=None, help="output folder for run.json and run.mp4 (sweeps: the report)")
+    add_output_option(parser, "simulate", "run.json and run.mp4 (sweeps: simulate.md/.json/.png)")
     parser.add_argument("--no-social", action="store_true", help="the robot without recognition (LiDAR + inflation)")
-    add_planner_option(parser)
-    parser.set_defaults(planner="grid")
+    add_planner_option(parser, default=RunOptions.planner)
     parser.add_argument(
         "--seed", type=_seed, default=0, metavar="N",
         help="0: the scene as written (default); N >= 1: people jittered by 5 cm / 5 deg, and the sensor noise, from N",
@@ -116,24 +124,20 @@ def run(args: argparse.Namespace) -> int:
             from sid.perception.pose.session import quiet_load_warnings
 
             quiet_load_warnings()
-        out = None if args.out is None else check_output_folder(args.out)
+        out = check_output_folder(args.out)
         world = load_scene(args.scene)
-        if out is None:
-            record = write_run(world, options, None, gif=args.gif, progress=ProgressBar("simulate"))
-        else:  # whole files only, even when interrupted; an earlier run's files go
-            with staged_output(out, RUN_FILES) as staged:
-                record = write_run(
-                    world, options, staged.path, gif=args.gif, progress=ProgressBar("simulate"), still_s=args.still
-                )
+        with staged_output(out, RUN_FILES) as staged:  # whole files only, even when interrupted; earlier ones go
+            record = write_run(
+                world, options, staged.path, gif=args.gif, progress=ProgressBar("simulate"), still_s=args.still
+            )
     except (*INPUT_ERRORS, OSError) as exc:
         return fail("sid simulate", exc)
     for key in SUMMARY_KEYS:
         value = record[key]
         print(f"{key:22s} {round(value, 3) if isinstance(value, float) else value}")
-    if out is not None:
-        extra = (("run.gif",) if args.gif else ()) + (("run.png",) if args.still is not None else ())
-        print_written(out / name for name in ("run.json", "run.mp4", *extra))
-    return 0 if record["success"] else 1
+    extra = (("run.gif",) if args.gif else ()) + (("run.png",) if args.still is not None else ())
+    print_written(out / name for name in ("run.json", "run.mp4", *extra))
+    return ExitCode.OK if record["success"] else ExitCode.NO_PATH
 
 
 def _sweep(args: argparse.Namespace) -> int:
@@ -144,18 +148,16 @@ def _sweep(args: argparse.Namespace) -> int:
     command = "sid " + " ".join(shlex.quote(a) for a in sys.argv[1:]) if sys.argv[1:] else "sid simulate"
     try:
         options = _options(args)
-        if args.out is not None:
-            check_output_folder(args.out)
+        check_output_folder(args.out)
         jobs = sweep_jobs(scenes, args.seeds, options)
         executor = f"Ray at {args.ray}" if args.ray else f"{args.workers} worker process(es)"
         start = time.perf_counter()
         records = run_sweep(jobs, args.workers, args.ray, ProgressBar("sweep"))
         wall = time.perf_counter() - start
         print(sweep_markdown(records, command, wall, executor))
-        if args.out is not None:
-            with staged_output(args.out, SWEEP_FILES) as staged:
-                written = write_sweep_report(records, staged.path, command, wall, executor).values()
-            print_written(staged.final(path) for path in written)
-    except (*INPUT_ERRORS, OSError) as exc:
+        with staged_output(args.out, SWEEP_FILES) as staged:
+            written = write_sweep_report(records, staged.path, command, wall, executor).values()
+        print_written(staged.final(path) for path in written)
+    except (*INPUT_ERRORS, OSError, MissingDependencyError) as exc:
         return fail("sid simulate", exc)
     return 0

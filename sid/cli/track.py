@@ -13,7 +13,7 @@ Output, one line per good input line, flushed as it is written, the tracks as `s
      "timing_ms": {"track": ms, "track_groups": ms}}
 A malformed line (not UTF-8 JSON, a key given twice, an unknown field, a missing or non-finite number, a timestamp
 not after the last good line's, two people with one id) is reported on stderr with its line number and skipped,
-or ends the run with --strict (exit 1); everything written before it stays written. The people and group trackers
+or ends the run with --strict (exit 2); everything written before it stays written. The people and group trackers
 run with their defaults; the group detector that finds conversations among the tracks takes the options below.
 """
 
@@ -24,7 +24,7 @@ from collections.abc import Iterable
 from typing import Any, TextIO
 
 from sid.checks import check_limit
-from sid.cli.common import fail, process_json_lines, refuse_unknown_fields, run_json_lines
+from sid.cli.common import fail, plain_text, process_json_lines, refuse_unknown_fields, run_json_lines
 from sid.cli.grouping import add_group_params, group_params_from
 from sid.documents import is_number, summary
 from sid.perception.people import Person
@@ -40,11 +40,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "track",
         help="track people and groups over JSON-lines detections",
-        description=__doc__.split("\n\n", 1)[1].split("\n\n")[0] if __doc__ else None,
+        description=plain_text(__doc__.split("\n\n", 1)[1].split("\n\n")[0]) if __doc__ else None,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("file", metavar="FILE", help="JSON-lines input, or - for stdin")
-    parser.add_argument("--strict", action="store_true", help="stop at the first malformed line (exit 1)")
+    parser.add_argument("--strict", action="store_true", help="stop at the first malformed line (exit 2)")
     add_group_params(parser)
     parser.set_defaults(func=run)
 

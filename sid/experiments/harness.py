@@ -71,7 +71,7 @@ class Task:
             try:
                 self._references[mode] = plan(self.problems[mode], "grid")
             except PlanningError as exc:
-                raise PlanningError(f"{self.scenario.name}: {exc}") from exc
+                raise type(exc)(f"{self.scenario.name}: {exc}") from exc
         return self._references[mode].cost
 
 

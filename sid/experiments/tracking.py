@@ -41,8 +41,7 @@ from costmap.grid import GridSpec
 from costmap.layer import LayerInputs
 from costmap.plugins import CostmapParams, layered_costmap
 from sid.checks import check_number
-from sid.distribution import install_hint
-from sid.errors import SidError
+from sid.distribution import MissingDependencyError, install_hint
 from sid.experiments.fformation import LabelledFrame, format_threshold, score
 from sid.perception.frame import Frame
 from sid.perception.keypoints import PoseDetection
@@ -68,10 +67,6 @@ __all__ = [
 
 Progress = Callable[[int, int, str], None]
 """progress(done, total, what) after each frame (``sid.experiments.progress.ProgressBar``)."""
-
-
-class MissingDependencyError(SidError, RuntimeError):
-    """An optional package the evaluation needs is not installed."""
 
 
 @dataclass(frozen=True)

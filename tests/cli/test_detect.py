@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from sid.cli import main
+from sid.cli.common import ExitCode
 from sid.distribution import install_hint
 from sid.perception.frame import Frame
 from sid.perception.pipeline import Pipeline
@@ -250,7 +251,10 @@ def test_missing_openvino_provider_is_explained(tmp_path, capsys):
     from tests.pose_models import build_yolo_pose_model
 
     model = build_yolo_pose_model(tmp_path / "yolo.onnx", np.zeros((56, 10)))
-    assert main(["detect", "--source", "synthetic:S1", "--model", str(model), "--provider", "openvino"]) == 2
+    assert (
+        main(["detect", "--source", "synthetic:S1", "--model", str(model), "--provider", "openvino"])
+        == ExitCode.MISSING_DEPENDENCY
+    )
     err = capsys.readouterr().err
     assert "openvino provider is not available" in err and install_hint("openvino") in err
 

@@ -82,7 +82,7 @@ def test_strict_stops_at_the_first_bad_line_keeping_earlier_output(tmp_path, cap
     source = tmp_path / "frames.jsonl"
     source.write_text(json.dumps(PAIR) + "\n" + '{"people": 3}\n' + json.dumps(PAIR) + "\n")
     code, out, err = run_sid(["groups", "--strict", str(source)], capsys)
-    assert code == 1
+    assert code == 2  # bad input
     assert len(out) == 1 and json.loads(out[0])["frame"] == 0
     assert "line 2: 'people' must be a list" in err
 
@@ -125,7 +125,7 @@ def test_lines_that_are_not_utf8_are_reported_and_skipped(tmp_path, capsys):
     ]
     code, out, err = run_sid(["groups", "--strict", str(source)], capsys)
     assert (
-        code == 1
+        code == 2
         and len(out) == 1
         and err.splitlines() == ["sid groups: line 2: not UTF-8 text (byte 0xe9 at byte 40 of the line)"]
     )
@@ -135,7 +135,7 @@ def test_a_utf16_file_is_named_as_such(tmp_path, capsys):
     source = tmp_path / "frames.jsonl"
     source.write_text(json.dumps(PAIR) + "\n", encoding="utf-16")
     code, out, err = run_sid(["groups", "--strict", str(source)], capsys)
-    assert code == 1 and out == []
+    assert code == 2 and out == []
     assert err == "sid groups: line 1: not UTF-8 text (it starts with a UTF-16 byte-order mark; save it as UTF-8)\n"
 
 

@@ -11,6 +11,7 @@ import pytest
 from costmap.render import OBSTACLE, default_scale, world_to_image
 from planner.metrics import FIXED_KEYS
 from sid.cli import main
+from sid.cli.common import ExitCode
 from sid.experiments.demo import DEMO_SCENARIO
 from sid.scenario.loader import load_scenario
 
@@ -47,7 +48,7 @@ def test_a_plan_stopped_before_its_first_iteration_suggests_no_repeat(tmp_path, 
     out = tmp_path / "out"
     code = main(["plan", write_scenario(tmp_path), "--out", str(out), "--planner", "rrtconnect", "--time", "1e-300"])
     printed = capsys.readouterr().out
-    assert code == 1 and "found no path" in printed and "repeat exactly" not in printed
+    assert code == ExitCode.NO_PATH and "found no path" in printed and "repeat exactly" not in printed
 
 
 def test_plan_without_social_layer_crosses_the_conversation(tmp_path):
@@ -58,17 +59,17 @@ def test_plan_without_social_layer_crosses_the_conversation(tmp_path):
 
 
 @pytest.mark.parametrize(
-    ("robot", "args", "message"),
+    ("robot", "args", "message", "expected"),
     [
-        ({"goal": [5.0, -2.9, 0.0]}, [], "goal (5.00, -2.90) is in collision"),
-        ({}, ["--planner", "prmstar"], "PRM* is not available"),
-        ({}, ["--planner", "dstar"], "unknown planner 'dstar'"),
-        ({}, ["--time", "-1"], "time_limit must be a positive number"),
+        ({"goal": [5.0, -2.9, 0.0]}, [], "no path: goal (5.00, -2.90) is in collision", ExitCode.NO_PATH),
+        ({}, ["--planner", "prmstar"], "PRM* is not available", ExitCode.USAGE),
+        ({}, ["--planner", "dstar"], "unknown planner 'dstar'", ExitCode.USAGE),
+        ({}, ["--time", "-1"], "time_limit must be a positive number", ExitCode.USAGE),
     ],
 )
-def test_plan_refuses_impossible_or_bad_requests(tmp_path, capsys, robot, args, message):
+def test_plan_refuses_impossible_or_bad_requests(tmp_path, capsys, robot, args, message, expected):
     code = main(["plan", write_scenario(tmp_path, **robot), "--out", str(tmp_path / "out"), *args])
-    assert code == 2
+    assert code == expected
     assert message in capsys.readouterr().err
 
 
@@ -91,16 +92,16 @@ def test_plan_says_no_path_for_a_goal_inside_a_box_or_walled_in(tmp_path, capsys
     data["obstacles"].append(obstacle)
     path = tmp_path / "scenario.json"
     path.write_text(json.dumps(data))
-    assert main(["plan", str(path), "--out", str(tmp_path / "out"), "--planner", "grid"]) == 2
+    assert main(["plan", str(path), "--out", str(tmp_path / "out"), "--planner", "grid"]) == ExitCode.NO_PATH
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith(message)
     assert not (tmp_path / "out" / "path.json").exists()
 
 
-def test_plan_that_finds_nothing_exits_1_and_says_so(tmp_path, capsys):
+def test_plan_that_finds_nothing_exits_with_no_path_and_says_so(tmp_path, capsys):
     out = tmp_path / "out"
     args = ["plan", write_scenario(tmp_path), "--out", str(out), "--planner", "rrtstar", "--iterations", "2"]
-    assert main([*args, "--seed", "1"]) == 1
+    assert main([*args, "--seed", "1"]) == ExitCode.NO_PATH
     assert "rrtstar found no path" in capsys.readouterr().out
     record = json.loads((out / "path.json").read_text())
     assert record["success"] is False and record["waypoints"] == [] and record["ospace_intrusion_m"] is None

@@ -157,7 +157,7 @@ def test_strict_stops_at_the_first_bad_line_keeping_earlier_output(tmp_path, cap
     lines, _ = scene(5)
     source = write_lines(tmp_path / "in.jsonl", [*lines[:4], '{"timestamp": 9, "people": [{"x": 0}]}', lines[4]])
     code, out, err = run_sid(["track", "--strict", str(source)], capsys)
-    assert code == 1 and [record["timestamp"] for record in out] == [line["timestamp"] for line in lines[:4]]
+    assert code == 2 and [record["timestamp"] for record in out] == [line["timestamp"] for line in lines[:4]]
     assert len(out[-1]["people"]) == 5
     assert err == ["sid track: line 5: people[0] is missing 'y'"]
 

@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 
 from sid.cli import main
+from sid.cli.common import ExitCode
 from sid.distribution import install_hint
 
 
@@ -15,7 +16,7 @@ def test_without_rclpy_it_says_how_to_install_it(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
     monkeypatch.setitem(sys.modules, "rclpy", None)  # import rclpy now raises ImportError
-    assert main(["ros", "--source", "synthetic:S4"]) == 2
+    assert main(["ros", "--source", "synthetic:S4"]) == ExitCode.MISSING_DEPENDENCY
     err = capsys.readouterr().err
     assert "rclpy" in err and install_hint("ros") in err and "docs/ros2.md" in err
 

@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from sid.cpu import keep_freed_memory
-from sid.distribution import install_hint
+from sid.distribution import MissingDependencyError, install_hint
 from sid.experiments.harness import summarise
 from sid.experiments.simulate.loop import RunOptions
 from sid.experiments.simulate.run import run_record
@@ -102,7 +102,7 @@ def _on_ray(jobs: Sequence[Job], address: str, progress: Progress | None) -> lis
     try:
         import ray
     except ImportError:
-        raise ValueError(f"sweep: running on Ray needs Ray: {install_hint('cluster')}") from None
+        raise MissingDependencyError(f"sweep: running on Ray needs Ray: {install_hint('cluster')}") from None
     root = str(Path(__file__).resolve().parents[3])  # where the sid, costmap and planner packages live
     paths = os.pathsep.join([root, *(p for p in sys.path if p)])
     started = not ray.is_initialized()

@@ -66,8 +66,8 @@ def load_pose_estimator(
     a list of onnxruntime provider names; ``estimator.model.providers`` says what the session uses.
 
     Raises PoseModelError (missing file, not ONNX, unsupported signature; the message lists the contracts and
-    where such models come from) and ValueError for options the model cannot take, a bad thread count, an unknown
-    provider, or ``"openvino"`` when it is not installed.
+    where such models come from), ValueError for options the model cannot take, a bad thread count or an unknown
+    provider, and ``sid.distribution.MissingDependencyError`` for ``"openvino"`` when it is not installed.
     """
     model = OnnxModel(path, threads=threads, providers=providers, spinning=spinning)
     name = detect_contract(model.signature, contract, source=str(model.path))

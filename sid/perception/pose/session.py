@@ -33,7 +33,7 @@ import numpy as np
 import onnxruntime as ort
 
 from sid.cpu import physical_cores, usable_cpus
-from sid.distribution import install_hint
+from sid.distribution import MissingDependencyError, install_hint
 from sid.documents import special_file
 from sid.perception.pose.contracts import ModelSignature, PoseModelError, supported_contracts_text
 
@@ -81,8 +81,8 @@ def resolve_providers(providers: str | Sequence[str] | None = None) -> list[str]
     """The onnxruntime execution providers for a choice: None or ``"auto"`` (``default_providers()``), ``"cpu"``,
     ``"openvino"`` (then CPU for any operator OpenVINO does not take), or an explicit list of provider names.
 
-    Raises ValueError for an unknown choice, an empty list, or ``"openvino"`` when this onnxruntime build does not
-    offer it (the message says how to install it).
+    Raises ValueError for an unknown choice or an empty list, and ``sid.distribution.MissingDependencyError`` for
+    ``"openvino"`` when this onnxruntime build does not offer it (the message says how to install it).
     """
     if providers is None:
         return default_providers()
@@ -95,7 +95,8 @@ def resolve_providers(providers: str | Sequence[str] | None = None) -> list[str]
         if choice == "openvino":
             available = ort.get_available_providers()
             if OPENVINO_PROVIDER not in available:
-                raise ValueError(OPENVINO_MISSING.format(available=", ".join(available)) + _overwritten_hint())
+                missing = OPENVINO_MISSING.format(available=", ".join(available)) + _overwritten_hint()
+                raise MissingDependencyError(missing)
             return [OPENVINO_PROVIDER, CPU_PROVIDER]
         raise ValueError(
             f"pose: unknown provider {providers!r}: expected one of {', '.join(PROVIDER_CHOICES)} "

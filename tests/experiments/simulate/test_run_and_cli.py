@@ -1,12 +1,14 @@
 """``sid simulate``: one run with its files, the scene list, bad input."""
 
 import json
+from pathlib import Path
 
 import imageio_ffmpeg
 import numpy as np
 import pytest
 
 from sid.cli import main
+from sid.cli.common import ExitCode
 from sid.experiments.simulate.video import VideoWriter
 from tests.experiments.simulate.tiny import TINY
 
@@ -23,7 +25,7 @@ def scene(tmp_path):
 
 def test_a_run_writes_run_json_and_a_video(scene, tmp_path, capsys):
     out = tmp_path / "out"
-    assert main(["simulate", scene, "--out", str(out), "--gif"]) == 1  # the time limit ends it before the goal
+    assert main(["simulate", scene, "--out", str(out), "--gif"]) == ExitCode.NO_PATH  # the time limit ends it first
     record = json.loads((out / "run.json").read_text())
     assert set(record) >= RUN_KEYS
     assert record["success"] is False and record["reason"].startswith("time limit (0.5 s)")
@@ -36,11 +38,12 @@ def test_a_run_writes_run_json_and_a_video(scene, tmp_path, capsys):
     assert "ospace_intrusion_m" in printed and f"wrote {out / 'run.mp4'}" in printed
 
 
-def test_without_out_only_the_summary_is_printed(scene, tmp_path, capsys, monkeypatch):
+def test_without_out_the_files_go_to_the_default_folder(scene, tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    assert main(["simulate", scene, "--no-social"]) == 1
-    assert "collisions" in capsys.readouterr().out
-    assert not list(tmp_path.glob("run.*"))
+    assert main(["simulate", scene, "--no-social"]) == ExitCode.NO_PATH
+    printed = capsys.readouterr().out
+    assert "collisions" in printed and f"wrote {Path('sid-simulate') / 'run.json'}" in printed
+    assert sorted(p.name for p in (tmp_path / "sid-simulate").iterdir()) == ["run.json", "run.mp4"]
 
 
 def test_list_and_bad_input(capsys, tmp_path):

@@ -11,7 +11,7 @@ import onnxruntime as ort
 import pytest
 
 from sid.cpu import physical_cores
-from sid.distribution import install_hint
+from sid.distribution import MissingDependencyError, install_hint
 from sid.perception.pose import load_pose_estimator
 from sid.perception.pose.session import (
     CPU_PROVIDER,
@@ -88,7 +88,9 @@ def test_unknown_provider_is_refused_before_loading(tmp_path):
 
 @pytest.mark.skipif(HAS_OPENVINO, reason="the openvino provider is installed here")
 def test_missing_openvino_says_how_to_install_it(tmp_path):
-    with pytest.raises(ValueError, match="openvino provider is not available.*" + re.escape(install_hint("openvino"))):
+    with pytest.raises(
+        MissingDependencyError, match="openvino provider is not available.*" + re.escape(install_hint("openvino"))
+    ):
         load_pose_estimator(build_multipose_model(tmp_path / "m.onnx"), providers="openvino")
 
 
@@ -135,5 +137,7 @@ def test_openvino_overwritten_by_plain_onnxruntime_says_how_to_restore_it(monkey
     import importlib.metadata
 
     monkeypatch.setattr(importlib.metadata, "version", lambda name: "1.24.1")
-    with pytest.raises(ValueError, match="onnxruntime-openvino 1.24.1 is installed, but the plain onnxruntime"):
+    with pytest.raises(
+        MissingDependencyError, match="onnxruntime-openvino 1.24.1 is installed, but the plain onnxruntime"
+    ):
         resolve_providers("openvino")
