@@ -1,6 +1,6 @@
 """Reading the project's JSON / YAML input files (scenarios, scenes) with one rule and one set of errors, the headers
-of image files before their pixels, and writing output files whole (a temporary file in the same folder, then a
-rename)."""
+of image files before their pixels, writing output files whole (a temporary file in the same folder, then a
+rename), and counting nouns in output text."""
 
 from __future__ import annotations
 
@@ -31,6 +31,7 @@ __all__ = [
     "summary",
     "unique_keys",
     "write_atomically",
+    "plural",
 ]
 
 
@@ -239,6 +240,12 @@ def read_image_header(path: str | Path, what: str) -> ImageHeader:
         f"cannot read {what} {path}: not a PNG, JPEG, PGM/PPM, BMP or TIFF image (the formats whose size sid reads "
         "before decoding)"
     )
+
+
+def plural(count: int, singular: str, plural_form: str | None = None) -> str:
+    """``count`` and the noun it takes in messages and reports: ``1 group``, ``2 groups``, ``1 person`` (with
+    ``plural_form="people"``), ``0 people``."""
+    return f"{count} {singular if count == 1 else (plural_form or singular + 's')}"
 
 
 TEMPORARY_PREFIX = ".sid-partial-"

@@ -144,3 +144,18 @@ def test_write_atomically_gives_the_permissions_of_the_users_umask(tmp_path, uma
         os.umask(previous)
     assert stat.S_IMODE((tmp_path / "a.png").stat().st_mode) == 0o666 & ~umask
     assert (tmp_path / "a.png").stat().st_mode == (tmp_path / "b.txt").stat().st_mode
+
+
+def test_plural_counts_one_and_many():
+    from sid.documents import plural
+
+    assert [plural(n, "group") for n in (0, 1, 2)] == ["0 groups", "1 group", "2 groups"]
+    assert plural(1, "person", "people") == "1 person" and plural(3, "person", "people") == "3 people"
+
+
+def test_costmap_says_one_group_not_one_groups(tmp_path, capsys):
+    from sid.cli import main
+    from tests.conftest import REPO_ROOT
+
+    assert main(["costmap", str(REPO_ROOT / "examples" / "conversation.json"), "--out", str(tmp_path)]) == 0
+    assert ", 1 group (social)" in capsys.readouterr().out

@@ -18,6 +18,7 @@ from sid.cli.common import (
     positive_int,
     staged_output,
 )
+from sid.documents import plural
 from sid.experiments.bench import (
     FULL,
     QUICK,
@@ -155,6 +156,7 @@ def run(args: argparse.Namespace) -> int:
     print(markdown(report, comparison), end="")
     print(f"wrote {json_path} and {md_path}", file=sys.stderr)
     if result.failures:
-        print(f"sid bench: {len(result.failures)} benchmark(s) failed: {', '.join(result.failures)}", file=sys.stderr)
+        failed = plural(len(result.failures), "benchmark")
+        print(f"sid bench: {failed} failed: {', '.join(result.failures)}", file=sys.stderr)
         return ExitCode.FAILURE
     return 0

@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import IO, Any, TextIO, cast
 
 from sid.distribution import MissingDependencyError
-from sid.documents import TEMPORARY_PREFIX, special_file, unique_keys
+from sid.documents import TEMPORARY_PREFIX, plural, special_file, unique_keys
 from sid.errors import SidError
 
 __all__ = [
@@ -240,7 +240,7 @@ def process_json_lines(
         out.write(json.dumps(record) + "\n")
         out.flush()
     if skipped:
-        print(f"{command}: skipped {skipped} malformed line(s)", file=err, flush=True)
+        print(f"{command}: skipped {plural(skipped, 'malformed line')}", file=err, flush=True)
     return 0
 
 

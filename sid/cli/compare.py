@@ -10,6 +10,7 @@ from planner.facade import PLANNERS
 from planner.problem import DEFAULT_COST_WEIGHT
 from sid.cli.common import add_output_option, check_output_folder, fail, plain_text, print_written, staged_output
 from sid.cli.planning import INPUT_ERRORS
+from sid.documents import plural
 from sid.experiments.compare import BY_SCENARIO, format_summary, write_comparison
 from sid.experiments.harness import prepare, run_matrix, summarise
 from sid.experiments.progress import ProgressBar
@@ -51,7 +52,7 @@ def run(args: argparse.Namespace) -> int:
         print(file=sys.stderr)  # end the progress bar's line
         return fail("sid compare", exc)
     print(format_summary(summarise([run.record() for run in runs], BY_SCENARIO)))
-    title = f"Planner comparison: {len(tasks)} scenario(s), {args.runs} seeds, {args.time:g} s budget"
+    title = f"Planner comparison: {plural(len(tasks), 'scenario')}, {plural(args.runs, 'seed')}, {args.time:g} s budget"
     try:
         with staged_output(args.out, ()) as staged:
             paths = {key: staged.final(path) for key, path in write_comparison(runs, staged.path, title).items()}

@@ -8,6 +8,7 @@ from costmap.export import export_costmap
 from costmap.mapfile import MapFileError
 from sid.cli.common import OutputFolderError, check_output_folder, fail, plain_text, print_written, staged_output
 from sid.cli.planning import add_scenario_arguments
+from sid.documents import plural
 from sid.scenario.build import build_costmap
 from sid.scenario.loader import ScenarioError, load_scenario
 from sid.scenario.obstacles import outline
@@ -49,7 +50,8 @@ def run(args: argparse.Namespace) -> int:
     counts = {name: int((grid > 0).sum()) for name, grid in layered.grids.items()}
     print(
         f"{scenario.name}: {layered.spec.width}x{layered.spec.height} cells at {layered.spec.resolution} m, "
-        f"{len(layered.inputs.people)} people, {len(layered.inputs.groups)} groups ({kind})"
+        f"{plural(len(layered.inputs.people), 'person', 'people')}, {plural(len(layered.inputs.groups), 'group')} "
+        f"({kind})"
     )
     print("non-zero cells per layer: " + ", ".join(f"{k} {v}" for k, v in counts.items()))
     print_written(paths.values())

@@ -29,7 +29,7 @@ from sid.cli.common import (
     signals_deferred,
 )
 from sid.distribution import MissingDependencyError, install_hint
-from sid.documents import write_atomically
+from sid.documents import plural, write_atomically
 from sid.perception.camera import Calibration
 from sid.perception.frame import Frame
 from sid.perception.group import Group
@@ -232,7 +232,7 @@ class _OutFolder:
         self.folder = folder
         cleared = clear_owned(folder, OUTPUTS)  # an earlier run's files, so none is mistaken for this run's
         if cleared:
-            print(f"detect: removed {len(cleared)} file(s) of an earlier run from {folder}", file=sys.stderr)
+            print(f"detect: removed {plural(len(cleared), 'file')} of an earlier run from {folder}", file=sys.stderr)
         # Unbuffered: a line that fails half-written is cut off below, and no buffer writes it again at close.
         self._lines = os.open(folder / "detections.jsonl", os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
 
@@ -394,5 +394,5 @@ def run(args: argparse.Namespace) -> int:
     seconds = time.perf_counter() - started  # the frames' wall-clock time, start-up (imports, model load) aside
     rate = f" in {seconds:.1f} s ({(done + skipped) / seconds:.1f} frames/s)" if done + skipped else ""
     median = f", median {np.median(totals):.2f} ms per frame" if totals else ""
-    print(f"detect: {done} frames with people, {skipped} skipped{rate}{median}", file=sys.stderr)
+    print(f"detect: {plural(done, 'frame')} with people, {skipped} skipped{rate}{median}", file=sys.stderr)
     return interrupted

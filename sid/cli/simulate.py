@@ -21,7 +21,7 @@ from sid.cli.common import (
 )
 from sid.cli.planning import INPUT_ERRORS, add_planner_option
 from sid.distribution import MissingDependencyError
-from sid.documents import special_file
+from sid.documents import plural, special_file
 from sid.experiments.progress import ProgressBar
 from sid.experiments.simulate.loop import PERCEPTIONS, RunOptions
 from sid.experiments.simulate.scenes import SCENE_ORDER, load_scene, scene_list
@@ -150,7 +150,7 @@ def _sweep(args: argparse.Namespace) -> int:
         options = _options(args)
         check_output_folder(args.out)
         jobs = sweep_jobs(scenes, args.seeds, options)
-        executor = f"Ray at {args.ray}" if args.ray else f"{args.workers} worker process(es)"
+        executor = f"Ray at {args.ray}" if args.ray else plural(args.workers, "worker process", "worker processes")
         start = time.perf_counter()
         records = run_sweep(jobs, args.workers, args.ray, ProgressBar("sweep"))
         wall = time.perf_counter() - start

@@ -11,6 +11,7 @@ from typing import Any
 
 import cv2
 
+from sid.documents import plural
 from sid.experiments.charts import NAVIGATION_PANELS, bar_chart
 from sid.experiments.demo import comparison_picture
 from sid.experiments.harness import summarise
@@ -84,7 +85,8 @@ def navigation_markdown(result: NavigationResult, seeds: int, command: str) -> s
         "",
         f"Command: `{command}`",
         "",
-        f"{result.tasks} tasks ({len({r['layout'] for r in result.runs})} layouts x {seeds} draw(s) x 2 directions; "
+        f"{plural(result.tasks, 'task')} ({plural(len({r['layout'] for r in result.runs}), 'layout')} x "
+        f"{plural(seeds, 'draw')} x 2 directions; "
         "see `sid.experiments.navigation` and docs/reproduction.md), planners: "
         f"{', '.join(settings.planners)}; budget {budget}; cost weight {settings.cost_weight:g}. "
         "Each task is planned on the costmap without the social layer (known map + LiDAR) and on the costmap with "
@@ -219,7 +221,8 @@ def write_navigation_report(result: NavigationResult, out_dir: str | Path, seeds
         NAVIGATION_PANELS,
         paths["png"],
         "Navigation past conversations: without vs with the social layer",
-        f"{result.tasks} tasks (group sizes 2-5, both directions, {seeds} draw(s) per layout), {budget}",
+        f"{plural(result.tasks, 'task')} (group sizes 2-5, both directions, {plural(seeds, 'draw')} per layout), "
+        f"{budget}",
     )
     if result.example is not None:
         paths["example"] = out / "navigation_example.png"
@@ -264,7 +267,8 @@ def table1_markdown(result: Table1Result, command: str) -> str:
         "",
         f"Command: `{command}`",
         "",
-        f"RMSE per scenario over {s.variations} layout variation(s) x {s.frames} frames, seed {s.seed}. "
+        f"RMSE per scenario over {plural(s.variations, 'layout variation')} x {plural(s.frames, 'frame')}, "
+        f"seed {s.seed}. "
         "IZA: interaction-zone area (m^2); IPX/IPY: interest point (m); HPX/HPY: person position (m); HFD: facing "
         "direction (deg). Group errors over the frames where the group was found, person errors over matched "
         "people (HFD: those with a facing); misses are counted in the second table.",

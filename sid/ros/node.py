@@ -34,6 +34,7 @@ from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
 
 from costmap.plugins import CostmapParams
+from sid.documents import plural
 from sid.perception.camera import Intrinsics
 from sid.perception.frame import Frame
 from sid.perception.pipeline import Pipeline, PoseFn
@@ -219,7 +220,8 @@ class SocialCostmapNode:
             return
         timing = ", ".join(f"{k} {v:.1f}" for k, v in update.timing_ms.items())
         self.node.get_logger().debug(
-            f"frame {frame.index}: {len(update.people)} people, {len(update.groups)} groups; ms: {timing}"
+            f"frame {frame.index}: {plural(len(update.people), 'person', 'people')}, "
+            f"{plural(len(update.groups), 'group')}; ms: {timing}"
         )
 
     def frame_pose(self, frame: Frame, stamp: Any | None) -> RobotPose | None:

@@ -275,7 +275,7 @@ def test_summary_counts_every_skipped_frame(tmp_path, capsys):
     assert main(["detect", "--source", str(tmp_path), "--model", str(model), "--no-keypoints"]) == 0
     captured = capsys.readouterr()
     assert len(_lines(captured.out)) == 1
-    assert "1 frames with people, 3 skipped" in captured.err
+    assert "1 frame with people, 3 skipped" in captured.err
 
 
 def test_a_frame_is_skipped_for_depth_only_when_no_pixel_has_any():

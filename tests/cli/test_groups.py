@@ -66,7 +66,7 @@ def test_malformed_lines_are_reported_with_their_number_and_skipped(tmp_path, ca
     assert "line 4: groups: person ids must be unique" in err
     assert "line 5: not valid JSON (NaN is not a number)" in err
     assert "line 6: expected a JSON object" in err
-    assert "skipped 6 malformed line(s)" in err
+    assert "skipped 6 malformed lines" in err
 
 
 def test_a_number_too_large_for_a_float_is_a_malformed_line(capsys, monkeypatch):
@@ -121,7 +121,7 @@ def test_lines_that_are_not_utf8_are_reported_and_skipped(tmp_path, capsys):
     assert err.splitlines() == [
         "sid groups: line 2: not UTF-8 text (byte 0xe9 at byte 40 of the line)",
         "sid groups: line 3: not UTF-8 text (byte 0xff at byte 2 of the line)",
-        "sid groups: skipped 2 malformed line(s)",
+        "sid groups: skipped 2 malformed lines",
     ]
     code, out, err = run_sid(["groups", "--strict", str(source)], capsys)
     assert (

@@ -77,7 +77,7 @@ def test_detect_rerun_clears_the_earlier_runs_pictures(tmp_path, capsys):
         "overlay_000000.png",
         "topview_000000.png",
     ]
-    assert "removed 7 file(s) of an earlier run" in capsys.readouterr().err
+    assert "removed 7 files of an earlier run" in capsys.readouterr().err
 
 
 def test_every_file_detect_writes_has_the_permissions_of_the_users_umask(tmp_path, capsys):

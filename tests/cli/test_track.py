@@ -139,7 +139,7 @@ def test_malformed_lines_are_reported_with_their_number_and_skipped(tmp_path, ca
     code, out, err = run_sid(["track", str(source)], capsys)
     assert code == 0 and [record["timestamp"] for record in out] == [0.0, 0.5]
     expected = [f"sid track: line {number}: {problem}" for number, (_, problem) in enumerate(BAD_LINES, start=2)]
-    assert err == [*expected, f"sid track: skipped {len(BAD_LINES)} malformed line(s)"]
+    assert err == [*expected, f"sid track: skipped {len(BAD_LINES)} malformed lines"]
 
 
 def test_too_many_people_in_a_line_are_refused_by_the_people_limit(tmp_path, capsys, monkeypatch):
@@ -178,7 +178,7 @@ def test_timestamps_out_of_order_are_refused_naming_both(tmp_path, capsys):
         "sid track: line 2: frame is out of time order: its timestamp 0.5 s is not after the last one, 1.0 s",
         "sid track: line 3: frame is out of time order: its timestamp 1.0 s is not after the last one, 1.0 s",
         "sid track: line 4: tracker: person id 1 appears twice in one frame",
-        "sid track: skipped 3 malformed line(s)",
+        "sid track: skipped 3 malformed lines",
     ]
 
 
@@ -213,7 +213,7 @@ def test_stdin_is_read_as_bytes_line_by_line():
     assert len(records[-1]["people"]) == 5
     assert done.stderr.decode().splitlines() == [
         "sid track: line 4: not UTF-8 text (byte 0xff at byte 1 of the line)",
-        "sid track: skipped 1 malformed line(s)",
+        "sid track: skipped 1 malformed line",
     ]
 
 

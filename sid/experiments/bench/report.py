@@ -27,7 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from sid.cpu import physical_cores, usable_cpus
-from sid.documents import is_number, load_document
+from sid.documents import is_number, load_document, plural
 
 __all__ = [
     "FIXED_FIELDS",
@@ -161,7 +161,7 @@ def markdown(report: dict[str, Any], comparison: str | None = None) -> str:
         f"- settings: {'--quick' if s['quick'] else 'full run'}"
         + (f", --only {s['only']}" if s.get("only") else "")
         + f"; per stage {s['warmup']} warm-up calls, then {s['min_runs']}-{s['max_runs']} timed calls within "
-        f"{s['budget_s']} s; {s['plan_runs']} seed(s) per sampling planner",
+        f"{s['budget_s']} s; {plural(s['plan_runs'], 'seed')} per sampling planner",
         "",
         "Times in milliseconds per call: median, minimum and maximum over the timed runs. The paper column is the "
         "paper's Table 2 on a Jetson Orin NX (another machine, GPU pose model); it is shown where a stage does the "
@@ -211,7 +211,7 @@ def format_comparison(old: dict[str, Any], new: dict[str, Any]) -> str:
     only_old = [n for n in old_stages if n not in new_stages]
     only_new = [n for n in new_stages if n not in old_stages]
     if only_old and new.get("settings", {}).get("only"):
-        lines.append(f"{len(only_old)} stage(s) of the old report were not selected by --only")
+        lines.append(f"{plural(len(only_old), 'stage')} of the old report not selected by --only")
     elif only_old:
         lines.append("only in the old report: " + ", ".join(only_old))
     if only_new:

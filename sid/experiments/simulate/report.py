@@ -6,6 +6,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
+from sid.documents import plural
 from sid.experiments.charts import Panel, bar_chart, from_key
 from sid.experiments.reproduce import cell, markdown_table, percent, write_json
 from sid.experiments.simulate.sweep import sweep_summary
@@ -61,9 +62,9 @@ def sweep_markdown(records: Sequence[dict], command: str, wall_time_s: float, ex
         "",
         f"Command: `{command}`",
         "",
-        f"{len(records)} runs ({executor}, wall time {wall_time_s:.0f} s). Each run drives the robot from its start "
-        "with the camera and LiDAR in the loop (`sid.experiments.simulate`); metrics are measured on the driven "
-        "trajectory against the people and groups where they truly were at each step.",
+        f"{plural(len(records), 'run')} ({executor}, wall time {wall_time_s:.0f} s). Each run drives the robot from "
+        "its start with the camera and LiDAR in the loop (`sid.experiments.simulate`); metrics are measured on the "
+        "driven trajectory against the people and groups where they truly were at each step.",
         "",
         "## All scenes",
         "",
@@ -106,6 +107,7 @@ def write_sweep_report(
         SIMULATE_PANELS,
         paths["png"],
         "Closed-loop navigation past conversations: without vs with the social layer",
-        f"{len(records)} runs over {len({r['scene'] for r in records})} scenes, camera and LiDAR in the loop",
+        f"{plural(len(records), 'run')} over {plural(len({r['scene'] for r in records}), 'scene')}, camera and LiDAR "
+        "in the loop",
     )
     return paths

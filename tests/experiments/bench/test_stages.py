@@ -95,7 +95,7 @@ def test_compare_prints_change_per_stage(tmp_path, capsys):
     row = next(line for line in printed.splitlines() if line.startswith("dbscan/4 "))
     new_ms = load_report(out / "bench.json")["stages"]["dbscan/4"]["median_ms"]
     assert f"{new_ms / 1000.0:.2f}" in row and "faster" in row
-    assert "1 stage(s) of the old report were not selected by --only" in printed
+    assert "1 stage of the old report not selected by --only" in printed
     assert "different machines" in printed
     assert "Change against the earlier report" in (out / "bench.md").read_text()
     full_run = load_report(out / "bench.json") | {"settings": {"only": None}}
