@@ -4,7 +4,6 @@ prints a table (median time, success, cost ratio to the grid reference, o-space 
 from __future__ import annotations
 
 import argparse
-import sys
 
 from planner.facade import PLANNERS
 from planner.problem import DEFAULT_COST_WEIGHT
@@ -45,11 +44,12 @@ def run(args: argparse.Namespace) -> int:
         check_output_folder(args.out)  # before the runs, not after them
     except ValueError as exc:
         return fail("sid compare", exc)
+    bar = ProgressBar("compare")
     try:
         tasks = [prepare(load_scenario(path), args.cost_weight) for path in args.scenarios]
-        runs = run_matrix(tasks, args.planners, args.runs, (args.time,), progress=ProgressBar("compare"))
+        runs = run_matrix(tasks, args.planners, args.runs, (args.time,), progress=bar)
     except INPUT_ERRORS as exc:
-        print(file=sys.stderr)  # end the progress bar's line
+        bar.close()
         return fail("sid compare", exc)
     print(format_summary(summarise([run.record() for run in runs], BY_SCENARIO)))
     title = f"Planner comparison: {plural(len(tasks), 'scenario')}, {plural(args.runs, 'seed')}, {args.time:g} s budget"

@@ -21,7 +21,7 @@ def test_the_table_has_a_row_per_set_with_both_group_trackers(tmp_path: Path, ca
     lines = captured.out.splitlines()
     assert lines[0].split()[:5] == ["set", "frames", "MOTA", "IDF1", "IDsw"] and "coherent" in lines[0]
     assert [line.split()[:2] for line in lines[1:]] == [["north", "20"], ["south", "20"]]
-    assert "crowd [" in captured.err  # the progress bar
+    assert "crowd: 20/20 (100 %)" in captured.err  # the progress, line by line off a terminal
 
 
 def test_json_holds_the_settings_and_every_score(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:

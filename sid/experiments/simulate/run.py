@@ -25,7 +25,7 @@ from sid.experiments.simulate.world import SimWorld
 __all__ = ["StepProgress", "options_record", "run_record", "write_run"]
 
 StepProgress = Callable[[int, int, str], None]
-"""progress(step, steps at the time limit, what)."""
+"""progress(step, steps at the time limit, what); at the end progress(steps run, steps run, reason)."""
 
 
 def options_record(options: RunOptions) -> dict:
@@ -67,9 +67,12 @@ def write_run(
     mode = "with" if options.social else "without"
     label = f"{world.scenario.name}, {mode} the social layer, seed {options.seed}"
 
+    last = 0  # the last step run
+
     def observe(view: StepView) -> None:
+        nonlocal last
         driven.append((view.robot.x, view.robot.y))
-        step = int(round(view.t * settings.rate_hz))
+        step = last = int(round(view.t * settings.rate_hz))
         if progress is not None:
             progress(step, total, f"t = {view.t:4.1f} s")
         if writer is not None:
@@ -84,8 +87,8 @@ def write_run(
     finally:
         if writer is not None:
             writer.close()
-    if progress is not None:
-        progress(total, total, record["reason"])
+    if progress is not None:  # the run's own end: the goal may be reached before the time limit
+        progress(last, last, record["reason"])
     if out_dir is not None:
         write_json(out_dir / "run.json", record)
         if still and not cv2.imwrite(str(out_dir / "run.png"), still[1]):

@@ -5,14 +5,15 @@ obstacles' outlines, the LiDAR hits, the people and groups the robot perceives, 
 planned path (purple), the driven path (navy), the robot's disc and heading (navy), the goal, the true people as
 grey rings, a legend of all of it, the time in the title, and the camera's colour image in a column on the right.
 
-``VideoWriter`` writes MP4 (H.264 through imageio-ffmpeg's bundled ffmpeg) and, on request, a GIF (Pillow) of every
-``gif_every``-th frame at full size.
+``VideoWriter`` writes MP4 (MPEG-4 Part 2, OpenCV's ``mp4v``: the FFmpeg inside opencv-python has no H.264 encoder;
+VLC, QuickTime and the Windows players show it, web browsers do not) and, on request, a GIF (Pillow) of every
+``gif_every``-th frame at full size, for web pages.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Generator
+from collections.abc import Callable
 from pathlib import Path
 from types import TracebackType
 
@@ -50,6 +51,7 @@ __all__ = [
     "TRUE_PERSON",
     "VideoWriter",
     "frame_picture",
+    "MP4_CODEC",
 ]
 
 ROBOT = (90, 40, 0)  # BGR: navy, the robot and its driven path
@@ -162,13 +164,17 @@ def frame_picture(view: StepView, world: SimWorld, driven: np.ndarray, title: st
     return np.hstack([img, strip])
 
 
+MP4_CODEC = "mp4v"
+"""OpenCV's four-character code of the MP4 video codec (MPEG-4 Part 2)."""
+
+
 class VideoWriter:
-    """Frames (BGR, all the same size) to ``mp4`` (imageio-ffmpeg) and optionally ``gif`` (Pillow); a context
-    manager that finishes both files on exit."""
+    """Frames (BGR, all the same size) to ``mp4`` (OpenCV) and optionally ``gif`` (Pillow); a context manager that
+    finishes both files on exit. OSError when OpenCV cannot write the MP4 file."""
 
     def __init__(self, mp4: Path | None, fps: float, gif: Path | None = None, gif_every: int = 2) -> None:
         self.mp4, self.gif, self.fps, self.gif_every = mp4, gif, float(fps), max(1, int(gif_every))
-        self._writer: Generator[None, np.ndarray | None, None] | None = None
+        self._writer: cv2.VideoWriter | None = None
         self._size = (0, 0)
         self._gif_frames: list[np.ndarray] = []
         self._count = 0
@@ -177,28 +183,24 @@ class VideoWriter:
         return self
 
     def add(self, bgr: np.ndarray) -> None:
-        rgb = np.ascontiguousarray(cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB))
         if self.mp4 is not None:
             if self._writer is None:
-                import imageio_ffmpeg
-
-                # H.264 in yuv420p needs even sizes: pad by one pixel where needed.
-                self._size = (rgb.shape[1] + rgb.shape[1] % 2, rgb.shape[0] + rgb.shape[0] % 2)
-                writer = imageio_ffmpeg.write_frames(
-                    str(self.mp4), self._size, fps=self.fps, macro_block_size=1, quality=7
-                )
-                writer.send(None)
-                self._writer = writer
+                # 4:2:0 video needs even sizes: pad by one pixel where needed.
+                self._size = (bgr.shape[1] + bgr.shape[1] % 2, bgr.shape[0] + bgr.shape[0] % 2)
+                self._writer = cv2.VideoWriter(str(self.mp4), cv2.VideoWriter.fourcc(*MP4_CODEC), self.fps, self._size)
+                if not self._writer.isOpened():
+                    self._writer = None
+                    raise OSError(f"cannot write {self.mp4}: OpenCV found no {MP4_CODEC} video encoder")
             padded = np.full((self._size[1], self._size[0], 3), 255, dtype=np.uint8)
-            padded[: rgb.shape[0], : rgb.shape[1]] = rgb
-            self._writer.send(padded)
+            padded[: bgr.shape[0], : bgr.shape[1]] = bgr
+            self._writer.write(padded)
         if self.gif is not None and self._count % self.gif_every == 0:
-            self._gif_frames.append(rgb)  # full size: its text is as legible as the video's
+            self._gif_frames.append(cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB))  # full size: as legible as the video
         self._count += 1
 
     def close(self) -> None:
         if self._writer is not None:
-            self._writer.close()
+            self._writer.release()
             self._writer = None
         if self.gif is not None and self._gif_frames:
             from PIL import Image
