@@ -52,6 +52,7 @@ def load_pose_estimator(
     iou_threshold: float | None = None,
     providers: str | Sequence[str] | None = None,
     spinning: bool = False,
+    load_warnings: bool = False,
 ) -> MoveNetMultiPose | MoveNetSinglePose | YoloPose:
     """Open a pose model and wrap it in the estimator its contract needs.
 
@@ -64,12 +65,14 @@ def load_pose_estimator(
     iou_threshold: YOLO NMS overlap (default 0.7). providers: ``"auto"`` (default: TensorRT, CUDA, OpenVINO when
     this onnxruntime offers them, then CPU), ``"cpu"``, ``"openvino"`` (needs ``pip install 'sid-social[openvino]'``) or
     a list of onnxruntime provider names; ``estimator.model.providers`` says what the session uses.
+    load_warnings: let onnxruntime print the warnings of loading the model (e.g. deprecated attributes some
+    exporters write; kept out by default).
 
     Raises PoseModelError (missing file, not ONNX, unsupported signature; the message lists the contracts and
     where such models come from), ValueError for options the model cannot take, a bad thread count or an unknown
     provider, and ``sid.distribution.MissingDependencyError`` for ``"openvino"`` when it is not installed.
     """
-    model = OnnxModel(path, threads=threads, providers=providers, spinning=spinning)
+    model = OnnxModel(path, threads=threads, providers=providers, spinning=spinning, load_warnings=load_warnings)
     name = detect_contract(model.signature, contract, source=str(model.path))
     if iou_threshold is not None and name != YOLO_POSE:
         raise ValueError(f"pose: iou_threshold applies to yolo_pose models only, this one is {name}")

@@ -20,13 +20,15 @@ Choices (see docs/models.md):
   ``"cpu"`` and ``"openvino"`` ask for one; asking for OpenVINO where it is not installed is an error. An explicit
   list of onnxruntime provider names is passed through as it is.
 - Session log level = errors only; converter warnings about deprecated attributes are noise to a user. Those
-  printed while the model loads go through onnxruntime's process-wide logger instead: the ``sid`` commands that
-  load a model call ``quiet_load_warnings()`` first (process-wide, so an entry point's choice, not this module's).
+  printed while the model loads go through onnxruntime's process-wide logger instead: it is held at errors only
+  while the session is created and set back to warnings, its default, afterwards (``load_warnings=True`` leaves it
+  alone, so they show). The ``sid`` commands call ``quiet_load_warnings()``: errors only for the whole process.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -108,11 +110,33 @@ def resolve_providers(providers: str | Sequence[str] | None = None) -> list[str]
     return names
 
 
+ORT_WARNING, ORT_ERROR = 2, 3
+"""onnxruntime's log severities: warnings (its process-wide logger's default) and errors."""
+_process_quiet = False
+"""Whether ``quiet_load_warnings`` made the process-wide logger report errors only."""
+
+
 def quiet_load_warnings() -> None:
     """Make onnxruntime's process-wide logger report errors only: the warnings it prints while a model loads
     (YOLO11n-pose's exporter sets an attribute deprecated since opset 13, two lines per session) tell an operator
     nothing. Process-wide, like ``sid.cpu.keep_freed_memory``: call it from an entry point, never from library code."""
-    ort.set_default_logger_severity(3)
+    global _process_quiet
+    _process_quiet = True
+    ort.set_default_logger_severity(ORT_ERROR)
+
+
+@contextmanager
+def _quiet_while_loading(load_warnings: bool) -> Iterator[None]:
+    """onnxruntime's process-wide logger at errors only inside, then back at warnings (see the module docstring);
+    nothing changes with ``load_warnings`` or after ``quiet_load_warnings``."""
+    if load_warnings or _process_quiet:
+        yield
+        return
+    ort.set_default_logger_severity(ORT_ERROR)
+    try:
+        yield
+    finally:
+        ort.set_default_logger_severity(ORT_WARNING)
 
 
 THREADS_PER_CPU = 4
@@ -162,6 +186,7 @@ class OnnxModel:
         threads: int | None = None,
         providers: str | Sequence[str] | None = None,
         spinning: bool = False,
+        load_warnings: bool = False,
     ):
         self.path = Path(path)
         self.threads = check_threads(threads) or physical_cores()
@@ -176,9 +201,13 @@ class OnnxModel:
         self.options = session_options(self.threads, spinning)
         self.provider_options = {name: _provider_options(name, self.threads) for name in chosen}
         try:
-            self.session = ort.InferenceSession(
-                str(self.path), self.options, providers=chosen, provider_options=list(self.provider_options.values())
-            )
+            with _quiet_while_loading(load_warnings):
+                self.session = ort.InferenceSession(
+                    str(self.path),
+                    self.options,
+                    providers=chosen,
+                    provider_options=list(self.provider_options.values()),
+                )
         except Exception as exc:  # onnxruntime raises several unrelated types for unreadable models
             raise PoseModelError(
                 f"{self.path} is not an ONNX model onnxruntime can load ({type(exc).__name__}: {str(exc)[:300]}). "
@@ -186,8 +215,10 @@ class OnnxModel:
             ) from exc
         asked_openvino = isinstance(providers, str) and providers.strip().lower() == "openvino"
         if asked_openvino and self.provider != OPENVINO_PROVIDER:  # onnxruntime fell back to CPU silently
-            raise ValueError(f"pose: the openvino provider failed to start on {self.path}; onnxruntime fell back to "
-                             f"{self.provider} (its log above says why); use --provider cpu")  # fmt: skip
+            raise ValueError(
+                f"pose: the openvino provider failed to start on {self.path}; onnxruntime fell back to "
+                f"{self.provider}; use --provider cpu (load_warnings=True shows onnxruntime's reason)"
+            )
         self.signature = ModelSignature.from_session(self.session)
         self._input_name = self.session.get_inputs()[0].name if self.signature.inputs else ""
         self._output_name = self.session.get_outputs()[0].name if self.signature.outputs else ""

@@ -21,7 +21,7 @@ from sid.perception.pose.session import (
     resolve_providers,
     session_options,
 )
-from tests.conftest import shared_path
+from tests.conftest import REPO_ROOT, shared_path
 from tests.pose_models import build_multipose_model
 
 HAS_OPENVINO = OPENVINO_PROVIDER in ort.get_available_providers()
@@ -141,3 +141,48 @@ def test_openvino_overwritten_by_plain_onnxruntime_says_how_to_restore_it(monkey
         MissingDependencyError, match="onnxruntime-openvino 1.24.1 is installed, but the plain onnxruntime"
     ):
         resolve_providers("openvino")
+
+
+LOAD_PROBE = """
+import sys
+from sid.perception.pose.session import OnnxModel
+OnnxModel(sys.argv[1])  # the default: quiet
+print("--", file=sys.stderr)
+OnnxModel(sys.argv[1], load_warnings=True)  # asked for: onnxruntime's process-wide logger is back at warnings
+"""
+
+
+def test_onnxruntime_load_warnings_show_only_when_asked_for(tmp_path):
+    """A Resize with an attribute deprecated since opset 13 (as YOLO11n-pose's exporter writes it): onnxruntime's
+    process-wide logger warns while the session is created; each load runs in this subprocess, with a clean logger."""
+    import subprocess
+    import sys
+
+    onnx = pytest.importorskip("onnx", reason="onnx builds the test model (the test extra)")
+    from onnx import TensorProto, helper
+
+    node = helper.make_node(
+        "Resize", ["x", "roi", "scales"], ["y"], mode="nearest", coordinate_transformation_mode="tf_half_pixel_for_nn"
+    )
+    graph = helper.make_graph(
+        [node],
+        "resize",
+        [helper.make_tensor_value_info("x", TensorProto.FLOAT, [1, 1, 4, 4])],
+        [helper.make_tensor_value_info("y", TensorProto.FLOAT, None)],
+        initializer=[
+            helper.make_tensor("roi", TensorProto.FLOAT, [0], []),
+            helper.make_tensor("scales", TensorProto.FLOAT, [4], [1, 1, 2, 2]),
+        ],
+    )
+    path = tmp_path / "resize.onnx"
+    onnx.save(helper.make_model(graph, opset_imports=[helper.make_opsetid("", 13)]), path)
+    done = subprocess.run(
+        [sys.executable, "-c", LOAD_PROBE, str(path)],
+        cwd=REPO_ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=True,
+    )
+    quiet, asked = done.stderr.split("--\n")
+    assert "onnxruntime" not in quiet and "tf_half_pixel_for_nn" in asked, done.stderr
