@@ -11,6 +11,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from sid.cli.common import add_bag_topic_options, fail, positive_int
+from sid.distribution import MissingDependencyError
 from sid.perception.frame import Frame
 from sid.perception.pose.contracts import PoseModelError
 from sid.perception.pose.quantize import FLOAT_LAYERS
@@ -155,7 +156,7 @@ def _comparison(reference: Path, candidate: Path, frames: list[tuple[str, Frame]
     return format_comparisons(rows, criteria), not any(row.problems(criteria) for row in rows)
 
 
-INPUT_ERRORS = (PoseModelError, SourceError, ValueError, OSError)
+INPUT_ERRORS = (PoseModelError, SourceError, ValueError, OSError, MissingDependencyError)
 
 
 def run_quantize(args: argparse.Namespace) -> int:

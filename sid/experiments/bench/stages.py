@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from sid.distribution import install_hint
 from sid.experiments.bench.baseline import BaselineGroup, baseline_groups
 from sid.experiments.bench.pose import timed_call
 from sid.experiments.bench.runner import RunSettings, Stats, measure, measure_parts
@@ -1007,7 +1008,7 @@ def benchmarks(ctx: Context) -> list[Benchmark]:
     ]
     items += [Benchmark(f"pose/{p.stem}", f"pose model {p.name}", _bench_pose(p)) for p in models]
     if models and importlib.util.find_spec("onnx") is None:
-        ctx.note("INT8 pose benchmarks skipped: quantizing needs the onnx package (pip install 'sid[quantize]')")
+        ctx.note(f"INT8 pose benchmarks skipped: quantizing needs the onnx package ({install_hint('quantize')})")
     elif models:
         items += [
             Benchmark(

@@ -18,7 +18,7 @@ loads wherever the float model does) whose convolutions and matrix products run 
 Calibration tensors are made by the model's own estimator (``preprocess`` of ``sid.perception.pose``: letterbox,
 padding value, dtype, layout), from whole RGB images, exactly as ``sid detect`` feeds the model.
 
-Needs the ``onnx`` package (``pip install 'sid[quantize]'``); onnxruntime's quantization tools import it.
+Needs the ``onnx`` package (``pip install 'sid-social[quantize]'``); onnxruntime's quantization tools import it.
 """
 
 from __future__ import annotations
@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from sid.distribution import MissingDependencyError, install_hint
 from sid.perception.pose.contracts import PoseModelError
 
 if TYPE_CHECKING:
@@ -54,7 +55,7 @@ WEIGHTED_OPS = ("Conv", "ConvTranspose", "MatMul", "Gemm")
 FLOAT_LAYERS = 4
 """``quantize_model``'s default: the last 4 weighted layers on every path to the outputs stay float, with the decoding
 after them (docs/models.md has the measurements that chose it)."""
-ONNX_MISSING = "sid model: quantizing needs the onnx package: pip install 'sid[quantize]' (or pip install onnx)"
+ONNX_MISSING = f"sid model: quantizing needs the onnx package: {install_hint('quantize')} (or pip install onnx)"
 
 
 @dataclass(frozen=True)
@@ -76,7 +77,7 @@ def _onnx() -> Any:
     try:
         import onnx
     except ImportError:
-        raise PoseModelError(ONNX_MISSING) from None
+        raise MissingDependencyError(ONNX_MISSING) from None
     return onnx
 
 

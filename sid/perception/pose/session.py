@@ -53,6 +53,8 @@ __all__ = [
     "quiet_load_warnings",
     "resolve_providers",
     "session_options",
+    "ORT_WARNING",
+    "ORT_ERROR",
 ]
 
 CPU_PROVIDER = "CPUExecutionProvider"
