@@ -83,3 +83,8 @@ def test_the_printed_hints_give_the_install_command(monkeypatch: pytest.MonkeyPa
     monkeypatch.setitem(sys.modules, "ray", None)  # import ray now raises ImportError
     with pytest.raises(MissingDependencyError, match=re.escape(install_hint("cluster"))):
         _on_ray([], "local", None)
+    from sid.perception.pose.quantize import quantize_model
+
+    monkeypatch.setitem(sys.modules, "onnx", None)
+    with pytest.raises(MissingDependencyError, match=re.escape(install_hint("quantize"))):
+        quantize_model("model.onnx", "int8.onnx", [])

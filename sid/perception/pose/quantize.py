@@ -207,9 +207,11 @@ def quantize_model(
     model's own pre-processing. max_images: use at most this many. per_channel: weights get one scale per output
     channel (else one per tensor). float_layers: leave ``decoding_nodes`` with that many layers float (0: none).
 
-    Raises PoseModelError (source missing or not a pose model, onnx not installed, nothing to quantize, the written
-    model not loading with the same contract), ValueError (no calibration image, output = source).
+    Raises PoseModelError (source missing or not a pose model, nothing to quantize, the written model not loading
+    with the same contract), ValueError (no calibration image, output = source), MissingDependencyError (onnx not
+    installed).
     """
+    onnx = _onnx()  # before onnxruntime.quantization, which imports onnx itself
     from onnxruntime.quantization import CalibrationMethod, QuantFormat, QuantType, quantize_static
     from onnxruntime.quantization.shape_inference import quant_pre_process
 
@@ -224,7 +226,6 @@ def quantize_model(
     tensors = [estimator.preprocess(image)[0] for image in _first(images, max_images)]
     if not tensors:
         raise ValueError("sid model: no calibration image: the calibration source gave no frames")
-    onnx = _onnx()
     model = onnx.load(str(source))
     removed = simplify_graph(model)
     weighted = sum(node.op_type in WEIGHTED_OPS for node in model.graph.node)
