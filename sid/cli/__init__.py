@@ -64,6 +64,7 @@ EXIT_CODES = (
             (ExitCode.USAGE, "bad command line or input"),
             (ExitCode.NO_PATH, "no path / goal not reached (plan, demo, simulate, reproduce navigation)"),
             (ExitCode.MISSING_DEPENDENCY, "an optional package is missing (the message says how to install it)"),
+            (ExitCode.DIFFERENT, "two pose models' results differ (model quantize, model compare)"),
         )
     )
     + "; 130 / 143 interrupted by Ctrl-C / SIGTERM."

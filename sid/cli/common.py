@@ -75,6 +75,9 @@ class ExitCode(IntEnum):
     simulate`` the goal not reached (run.json's ``reason`` says why)."""
     MISSING_DEPENDENCY = 4
     """An optional package the command needs is not installed; the message gives the install command."""
+    DIFFERENT = 5
+    """``sid model quantize`` / ``compare``: the two models' results differ beyond the tolerances (the table says
+    where; a quantized file is kept)."""
 
 
 def exit_code(error: Exception) -> ExitCode:

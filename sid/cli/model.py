@@ -10,7 +10,7 @@ import sys
 from collections.abc import Iterator
 from pathlib import Path
 
-from sid.cli.common import add_bag_topic_options, fail, positive_int
+from sid.cli.common import ExitCode, add_bag_topic_options, fail, positive_int
 from sid.distribution import MissingDependencyError
 from sid.perception.frame import Frame
 from sid.perception.pose.contracts import PoseModelError
@@ -187,7 +187,7 @@ def run_quantize(args: argparse.Namespace) -> int:
     )
     print(f"against {args.model} on the calibration frames:")
     print(table)
-    return 0 if same else 1
+    return ExitCode.OK if same else ExitCode.DIFFERENT
 
 
 def run_simplify(args: argparse.Namespace) -> int:
@@ -214,4 +214,4 @@ def run_compare(args: argparse.Namespace) -> int:
     except INPUT_ERRORS as exc:
         return fail(command, exc)
     print(table)
-    return 0 if same else 1
+    return ExitCode.OK if same else ExitCode.DIFFERENT
