@@ -88,7 +88,7 @@ def exit_code(error: Exception) -> ExitCode:
     problem = sys.modules.get("planner.problem")  # not imported here: commands that do not plan never load it
     if problem is not None and isinstance(error, problem.NoPathError):
         return ExitCode.NO_PATH
-    if isinstance(error, OSError):
+    if isinstance(error, OSError) and not isinstance(error, OutputFolderInUse):  # a busy folder: choose another
         return ExitCode.FAILURE
     return ExitCode.USAGE
 
@@ -347,15 +347,15 @@ def guarded_standard_output() -> Iterator[None]:
 
 def report_standard_output(command: str, error: StandardOutputError) -> int:
     """The exit code of a run whose standard output failed: 0, quietly, when its reader went away (a broken pipe, as
-    Unix tools do), else 2 with ``COMMAND: cannot write standard output (REASON)``. Standard output is pointed at
-    /dev/null, so that Python's flush at exit does not fail a second time."""
+    Unix tools do), else 1 (a failed run) with ``COMMAND: cannot write standard output (REASON)``. Standard output is
+    pointed at /dev/null, so that Python's flush at exit does not fail a second time."""
     if sys.__stdout__ is not None:  # None: closed from the start, then Python does not flush it
         with contextlib.suppress(OSError, ValueError):  # not a file descriptor (e.g. a test's capture)
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.__stdout__.fileno())
     if error.broken_pipe:
         return 0
     print(f"{command}: cannot write standard output ({error})", file=sys.stderr)
-    return 2
+    return ExitCode.FAILURE
 
 
 def print_written(paths: Iterable[object]) -> None:

@@ -323,9 +323,9 @@ def test_keys_given_twice_and_unknown_fields_are_malformed_lines_as_in_scenario_
         "sid groups: line 2: people[0]: unknown field 'thta' (the fields are id, x, y, theta, orientation_quality)",
         "sid groups: line 3: unknown field 'stamp' (the fields are frame, people)",
         "sid groups: line 4: not valid JSON (duplicate key 'x')",
-        "sid groups: skipped 4 malformed line(s)",
+        "sid groups: skipped 4 malformed lines",
     ]
     code, out, err = run_sid(["groups", "--strict", str(source)], capsys)
     assert (
-        code == 1 and out == [] and err.splitlines() == ["sid groups: line 1: not valid JSON (duplicate key 'frame')"]
+        code == 2 and out == [] and err.splitlines() == ["sid groups: line 1: not valid JSON (duplicate key 'frame')"]
     )
