@@ -40,7 +40,6 @@ from sid.sources import ROSBAG2_METADATA, FrameReadError, SourceError
 from sid.sources.ros_messages import Stamped, StampPairer, intrinsics_from_camera_info, rgbd_frame, stamp_seconds
 
 __all__ = [
-    "BAG_SUFFIXES",
     "CAMERA_INFO",
     "COLOR_TOPIC",
     "DEPTH_TOPIC",
@@ -54,7 +53,6 @@ IMAGE = "sensor_msgs/msg/Image"
 CAMERA_INFO = "sensor_msgs/msg/CameraInfo"
 COLOR_TOPIC = "/camera/camera/color/image_raw"
 DEPTH_TOPIC = "/camera/camera/aligned_depth_to_color/image_raw"
-BAG_SUFFIXES = (".db3", ".mcap")
 _LIBREALSENSE_PREFIX = "/device_"
 
 
