@@ -6,10 +6,34 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import re
+from collections.abc import Callable
 
+from sid.cli.common import plain_text
 from sid.perception.groups import GROUP_METHODS, GroupParams
 
-__all__ = ["add_group_params", "group_params_from"]
+__all__ = ["add_group_params", "add_json_lines_command", "group_params_from"]
+
+
+def add_json_lines_command(
+    subparsers: argparse._SubParsersAction,
+    name: str,
+    summary: str,
+    doc: str | None,
+    run: Callable[[argparse.Namespace], int],
+) -> argparse.ArgumentParser:
+    """A command on JSON lines of people (``sid groups``, ``sid track``): FILE or - for stdin, ``--strict`` and the
+    group detector's parameters; its description is the second paragraph of the module docstring ``doc``."""
+    parser = subparsers.add_parser(
+        name,
+        help=summary,
+        description=plain_text(doc.split("\n\n", 1)[1].split("\n\n")[0]) if doc else None,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("file", metavar="FILE", help="JSON-lines input, or - for stdin")
+    parser.add_argument("--strict", action="store_true", help="stop at the first malformed line (exit 2)")
+    add_group_params(parser)
+    parser.set_defaults(func=run)
+    return parser
 
 
 def add_group_params(parser: argparse.ArgumentParser) -> None:

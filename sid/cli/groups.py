@@ -18,8 +18,8 @@ from collections.abc import Iterable
 from typing import Any, TextIO
 
 from sid.checks import check_limit
-from sid.cli.common import fail, plain_text, process_json_lines, refuse_unknown_fields, run_json_lines
-from sid.cli.grouping import add_group_params, group_params_from
+from sid.cli.common import fail, process_json_lines, refuse_unknown_fields, run_json_lines
+from sid.cli.grouping import add_json_lines_command, group_params_from
 from sid.documents import is_number, summary
 from sid.perception.group import Group
 from sid.perception.groups import GroupParams, detect_groups
@@ -32,16 +32,9 @@ PERSON_FIELDS = ("id", "x", "y", "theta", "orientation_quality")
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
-    parser = subparsers.add_parser(
-        "groups",
-        help="detect conversational groups in JSON-lines frames of people",
-        description=plain_text(__doc__.split("\n\n", 1)[1].split("\n\n")[0]) if __doc__ else None,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+    add_json_lines_command(
+        subparsers, "groups", "detect conversational groups in JSON-lines frames of people", __doc__, run
     )
-    parser.add_argument("file", metavar="FILE", help="JSON-lines input, or - for stdin")
-    parser.add_argument("--strict", action="store_true", help="stop at the first malformed line (exit 2)")
-    add_group_params(parser)
-    parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:

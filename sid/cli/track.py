@@ -24,8 +24,8 @@ from collections.abc import Iterable
 from typing import Any, TextIO
 
 from sid.checks import check_limit
-from sid.cli.common import fail, plain_text, process_json_lines, refuse_unknown_fields, run_json_lines
-from sid.cli.grouping import add_group_params, group_params_from
+from sid.cli.common import fail, process_json_lines, refuse_unknown_fields, run_json_lines
+from sid.cli.grouping import add_json_lines_command, group_params_from
 from sid.documents import is_number, summary
 from sid.perception.people import Person
 from sid.tracking import TrackingSession
@@ -37,16 +37,7 @@ PERSON_FIELDS = ("id", "x", "y", "theta")
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
-    parser = subparsers.add_parser(
-        "track",
-        help="track people and groups over JSON-lines detections",
-        description=plain_text(__doc__.split("\n\n", 1)[1].split("\n\n")[0]) if __doc__ else None,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
-    parser.add_argument("file", metavar="FILE", help="JSON-lines input, or - for stdin")
-    parser.add_argument("--strict", action="store_true", help="stop at the first malformed line (exit 2)")
-    add_group_params(parser)
-    parser.set_defaults(func=run)
+    add_json_lines_command(subparsers, "track", "track people and groups over JSON-lines detections", __doc__, run)
 
 
 def run(args: argparse.Namespace) -> int:
