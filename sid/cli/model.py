@@ -43,8 +43,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         description="Writes OUT.onnx: the model's convolutions in INT8 (uint8 activations, int8 per-channel "
         "weights, QDQ), its decoding float, the same input and output as IN (use it with --model anywhere). "
         "Calibrates on the colour images of the sources through the model's own pre-processing, then compares "
-        "OUT with IN on those frames as sid model compare does. Exit 0: written and the same results; 1: written "
-        "but the results differ (listed); 2: bad input.",
+        "OUT with IN on those frames as sid model compare does. Exit 0: written and the same results; 5: written "
+        "but the results differ (listed); 2: bad input; 4: the quantize extra is missing.",
     )
     quantize.add_argument("model", type=Path, metavar="IN.onnx", help="the float pose model")
     quantize.add_argument("output", type=Path, metavar="OUT.onnx", help="where to write the INT8 model")
@@ -76,7 +76,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         description="Runs pose -> lift -> groups with each model on every frame and prints, per frame, the people "
         "each finds, the mean and lowest OKS (COCO constants) of the candidate's keypoints against the "
         "reference's, the largest position and facing differences after lifting, and whether the groups agree. "
-        "Exit 0: the same results on every frame; 1: they differ (listed); 2: bad input.",
+        "Exit 0: the same results on every frame; 5: they differ (listed); 2: bad input.",
     )
     compare.add_argument("reference", type=Path, metavar="REFERENCE.onnx", help="e.g. the float model")
     compare.add_argument("candidate", type=Path, metavar="CANDIDATE.onnx", help="e.g. its INT8 quantization")
