@@ -28,7 +28,7 @@ from sid.perception.robot_pose import RobotPose
 from sid.tracking.assignment import load_solver
 from sid.tracking.records import TrackedGroup, TrackedPerson, Tracks
 from sid.tracking.session import TrackingParams, TrackingSession
-from sid.tracking.view import ViewCone, camera_view_cone
+from sid.tracking.view import ViewCone, pipeline_view
 
 __all__ = ["STREAM_PLUGINS", "SocialStream", "StreamUpdate"]
 
@@ -116,8 +116,5 @@ class SocialStream:
         )
 
     def view(self, frame: Frame) -> ViewCone:
-        """The colour camera's field of view on the ground at ``frame`` (from its robot pose: in the map, else in
-        base_footprint), up to the pipeline's lifting range."""
-        return camera_view_cone(
-            frame.calibration, self.pipeline.mount, frame.robot_pose, self.pipeline.lift_params.max_range
-        )
+        """The colour camera's field of view on the ground at ``frame`` (``sid.tracking.view.pipeline_view``)."""
+        return pipeline_view(frame, self.pipeline)

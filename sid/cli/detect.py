@@ -42,7 +42,7 @@ from sid.perception.pipeline import FrameResult, Pipeline, PosedFrame, PoseFn, i
 from sid.perception.pose.contracts import PoseModelError
 from sid.perception.pose.session import PROVIDER_CHOICES
 from sid.sources import BAG_TOPICS, RECORDING_SUFFIXES, FrameReadError, SourceError, frames_or_errors, open_source
-from sid.tracking import SessionUpdate, TrackingError, TrackingSession, ViewCone, camera_fov, camera_view_cone
+from sid.tracking import SessionUpdate, TrackingError, TrackingSession, camera_fov, pipeline_view
 
 if TYPE_CHECKING:  # costmap.render (the costmap layers, shapely) is imported only for --out: start-up time
     from costmap.render import CameraView
@@ -272,11 +272,6 @@ def _close_source(source: Iterable[Frame]) -> None:
         close()
 
 
-def _view(frame: Frame, pipeline: Pipeline) -> ViewCone:
-    """The camera's field of view on the ground, in the frame of the pipeline's output for ``frame``."""
-    return camera_view_cone(frame.calibration, pipeline.mount, frame.robot_pose, pipeline.lift_params.max_range)
-
-
 def _tracked_json(record: dict, tracked: SessionUpdate) -> dict:
     """A frame's JSON line with its people and groups replaced by the tracks (ids: track ids), each person's 3D
     keypoints taken from the detection it matched (null when missed), and ``reset`` when the trackers were."""
@@ -354,7 +349,7 @@ def run(args: argparse.Namespace) -> int:
                 reason = "no people"
                 if tracking is not None:  # tracks still age through a frame without people
                     with contextlib.suppress(TrackingError):  # such a frame is skipped anyway
-                        tracking.update(result, _view(frame, pipeline))
+                        tracking.update(result, pipeline_view(frame, pipeline))
             if reason or result is None:  # result is None only when there is a reason
                 skipped += 1
                 print(f"detect: frame {frame.index}: skipped, {reason}", file=sys.stderr)
@@ -363,7 +358,7 @@ def run(args: argparse.Namespace) -> int:
             tracked = None
             if tracking is not None:
                 try:
-                    tracked = tracking.update(result, _view(frame, pipeline))
+                    tracked = tracking.update(result, pipeline_view(frame, pipeline))
                 except TrackingError as exc:
                     skipped += 1
                     print(f"detect: frame {frame.index}: skipped, {exc}", file=sys.stderr)

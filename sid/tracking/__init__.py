@@ -15,7 +15,7 @@ from sid.tracking.groups import GroupTracker, GroupTrackerParams
 from sid.tracking.records import GroupKind, MotionState, TrackedGroup, TrackedPerson, Tracks
 from sid.tracking.session import SessionUpdate, TrackingParams, TrackingSession
 from sid.tracking.tracker import PeopleTracker, TrackerParams, TrackingError
-from sid.tracking.view import View, ViewCone, ViewRegion, camera_fov, camera_view_cone, scene_view
+from sid.tracking.view import View, ViewCone, ViewRegion, camera_fov, camera_view_cone, pipeline_view, scene_view
 
 __all__ = [
     "GroupKind",
@@ -36,5 +36,6 @@ __all__ = [
     "ViewRegion",
     "camera_fov",
     "camera_view_cone",
+    "pipeline_view",
     "scene_view",
 ]

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -18,7 +18,11 @@ from sid.perception.camera import Calibration
 from sid.perception.mount import CameraMount
 from sid.perception.robot_pose import RobotPose
 
-__all__ = ["View", "ViewCone", "ViewRegion", "camera_fov", "camera_view_cone", "scene_view"]
+if TYPE_CHECKING:  # annotations only: the pipeline is the caller's
+    from sid.perception.frame import Frame
+    from sid.perception.pipeline import Pipeline
+
+__all__ = ["View", "ViewCone", "ViewRegion", "camera_fov", "camera_view_cone", "pipeline_view", "scene_view"]
 
 
 @dataclass(frozen=True)
@@ -120,3 +124,10 @@ def camera_view_cone(
     if pose is not None:
         (x, y), yaw = pose.to_map(np.array([x, y]))[0].tolist(), pose.yaw_to_map(yaw)
     return ViewCone(x, y, yaw, fov, max_range)
+
+
+def pipeline_view(frame: Frame, pipeline: Pipeline) -> ViewCone:
+    """``camera_view_cone`` of ``frame`` through ``pipeline``: the colour camera's field of view on the ground from the
+    frame's robot pose (in the map; without one in base_footprint, the frame of the pipeline's output), up to the
+    pipeline's lifting range."""
+    return camera_view_cone(frame.calibration, pipeline.mount, frame.robot_pose, pipeline.lift_params.max_range)
