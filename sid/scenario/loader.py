@@ -24,7 +24,7 @@ from costmap.layers.social import SocialParams
 from costmap.layers.tracked import TrackedPeopleParams
 from costmap.mapfile import MapFileError, read_map
 from costmap.occupancy import OccupancyGrid
-from costmap.plugins import PEOPLE_LAYERS, PLUGINS, CostmapParams
+from costmap.plugins import PEOPLE_LAYERS, PLUGINS, SECTIONS, CostmapParams, LayerInstance
 from sid.checks import LimitError, amount, check_limit
 from sid.documents import InputWarning, is_number, load_document, summary
 from sid.errors import SidError
@@ -200,18 +200,68 @@ def _params(value: Any, name: str, cls: type) -> Any:
         raise ScenarioError(f"{name}: {exc}") from exc
 
 
-def _plugins(value: Any, name: str) -> tuple[str, ...]:
-    """Layer names in combination order, each a key of ``costmap.plugins.PLUGINS``, at least one of them a layer
-    that marks people (the LiDAR's or a people layer): without one the robot would plan through them."""
+def _plugins(value: Any, name: str, declared: dict[str, str]) -> tuple[str, ...]:
+    """Layer instance names in combination order: each a key of ``costmap.plugins.PLUGINS`` (an instance of that
+    plugin) or a name ``declared`` with its plugin (``layers.NAME.plugin``); at least one of them a layer that
+    marks people (the LiDAR's or a people layer): without one the robot would plan through them."""
     if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
         raise _fail(name, "a list of layer names", value)
     for i, layer in enumerate(value):
-        if layer not in PLUGINS:
-            raise ScenarioError(f"{name}[{i}]: unknown layer {summary(layer)}; known layers: {', '.join(PLUGINS)}")
+        if layer not in PLUGINS and layer not in declared:
+            raise ScenarioError(
+                f"{name}[{i}]: unknown layer {summary(layer)}; known layers: {', '.join(PLUGINS)}, or a name of "
+                f"your own declared as layers.{layer}: {{plugin: ...}}"
+            )
     marking = ("lidar", *sorted(PEOPLE_LAYERS))
-    if not set(value) & set(marking):
+    if not {declared.get(v, v) for v in value} & set(marking):
         raise ScenarioError(f"{name}: {value} has no layer that marks people; list one of {', '.join(marking)}")
     return tuple(value)
+
+
+_SECTION_TYPES: dict[str, type] = {
+    "obstacle": ObstacleParams,
+    "inflation": InflationParams,
+    "social": SocialParams,
+    "tracked_people": TrackedPeopleParams,
+}
+"""The ``layers`` sections of each plugin's default parameters, by ``costmap.plugins.SECTIONS`` name."""
+
+
+def _layers(value: Any, grid: GridSpec, lidar: LidarSpec, edges: int) -> CostmapParams:
+    """The ``layers`` block: ``plugins``, each plugin's default parameters (``obstacle``, ``inflation``, ``social``,
+    ``tracked_people``) and the instances named otherwise than their plugin, ``NAME: {plugin: P, ...P's
+    parameters}`` (NAME listed in ``plugins``), as Nav2's costmap declares its layers."""
+    if not isinstance(value, dict):
+        raise _fail("layers", "a mapping", value)
+    listed = value.get("plugins", list(CostmapParams().plugins))
+    names = {v for v in listed if isinstance(v, str) and v not in PLUGINS} if isinstance(listed, list) else set()
+    data = _mapping(value, "layers", {"plugins", *_SECTION_TYPES, *names})
+    declared: dict[str, str] = {}
+    for key in sorted(names & set(data)):
+        where = f"layers.{key}"
+        section = _mapping(data[key], where, set(data[key]) if isinstance(data[key], dict) else set(), {"plugin"})
+        plugin = section["plugin"]
+        if not isinstance(plugin, str) or plugin not in PLUGINS:
+            known = ", ".join(PLUGINS)
+            raise ScenarioError(f"{where}.plugin: unknown plugin {summary(plugin)}; known plugins: {known}")
+        declared[key] = plugin
+    plugins = _plugins(listed, "layers.plugins", declared)
+    sections = {k: _params(v, f"layers.{k}", _SECTION_TYPES[k]) for k, v in data.items() if k in _SECTION_TYPES}
+    instances = {}
+    for key, plugin in declared.items():
+        own = {k: v for k, v in data[key].items() if k != "plugin"}
+        kind = SECTIONS.get(plugin)
+        if kind is None and own:
+            raise ScenarioError(f"layers.{key}: the {plugin} plugin takes no parameters, got {', '.join(own)}")
+        params = None if kind is None else _params(own, f"layers.{key}", _SECTION_TYPES[kind])
+        instances[key] = LayerInstance(plugin, params)
+    try:
+        layers = CostmapParams(plugins=plugins, instances=instances, **sections)
+    except ValueError as exc:
+        raise ScenarioError(f"layers.{exc}") from exc
+    _check_scan(grid, lidar, layers, edges)
+    _check_inflation(grid, layers)
+    return layers
 
 
 # --- sections -----------------------------------------------------------------------------------------------
@@ -401,7 +451,7 @@ def _check_scan(grid: GridSpec, lidar: LidarSpec, layers: CostmapParams, edges: 
     (Limits.scan_edges), its ray tests against obstacles and people."""
     _limit("lidar.beams", lidar.beams, "lidar_beams", "beams")
     _limit("lidar", lidar.beams * edges, "scan_edges", "ray tests", f"{lidar.beams} beams x {amount(edges)} edges = ")
-    longest = max(lidar.range_max, layers.obstacle.raytrace_max_range)
+    longest = max([lidar.range_max] + [layers.layer_params(n).raytrace_max_range for n in layers.named("lidar")])
     cells = math.ceil(longest / grid.resolution)
     detail = f"{lidar.beams} beams x {amount(cells)} cells of range ({longest:g} m at {grid.resolution:g} m) = "
     _limit("lidar", lidar.beams * cells, "scan_cells", "beam cells", detail)
@@ -410,12 +460,15 @@ def _check_scan(grid: GridSpec, lidar: LidarSpec, layers: CostmapParams, edges: 
 def _check_inflation(grid: GridSpec, layers: CostmapParams) -> None:
     """An inflation radius within the map's diagonal: costs cannot spread farther than the map, and Nav2's cost
     table grows with the square of the radius in cells."""
-    radius, reach = layers.inflation.inflation_radius, math.hypot(*grid.size_m)
-    if radius > reach:
-        raise ScenarioError(
-            f"layers.inflation.inflation_radius: {radius:g} m is more than the map's diagonal ({reach:g} m), the "
-            "farthest any cost can spread; use at most that"
-        )
+    reach = math.hypot(*grid.size_m)
+    for name in layers.named("inflation"):
+        radius = layers.layer_params(name).inflation_radius
+        if radius > reach:
+            section = "inflation" if name == "inflation" else name
+            raise ScenarioError(
+                f"layers.{section}.inflation_radius: {radius:g} m is more than the map's diagonal ({reach:g} m), "
+                "the farthest any cost can spread; use at most that"
+            )
 
 
 def _static_map(path: Path) -> OccupancyGrid:
@@ -516,21 +569,7 @@ def scenario_from_dict(data: Any, base_dir: Path | None = None, default_name: st
         _length(lidar_data.get("body_radius", defaults.body_radius), "lidar.body_radius", grid),
     )
 
-    layer_sections: dict[str, Callable[[Any, str], Any]] = {
-        "plugins": _plugins,
-        "obstacle": lambda v, n: _params(v, n, ObstacleParams),
-        "inflation": lambda v, n: _params(v, n, InflationParams),
-        "social": lambda v, n: _params(v, n, SocialParams),
-        "tracked_people": lambda v, n: _params(v, n, TrackedPeopleParams),
-    }
-    layers_data = _mapping(data.get("layers", {}), "layers", set(layer_sections))
-    sections = {k: layer_sections[k](v, f"layers.{k}") for k, v in layers_data.items()}
-    try:
-        layers = CostmapParams(**sections)
-    except ValueError as exc:
-        raise ScenarioError(f"layers.{exc}") from exc
-    _check_scan(grid, lidar, layers, _edge_count(obstacles, people))
-    _check_inflation(grid, layers)
+    layers = _layers(data.get("layers", {}), grid, lidar, _edge_count(obstacles, people))
 
     return Scenario(
         name=name,

@@ -1,0 +1,93 @@
+"""Layer instances as in Nav2: each with a name, a plugin and its own parameters; two LiDAR layers in one costmap."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from costmap.grid import LETHAL, GridSpec
+from costmap.layer import LayerInputs
+from costmap.layers.obstacle import ObstacleLayer, ObstacleParams
+from costmap.plugins import CostmapParams, LayerInstance, layered_costmap
+from costmap.scan import LaserScan
+from sid.scenario.loader import ScenarioError, scenario_from_dict
+
+SPEC = GridSpec.from_size(0.05, (-1.0, -5.0), (12.0, 10.0))
+NEAR = ObstacleParams(obstacle_max_range=3.0, raytrace_max_range=3.0)
+
+
+def _scan() -> LaserScan:
+    """Two returns straight ahead of a sensor at the origin: one at 2 m (beam 0), one at 6 m (beam 1, 0.1 rad left)."""
+    return LaserScan(np.array([2.0, 6.0]), 0.0, 0.1, 8.0, (0.0, 0.0, 0.0))
+
+
+def _lethal_at(layered, name: str, x: float, y: float) -> bool:
+    (row, col) = SPEC.world_to_cell(np.array([x, y]))[0]
+    return bool(layered.grids[name][row, col] == LETHAL)
+
+
+def test_two_lidar_layers_with_their_own_parameters_in_one_costmap() -> None:
+    params = CostmapParams(
+        plugins=("near_lidar", "lidar", "inflation"), instances={"near_lidar": LayerInstance("lidar", NEAR)}
+    )
+    layered = layered_costmap(SPEC, params)
+    assert [layer.name for layer in layered.layers] == ["near_lidar", "lidar", "inflation"]
+    near, far = layered.layer("near_lidar"), layered.layer("lidar")
+    assert isinstance(near, ObstacleLayer) and isinstance(far, ObstacleLayer)
+    assert near.params == NEAR and far.params == params.obstacle  # a plugin's own name: the costmap's section
+    layered.update(LayerInputs(scan=_scan()))
+    far_hit = (6.0 * np.cos(0.1), 6.0 * np.sin(0.1))
+    assert _lethal_at(layered, "near_lidar", 2.0, 0.0) and not _lethal_at(layered, "near_lidar", *far_hit)
+    assert _lethal_at(layered, "lidar", 2.0, 0.0) and _lethal_at(layered, "lidar", *far_hit)
+    assert params.named("lidar") == ["near_lidar", "lidar"] and params.plugin("near_lidar") == "lidar"
+
+
+def test_an_instance_of_an_unknown_plugin_is_refused() -> None:
+    params = CostmapParams(plugins=("lidar", "sonar_1"), instances={"sonar_1": LayerInstance("sonar")})
+    with pytest.raises(ValueError, match="unknown layer 'sonar'"):
+        layered_costmap(SPEC, params)
+    with pytest.raises(ValueError, match="must be a LayerInstance"):
+        CostmapParams(instances={"near": "lidar"})  # type: ignore[dict-item]
+
+
+def _scenario(layers: dict) -> dict:
+    return {
+        "map": {"resolution": 0.05, "origin": [-1, -5], "size": [12, 10]},
+        "robot": {"start": [0, 0, 0], "goal": [5, 0, 0]},
+        "layers": layers,
+    }
+
+
+def test_a_scenario_file_declares_named_layers_as_nav2_does() -> None:
+    layers = {
+        "plugins": ["static", "near_lidar", "lidar", "social", "inflation"],
+        "near_lidar": {"plugin": "lidar", "obstacle_max_range": 3.0, "raytrace_max_range": 3.0},
+        "obstacle": {"obstacle_max_range": 8.0},
+    }
+    params = scenario_from_dict(_scenario(layers)).layers
+    assert params.layer_params("near_lidar") == NEAR
+    assert params.layer_params("lidar") == ObstacleParams(obstacle_max_range=8.0)
+    assert params.named("lidar") == ["near_lidar", "lidar"]
+    only_near = {"plugins": ["near_lidar", "inflation"], "near_lidar": {"plugin": "lidar"}}
+    assert scenario_from_dict(_scenario(only_near)).layers.layer_params("near_lidar") == ObstacleParams()
+
+
+@pytest.mark.parametrize(
+    ("layers", "message"),
+    [
+        ({"plugins": ["lidar", "near"]}, r"layers.plugins\[1\]: unknown layer \"near\""),
+        ({"plugins": ["lidar"], "near": {"plugin": "lidar"}}, "layers.near: unknown field"),
+        ({"plugins": ["near", "inflation"], "near": {"obstacle_max_range": 2}}, "layers.near.plugin: required"),
+        ({"plugins": ["near"], "near": {"plugin": "sonar"}}, 'layers.near.plugin: unknown plugin "sonar"'),
+        ({"plugins": ["lidar", "near"], "near": {"plugin": "lidar", "sigma": 1}}, "layers.near.sigma: unknown"),
+        ({"plugins": ["near", "inflation"], "near": {"plugin": "inflation"}}, "has no layer that marks people"),
+        ({"plugins": ["lidar", "map"], "map": {"plugin": "static", "x": 1}}, "static plugin takes no parameters"),
+        (
+            {"plugins": ["lidar", "wide"], "wide": {"plugin": "inflation", "inflation_radius": 50}},
+            "layers.wide.inflation_radius: 50 m is more than the map's diagonal",
+        ),
+    ],
+)
+def test_bad_layer_instances_are_named(layers: dict, message: str) -> None:
+    with pytest.raises(ScenarioError, match=message):
+        scenario_from_dict(_scenario(layers))
