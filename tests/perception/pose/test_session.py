@@ -22,7 +22,7 @@ from sid.perception.pose.session import (
     session_options,
 )
 from tests.conftest import REPO_ROOT, shared_path
-from tests.pose_models import build_multipose_model
+from tests.pose_models import IR_VERSION, build_multipose_model
 
 HAS_OPENVINO = OPENVINO_PROVIDER in ort.get_available_providers()
 needs_openvino = pytest.mark.skipif(
@@ -175,7 +175,8 @@ def test_onnxruntime_load_warnings_show_only_when_asked_for(tmp_path):
         ],
     )
     path = tmp_path / "resize.onnx"
-    onnx.save(helper.make_model(graph, opset_imports=[helper.make_opsetid("", 13)]), path)
+    model = helper.make_model(graph, opset_imports=[helper.make_opsetid("", 13)], ir_version=IR_VERSION)
+    onnx.save(model, path)
     done = subprocess.run(
         [sys.executable, "-c", LOAD_PROBE, str(path)],
         cwd=REPO_ROOT,
