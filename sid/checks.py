@@ -6,10 +6,11 @@ Records call these from ``__post_init__`` so that a bad value fails where it is 
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 import os
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -24,6 +25,8 @@ __all__ = [
     "check_number",
     "check_numbers",
     "limits",
+    "limits_from_environment",
+    "use_limits",
 ]
 
 LIMITS_ENV = "SID_LIMITS"
@@ -48,7 +51,8 @@ class Limits:
     image_pixels: pixels of a camera's image (its calibration's width x height; 33 177 600 is 8K UHD), which every
     frame is decoded at.
     sim_steps: steps of one ``sid simulate`` run, ``time_limit_s`` x ``rate_hz`` (each step's people are kept).
-    Raise one with ``SID_LIMITS="NAME=VALUE,..."`` (an environment variable, read at each check).
+    Raise one with ``SID_LIMITS="NAME=VALUE,..."`` (an environment variable the command line reads when it starts;
+    ``use_limits`` from Python).
     """
 
     map_cells: int = 4_000_000
@@ -66,9 +70,29 @@ class LimitError(SidError, ValueError):
     """An input above a limit of ``Limits``; the message names the field, the value, the limit and how to raise it."""
 
 
+_IN_FORCE: list[Limits] = [Limits()]  # the limits every check applies: one process-wide value, set by use_limits
+
+
 def limits() -> Limits:
-    """The limits in force: ``Limits()`` with the values of ``$SID_LIMITS`` (``NAME=VALUE`` pairs, comma-separated;
-    ValueError naming the variable for a malformed one)."""
+    """The limits in force: ``Limits()`` unless an entry point (the command line: ``$SID_LIMITS``) or the caller set
+    others with ``use_limits``."""
+    return _IN_FORCE[-1]
+
+
+@contextlib.contextmanager
+def use_limits(value: Limits) -> Iterator[Limits]:
+    """The limits every check applies within the block, process-wide, then those before it again: ``sid.cli.main``
+    runs each command under ``use_limits(limits_from_environment())``; a program embedding sid calls it likewise."""
+    _IN_FORCE.append(value)
+    try:
+        yield value
+    finally:
+        _IN_FORCE.pop()
+
+
+def limits_from_environment() -> Limits:
+    """``Limits()`` with the values of ``$SID_LIMITS`` (``NAME=VALUE`` pairs, comma-separated; ValueError naming the
+    variable for a malformed one). Read by the entry points, once, not by the checks."""
     text = os.environ.get(LIMITS_ENV, "").strip()
     if not text:
         return Limits()

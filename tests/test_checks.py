@@ -70,12 +70,19 @@ def test_limit_error_names_field_value_limit_and_how_to_raise_it():
     )
 
 
-def test_sid_limits_raises_a_limit(monkeypatch):
-    from sid.checks import Limits, check_limit, limits
+def test_sid_limits_raises_a_limit_where_an_entry_point_puts_it_in_force(monkeypatch):
+    from sid.checks import LimitError, Limits, check_limit, limits, limits_from_environment, use_limits
 
     monkeypatch.setenv("SID_LIMITS", "people=5000, map_cells=1e8")
-    assert limits() == Limits(map_cells=100_000_000, people=5000)
-    check_limit("people", 4000, "people", "people")  # no error
+    assert limits() == Limits()  # the checks do not read the environment
+    with use_limits(limits_from_environment()) as raised:
+        assert raised == limits() == Limits(map_cells=100_000_000, people=5000)
+        check_limit("people", 4000, "people", "people")  # no error
+        # nested: the innermost holds, then the outer again
+        with use_limits(Limits(people=3)), pytest.raises(LimitError, match="more than the limit of 3 people"):
+            check_limit("people", 4, "people", "people")
+        assert limits() == raised
+    assert limits() == Limits()
 
 
 @pytest.mark.parametrize(
@@ -83,8 +90,8 @@ def test_sid_limits_raises_a_limit(monkeypatch):
     [("peple=5", "unknown limit 'peple'"), ("people=0", "people must be a whole number >= 1"), ("people=1.5", "whole")],
 )
 def test_a_malformed_sid_limits_is_named(monkeypatch, text, message):
-    from sid.checks import limits
+    from sid.checks import limits_from_environment
 
     monkeypatch.setenv("SID_LIMITS", text)
     with pytest.raises(ValueError, match=rf"\$SID_LIMITS: .*{message}"):
-        limits()
+        limits_from_environment()

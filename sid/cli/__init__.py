@@ -13,7 +13,7 @@ import warnings
 from typing import TextIO
 
 from sid import __version__
-from sid.checks import limits
+from sid.checks import limits_from_environment, use_limits
 from sid.cli.common import (
     ExitCode,
     StandardOutputError,
@@ -98,7 +98,7 @@ def main(argv: list[str] | None = None) -> int:
             return report_standard_output(f"sid {known}" if known else "sid", exc)
     command = f"sid {args.command}"
     try:
-        limits()  # a malformed $SID_LIMITS is said once, before any work
+        in_force = limits_from_environment()  # $SID_LIMITS, read here once; a malformed one is said before any work
     except ValueError as exc:
         print(f"{command}: {exc}", file=sys.stderr)
         return ExitCode.USAGE
@@ -118,7 +118,7 @@ def main(argv: list[str] | None = None) -> int:
             default_show(message, category, filename, lineno, file, line)
 
     keep_freed_memory()  # numpy's image-sized temporaries reuse heap memory instead of new mappings (sid.cpu)
-    with warnings.catch_warnings(), signals_as_interrupts(), guarded_standard_output():
+    with use_limits(in_force), warnings.catch_warnings(), signals_as_interrupts(), guarded_standard_output():
         warnings.showwarning = show
         try:
             code = int(args.func(args) or 0)

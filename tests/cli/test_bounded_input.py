@@ -22,7 +22,7 @@ from costmap.layers.obstacle import ObstacleParams
 from costmap.layers.social import SocialParams
 from costmap.layers.tracked import TrackedPeopleParams
 from costmap.mapfile import MapFileError, read_map
-from sid.checks import LimitError
+from sid.checks import LimitError, limits_from_environment, use_limits
 from sid.cli import main
 from sid.experiments.simulate.world import load_world
 from sid.perception.camera import Calibration, Intrinsics
@@ -423,10 +423,11 @@ def test_sid_limits_raises_the_new_limits(tmp_path, monkeypatch):
     }
     for setting, message in refusals.items():
         monkeypatch.setenv("SID_LIMITS", setting)
-        with pytest.raises(ScenarioError, match=message):
+        with use_limits(limits_from_environment()), pytest.raises(ScenarioError, match=message):
             load_world(path)
     monkeypatch.setenv("SID_LIMITS", "sim_steps=10000,obstacle_points=120,scan_edges=90000")
-    assert len(load_world(path).scenario.obstacles) == 30
+    with use_limits(limits_from_environment()):
+        assert len(load_world(path).scenario.obstacles) == 30
 
 
 def test_a_calibration_larger_than_the_image_limit_is_refused_before_any_frame(tmp_path, capsys):

@@ -15,6 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import sid.perception.gcff as gcff
+from sid.checks import Limits, use_limits
 from sid.experiments.fformation import load_settings_gc
 from sid.perception.gcff import GCFFParams, gcff_labels
 from tests.conftest import SHARED
@@ -243,9 +244,8 @@ def test_params_of_the_wrong_type_are_refused():
         gcff_labels(np.zeros((1, 2)), np.zeros(1), {"stride": 0.45})  # type: ignore[arg-type]
 
 
-def test_too_many_people_is_a_limit_error(monkeypatch):
-    monkeypatch.setenv("SID_LIMITS", "people=3")
-    with pytest.raises(ValueError, match="people"):
+def test_too_many_people_is_a_limit_error():
+    with use_limits(Limits(people=3)), pytest.raises(ValueError, match="people"):
         gcff_labels(np.zeros((4, 2)), np.zeros(4))
 
 

@@ -7,6 +7,7 @@ import json
 
 import pytest
 
+from sid.checks import Limits, use_limits
 from sid.cli import main
 from sid.documents import InputWarning
 from sid.scenario.loader import ScenarioError, load_scenario
@@ -15,16 +16,15 @@ from tests.conftest import REPO_ROOT
 MALFORMED = REPO_ROOT / "tests" / "fixtures" / "malformed" / "scenario"
 
 
-def test_sid_limits_lets_a_larger_map_load(monkeypatch):
+def test_raised_limits_let_a_larger_map_load():
     with pytest.raises(ScenarioError, match="map_cells"):
         load_scenario(MALFORMED / "map_1000m.json")
-    monkeypatch.setenv("SID_LIMITS", "map_cells=400000000")
-    assert load_scenario(MALFORMED / "map_1000m.json").grid.shape == (20000, 20000)  # nothing allocated yet
+    with use_limits(Limits(map_cells=400_000_000)):
+        assert load_scenario(MALFORMED / "map_1000m.json").grid.shape == (20000, 20000)  # nothing allocated yet
 
 
-def test_people_limit_counts_before_parsing_them(monkeypatch):
-    monkeypatch.setenv("SID_LIMITS", "people=2")
-    with pytest.raises(ScenarioError, match=r"people: 4 people is more than the limit of 2 people"):
+def test_people_limit_counts_before_parsing_them():
+    with use_limits(Limits(people=2)), pytest.raises(ScenarioError, match=r"people: 4 people is more than the limit"):
         load_scenario(REPO_ROOT / "examples" / "conversation.json")
 
 

@@ -22,6 +22,7 @@ from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
 
+from sid.checks import Limits, limits, use_limits
 from sid.cpu import keep_freed_memory
 from sid.distribution import MissingDependencyError, install_hint
 from sid.experiments.harness import summarise
@@ -70,10 +71,12 @@ def run_job(job: Job) -> dict:
     return record
 
 
-def _worker_job(job: Job) -> dict:
-    """``run_job`` in a worker process (pool or Ray), with the allocator set as the ``sid`` command sets it."""
+def _worker_job(job: Job, in_force: Limits) -> dict:
+    """``run_job`` in a worker process (pool or Ray), with the allocator set as the ``sid`` command sets it and the
+    parent's limits in force (``sid.checks.use_limits``: a fresh interpreter starts with the defaults)."""
     keep_freed_memory()
-    return run_job(job)
+    with use_limits(in_force):
+        return run_job(job)
 
 
 def _in_process(jobs: Sequence[Job], progress: Progress | None) -> list[dict]:
@@ -89,7 +92,7 @@ def _in_workers(jobs: Sequence[Job], workers: int, progress: Progress | None) ->
     results: list[dict | None] = [None] * len(jobs)
     # spawn, not fork: a fresh interpreter per worker, whatever threads the parent runs (onnxruntime, Ray).
     with ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn")) as pool:
-        futures = {pool.submit(_worker_job, job): i for i, job in enumerate(jobs)}
+        futures = {pool.submit(_worker_job, job, limits()): i for i, job in enumerate(jobs)}
         for done, future in enumerate(as_completed(futures)):
             i = futures[future]
             results[i] = future.result()
@@ -114,7 +117,7 @@ def _on_ray(jobs: Sequence[Job], address: str, progress: Progress | None) -> lis
             ray.init(address=address, **kwargs)
     try:
         remote = ray.remote(num_cpus=1)(_worker_job)
-        refs = [remote.remote(job) for job in jobs]
+        refs = [remote.remote(job, limits()) for job in jobs]
         index = {ref: i for i, ref in enumerate(refs)}
         pending, done = list(refs), 0
         while pending:
