@@ -28,6 +28,7 @@ from sid.documents import TEMPORARY_PREFIX, plural, special_file, unique_keys
 from sid.errors import SidError
 
 __all__ = [
+    "ExitCode",
     "LOCK_NAME",
     "LineHandler",
     "LineTooLong",
@@ -38,12 +39,15 @@ __all__ = [
     "StandardOutputError",
     "Terminated",
     "add_bag_topic_options",
+    "add_output_option",
     "bounded_lines",
     "check_output_folder",
     "clear_owned",
+    "exit_code",
     "fail",
     "guarded_standard_output",
     "output_folder_lock",
+    "plain_text",
     "positive_int",
     "print_written",
     "process_json_lines",
@@ -54,10 +58,7 @@ __all__ = [
     "signals_as_interrupts",
     "signals_deferred",
     "staged_output",
-    "ExitCode",
-    "exit_code",
-    "add_output_option",
-    "plain_text",
+    "whole_number",
 ]
 
 
@@ -142,15 +143,23 @@ def plain_text(doc: str) -> str:
     return doc.replace("`", "")
 
 
-def positive_int(text: str) -> int:
-    """argparse type: a whole number >= 1."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}")
-    return value
+def whole_number(low: int) -> Callable[[str], int]:
+    """argparse type: a whole number >= ``low``."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            value = low - 1
+        if value < low:
+            raise argparse.ArgumentTypeError(f"expected a whole number >= {low}, got {text!r}")
+        return value
+
+    return parse
+
+
+positive_int = whole_number(1)
+"""argparse type: a whole number >= 1."""
 
 
 def fail(command: str, error: Exception) -> int:

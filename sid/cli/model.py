@@ -10,7 +10,7 @@ import sys
 from collections.abc import Iterator
 from pathlib import Path
 
-from sid.cli.common import ExitCode, add_bag_topic_options, fail, positive_int
+from sid.cli.common import ExitCode, add_bag_topic_options, fail, positive_int, whole_number
 from sid.distribution import MissingDependencyError
 from sid.perception.frame import Frame
 from sid.perception.pose.contracts import PoseModelError
@@ -54,7 +54,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     quantize.add_argument(
         "--float-layers",
-        type=_layer_count,
+        type=whole_number(0),
         default=FLOAT_LAYERS,
         metavar="K",
         help="keep the last K weighted layers on every path to the outputs, and the decoding after them, float "
@@ -82,17 +82,6 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     compare.add_argument("candidate", type=Path, metavar="CANDIDATE.onnx", help="e.g. its INT8 quantization")
     _add_sources(compare, "--source", "sources")
     compare.set_defaults(func=run_compare)
-
-
-def _layer_count(text: str) -> int:
-    """argparse type: a whole number >= 0."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {text!r}") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {text!r}")
-    return value
 
 
 def _add_sources(parser: argparse.ArgumentParser, option: str, what: str) -> None:
