@@ -72,12 +72,12 @@ def test_every_install_command_names_the_distribution(path: Path) -> None:
 def test_the_printed_hints_give_the_install_command(monkeypatch: pytest.MonkeyPatch) -> None:
     """Each message about a missing optional dependency, raised with the dependency hidden."""
     from sid.cli.ros import INSTALL_HINT
-    from sid.experiments import crowd, tracking
+    from sid.experiments import crowd, synthetic_tracking
     from sid.experiments.simulate.sweep import _on_ray
     from sid.perception.pose.session import OPENVINO_MISSING
 
     assert install_hint("ros") in INSTALL_HINT and install_hint("openvino") in OPENVINO_MISSING
-    monkeypatch.setattr(tracking.importlib.util, "find_spec", lambda name: None)
+    monkeypatch.setattr(synthetic_tracking.importlib.util, "find_spec", lambda name: None)
     with pytest.raises(MissingDependencyError, match=re.escape(install_hint("eval"))):
         crowd.require_motmetrics()
     monkeypatch.setitem(sys.modules, "ray", None)  # import ray now raises ImportError

@@ -234,8 +234,8 @@ def _table(scores: dict[str, dict[str, dict[str, float]]]) -> str:
 
 
 def add_tracking_parser(tasks: argparse._SubParsersAction) -> None:
-    """``sid eval tracking``: the options of ``sid.experiments.tracking.TrackingEvalSettings``."""
-    from sid.experiments.tracking import TrackingEvalSettings
+    """``sid eval tracking``: the options of ``sid.experiments.synthetic_tracking.TrackingEvalSettings``."""
+    from sid.experiments.synthetic_tracking import TrackingEvalSettings
     from sid.synthetic.sequence import SEQUENCES
 
     defaults = TrackingEvalSettings()
@@ -264,7 +264,7 @@ def add_tracking_parser(tasks: argparse._SubParsersAction) -> None:
 
 def run_tracking(args: argparse.Namespace) -> int:
     from sid.experiments.progress import ProgressBar
-    from sid.experiments.tracking import TrackingEvalSettings, evaluate_tracking
+    from sid.experiments.synthetic_tracking import TrackingEvalSettings, evaluate_tracking
 
     try:
         settings = TrackingEvalSettings(

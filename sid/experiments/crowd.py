@@ -35,7 +35,7 @@ import numpy as np
 from sid.distribution import MissingDependencyError, install_hint
 from sid.experiments.fformation import format_threshold, frame_matches
 from sid.experiments.gmitre import LinkCounts, gmitre_counts
-from sid.experiments.tracking import as_truth_ids, identify, mot_scores
+from sid.experiments.synthetic_tracking import as_truth_ids, identify, mot_scores
 from sid.experiments.trajectories import ReplaySettings, TrajectorySet, replay
 from sid.tracking.coherent import CoherentMotion, CoherentMotionParams
 from sid.tracking.groups import GroupTracker, GroupTrackerParams

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from sid.distribution import install_hint
-from sid.experiments import tracking
-from sid.experiments.tracking import (
+from sid.experiments import synthetic_tracking
+from sid.experiments.synthetic_tracking import (
     MissingDependencyError,
     TrackingEvalSettings,
     as_truth_ids,
@@ -59,7 +59,7 @@ def test_people_are_identified_by_nearest_position_within_the_gate() -> None:
 
 
 def test_a_missing_motmetrics_is_explained(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(tracking.importlib.util, "find_spec", lambda name: None)
+    monkeypatch.setattr(synthetic_tracking.importlib.util, "find_spec", lambda name: None)
     with pytest.raises(MissingDependencyError, match=re.escape(install_hint("eval"))):
         evaluate_tracking(TrackingEvalSettings(sequences=("walking_pairs",), frames=2))
 
@@ -82,15 +82,15 @@ def _replay(name: str, seconds: float) -> tuple[dict[str, Any], _Walkers]:
     ``TruthPose``, a ``SocialStream``): its motmetrics scores, and its two walkers identified as the evaluation
     identifies people (minimum total distance within its match distance)."""
     settings = TrackingEvalSettings(sequences=(name,), frames=round(seconds * TrackingEvalSettings().fps) + 1)
-    logs = tracking._run_sequence(name, settings, None)
-    scores = mot_scores([tracking._accumulate(logs, settings.match_distance)], [name])[name]
+    logs = synthetic_tracking._run_sequence(name, settings, None)
+    scores = mot_scores([synthetic_tracking._accumulate(logs, settings.match_distance)], [name])[name]
     walkers = sorted(p.id for p in builtin_sequence(name).people if p.trajectory.path)
     out = _Walkers({w: set() for w in walkers}, longest_coast=dict.fromkeys(walkers, 0.0))
     coasting = dict.fromkeys(walkers, 0)
     for log in logs:
         ids = [p.id for p in log.truth.people]
         positions = np.array([[p.x, p.y] for p in log.truth.people])
-        seen = dict(zip(ids, tracking._seen(log).tolist(), strict=True))
+        seen = dict(zip(ids, synthetic_tracking._seen(log).tolist(), strict=True))
         track_of = dict(
             zip(identify(log.track_positions, ids, positions, settings.match_distance), log.track_ids, strict=True)
         )
