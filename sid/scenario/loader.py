@@ -18,10 +18,6 @@ from typing import Any, TypeVar
 import numpy as np
 
 from costmap.grid import GridSpec
-from costmap.layers.inflation import InflationParams
-from costmap.layers.obstacle import ObstacleParams
-from costmap.layers.social import SocialParams
-from costmap.layers.tracked import TrackedPeopleParams
 from costmap.mapfile import MapFileError, read_map
 from costmap.occupancy import OccupancyGrid
 from costmap.plugins import PEOPLE_LAYERS, PLUGINS, SECTIONS, CostmapParams, LayerInstance
@@ -218,13 +214,8 @@ def _plugins(value: Any, name: str, declared: dict[str, str]) -> tuple[str, ...]
     return tuple(value)
 
 
-_SECTION_TYPES: dict[str, type] = {
-    "obstacle": ObstacleParams,
-    "inflation": InflationParams,
-    "social": SocialParams,
-    "tracked_people": TrackedPeopleParams,
-}
-"""The ``layers`` sections of each plugin's default parameters, by ``costmap.plugins.SECTIONS`` name."""
+_SECTION_TYPES: dict[str, type] = {section: type(getattr(CostmapParams(), section)) for section in SECTIONS.values()}
+"""The ``layers`` sections of each plugin's default parameters (``costmap.plugins.SECTIONS``) and their records."""
 
 
 def _layers(value: Any, grid: GridSpec, lidar: LidarSpec, edges: int) -> CostmapParams:
