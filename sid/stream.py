@@ -1,8 +1,8 @@
 """The streaming object: one call per frame keeps people, groups and the social costmap up to date.
 
-``SocialStream.update(frame, robot_pose)`` runs the stateless per-frame pipeline (``sid.perception.pipeline``), then
-the people and group trackers (``sid.tracking.session``), then the layered costmap (``costmap``) on the tracks, and
-returns a ``StreamUpdate``. Positions are in the map frame when a robot pose is known (``robot_pose``, else
+``SocialStream.update(frame, robot_pose)`` runs the stateless per-frame pipeline (``sid.perception.pipeline``) and
+the people and group trackers (``sid.tracking.stream.PeopleStream``), then the layered costmap (``costmap``) on the
+tracks, and returns a ``StreamUpdate``. Positions are in the map frame when a robot pose is known (``robot_pose``, else
 ``frame.robot_pose``), else in ``base_footprint`` (right only while the robot stands still).
 
 Resets (documented, not errors; ``StreamUpdate.reset`` says why): a jump of the robot pose, or a pose that appears
@@ -13,7 +13,6 @@ changed): a frame not after the last one in time, a non-finite timestamp, a robo
 
 from __future__ import annotations
 
-import dataclasses
 import time
 from dataclasses import dataclass
 
@@ -27,8 +26,9 @@ from sid.perception.pipeline import FrameResult, Pipeline
 from sid.perception.robot_pose import RobotPose
 from sid.tracking.assignment import load_solver
 from sid.tracking.records import TrackedGroup, TrackedPerson, Tracks
-from sid.tracking.session import TrackingParams, TrackingSession
-from sid.tracking.view import ViewCone, pipeline_view
+from sid.tracking.session import TrackingParams
+from sid.tracking.stream import PeopleStream
+from sid.tracking.view import ViewCone
 
 __all__ = ["STREAM_PLUGINS", "SocialStream", "StreamUpdate"]
 
@@ -81,23 +81,19 @@ class SocialStream:
         elif costmap_params is not None:
             raise ValueError("stream: costmap_params only apply when the costmap is built from a GridSpec")
         self.costmap = costmap
-        self.tracking = TrackingSession(params, pipeline.group_params)
+        self.people = PeopleStream(pipeline, params)
         load_solver()  # now, not on the first ambiguous frame: a robot should not pause mid-run for an import
 
     def reset(self) -> None:
         """Forget every track and group (ids keep counting up); the costmap empties at the next update."""
-        self.tracking.reset()
+        self.people.reset()
 
     def update(self, frame: Frame, robot_pose: RobotPose | None = None, scan: LaserScan | None = None) -> StreamUpdate:
         """One frame: pipeline, trackers, costmap. ``robot_pose``: base_footprint in the map at the frame's time
         (None: ``frame.robot_pose``). ``scan``: a 2D scan for the LiDAR layer, in the costmap's frame."""
         start = time.perf_counter()
-        pose = frame.robot_pose if robot_pose is None else robot_pose
-        self.tracking.check(frame.timestamp, pose, f"stream: frame {frame.index}")
-        if pose is not frame.robot_pose:
-            frame = dataclasses.replace(frame, robot_pose=pose)
-        result = self.pipeline(frame)
-        tracked = self.tracking.update(result, self.view(frame))
+        step = self.people.update(frame, robot_pose)
+        result, tracked = step.result, step.tracks
         t0 = time.perf_counter()
         conversations = [g.as_group() for g in tracked.groups if g.kind == "conversation"]
         tracks = Tracks(tracked.people, tracked.groups)
@@ -116,5 +112,5 @@ class SocialStream:
         )
 
     def view(self, frame: Frame) -> ViewCone:
-        """The colour camera's field of view on the ground at ``frame`` (``sid.tracking.view.pipeline_view``)."""
-        return pipeline_view(frame, self.pipeline)
+        """The colour camera's field of view on the ground at ``frame`` (``PeopleStream.view``)."""
+        return self.people.view(frame)

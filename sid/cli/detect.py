@@ -42,7 +42,7 @@ from sid.perception.pipeline import FrameResult, Pipeline, PosedFrame, PoseFn, i
 from sid.perception.pose.contracts import PoseModelError
 from sid.perception.pose.session import PROVIDER_CHOICES
 from sid.sources import BAG_TOPICS, RECORDING_SUFFIXES, FrameReadError, SourceError, frames_or_errors, open_source
-from sid.tracking import SessionUpdate, TrackingError, TrackingSession, camera_fov, pipeline_view
+from sid.tracking import PeopleStream, SessionUpdate, TrackingError, camera_fov
 
 if TYPE_CHECKING:  # costmap.render (the costmap layers, shapely) is imported only for --out: start-up time
     from costmap.render import CameraView
@@ -325,44 +325,39 @@ def run(args: argparse.Namespace) -> int:
 
     done = skipped = 0
 
-    def report(error: FrameReadError) -> None:
+    def skip(index: int | None, reason: object) -> None:
         nonlocal skipped
         skipped += 1
-        print(f"detect: frame {error.index}: skipped, {error}", file=sys.stderr)
+        print(f"detect: frame {index}: skipped, {reason}", file=sys.stderr)
 
     interrupted = 0  # the exit code of the signal that stopped the run
     single = isinstance(source, Sized) and len(source) == 1
-    tracking = None if args.no_tracking or single else TrackingSession(group_params=pipeline.group_params)
+    stream = None if args.no_tracking or single else PeopleStream(pipeline)
     totals: list[float] = []
     started = time.perf_counter()
     try:
         # The next frame is read and posed in a worker thread while this one lifts, groups, tracks and writes.
         for item in run_ahead(_posed_frames(source, pipeline)):
             if isinstance(item, FrameReadError):
-                report(item)
+                skip(item.index, item)
                 continue
             if args.frames is not None and done + skipped >= args.frames:
                 break
             frame = item.frame
-            reason, result = (item.reason, None) if isinstance(item, _Skipped) else (None, pipeline.locate(item))
-            if result is not None and not result.people:
-                reason = "no people"
-                if tracking is not None:  # tracks still age through a frame without people
-                    with contextlib.suppress(TrackingError):  # such a frame is skipped anyway
-                        tracking.update(result, pipeline_view(frame, pipeline))
-            if reason or result is None:  # result is None only when there is a reason
-                skipped += 1
-                print(f"detect: frame {frame.index}: skipped, {reason}", file=sys.stderr)
+            if isinstance(item, _Skipped):
+                skip(frame.index, item.reason)
+                continue
+            try:  # the trackers take every frame: tracks age through one without people, which is then skipped
+                step = None if stream is None else stream.update_posed(item)
+            except TrackingError as exc:
+                skip(frame.index, exc)
+                continue
+            result, tracked = (pipeline.locate(item), None) if step is None else (step.result, step.tracks)
+            if not result.people:
+                skip(frame.index, "no people")
                 continue
             record = result.to_json(keypoints=not args.no_keypoints)
-            tracked = None
-            if tracking is not None:
-                try:
-                    tracked = tracking.update(result, pipeline_view(frame, pipeline))
-                except TrackingError as exc:
-                    skipped += 1
-                    print(f"detect: frame {frame.index}: skipped, {exc}", file=sys.stderr)
-                    continue
+            if tracked is not None:
                 record = _tracked_json(record, tracked)
             records = picture_records(result, tracked)
             pictures = _pictures(frame, result, records, mount) if args.out is not None else {}

@@ -7,6 +7,7 @@
 - ``groups``: ``GroupTracker`` (stable group ids, hysteresis, walking groups that are never an o-space).
 - ``coherent``: ``CoherentMotion``, the classical walking-group reference the group tracker is measured against.
 - ``session``: ``TrackingSession``, both trackers over the pipeline's per-frame results, with resets on pose jumps.
+- ``stream``: ``PeopleStream``, the per-frame pipeline then both trackers, frame after frame (``sid detect``).
 
 Use ``sid.stream.SocialStream`` to run them with the pipeline and the costmap; docs/tracking.md has the measurements.
 """
@@ -14,6 +15,7 @@ Use ``sid.stream.SocialStream`` to run them with the pipeline and the costmap; d
 from sid.tracking.groups import GroupTracker, GroupTrackerParams
 from sid.tracking.records import GroupKind, MotionState, TrackedGroup, TrackedPerson, Tracks
 from sid.tracking.session import SessionUpdate, TrackingParams, TrackingSession
+from sid.tracking.stream import PeopleStream, TrackedFrame
 from sid.tracking.tracker import PeopleTracker, TrackerParams, TrackingError
 from sid.tracking.view import View, ViewCone, ViewRegion, camera_fov, camera_view_cone, pipeline_view, scene_view
 
@@ -22,8 +24,10 @@ __all__ = [
     "GroupTracker",
     "GroupTrackerParams",
     "MotionState",
+    "PeopleStream",
     "PeopleTracker",
     "SessionUpdate",
+    "TrackedFrame",
     "TrackedGroup",
     "TrackedPerson",
     "TrackerParams",

@@ -66,3 +66,24 @@ def test_pictures_draw_the_records_of_the_json_line(tmp_path, capsys, monkeypatc
         assert {p.id for p in pictured.labels if p is not None} <= set(ids), index
         assert [list(g.members) for g in pictured.groups] == [g["members"] for g in record["groups"]], index
         assert (tmp_path / f"overlay_{index:06d}.png").exists() and (tmp_path / f"topview_{index:06d}.png").exists()
+
+
+def test_a_frame_out_of_time_order_is_skipped_and_the_tracks_go_on(capsys, monkeypatch) -> None:
+    """A frame the trackers refuse (its timestamp repeats an earlier one) is reported and skipped; the tracks and
+    their ids carry on through the frames after it as if it had not come."""
+    from dataclasses import replace
+
+    from sid.cli import detect
+    from sid.sources.synthetic import SyntheticSource
+
+    frames = list(SyntheticSource("S1", frames=8))
+    frames[5] = replace(frames[5], timestamp=frames[3].timestamp)
+    monkeypatch.setattr(detect, "open_source", lambda spec, **options: iter(frames))
+    assert main(["detect", "--source", "synthetic:S1", "--no-keypoints"]) == 0
+    captured = capsys.readouterr()
+    records = _lines(captured.out)
+    assert [r["frame"] for r in records] == [0, 1, 2, 3, 4, 6, 7]
+    assert "detect: frame 5: skipped, frame 5 is out of time order" in captured.err
+    assert "7 frames with people, 1 skipped" in captured.err
+    ids = [sorted(p["id"] for p in r["people"]) for r in records[2:]]
+    assert all(i == ids[0] for i in ids) and len(ids[0]) == 2
