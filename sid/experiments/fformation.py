@@ -74,6 +74,7 @@ DEFAULT_GRID: dict[str, tuple[float, ...]] = {
     "angular_weight": (0.35, 0.5, 0.75),
     "radius_max": (0.8, 1.0),
     "body_radius": (0.1, 0.2),
+    "coarse_pair_reach": (0.0, 1.0, 1.5, 2.0),
 }
 """The o-space parameters ``sid eval fformation --cross-validate`` chooses among, the grid that chose the
 defaults (docs/groups.md)."""

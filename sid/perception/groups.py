@@ -115,6 +115,11 @@ class GroupParams:
       15 degrees is taken as quantised to the largest of these. Chosen by cross-validation (docs/groups.md).
     angular_weight: weight of a member's facing against standing on the circle, 1 being GCFF's proposal distance.
       Chosen by cross-validation (docs/groups.md).
+    coarse_pair_reach: in a frame whose facings are quantised coarser than facing_slack (half the step wider
+      than it: four or eight directions), two people with known facings at most this far apart (m) also propose
+      the o-space of their pair, centred on their midpoint: a quantised facing may point 45 degrees from the
+      centre, the proposals ahead then miss it, and proximity carries the decision. 0 turns it off. Chosen by
+      cross-validation (docs/groups.md).
     unknown_facing_cost: a person without facing may join a group formed by others when standing on its circle; the
       unexplained facing costs as much as a proposal this far (m) from the centre. 0.5: its square, 0.25 m^2, leaves
       room under the price for standing 0.6 m off the circle; a doubtful facing then gains nothing over a clear one
@@ -156,6 +161,7 @@ class GroupParams:
     alone_price: float = 0.65
     facing_slack: float = 0.4
     angular_weight: float = 0.35
+    coarse_pair_reach: float = 1.5
     unknown_facing_cost: float = 0.5
     body_radius: float = 0.1
     facing_weight_floor: float = 0.5
@@ -173,6 +179,7 @@ class GroupParams:
         if self.method not in GROUP_METHODS:
             raise ValueError(f"groups: method must be one of {', '.join(GROUP_METHODS)}, got {summary(self.method)}")
         self.ospace_model  # noqa: B018 - builds (and so checks) the o-space fields, once per record
+        self.coarse_ospace_model  # noqa: B018 - and the coarse-facing field
         self.gcff_params  # noqa: B018 - likewise the graph-cut fields
         check_number("groups", "facing_weight_floor", self.facing_weight_floor, low=0, low_open=True, high=1)
         check_number("groups", "facing_slack", self.facing_slack, low=0, high=math.pi)
@@ -215,6 +222,14 @@ class GroupParams:
             for old, new in names.items():
                 message = message.replace(f"groups: {old} ", f"groups: {new} ", 1)
             raise ValueError(message) from None
+
+    @cached_property
+    def coarse_ospace_model(self) -> OSpaceModel:
+        """``ospace_model`` for a frame with coarse facings: close pairs propose their o-space too."""
+        try:
+            return replace(self.ospace_model, pair_reach=self.coarse_pair_reach)
+        except ValueError as exc:
+            raise ValueError(str(exc).replace("ospace: pair_reach", "groups: coarse_pair_reach", 1)) from None
 
 
 @dataclass(frozen=True)
@@ -276,13 +291,14 @@ def _ospace_groups(
     origin = complex(math.fsum(positions[i].real for i in order), math.fsum(positions[i].imag for i in order))
     origin /= len(order)
     thetas = [people[i].theta for i in order]
-    slack = max(params.facing_slack, 0.5 * facing_step(thetas))  # rad, every facing's cone
+    half_step = 0.5 * facing_step(thetas)  # rad
+    coarse = half_step > params.facing_slack  # quantised more coarsely than the facings' own slack
     found = find_ospaces(
         [positions[i] - origin for i in order],
         [facing[i] for i in order],
         [floor + (1.0 - floor) * min(max(people[i].orientation_quality, 0.0), 1.0) for i in order],
-        params.ospace_model,
-        [slack] * len(order),
+        params.coarse_ospace_model if coarse else params.ospace_model,
+        [max(params.facing_slack, half_step)] * len(order),  # rad, every facing's cone
     )
     members = [sorted(order[k] for k in ospace.members.tolist()) for ospace in found]
     centres = [ospace.centre + origin for ospace in found]

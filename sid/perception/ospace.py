@@ -28,9 +28,12 @@ facing turned into its cone towards the centre (f'_j), the c and R that minimise
    uncapacitated facility-location problem), each person then takes the cheapest open o-space or stays alone;
 2. refit: each group's c and R from its members.
 
-The first candidates are every known-facing person's proposals at several radii (``radius_min`` to ``radius_max``);
-later rounds use the refitted groups plus the first proposals of whoever is still alone. Only people with a known
-facing open an o-space and a group needs two of them; people with unknown facing may then join one.
+The first candidates are every known-facing person's proposals at several radii (``radius_min`` to ``radius_max``)
+and, for two known facings within ``pair_reach`` of each other, neither facing more than 90 degrees away from the
+other, the o-space of their pair (centre their midpoint, radius half their distance): where facings are coarse the
+proposals ahead miss the centre, and proximity has to carry the decision. Later rounds use the refitted groups plus
+the first proposals of whoever is still alone. Only people with a known facing open an o-space and a group needs
+two of them; people with unknown facing may then join one.
 
 Two implementations of the same arithmetic, cross-checked by the tests: a crowd runs on numpy arrays,
 candidate-major (row k lists the people within reach of candidate k's centre, a KD-tree's answer), so the work grows
@@ -89,6 +92,7 @@ class OSpaceModel:
     body_radius: float
     alone_price: float
     angular_weight: float = 1.0
+    pair_reach: float = 0.0
 
     def __post_init__(self) -> None:
         far, vast = MAX_LENGTH, MAX_LENGTH**2  # squared and summed downstream: bounded, they stay finite
@@ -99,6 +103,7 @@ class OSpaceModel:
         check_number("ospace", "unknown_cost", self.unknown_cost, low=0, high=far, unit="metres")
         check_number("ospace", "body_radius", self.body_radius, low=0, high=far, unit="metres")
         check_number("ospace", "angular_weight", self.angular_weight, low=0, low_open=True)
+        check_number("ospace", "pair_reach", self.pair_reach, low=0, high=far, unit="metres")
         steps = self.radius_steps
         if isinstance(steps, bool) or int(steps) != steps or not 1 <= steps <= MAX_RADIUS_STEPS:
             raise ValueError(f"ospace: radius_steps must be an integer in [1, {MAX_RADIUS_STEPS}], got {steps}")
@@ -113,6 +118,17 @@ class OSpaceModel:
     def radius_list(self) -> list[float]:
         """``radii`` as Python numbers."""
         return self.radii.tolist()
+
+    @cached_property
+    def pair_reach_squared(self) -> float:
+        """Squared distance (m^2) up to which two people propose their pair's o-space: ``pair_reach`` squared,
+        widened by ``TIE`` so that a pair exactly at ``pair_reach`` stays in after any rigid motion's rounding."""
+        return self.pair_reach * self.pair_reach * (1.0 + TIE)
+
+    def pair_proposal(self, a: complex, b: complex, distance2: float) -> tuple[complex, float]:
+        """The o-space two people at ``a`` and ``b`` (complex, m), ``distance2`` (m^2) apart, propose together:
+        centre their midpoint, radius half their distance clamped to the model's range."""
+        return (a + b) * 0.5, min(max(0.5 * math.sqrt(distance2), self.radius_min), self.radius_max)
 
     @cached_property
     def reach(self) -> float:
@@ -176,6 +192,7 @@ def _find_crowd(
     f = np.where(known, facing, 0)
     w = np.where(known, weight, 0.0)
     radii = model.radii
+    # The first proposals: each known facing's at every radius, then each close pair's; made by (owner, partner).
     first_owner = owners.repeat(len(radii))
     first_radii = radii[None, :].repeat(len(owners), axis=0).ravel()
     first_centres = positions[first_owner] + first_radii * f[first_owner]
@@ -183,6 +200,12 @@ def _find_crowd(
     table = np.array((positions.real, positions.imag, f.real, f.imag, w, np.cos(slack), np.sin(slack)))
     known_list = known.tolist()
     tree = cKDTree(table[:2].T)
+    first_partner = first_owner
+    if model.pair_reach > 0:
+        a, b, pair_centres, pair_radii = _pair_proposals(positions, facing, owners, model)
+        first_owner, first_partner = np.concatenate((first_owner, a)), np.concatenate((first_partner, b))
+        first_centres = np.concatenate((first_centres, pair_centres))
+        first_radii = np.concatenate((first_radii, pair_radii))
     centres, rad = first_centres, first_radii
     labels: list[int] = []
     for _ in range(_MAX_ROUNDS):
@@ -195,7 +218,7 @@ def _find_crowd(
         fitted_centres, fitted_radii = _refit(label_array, table, centres[behind], rad[behind], model)
         if labels == previous:
             break
-        alone = label_array[first_owner] < 0
+        alone = (label_array[first_owner] < 0) | (label_array[first_partner] < 0)
         centres = np.concatenate((fitted_centres, first_centres[alone]))
         rad = np.concatenate((fitted_radii, first_radii[alone]))
     # Members of group k: a slice of the people sorted by label (stable, so ascending within each group).
@@ -207,6 +230,37 @@ def _find_crowd(
             bounds[:-1], bounds[1:], fitted_centres.tolist(), fitted_radii.tolist(), strict=True
         )
     ]
+
+
+def _pair_proposals(
+    positions: np.ndarray, facing: np.ndarray, owners: np.ndarray, model: OSpaceModel
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The pair proposals (``OSpaceModel.pair_proposal``) of the ``owners`` (indices of known facings, ascending) at
+    ``positions`` (complex, m) within ``pair_reach`` of each other, neither facing (``facing``, complex unit) away
+    from the other (``_face_partner``): first and second person (ascending, pairs in
+    lexicographic order), centres (complex) and radii (m)."""
+    from scipy.spatial import cKDTree
+
+    xy = np.column_stack((positions.real, positions.imag))[owners]
+    bound = model.pair_reach_squared
+    found = cKDTree(xy).query_pairs(math.sqrt(bound) * (1.0 + 1e-6), output_type="ndarray")  # a superset
+    found = found[np.lexsort((found[:, 1], found[:, 0]))]
+    a, b = owners[found[:, 0]], owners[found[:, 1]]
+    dx, dy = positions[b].real - positions[a].real, positions[b].imag - positions[a].imag
+    distance2 = dx * dx + dy * dy
+    fa, fb, tie = facing[a], facing[b], TIE * np.sqrt(distance2)
+    # As the small path decides it (``_face_partner``).
+    keep = (distance2 <= bound) & (fa.real * dx + fa.imag * dy >= -tie) & (fb.real * dx + fb.imag * dy <= tie)
+    a, b, distance2 = a[keep], b[keep], distance2[keep]
+    radii = np.minimum(np.maximum(0.5 * np.sqrt(distance2), model.radius_min), model.radius_max)
+    return a, b, (positions[a] + positions[b]) * 0.5, radii
+
+
+def _face_partner(fa: complex, fb: complex, dx: float, dy: float, tie: float) -> bool:
+    """Whether neither of two people, facing ``fa`` and ``fb`` (complex unit), the second (dx, dy) (m) from the
+    first, faces away from the other: each facing within 90 degrees of the direction to the partner (``tie``, m, the
+    rounding allowed on the projections). Side by side counts; back to back does not."""
+    return fa.real * dx + fa.imag * dy >= -tie and fb.real * dx + fb.imag * dy <= tie
 
 
 def _near(tree: cKDTree, centres: np.ndarray, reach: float) -> np.ndarray:
@@ -411,20 +465,29 @@ def _find_small(
     people who may join it. The first candidates' rows do not change between rounds: computed once."""
     known: list[bool] = []
     people: list[_Person] = []
-    first: list[tuple[complex, float]] = []  # (centre, radius) of each known facing's first proposals
-    first_owner: list[int] = []
+    first: list[tuple[complex, float]] = []  # (centre, radius) of the first proposals
+    first_owner: list[tuple[int, int]] = []  # who made each (twice the same person for a person's own)
     radii = model.radius_list
     for j, (p, f, w, s) in enumerate(zip(positions, facing, weight, slack, strict=True)):
         if f == f:  # a known facing: a complex NaN is unequal to itself
             known.append(True)
             people.append((p.real, p.imag, f.real, f.imag, w, math.cos(s), math.sin(s)))
             first += [(p + r * f, r) for r in radii]
-            first_owner += [j] * len(radii)
+            first_owner += [(j, j)] * len(radii)
         else:
             known.append(False)
             people.append((p.real, p.imag, 0.0, 0.0, 0.0, 1.0, 0.0))
-    if len(first) < 2 * len(radii):
+    if sum(known) < 2:
         return []
+    if model.pair_reach > 0:
+        owners, bound = [j for j, k in enumerate(known) if k], model.pair_reach_squared
+        for i, a in enumerate(owners):
+            for b in owners[i + 1 :]:
+                dx, dy = positions[b].real - positions[a].real, positions[b].imag - positions[a].imag
+                distance2 = dx * dx + dy * dy
+                if distance2 <= bound and _face_partner(facing[a], facing[b], dx, dy, TIE * math.sqrt(distance2)):
+                    first.append(model.pair_proposal(positions[a], positions[b], distance2))
+                    first_owner.append((a, b))
     scene = _SmallScene(people, known, model)
     first_rows = scene.rows(first)
     candidates, rows = first, first_rows
@@ -435,7 +498,7 @@ def _find_small(
         fitted = _refit_small(labels, people, [candidates[k] for k in behind], model)
         if labels == previous:
             break
-        alone = [k for k, o in enumerate(first_owner) if labels[o] < 0]
+        alone = [k for k, (a, b) in enumerate(first_owner) if labels[a] < 0 or labels[b] < 0]
         candidates = fitted + [first[k] for k in alone]
         rows = scene.rows(fitted) + [first_rows[k] for k in alone]
     return [

@@ -92,8 +92,8 @@ def test_group_params_come_from_the_options(tmp_path, capsys, monkeypatch):
     code, out, _ = run_sid(["groups", "-", "--method", "rays", "--spread-threshold", "0.3"], capsys)
     assert code == 0 and json.loads(out[0])["groups"] == []  # D = 0.4 m > 0.3 m
     monkeypatch.setattr(sys, "stdin", io.StringIO(json.dumps(PAIR) + "\n"))
-    code, out, _ = run_sid(["groups", "-", "--group-price", "0.01"], capsys)
-    assert code == 0 and json.loads(out[0])["groups"] == []  # the o-space method: the pair costs more than that
+    code, out, _ = run_sid(["groups", "-", "--alone-price", "0.005"], capsys)
+    assert code == 0 and json.loads(out[0])["groups"] == []  # the o-space method: two alone cost less than a group
     code, _, err = run_sid(["groups", "-", "--eps", "-1"], capsys)
     assert code == 2 and "eps must be a positive" in err
     code, _, err = run_sid(["groups", str(tmp_path / "missing.jsonl")], capsys)

@@ -417,6 +417,22 @@ def test_quantised_facings_widen_their_cones_to_half_the_step():
     assert [g.members for g in detect_groups([*pair, Person(3, 10.0, 10.0, math.radians(37), 1.0)], wide)] == [(1, 2)]
 
 
+def test_coarse_facings_let_proximity_pair_people_the_cones_alone_do_not():
+    # GDet S1 t=1213: two people 1.37 m apart side by side, both facing 90 degrees, facings on a 90 degree grid.
+    # Their 45 degree cones hold no centre that the proposals ahead of them reach; their pair's midpoint does.
+    pair = [Person(1, 0.0, 0.0, math.pi / 2, 1.0), Person(2, 1.37, 0.0, math.pi / 2, 1.0)]
+    far = Person(3, 10.0, 10.0, math.pi, 1.0)
+    assert [g.members for g in detect_groups([*pair, far])] == [(1, 2)]
+    assert detect_groups([*pair, far], GroupParams(coarse_pair_reach=0.0)) == []
+    # Continuous facings (a third off the grid) keep their 23 degree cones and propose no pairs.
+    assert detect_groups([*pair, Person(3, 10.0, 10.0, math.radians(37), 1.0)]) == []
+    # Beyond the reach no pair is proposed.
+    apart = [pair[0], replace(pair[1], x=1.6)]
+    assert detect_groups([*apart, far], GroupParams(coarse_pair_reach=1.5)) == []
+    with pytest.raises(ValueError, match="groups: coarse_pair_reach"):
+        GroupParams(coarse_pair_reach=-1.0)
+
+
 def test_gcff_is_a_method_with_zones_like_the_others():
     ring = circle(5, 0.9, centre=(2.0, 1.0), start_deg=10, first_id=20)
     [group] = detect_groups(ring, GroupParams(method="gcff"))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import cmath
+import itertools
 import math
 
 import numpy as np
@@ -13,6 +14,7 @@ from sid.perception.groups import GroupParams
 from sid.perception.ospace import OSpaceModel, find_ospaces
 
 MODEL = GroupParams().ospace_model
+PAIRS = GroupParams(coarse_pair_reach=1.5).coarse_ospace_model  # close pairs propose their o-space too
 
 
 def inputs(people: list[tuple[float, float, float | None]]) -> tuple[list[complex], list[complex], list[float]]:
@@ -59,13 +61,14 @@ def test_the_crowd_path_gives_what_the_small_scene_path_gives(monkeypatch):
 
 @pytest.mark.parametrize("seed", range(12))
 @pytest.mark.parametrize("slack", [0.0, 0.4, math.pi / 4])
-def test_the_two_paths_agree_on_random_scenes(seed: int, slack: float, monkeypatch) -> None:
+@pytest.mark.parametrize("model", [MODEL, PAIRS], ids=["own proposals", "pair proposals"])
+def test_the_two_paths_agree_on_random_scenes(seed: int, slack: float, model: OSpaceModel, monkeypatch) -> None:
     scene = random_scene(seed)
     slacks = [slack] * len(scene[0])
     monkeypatch.setattr(ospace, "_SMALL_PEOPLE_MAX", 0)
-    crowd = find_ospaces(*scene, MODEL, slacks)
+    crowd = find_ospaces(*scene, model, slacks)
     monkeypatch.setattr(ospace, "_SMALL_PEOPLE_MAX", 1000)
-    small = find_ospaces(*scene, MODEL, slacks)
+    small = find_ospaces(*scene, model, slacks)
     assert [g.members.tolist() for g in crowd] == [g.members.tolist() for g in small]
     assert [g.centre for g in crowd] == pytest.approx([g.centre for g in small], abs=1e-9)
     assert [g.radius for g in crowd] == pytest.approx([g.radius for g in small], abs=1e-9)
@@ -127,6 +130,34 @@ def test_random_scenes_give_the_recorded_groups(seed: int) -> None:
     assert [g.members.tolist() for g in find_ospaces(*random_scene(seed), MODEL)] == EXPECTED_MEMBERS[seed]
 
 
+@pytest.mark.parametrize("small", [False, True])
+def test_a_close_pair_proposes_its_midpoint_where_the_proposals_ahead_miss(small: bool, monkeypatch) -> None:
+    # Side by side 1.37 m apart, both facing +y, cones of 45 degrees (facings quantised to 90): the proposals
+    # ahead of each lie 0.3-0.8 m in front, far from any centre both cones hold; their midpoint is in both cones.
+    monkeypatch.setattr(ospace, "_SMALL_PEOPLE_MAX", 1000 if small else 0)
+    scene = inputs([(0.0, 0.0, math.pi / 2), (1.37, 0.0, math.pi / 2)])
+    cones = [math.pi / 4] * 2
+    assert find_ospaces(*scene, MODEL, cones) == []
+    [group] = find_ospaces(*scene, PAIRS, cones)
+    assert group.members.tolist() == [0, 1]
+    assert group.centre.real == pytest.approx(0.685) and group.centre.imag > 0  # between them, in front of both
+    farther = inputs([(0.0, 0.0, math.pi / 2), (3.2, 0.0, math.pi / 2)])  # beyond pair_reach: no pair proposal
+    assert find_ospaces(*farther, PAIRS, cones) == []
+    # Back to back 0.6 m apart: neither faces the other, so no pair proposal, and no group.
+    assert find_ospaces(*inputs([(0.0, 0.0, math.pi), (0.6, 0.0, 0.0)]), PAIRS, cones) == []
+
+
+@pytest.mark.parametrize("angle", [0.0, 0.01, 0.05, 0.3])
+def test_a_pair_exactly_at_pair_reach_proposes_whatever_the_rounding(angle: float) -> None:
+    # 1.5 m apart: the distance's rounding after a rotation must not decide whether the pair proposes (at 0.01
+    # and 0.05 rad the squared distance rounds above 2.25, at 0 and 0.3 it is 2.25 exactly).
+    turn = cmath.exp(1j * angle)
+    positions = [0j, 1.5 * turn]
+    facing = [1j * turn, 1j * turn]
+    found = find_ospaces(positions, facing, [1.0, 1.0], PAIRS, [math.pi / 4] * 2)
+    assert [g.members.tolist() for g in found] == [[0, 1]]
+
+
 def test_two_people_without_facing_form_nothing():
     assert find_ospaces(*inputs([(0.0, 0.0, None), (0.8, 0.0, None), (0.4, 0.5, -math.pi / 2)]), MODEL) == []
 
@@ -141,6 +172,8 @@ def test_two_people_without_facing_form_nothing():
         ("body_radius", -1),
         ("alone_price", 0.0),
         ("angular_weight", -1.0),
+        ("pair_reach", -0.5),
+        ("pair_reach", math.inf),
     ],
 )
 def test_bad_constants_are_refused_by_name(field, value):
@@ -157,7 +190,8 @@ def test_reach_squared_is_the_exact_threshold_of_the_rounded_root():
 
 
 @pytest.mark.parametrize("seed", range(40))
-def test_the_small_path_matches_a_direct_transcription_of_the_crowd_rules(seed: int) -> None:
+@pytest.mark.parametrize("model", [MODEL, PAIRS], ids=["own proposals", "pair proposals"])
+def test_the_small_path_matches_a_direct_transcription_of_the_crowd_rules(seed: int, model: OSpaceModel) -> None:
     # Rows and greedy passes written out plainly (no shortcuts: every row in every pass, every neighbour tested),
     # on scenes small enough for the small path, with ties from a coarse grid in half of them.
     rng = np.random.default_rng(seed)
@@ -172,8 +206,8 @@ def test_the_small_path_matches_a_direct_transcription_of_the_crowd_rules(seed: 
     facing = [complex(math.cos(a), math.sin(a)) if rng.random() > 0.15 else complex(math.nan, math.nan) for a in angles]
     weight = rng.choice([1.0, 0.5, 0.75], n).tolist()
     slack = [float(rng.choice([0.0, 0.4, math.pi / 4]))] * n
-    found = find_ospaces(positions, facing, weight, MODEL, slack)
-    expected = plain_search(positions, facing, weight, slack, MODEL)
+    found = find_ospaces(positions, facing, weight, model, slack)
+    expected = plain_search(positions, facing, weight, slack, model)
     assert [(g.members.tolist(), g.centre, g.radius) for g in found] == expected
 
 
@@ -190,7 +224,18 @@ def plain_search(positions, facing, weight, slack, model) -> list[tuple[list[int
     ]
     radii = model.radii.tolist()
     first = [(positions[o] + r * facing[o], r) for o in owners for r in radii]
-    first_owner = [o for o in owners for _ in radii]
+    first_owner = [(o, o) for o in owners for _ in radii]
+    for a, b in itertools.combinations(owners, 2):  # pairs at most pair_reach apart (TIE above it) propose too,
+        distance = abs(positions[b] - positions[a])  # unless one faces more than 90 degrees away from the other
+        towards = [
+            cmath.phase((positions[b] - positions[a]) / facing[a]),
+            cmath.phase((positions[a] - positions[b]) / facing[b]),
+        ]
+        if distance <= model.pair_reach * (1 + 1e-9) and max(map(abs, towards)) <= math.pi / 2 + 1e-9:
+            first.append(
+                ((positions[a] + positions[b]) / 2, min(max(distance / 2, model.radius_min), model.radius_max))
+            )
+            first_owner.append((a, b))
     candidates, labels = first, []
     for _ in range(8):
         previous = labels
@@ -199,7 +244,7 @@ def plain_search(positions, facing, weight, slack, model) -> list[tuple[list[int
         fitted = ospace._refit_small(labels, people, [candidates[k] for k in behind], model)
         if labels == previous:
             break
-        candidates = fitted + [first[k] for k, o in enumerate(first_owner) if labels[o] < 0]
+        candidates = fitted + [first[k] for k, (a, b) in enumerate(first_owner) if min(labels[a], labels[b]) < 0]
     return [
         ([j for j, label in enumerate(labels) if label == g], centre, radius)
         for g, (centre, radius) in enumerate(fitted)
