@@ -12,8 +12,8 @@ from costmap.grid import GridSpec
 from costmap.layer import LayerInputs
 from costmap.plugins import layered_costmap
 from planner.facade import plan
-from planner.metrics import path_metrics
 from planner.problem import PlanningProblem
+from sid.experiments.path_metrics import path_metrics
 from sid.perception.mount import CameraMount
 from sid.perception.pipeline import Pipeline
 from sid.scenario.lidar import simulate_scan

@@ -8,9 +8,9 @@ from __future__ import annotations
 import cv2
 
 from planner.facade import plan
-from planner.metrics import path_metrics
-from planner.render import WITH_COLOUR, WITHOUT_COLOUR, PathStyle, render_paths
 from sid.experiments.demo import demo_scenario
+from sid.experiments.path_metrics import path_metrics
+from sid.experiments.path_render import WITH_COLOUR, WITHOUT_COLOUR, PathStyle, render_paths
 from sid.perception.groups import detect_groups
 from sid.scenario.build import build_costmap, planning_problem
 

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from planner.render import WITH_COLOUR, WITHOUT_COLOUR
+from sid.experiments.path_render import WITH_COLOUR, WITHOUT_COLOUR
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

@@ -3,10 +3,10 @@ known map and LiDAR: "without") and on the costmap with it ("with"), measure eve
 
 One ``Task`` per scenario holds its groups (detected from its people with ``sid.perception.groups.detect_groups``),
 the costmap and planning problem of each mode, and the grid planner's cost as the reference for cost ratios. Every
-path is measured against those groups and on the social costmap (``planner.metrics.result_metrics``), also when the
-robot planned without the social layer: "the path went through the conversation" is measured whether or not the
-robot knew about it, and the two modes' numbers compare directly. ``sid demo``, ``sid plan``, ``sid compare``,
-``sid reproduce navigation`` and ``sid bench``'s planner stages all plan through here.
+path is measured against those groups and on the social costmap (``sid.experiments.path_metrics.result_metrics``),
+also when the robot planned without the social layer: "the path went through the conversation" is measured whether
+or not the robot knew about it, and the two modes' numbers compare directly. ``sid demo``, ``sid plan``, ``sid
+compare``, ``sid reproduce navigation`` and ``sid bench``'s planner stages all plan through here.
 
 World frame (REP-103), metres, seconds. A run's ``cost_ratio`` is its path cost J over the grid planner's J on the
 same costmap (``raw_cost_ratio``: the planner's own path before smoothing); ``detour`` is, on a "with" run, its
@@ -26,8 +26,8 @@ from shapely.geometry import Point
 from costmap.layered import LayeredCostmap
 from costmap.layers.social import group_zone_polygon
 from planner.facade import PlanResult, plan, resolve_planner
-from planner.metrics import result_metrics
 from planner.problem import DEFAULT_COST_WEIGHT, PlanningError, PlanningProblem
+from sid.experiments.path_metrics import result_metrics
 from sid.perception.group import Group
 from sid.perception.groups import detect_groups
 from sid.scenario.build import build_costmap, planning_problem

@@ -1,12 +1,12 @@
-"""Pictures and tables of a ``harness.Comparison``: its paths over the costmap (``planner.render``, BGR uint8) with a
-metrics table under them, and the same table as plain text."""
+"""Pictures and tables of a ``harness.Comparison``: its paths over the costmap (``sid.experiments.path_render``, BGR
+uint8) with a metrics table under them, and the same table as plain text."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from planner.render import WITH_COLOUR, WITHOUT_COLOUR, PathStyle, add_header, add_table, render_paths
 from sid.experiments.harness import LABELS, Comparison
+from sid.experiments.path_render import WITH_COLOUR, WITHOUT_COLOUR, PathStyle, add_header, add_table, render_paths
 from sid.scenario.obstacles import outline
 
 __all__ = ["HEADER", "STYLES", "format_table", "metric_cells", "plan_picture"]

@@ -20,12 +20,10 @@ import json
 import threading
 import time
 from collections.abc import Iterable
-from dataclasses import fields
 from typing import Any
 
 import rclpy
 from nav_msgs.msg import OccupancyGrid, Odometry
-from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
 from rclpy.time import Time as RosTime
@@ -33,7 +31,6 @@ from sensor_msgs.msg import CameraInfo, Image
 from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
 
-from costmap.plugins import CostmapParams
 from sid.documents import plural
 from sid.perception.camera import Intrinsics
 from sid.perception.frame import Frame
@@ -41,12 +38,12 @@ from sid.perception.pipeline import Pipeline, PoseFn
 from sid.perception.robot_pose import RobotPose
 from sid.ros import messages
 from sid.ros.convert import grid_fields, groups_document, scene_markers, yaw_from_quaternion
-from sid.ros.params import NODE_NAME, PARAMETERS, NodeParams, ros_name
+from sid.ros.params import NODE_NAME, read_params
 from sid.sources import FrameReadError, skip_unreadable
 from sid.sources.ros_messages import StampPairer, intrinsics_from_camera_info, rgbd_frame, stamp_seconds
 from sid.stream import SocialStream, StreamUpdate
 
-__all__ = ["COSTMAP_LAYERS", "LATCHED", "SPIN_WAIT", "SocialCostmapNode", "spin"]
+__all__ = ["LATCHED", "SPIN_WAIT", "SocialCostmapNode", "spin"]
 
 LATCHED = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
@@ -57,14 +54,6 @@ LATCHED = QoSProfile(
 """What map topics offer, and Nav2's costmap filters expect of a mask and its filter info."""
 SPIN_WAIT = 0.2
 """Longest wait (s) for a callback before the spin loop returns to Python (and to its signal handlers)."""
-COSTMAP_LAYERS = ("tracked_people",)
-"""Only sid's layer: Nav2's own costmaps keep their static, obstacle and inflation layers."""
-
-
-def _typed(value: Any, default: object) -> Any:
-    """A parameter value in the type of its default (a YAML ``20`` for a float parameter is 20.0)."""
-    kind: Any = type(default)
-    return kind(value)
 
 
 class SocialCostmapNode:
@@ -73,12 +62,7 @@ class SocialCostmapNode:
 
     def __init__(self, pose: PoseFn, camera_topics: bool = True) -> None:
         self.node: Node = rclpy.create_node(NODE_NAME)
-        for name, default, description in PARAMETERS:
-            self.node.declare_parameter(
-                name, default, ParameterDescriptor(description=description, dynamic_typing=True)
-            )
-        values = {name: _typed(self.node.get_parameter(name).value, default) for name, default, _ in PARAMETERS}
-        self.params = p = NodeParams(**{f.name: values[ros_name(f.name)] for f in fields(NodeParams)})
+        self.params = p = read_params(self.node)
         self.pose = pose
         self.stream = self._new_stream()
         self.fixed_robot = False
@@ -127,8 +111,8 @@ class SocialCostmapNode:
         )
 
     def _new_stream(self) -> SocialStream:
-        costmap = CostmapParams(plugins=COSTMAP_LAYERS)
-        return SocialStream(Pipeline(self.pose, self.params.mount, group=False), self.params.grid, costmap)
+        pipeline = Pipeline(self.pose, self.params.mount, group=False)
+        return SocialStream(pipeline, self.params.grid, self.params.layers)
 
     def _pose_source(self) -> str:
         chosen = self.params.pose_source

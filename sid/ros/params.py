@@ -1,28 +1,59 @@
-"""The ``sid ros`` node's ROS parameters: names, defaults and descriptions, and the record the node reads them into.
+"""The ``sid ros`` node's ROS parameters: names, defaults and descriptions, the record the node reads them into, and
+``read_params``, which declares and reads them on the node.
 
-Nothing here imports ROS: the node declares each ``PARAMETERS`` entry with its description, and tests check the
-shipped parameters YAML against the same table.
+The fixed parameters are the ``PARAMETERS`` table; tests check the shipped parameters YAML against it. The costmap's
+layers are named as Nav2's costmap_2d names them: ``costmap.plugins`` lists layer instances, a name that is not a
+plugin's gets ``costmap.NAME.plugin``, and every instance its plugin's parameters as ``costmap.NAME.FIELD``; they are
+declared once the list is read. Importing this module imports no ROS; ``read_params`` needs an rclpy node.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from collections.abc import Sequence
+from dataclasses import dataclass, field, fields, replace
+from typing import TYPE_CHECKING, Any
 
 from costmap.grid import GridSpec
+from costmap.plugins import PLUGINS, SECTIONS, CostmapParams
 from sid.checks import check_number, check_numbers
 from sid.perception.mount import CameraMount
 from sid.perception.robot_pose import BASE_FRAME, MAP_FRAME
+from sid.scenario.loader import layers_from_dict
 from sid.sources.rosbag2 import COLOR_TOPIC, DEPTH_TOPIC
 
-__all__ = ["DESCRIPTIONS", "NODE_NAME", "NodeParams", "PARAMETERS", "POSE_SOURCES", "ros_name"]
+if TYPE_CHECKING:
+    from rclpy.node import Node
+
+__all__ = [
+    "DEFAULT_LAYERS",
+    "DESCRIPTIONS",
+    "LAYERS_PARAMETER",
+    "NODE_NAME",
+    "NODE_PLUGINS",
+    "NodeParams",
+    "PARAMETERS",
+    "POSE_SOURCES",
+    "read_params",
+    "ros_name",
+]
 
 NODE_NAME = "sid_social_costmap"
 POSE_SOURCES = ("auto", "tf", "odom", "none")
+LAYERS_PARAMETER = "costmap.plugins"
+"""The ROS parameter listing the costmap's layer instances (Nav2's ``plugins``)."""
+DEFAULT_LAYERS = ("tracked_people",)
+"""Only sid's layer: Nav2's own costmaps keep their static, obstacle and inflation layers."""
+NODE_PLUGINS = ("social", "tracked_people", "inflation")
+"""The plugins the node can feed: it reads no map and no scan, so ``static`` and ``lidar`` layers would stay empty."""
 
 
 @dataclass(frozen=True)
 class NodeParams:
-    """Every parameter of the node (ROS name = field name with ``__`` read as ``.``; metres, radians, seconds)."""
+    """Every parameter of the node (ROS name = field name with ``__`` read as ``.``; metres, radians, seconds).
+
+    ``layers``: the costmap's layer instances, from ``costmap.plugins`` and ``costmap.NAME.*`` (see the module
+    docstring), each of a plugin in ``NODE_PLUGINS``.
+    """
 
     color_topic: str = COLOR_TOPIC
     depth_topic: str = DEPTH_TOPIC
@@ -44,6 +75,7 @@ class NodeParams:
     costmap__height: float = 20.0
     costmap__origin_x: float = -10.0
     costmap__origin_y: float = -10.0
+    layers: CostmapParams = field(default_factory=lambda: CostmapParams(plugins=DEFAULT_LAYERS))
     costmap_topic: str = "/social_costmap"
     filter_info_topic: str = "/social_costmap_filter_info"
     markers_topic: str = "/social_markers"
@@ -56,6 +88,16 @@ class NodeParams:
         check_numbers("parameters", self, ("sync_tolerance", "transform_timeout"), low=0, unit="seconds")
         self.grid  # noqa: B018 - checks the costmap geometry now, with a message naming it
         self.mount  # noqa: B018 - the same for the camera mount
+        taken = {ros_name(f.name).removeprefix("costmap.") for f in fields(self) if ros_name(f.name).count(".")}
+        for name in self.layers.plugins:
+            plugin = self.layers.plugin(name)
+            if name in taken:
+                raise ValueError(f"{LAYERS_PARAMETER}: costmap.{name} is a parameter already; name the layer otherwise")
+            if plugin not in NODE_PLUGINS:
+                raise ValueError(
+                    f"{LAYERS_PARAMETER}: {name} is a {plugin} layer, which the node cannot feed (it reads no map and "
+                    f"no scan; Nav2's own costmaps keep those layers); the node's plugins: {', '.join(NODE_PLUGINS)}"
+                )
 
     @property
     def grid(self) -> GridSpec:
@@ -98,6 +140,9 @@ DESCRIPTIONS: dict[str, str] = {
     "costmap__height": "costmap extent along global y (m)",
     "costmap__origin_x": "global x of the costmap's lower-left corner (m)",
     "costmap__origin_y": "global y of the costmap's lower-left corner (m)",
+    "layers": "the costmap's layer instances in combination order, as Nav2's plugins: a plugin's name (social, "
+    "tracked_people, inflation) or a name of your own with costmap.NAME.plugin; each instance's parameters are "
+    "costmap.NAME.FIELD (docs/ros2.md)",
     "costmap_topic": "nav_msgs/OccupancyGrid KeepoutFilter mask (reliable, transient local, depth 1)",
     "filter_info_topic": "nav2_msgs/CostmapFilterInfo for the mask (published when nav2_msgs is importable)",
     "markers_topic": "visualization_msgs/MarkerArray of people and groups for RViz",
@@ -106,11 +151,69 @@ DESCRIPTIONS: dict[str, str] = {
 
 
 def ros_name(field: str) -> str:
-    """A NodeParams field name -> its ROS parameter name (``costmap__width`` -> ``costmap.width``)."""
-    return field.replace("__", ".")
+    """A NodeParams field name -> its ROS parameter name (``costmap__width`` -> ``costmap.width``; ``layers`` ->
+    ``costmap.plugins``)."""
+    return LAYERS_PARAMETER if field == "layers" else field.replace("__", ".")
 
 
 PARAMETERS: tuple[tuple[str, object, str], ...] = tuple(
-    (ros_name(f.name), f.default, DESCRIPTIONS[f.name]) for f in fields(NodeParams)
+    (ros_name(f.name), list(DEFAULT_LAYERS) if f.name == "layers" else f.default, DESCRIPTIONS[f.name])
+    for f in fields(NodeParams)
 )
-"""(ROS name, default, description) of every parameter, in declaration order."""
+"""(ROS name, default, description) of every fixed parameter, in declaration order (``costmap.plugins`` with the
+names of the default layers; the instances' own parameters are declared by ``read_params``)."""
+
+
+def _typed(value: Any, default: object) -> Any:
+    """A parameter value in the type of its default (a YAML ``20`` for a float parameter is 20.0)."""
+    kind: Any = type(default)
+    return kind(value)
+
+
+def _declare(node: Node, name: str, default: object, description: str) -> Any:
+    """Declare the parameter ``name`` on ``node`` (any type accepted: values are checked when read) and return its
+    value: the one given (``-p``, a parameters file) or ``default``."""
+    from rcl_interfaces.msg import ParameterDescriptor
+
+    descriptor = ParameterDescriptor(description=description, dynamic_typing=True)
+    return node.declare_parameter(name, default, descriptor).value
+
+
+def _layer_parameters(node: Node, names: Sequence[str]) -> dict[str, Any]:
+    """Declare and read the parameters of the layer instances ``names``, as the sections of a scenario file's
+    ``layers`` block (the mapping ``sid.scenario.loader.layers_from_dict`` reads): a plugin's own name -> its section
+    (``costmap.social.FIELD`` -> ``social: {FIELD: ...}``), another name -> ``{plugin: P, FIELD: ...}``."""
+    mapping: dict[str, Any] = {}
+    for name in dict.fromkeys(names):  # a name listed twice is refused by the loader, declared once here
+        entry: dict[str, Any]
+        if name in PLUGINS:
+            plugin, entry = name, {}
+            if name in SECTIONS:
+                mapping[SECTIONS[name]] = entry
+        else:
+            description = f"plugin of the layer instance {name}: one of {', '.join(NODE_PLUGINS)}"
+            plugin = _declare(node, f"costmap.{name}.plugin", "", description)
+            entry = {"plugin": plugin} if plugin != "" else {}
+            mapping[name] = entry
+        section = SECTIONS.get(plugin) if isinstance(plugin, str) else None
+        if section is None:
+            continue
+        record = getattr(CostmapParams(), section)
+        for f in fields(record):
+            description = f"{f.name} of the {name} layer ({plugin} plugin; docs/scenario.md, layer parameters)"
+            entry[f.name] = _declare(node, f"costmap.{name}.{f.name}", getattr(record, f.name), description)
+    return mapping
+
+
+def read_params(node: Node) -> NodeParams:
+    """Declare every parameter of the node on ``node`` (an ``rclpy.node.Node``), each with its description, and read
+    them: the fixed ones (``PARAMETERS``), then the layer instances ``costmap.plugins`` lists, Nav2-style (see the
+    module docstring), built by the scenario loader's ``layers_from_dict``. A bad value raises ValueError naming the
+    parameter."""
+    values = {name: _declare(node, name, default, description) for name, default, description in PARAMETERS}
+    names = values.pop(LAYERS_PARAMETER)
+    fixed = {f.name: _typed(values[ros_name(f.name)], f.default) for f in fields(NodeParams) if f.name != "layers"}
+    params = NodeParams(**fixed)
+    listed = names if isinstance(names, list) and all(isinstance(n, str) for n in names) else []
+    mapping = {"plugins": names, **_layer_parameters(node, listed)}
+    return replace(params, layers=layers_from_dict(mapping, params.grid, where="costmap"))

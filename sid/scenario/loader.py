@@ -41,6 +41,7 @@ __all__ = [
     "ScenarioError",
     "SegmentObstacle",
     "TOP_LEVEL",
+    "layers_from_dict",
     "load_scenario",
     "read_scenario_file",
     "scenario_from_dict",
@@ -196,17 +197,18 @@ def _params(value: Any, name: str, cls: type) -> Any:
         raise ScenarioError(f"{name}: {exc}") from exc
 
 
-def _plugins(value: Any, name: str, declared: dict[str, str]) -> tuple[str, ...]:
-    """Layer instance names in combination order: each a key of ``costmap.plugins.PLUGINS`` (an instance of that
-    plugin) or a name ``declared`` with its plugin (``layers.NAME.plugin``); at least one of them a layer that
-    marks people (the LiDAR's or a people layer): without one the robot would plan through them."""
+def _plugins(value: Any, where: str, declared: dict[str, str]) -> tuple[str, ...]:
+    """Layer instance names in combination order (``WHERE.plugins``): each a key of ``costmap.plugins.PLUGINS`` (an
+    instance of that plugin) or a name ``declared`` with its plugin (``WHERE.NAME.plugin``); at least one of them a
+    layer that marks people (the LiDAR's or a people layer): without one the robot would plan through them."""
+    name = f"{where}.plugins"
     if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
         raise _fail(name, "a list of layer names", value)
     for i, layer in enumerate(value):
         if layer not in PLUGINS and layer not in declared:
             raise ScenarioError(
                 f"{name}[{i}]: unknown layer {summary(layer)}; known layers: {', '.join(PLUGINS)}, or a name of "
-                f"your own declared as layers.{layer}: {{plugin: ...}}"
+                f"your own declared as {where}.{layer}: {{plugin: ...}}"
             )
     marking = ("lidar", *sorted(PEOPLE_LAYERS))
     if not {declared.get(v, v) for v in value} & set(marking):
@@ -218,40 +220,46 @@ _SECTION_TYPES: dict[str, type] = {section: type(getattr(CostmapParams(), sectio
 """The ``layers`` sections of each plugin's default parameters (``costmap.plugins.SECTIONS``) and their records."""
 
 
-def _layers(value: Any, grid: GridSpec, lidar: LidarSpec, edges: int) -> CostmapParams:
-    """The ``layers`` block: ``plugins``, each plugin's default parameters (``obstacle``, ``inflation``, ``social``,
+def layers_from_dict(
+    value: Any, grid: GridSpec, where: str = "layers", lidar: LidarSpec | None = None, edges: int = 0
+) -> CostmapParams:
+    """The costmap's layers from a mapping (a scenario file's ``layers`` block; the ``sid ros`` node's ``costmap.*``
+    parameters): ``plugins``, each plugin's default parameters (``obstacle``, ``inflation``, ``social``,
     ``tracked_people``) and the instances named otherwise than their plugin, ``NAME: {plugin: P, ...P's
-    parameters}`` (NAME listed in ``plugins``), as Nav2's costmap declares its layers."""
+    parameters}`` (NAME listed in ``plugins``), as Nav2's costmap declares its layers. Errors name the field as
+    ``WHERE.FIELD``. Checked against ``grid``: the simulated scan's size when ``lidar`` feeds the costmap (``edges``:
+    what each beam is tested against), and each inflation radius."""
     if not isinstance(value, dict):
-        raise _fail("layers", "a mapping", value)
+        raise _fail(where, "a mapping", value)
     listed = value.get("plugins", list(CostmapParams().plugins))
     names = {v for v in listed if isinstance(v, str) and v not in PLUGINS} if isinstance(listed, list) else set()
-    data = _mapping(value, "layers", {"plugins", *_SECTION_TYPES, *names})
+    data = _mapping(value, where, {"plugins", *_SECTION_TYPES, *names})
     declared: dict[str, str] = {}
     for key in sorted(names & set(data)):
-        where = f"layers.{key}"
-        section = _mapping(data[key], where, set(data[key]) if isinstance(data[key], dict) else set(), {"plugin"})
+        field_name = f"{where}.{key}"
+        section = _mapping(data[key], field_name, set(data[key]) if isinstance(data[key], dict) else set(), {"plugin"})
         plugin = section["plugin"]
         if not isinstance(plugin, str) or plugin not in PLUGINS:
             known = ", ".join(PLUGINS)
-            raise ScenarioError(f"{where}.plugin: unknown plugin {summary(plugin)}; known plugins: {known}")
+            raise ScenarioError(f"{field_name}.plugin: unknown plugin {summary(plugin)}; known plugins: {known}")
         declared[key] = plugin
-    plugins = _plugins(listed, "layers.plugins", declared)
-    sections = {k: _params(v, f"layers.{k}", _SECTION_TYPES[k]) for k, v in data.items() if k in _SECTION_TYPES}
+    plugins = _plugins(listed, where, declared)
+    sections = {k: _params(v, f"{where}.{k}", _SECTION_TYPES[k]) for k, v in data.items() if k in _SECTION_TYPES}
     instances = {}
     for key, plugin in declared.items():
         own = {k: v for k, v in data[key].items() if k != "plugin"}
         kind = SECTIONS.get(plugin)
         if kind is None and own:
-            raise ScenarioError(f"layers.{key}: the {plugin} plugin takes no parameters, got {', '.join(own)}")
-        params = None if kind is None else _params(own, f"layers.{key}", _SECTION_TYPES[kind])
+            raise ScenarioError(f"{where}.{key}: the {plugin} plugin takes no parameters, got {', '.join(own)}")
+        params = None if kind is None else _params(own, f"{where}.{key}", _SECTION_TYPES[kind])
         instances[key] = LayerInstance(plugin, params)
     try:
         layers = CostmapParams(plugins=plugins, instances=instances, **sections)
     except ValueError as exc:
-        raise ScenarioError(f"layers.{exc}") from exc
-    _check_scan(grid, lidar, layers, edges)
-    _check_inflation(grid, layers)
+        raise ScenarioError(f"{where}.{exc}") from exc
+    if lidar is not None:
+        _check_scan(grid, lidar, layers, edges)
+    _check_inflation(grid, layers, where)
     return layers
 
 
@@ -448,7 +456,7 @@ def _check_scan(grid: GridSpec, lidar: LidarSpec, layers: CostmapParams, edges: 
     _limit("lidar", lidar.beams * cells, "scan_cells", "beam cells", detail)
 
 
-def _check_inflation(grid: GridSpec, layers: CostmapParams) -> None:
+def _check_inflation(grid: GridSpec, layers: CostmapParams, where: str) -> None:
     """An inflation radius within the map's diagonal: costs cannot spread farther than the map, and Nav2's cost
     table grows with the square of the radius in cells."""
     reach = math.hypot(*grid.size_m)
@@ -457,7 +465,7 @@ def _check_inflation(grid: GridSpec, layers: CostmapParams) -> None:
         if radius > reach:
             section = "inflation" if name == "inflation" else name
             raise ScenarioError(
-                f"layers.{section}.inflation_radius: {radius:g} m is more than the map's diagonal ({reach:g} m), "
+                f"{where}.{section}.inflation_radius: {radius:g} m is more than the map's diagonal ({reach:g} m), "
                 "the farthest any cost can spread; use at most that"
             )
 
@@ -560,7 +568,7 @@ def scenario_from_dict(data: Any, base_dir: Path | None = None, default_name: st
         _length(lidar_data.get("body_radius", defaults.body_radius), "lidar.body_radius", grid),
     )
 
-    layers = _layers(data.get("layers", {}), grid, lidar, _edge_count(obstacles, people))
+    layers = layers_from_dict(data.get("layers", {}), grid, lidar=lidar, edges=_edge_count(obstacles, people))
 
     return Scenario(
         name=name,

@@ -9,10 +9,10 @@ import cv2
 import pytest
 
 from costmap.render import OBSTACLE, default_scale, world_to_image
-from planner.metrics import FIXED_KEYS
 from sid.cli import main
 from sid.cli.common import ExitCode
 from sid.experiments.demo import DEMO_SCENARIO
+from sid.experiments.path_metrics import FIXED_KEYS
 from sid.scenario.loader import load_scenario
 
 

@@ -98,3 +98,20 @@ def test_a_world_box_covers_the_cells_it_overlaps_clipped_to_the_grid():
             assert spec.window(box[:2], box[2:]) == Window(row0, row1, col0, col1).clipped(spec)
     for box in ((np.nan, 0.0, 1.0, 1.0), (0.0, 0.0, np.inf, 1.0), (-np.inf, 0.0, 1.0, 1.0), (20.0, 0.0, 21.0, 1.0)):
         assert spec.window(box[:2], box[2:]) is None
+
+
+def test_windows_union_grow_and_clip():
+    a, b = Window(2, 5, 3, 4), Window(4, 9, 0, 2)
+    assert a.union(b) == union(None, a, None, b) == Window(2, 9, 0, 4)
+    assert union(None, None) is None and a.union(None) == a
+    assert Window(1, 3, 1, 3).grown(2, SPEC) == Window(0, 5, 0, 5)
+    assert SPEC.whole.grown(3, SPEC) == SPEC.whole == Window(0, 160, 0, 200)
+    assert Window(-5, 2, 190, 300).clipped(SPEC) == Window(0, 2, 190, 200)
+    assert Window(-5, 0, 0, 3).clipped(SPEC) is None
+    assert SPEC.window((20.0, 0.0), (21.0, 1.0)) is None
+    assert SPEC.window((np.nan, 0.0), (1.0, 1.0)) is None and SPEC.window((0.0, 0.0), (np.inf, 1.0)) is None
+    assert SPEC.window_around([[0.0, 0.0], [-0.96, 0.07]]) == Window(80, 82, 0, 21)
+    assert SPEC.window_around(np.zeros((0, 2))) is None
+    costs = np.zeros(SPEC.shape)
+    costs[Window(1, 3, 4, 7).slices] = 1
+    assert costs.sum() == 6

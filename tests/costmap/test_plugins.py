@@ -1,16 +1,21 @@
-"""Layer instances as in Nav2: each with a name, a plugin and its own parameters; two LiDAR layers in one costmap."""
+"""The plugin list names, orders and checks the layers; layer instances as in Nav2, each with a name, a plugin and its
+own parameters (two LiDAR layers in one costmap); a scenario file's layers."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from costmap.grid import LETHAL, GridSpec
+from costmap.grid import FREE_SPACE, LETHAL, GridSpec
 from costmap.layer import LayerInputs
+from costmap.layered import LayeredCostmap
+from costmap.layers.inflation import InflationLayer, InflationParams
 from costmap.layers.obstacle import ObstacleLayer, ObstacleParams
-from costmap.plugins import CostmapParams, LayerInstance, layered_costmap
+from costmap.plugins import PLUGINS, CostmapParams, LayerInstance, layered_costmap
 from costmap.scan import LaserScan
+from sid.scenario.build import build_costmap
 from sid.scenario.loader import ScenarioError, scenario_from_dict
+from tests.costmap.scenes import Unknown
 
 SPEC = GridSpec.from_size(0.05, (-1.0, -5.0), (12.0, 10.0))
 NEAR = ObstacleParams(obstacle_max_range=3.0, raytrace_max_range=3.0)
@@ -91,3 +96,48 @@ def test_a_scenario_file_declares_named_layers_as_nav2_does() -> None:
 def test_bad_layer_instances_are_named(layers: dict, message: str) -> None:
     with pytest.raises(ScenarioError, match=message):
         scenario_from_dict(_scenario(layers))
+
+
+def test_the_plugin_list_names_orders_and_checks_the_layers():
+    layered = layered_costmap(SPEC)
+    assert [layer.name for layer in layered.layers] == ["lidar", "social", "inflation"]  # no static map, no static
+    assert isinstance(layered.layer("lidar"), ObstacleLayer) and layered.layer("static") is None
+    assert layered.layer("lidar").people_clear_radius == pytest.approx(0.2 + 0.1)
+    baseline = layered_costmap(SPEC, CostmapParams().without("social"), body_radius=0.3)
+    assert baseline.layer("lidar").people_clear_radius == 0.0  # nobody draws the people: their marks stay
+    assert layered_costmap(SPEC, CostmapParams(), body_radius=0.3).layer("lidar").people_clear_radius == 0.4
+    renamed = layered_costmap(
+        SPEC, CostmapParams(plugins=("lidar", "rear", "inflation")), plugins={**PLUGINS, "rear": PLUGINS["lidar"]}
+    )
+    assert list(renamed.grids) == ["lidar", "rear", "inflation"]
+    with pytest.raises(ValueError, match="unknown layer 'sonar'"):
+        layered_costmap(SPEC, CostmapParams(plugins=("lidar", "sonar")))
+    with pytest.raises(ValueError, match="listed twice"):
+        CostmapParams(plugins=("lidar", "lidar"))
+    with pytest.raises(ValueError, match="distinct names"):
+        LayeredCostmap(SPEC, [ObstacleLayer(SPEC), ObstacleLayer(SPEC)])
+    with pytest.raises(ValueError, match="differs from the costmap"):
+        LayeredCostmap(SPEC, [InflationLayer(GridSpec(0.1, 0.0, 0.0, 10, 10), InflationParams(), 0.25)])
+    with pytest.raises(ValueError, match="combination method"):
+        Unknown(SPEC, "min")
+
+
+def test_a_scenario_names_its_layers_in_order(tmp_path):
+    data = {
+        "map": {"resolution": 0.05, "origin": [0.0, 0.0], "size": [4.0, 3.0]},
+        "people": [{"id": 1, "x": 2.0, "y": 1.5}],
+        "robot": {"start": [0.5, 1.5], "goal": [3.5, 1.5]},
+        "layers": {"plugins": ["lidar", "inflation"]},
+    }
+    layered = build_costmap(scenario_from_dict(data, base_dir=tmp_path))
+    assert list(layered.grids) == ["lidar", "inflation"]
+    assert layered.master.cost_at([[2.0, 2.3]])[0] == FREE_SPACE  # no personal space: the person is a LiDAR mark
+    for plugins, message in (
+        (["lidar", "sonar"], r'layers\.plugins\[1\]: unknown layer "sonar"'),
+        (["lidar", "lidar"], r"layers\.plugins: a layer is listed twice"),
+        ("lidar", r"layers\.plugins: expected a list of layer names"),
+        ([], r"layers\.plugins: \[\] has no layer that marks people; list one of lidar, social, tracked_people"),
+        (["static", "inflation"], r"layers\.plugins: \['static', 'inflation'\] has no layer that marks people"),
+    ):
+        with pytest.raises(ScenarioError, match=message):
+            scenario_from_dict({**data, "layers": {"plugins": plugins}}, base_dir=tmp_path)

@@ -6,9 +6,9 @@ import json
 
 import cv2
 
-from planner.metrics import FIXED_KEYS
 from sid.experiments.demo import run_demo
 from sid.experiments.harness import LABELS
+from sid.experiments.path_metrics import FIXED_KEYS
 from sid.experiments.plan_pictures import format_table
 from sid.scenario.loader import load_scenario
 

@@ -41,3 +41,10 @@ def test_bad_parameter_is_reported(capsys: pytest.CaptureFixture[str]) -> None:
     code = main(["ros", "--source", "synthetic:S4", "--ros-args", "-p", "costmap.resolution:=0.0"])
     assert code == 2
     assert "costmap.*" in capsys.readouterr().err
+
+
+def test_a_bad_layer_instance_is_reported(capsys: pytest.CaptureFixture[str]) -> None:
+    pytest.importorskip("rclpy", reason="rclpy is not installed (pip install 'sid-social[ros]' or source ROS 2)")
+    layers = ["-p", "costmap.plugins:=[tracked_people, near]", "-p", "costmap.near.plugin:=lidar"]
+    assert main(["ros", "--source", "synthetic:S4", "--ros-args", *layers]) == ExitCode.USAGE
+    assert "costmap.plugins: near is a lidar layer, which the node cannot feed" in capsys.readouterr().err

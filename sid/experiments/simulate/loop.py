@@ -15,8 +15,9 @@ Per step of ``1 / rate_hz`` seconds, at time t (map frame, metres, radians, seco
 4. the planner (``planner.facade.plan``) replans from the robot's position when the rest of the path is blocked on
    the new costmap and every ``replan_period_s`` (also while it has no path); a periodic plan replaces the current
    path only when it costs at least ``replan_gain`` less than the rest of the current one on the same costmap;
-5. the path follower (``planner.follower``, regulated pure pursuit) gives a velocity command (zero without a path:
-   the robot waits) and the differential-drive model moves the robot (``sid.experiments.simulate.robot``).
+5. the path follower (``sid.experiments.simulate.follower``, regulated pure pursuit) gives a velocity command (zero
+   without a path: the robot waits) and the differential-drive model moves the robot
+   (``sid.experiments.simulate.robot``).
 
 Seed 0 runs the world as written, seed k >= 1 its jittered people (``sid.experiments.simulate.world.jittered``);
 the seed also draws the camera's noise. A task that the known map makes impossible (start or goal in an obstacle,
@@ -38,9 +39,9 @@ import numpy as np
 from costmap.grid import INSCRIBED, Costmap2D
 from costmap.scan import LaserScan
 from planner.facade import PlanResult, check_endpoints, plan, resolve_planner
-from planner.follower import FollowerParams, follow, remaining
 from planner.problem import DEFAULT_COST_WEIGHT, CostField, PlanningError, PlanningProblem
 from planner.validity import interpolate
+from sid.experiments.simulate.follower import FollowerParams, follow, remaining
 from sid.experiments.simulate.perception import (
     SIM_CALIBRATION,
     CameraSensing,

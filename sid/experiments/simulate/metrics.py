@@ -2,10 +2,11 @@
 each step (the groups ``sid.perception.groups.detect_groups`` finds on the exact positions, as in
 ``sid.experiments.harness``), whatever the robot saw.
 
-Each step's segment (from the robot's position at t to its position at t + dt) is measured with ``planner.metrics``
-against the people and groups of time t: length inside any group's interaction zone (``ospace_intrusion_m``,
-summed), whether it crosses the segment between two members (``crosses_group``), and its distance to every person's
-centre (``min_person_distance_m``: the smallest over the run). Map frame, metres, seconds.
+Each step's segment (from the robot's position at t to its position at t + dt) is measured with
+``sid.experiments.path_metrics`` against the people and groups of time t: length inside any group's interaction zone
+(``ospace_intrusion_m``, summed), whether it crosses the segment between two members (``crosses_group``), and its
+distance to every person's centre (``min_person_distance_m``: the smallest over the run). Map frame, metres,
+seconds.
 """
 
 from __future__ import annotations
@@ -16,7 +17,13 @@ import numpy as np
 from shapely.geometry import LineString
 from shapely.ops import unary_union
 
-from planner.metrics import PERSONAL_DISTANCE_M, crosses_group, group_zones, min_distance_to_points, path_length
+from sid.experiments.path_metrics import (
+    PERSONAL_DISTANCE_M,
+    crosses_group,
+    group_zones,
+    min_distance_to_points,
+    path_length,
+)
 from sid.experiments.simulate.loop import RunTrace
 
 __all__ = ["run_metrics"]

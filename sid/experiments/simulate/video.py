@@ -35,7 +35,7 @@ from costmap.render import (
     render_costmap,
     world_to_image,
 )
-from planner.render import WITH_COLOUR, PathStyle, path_extra
+from sid.experiments.path_render import WITH_COLOUR, PathStyle, path_extra
 from sid.experiments.simulate.loop import StepView
 from sid.experiments.simulate.perception import FIELD_OF_VIEW
 from sid.experiments.simulate.world import SimWorld

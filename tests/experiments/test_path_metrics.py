@@ -12,7 +12,7 @@ from shapely.geometry import LineString
 from costmap.grid import LETHAL, Costmap2D, GridSpec
 from costmap.layers.social import group_zone_polygon
 from planner.facade import PlanResult
-from planner.metrics import (
+from sid.experiments.path_metrics import (
     FIXED_KEYS,
     heading_change,
     min_distance_to_points,

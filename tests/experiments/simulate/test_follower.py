@@ -3,7 +3,7 @@ import math
 import numpy as np
 import pytest
 
-from planner.follower import FollowerParams, follow, nearest_arc_length, point_at, remaining
+from sid.experiments.simulate.follower import FollowerParams, follow, nearest_arc_length, point_at, remaining
 
 PARAMS = FollowerParams(max_speed=0.5, max_turn_rate=1.0)
 

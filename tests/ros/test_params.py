@@ -1,0 +1,125 @@
+"""The node's parameters read from real rclpy parameters: the defaults, and the costmap's layer instances named as
+Nav2's costmap_2d names them (``costmap.plugins``, ``costmap.NAME.plugin``, ``costmap.NAME.FIELD``), from a
+parameters file and from ``-p``."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from costmap.layer import LayerInputs
+from costmap.layers.inflation import InflationParams
+from costmap.layers.tracked import TrackedPeopleLayer, TrackedPeopleParams
+from costmap.plugins import CostmapParams, LayerInstance, layered_costmap
+from sid.ros.params import NODE_NAME, NodeParams, read_params
+from sid.tracking import TrackedPerson, Tracks
+
+rclpy = pytest.importorskip("rclpy", reason="rclpy is not installed (pip install 'sid-social[ros]' or source ROS 2)")
+
+
+@contextmanager
+def ros_node(*ros_args: str) -> Iterator:
+    """A node named as sid's, in a context of its own started with ``--ros-args ROS_ARGS``."""
+    context = rclpy.Context()
+    rclpy.init(args=["sid", "--ros-args", *ros_args], context=context)
+    node = rclpy.create_node(NODE_NAME, context=context)
+    try:
+        yield node
+    finally:
+        node.destroy_node()
+        rclpy.shutdown(context=context)
+
+
+def params_file(folder: Path, costmap: dict) -> Path:
+    path = folder / "params.yaml"
+    path.write_text(yaml.safe_dump({NODE_NAME: {"ros__parameters": {"costmap": costmap}}}))
+    return path
+
+
+def test_without_parameters_the_node_reads_its_defaults_and_declares_each_layer_parameter() -> None:
+    with ros_node() as node:
+        params = read_params(node)
+        assert params == NodeParams()
+        assert params.layers == CostmapParams(plugins=("tracked_people",))
+        assert node.get_parameter("costmap.plugins").value == ["tracked_people"]
+        assert node.get_parameter("costmap.tracked_people.lookahead").value == TrackedPeopleParams().lookahead
+        assert "tracked_people plugin" in node.describe_parameter("costmap.tracked_people.lookahead").description
+
+
+def test_a_parameters_file_names_two_tracked_people_layers_with_their_own_lookahead(tmp_path: Path) -> None:
+    costmap = {
+        "plugins": ["tracked_people", "walkers", "inflation"],
+        "walkers": {"plugin": "tracked_people", "lookahead": 1.5},
+        "inflation": {"inflation_radius": 0.3},
+    }
+    with ros_node(
+        "--params-file", str(params_file(tmp_path, costmap)), "-p", "costmap.tracked_people.lookahead:=0.5"
+    ) as node:
+        params = read_params(node)
+    layers = params.layers
+    assert layers.plugins == ("tracked_people", "walkers", "inflation")
+    assert layers.instances == {"walkers": LayerInstance("tracked_people", TrackedPeopleParams(1.5))}
+    assert layers.layer_params("tracked_people") == TrackedPeopleParams(0.5)
+    assert layers.layer_params("inflation") == InflationParams(inflation_radius=0.3)
+    layered = layered_costmap(params.grid, layers)
+    assert [layer.name for layer in layered.layers] == ["tracked_people", "walkers", "inflation"]
+    walker = TrackedPerson(1, 0.0, 0.0, 1.3, 0.0, None, "walking", True, True, 0.0, None, 0.05, 0.1)
+    layered.update(LayerInputs([walker.as_person()], tracks=Tracks([walker])))
+    for name, lookahead in (("tracked_people", 0.5), ("walkers", 1.5)):  # each layer stretches by its own lookahead
+        layer = layered.layer(name)
+        assert isinstance(layer, TrackedPeopleLayer)
+        reach = (0.8 + lookahead * 1.3) * math.sqrt(2 * math.log(200))  # where a walker's cost ends ahead of it
+        (inside, beyond) = params.grid.world_to_cell(np.array([[reach - 0.1, 0.0], [reach + 0.1, 0.0]]))
+        assert layer.costs[tuple(inside)] > 0 and layer.costs[tuple(beyond)] == 0, name
+
+
+def test_the_node_builds_its_costmap_from_the_layer_instances() -> None:
+    from sid.ros.node import SocialCostmapNode
+
+    args = ["-p", "costmap.plugins:=[walkers, inflation]", "-p", "costmap.walkers.plugin:=tracked_people"]
+    rclpy.init(args=["sid", "--ros-args", *args, "-p", "costmap.walkers.lookahead:=2.0", "-p", "pose_source:=none"])
+    try:
+        node = SocialCostmapNode(lambda frame: [], camera_topics=False)
+        try:
+            costmap = node.stream.costmap
+            assert list(costmap.grids) == ["walkers", "inflation"]
+            walkers = costmap.layer("walkers")
+            assert isinstance(walkers, TrackedPeopleLayer) and walkers.params == TrackedPeopleParams(2.0)
+        finally:
+            node.node.destroy_node()
+    finally:
+        rclpy.shutdown()
+
+
+@pytest.mark.parametrize(
+    ("ros_args", "message"),
+    [
+        (["-p", "costmap.plugins:=[tracked_people, walkers]"], r"costmap\.walkers\.plugin: required field is missing"),
+        (
+            ["-p", "costmap.plugins:=[tracked_people, near]", "-p", "costmap.near.plugin:=sonar"],
+            'costmap.near.plugin: unknown plugin "sonar"',
+        ),
+        (["-p", "costmap.plugins:=[tracked_people, tracked_people]"], r"costmap\.plugins: a layer is listed twice"),
+        (["-p", "costmap.plugins:=[inflation]"], r"costmap\.plugins: \['inflation'\] has no layer that marks people"),
+        (["-p", "costmap.tracked_people.lookahead:=soon"], r"costmap\.tracked_people\.lookahead: expected a finite"),
+        (["-p", "costmap.tracked_people.lookahead:=-1.0"], r"costmap\.tracked_people: .*lookahead"),
+        (
+            ["-p", "costmap.plugins:=[tracked_people, inflation]", "-p", "costmap.inflation.inflation_radius:=50.0"],
+            r"costmap\.inflation\.inflation_radius: 50 m is more than the map's diagonal",
+        ),
+        (["-p", "costmap.plugins:=[lidar, tracked_people]"], "lidar is a lidar layer, which the node cannot feed"),
+        (
+            ["-p", "costmap.plugins:=[tracked_people, width]", "-p", "costmap.width.plugin:=social"],
+            r"costmap\.width is a parameter already",
+        ),
+    ],
+)
+def test_a_bad_layer_instance_is_refused_naming_its_parameter(ros_args: list[str], message: str) -> None:
+    with ros_node(*ros_args) as node, pytest.raises(ValueError, match=message):
+        read_params(node)
