@@ -336,8 +336,10 @@ def _assign(cost: np.ndarray, near: np.ndarray, known: np.ndarray, model: OSpace
 
     Each pass opens every candidate with a positive saving that is the favourite (highest saving, then lowest
     index) of all the people it would serve, so candidates opened together serve nobody twice and the best one is
-    always among them; passes repeat until no candidate saves anything. Only known facings count towards opening.
-    Savings and costs within ``TIE`` (of the alone price) of each other count as equal.
+    always among them; passes repeat until no candidate saves anything. Only known facings count towards opening,
+    and a candidate that would lower the cost of fewer than two of them saves nothing (its o-space would dissolve,
+    and it would keep its one person from a pair). Savings and costs within ``TIE`` (of the alone price) of each
+    other count as equal.
     """
     count, tie = len(known), TIE * model.alone_price
     current = np.zeros(count) + model.alone_price
@@ -345,7 +347,9 @@ def _assign(cost: np.ndarray, near: np.ndarray, known: np.ndarray, model: OSpace
     opener = np.where(known[near], cost, np.inf)
     while True:
         gain = current[near] - opener
-        saving = np.add.reduce(np.where(gain > tie, gain, 0.0), axis=1) - model.price
+        gains = gain > tie
+        saving = np.add.reduce(np.where(gains, gain, 0.0), axis=1) - model.price
+        saving[np.add.reduce(gains, axis=1) < 2] = -np.inf  # an o-space needs two known facings
         if np.maximum.reduce(saving) <= tie:
             break
         candidate, column = np.nonzero(gain > tie)
@@ -452,8 +456,9 @@ _SLACK = 1e-9
 
 
 # A candidate o-space's row: (person, cost in m^2) of each person who may join it, ascending by person, and the
-# saving (m^2) of opening it while everyone is alone, the first pass of every ``_assign_small`` call (a candidate's
-# row does not change between rounds, so neither does this).
+# saving (m^2) of opening it while everyone is alone (-inf when it lowers the cost of fewer than two known facings),
+# the first pass of every ``_assign_small`` call (a candidate's row does not change between rounds, so neither does
+# this).
 _Row = tuple[list[tuple[int, float]], float]
 
 
@@ -546,7 +551,7 @@ class _SmallScene:
             cx, cy = centre.real, centre.imag
             turn_weight = twice_weight * radius
             entries = []
-            saving = 0.0
+            saving, gaining = 0.0, 0
             for j, px, py, fx, fy, w, cos_slack, sin_slack, nearest, known in self._table:
                 ox, oy = cx - px, cy - py  # from the person to the centre
                 length2 = ox * ox + oy * oy
@@ -568,7 +573,8 @@ class _SmallScene:
                     entries.append((j, cost))
                     if known and model.alone_price - cost > tie:
                         saving += model.alone_price - cost
-            rows.append((entries, saving - model.price))
+                        gaining += 1
+            rows.append((entries, saving - model.price if gaining >= 2 else -math.inf))
         return rows
 
     def _blocked(self, j: int, cx: float, cy: float) -> bool:
@@ -652,11 +658,12 @@ def _assign_small(rows: list[_Row], known: list[bool], model: OSpaceModel) -> li
                         current[j] = c
         for k in active:
             # (Gains added in order, not by the builtin ``sum``: it rounds differently from Python 3.12 on.)
-            total = 0.0
+            total, gaining = 0.0, 0
             for j, c in openers[k]:
                 if c < current[j] - tie:
                     total += current[j] - c
-            savings[k] = total - model.price
+                    gaining += 1
+            savings[k] = total - model.price if gaining >= 2 else -math.inf
         active = [k for k in active if savings[k] > tie]
     return _cheapest_opened([entries for entries, _ in rows], opened, count, tie)
 

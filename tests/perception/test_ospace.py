@@ -158,6 +158,16 @@ def test_a_pair_exactly_at_pair_reach_proposes_whatever_the_rounding(angle: floa
     assert [g.members.tolist() for g in found] == [[0, 1]]
 
 
+@pytest.mark.parametrize("small", [False, True])
+def test_a_cheap_group_price_opens_no_o_space_of_one(small: bool, monkeypatch) -> None:
+    # A price under the alone price makes each person's own proposal worth opening for them alone; such an o-space
+    # dissolves (a group needs two), and had it opened it would have kept the face-to-face pair apart.
+    monkeypatch.setattr(ospace, "_SMALL_PEOPLE_MAX", 1000 if small else 0)
+    cheap = GroupParams(group_price=0.01).ospace_model
+    [group] = find_ospaces(*inputs([(2.0, 0.0, 0.0), (2.8, 0.0, math.pi)]), cheap)
+    assert group.members.tolist() == [0, 1] and group.centre == pytest.approx(2.4 + 0j)
+
+
 def test_two_people_without_facing_form_nothing():
     assert find_ospaces(*inputs([(0.0, 0.0, None), (0.8, 0.0, None), (0.4, 0.5, -math.pi / 2)]), MODEL) == []
 
@@ -296,7 +306,8 @@ def plain_assign(rows, known, model) -> list[int]:
             for j, c in row:
                 if c < current[j] - tie:
                     total += current[j] - c
-            savings.append(total - model.price)
+            gaining = sum(c < current[j] - tie for j, c in row)  # fewer than two: an o-space of one, no saving
+            savings.append(total - model.price if gaining >= 2 else -math.inf)
         if max(savings) <= tie:
             break
         best = [
