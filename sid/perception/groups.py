@@ -57,6 +57,7 @@ from sid.perception.gcff import GCFFParams, gcff_labels
 from sid.perception.group import Group
 from sid.perception.ospace import OSpaceModel, find_ospaces
 from sid.perception.people import Person
+from sid.perception.rings import RingModel, joined_rings
 
 __all__ = ["GROUP_METHODS", "GroupParams", "QUANTISED_STEPS", "detect_groups", "facing_step"]
 
@@ -120,6 +121,14 @@ class GroupParams:
       the o-space of their pair, centred on their midpoint: a quantised facing may point 45 degrees from the
       centre, the proposals ahead then miss it, and proximity carries the decision. 0 turns it off. Chosen by
       cross-validation (docs/groups.md).
+    ring_radius_max: arcs found by the o-space search are joined into one group when together they make a ring
+      (sid.perception.rings: six or more people on one fitted circle, nobody inside it) of at most this radius
+      (m). 2.0: a reception's circle of 12 on 1.6 m with room for noise; 0 turns it off. Not fitted: on the
+      benchmarks, whose groups are narrower, every value scores the same (docs/groups.md).
+    ring_tolerance: how far (m) a member of a joined ring may stand off its circle. 0.2: a body's depth.
+    ring_facing_tolerance: how far (rad) a member's facing may point from a joined ring's centre (or the facings'
+      slack when wider). 0.6 (34 degrees): 10 degrees of facing noise stays inside at three standard deviations;
+      neighbouring conversations, whose members face their own centres, stay out.
     unknown_facing_cost: a person without facing may join a group formed by others when standing on its circle; the
       unexplained facing costs as much as a proposal this far (m) from the centre. 0.5: its square, 0.25 m^2, leaves
       room under the price for standing 0.6 m off the circle; a doubtful facing then gains nothing over a clear one
@@ -162,6 +171,9 @@ class GroupParams:
     facing_slack: float = 0.4
     angular_weight: float = 0.35
     coarse_pair_reach: float = 1.5
+    ring_radius_max: float = 2.0
+    ring_tolerance: float = 0.2
+    ring_facing_tolerance: float = 0.6
     unknown_facing_cost: float = 0.5
     body_radius: float = 0.1
     facing_weight_floor: float = 0.5
@@ -180,6 +192,7 @@ class GroupParams:
             raise ValueError(f"groups: method must be one of {', '.join(GROUP_METHODS)}, got {summary(self.method)}")
         self.ospace_model  # noqa: B018 - builds (and so checks) the o-space fields, once per record
         self.coarse_ospace_model  # noqa: B018 - and the coarse-facing field
+        self.ring_model  # noqa: B018 - and the rings'
         self.gcff_params  # noqa: B018 - likewise the graph-cut fields
         check_number("groups", "facing_weight_floor", self.facing_weight_floor, low=0, low_open=True, high=1)
         check_number("groups", "facing_slack", self.facing_slack, low=0, high=math.pi)
@@ -222,6 +235,14 @@ class GroupParams:
             for old, new in names.items():
                 message = message.replace(f"groups: {old} ", f"groups: {new} ", 1)
             raise ValueError(message) from None
+
+    @cached_property
+    def ring_model(self) -> RingModel:
+        """When the o-space method joins arcs into one wide ring (ValueError naming a bad field)."""
+        try:
+            return RingModel(self.ring_radius_max, self.ring_tolerance, self.ring_facing_tolerance)
+        except ValueError as exc:
+            raise ValueError(str(exc).replace("rings: ", "groups: ring_", 1)) from None
 
     @cached_property
     def coarse_ospace_model(self) -> OSpaceModel:
@@ -293,16 +314,27 @@ def _ospace_groups(
     thetas = [people[i].theta for i in order]
     half_step = 0.5 * facing_step(thetas)  # rad
     coarse = half_step > params.facing_slack  # quantised more coarsely than the facings' own slack
+    slack = max(params.facing_slack, half_step)  # rad, every facing's cone
+    seen = [positions[i] - origin for i in order]
+    seen_facing = [facing[i] for i in order]
     found = find_ospaces(
-        [positions[i] - origin for i in order],
-        [facing[i] for i in order],
+        seen,
+        seen_facing,
         [floor + (1.0 - floor) * min(max(people[i].orientation_quality, 0.0), 1.0) for i in order],
         params.coarse_ospace_model if coarse else params.ospace_model,
-        [max(params.facing_slack, half_step)] * len(order),  # rad, every facing's cone
+        [slack] * len(order),
     )
-    members = [sorted(order[k] for k in ospace.members.tolist()) for ospace in found]
-    centres = [ospace.centre + origin for ospace in found]
-    ranked = sorted(range(len(found)), key=lambda g: members[g][0])  # groups in order of their first member
+    joined, joined_centres = joined_rings(
+        [ospace.members.tolist() for ospace in found],
+        [ospace.centre for ospace in found],
+        seen,
+        seen_facing,
+        slack,
+        params.ring_model,
+    )
+    members = [sorted(order[k] for k in group) for group in joined]
+    centres = [centre + origin for centre in joined_centres]
+    ranked = sorted(range(len(members)), key=lambda g: members[g][0])  # groups in order of their first member
     return _zoned([members[g] for g in ranked], [centres[g] for g in ranked], ids, positions, facing, params)
 
 

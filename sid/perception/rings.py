@@ -1,0 +1,156 @@
+"""Wide rings: groups whose members all stand on one circle facing its centre, wider than the o-space search's radii
+(world frame, metres, radians).
+
+The o-space search (``sid.perception.ospace``) proposes centres at most ``radius_max`` (0.8 m) from each person, as
+wide as the benchmarks' groups are; a reception's circle of 8-12 people on 1.1-1.6 m comes out of it in arcs.
+``joined_rings`` joins two groups (or a group and someone alone) when together they make a ring of at least
+``MIN_MEMBERS`` people: the circle fitted to their positions (least squares, Kasa's algebraic fit) has a radius of at
+most ``RingModel.radius_max``, every member stands within ``tolerance`` of it, every known facing points within
+``facing_tolerance`` (or the facings' slack, when wider) of its centre, and nobody else stands inside it (the
+o-space is exclusive). The test is geometric and strict on purpose: the search's merges are priced, and two
+neighbouring conversations never pass this one, as each member faces their own group's centre.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from sid.checks import check_number
+
+__all__ = ["MIN_MEMBERS", "Ring", "RingModel", "fit_ring", "joined_rings"]
+
+MIN_MEMBERS = 6
+"""The fewest people a joined ring holds: n people 1 m apart on a circle stand 1 / (2 sin(pi / n)) from its centre,
+within the o-space search's radii (0.85 m) up to five; wider circles hold six or more."""
+_COLLINEAR = 1e-9
+"""Points whose spread matrix's determinant is below this share of its squared trace lie on a line: no circle."""
+_ANGLE_TIE = 1e-9
+"""rad: a facing this close to the edge of its cone is inside it, so that a rigid motion's rounding (~1e-15)
+cannot move a member out."""
+
+
+@dataclass(frozen=True)
+class RingModel:
+    """When arcs make one ring: its largest radius (m), how far a member may stand off the circle (m), and how far a
+    member's facing may point from the centre (rad; the facings' own slack when wider). ``radius_max`` 0 turns the
+    joining off."""
+
+    radius_max: float
+    tolerance: float
+    facing_tolerance: float
+
+    def __post_init__(self) -> None:
+        check_number("rings", "radius_max", self.radius_max, low=0, high=1e3, unit="metres")
+        check_number("rings", "tolerance", self.tolerance, low=0, high=1e3, unit="metres")
+        check_number("rings", "facing_tolerance", self.facing_tolerance, low=0, high=math.pi / 2)
+
+
+@dataclass(frozen=True)
+class Ring:
+    """A circle fitted to people: centre (complex x + iy, m), radius (m) and the largest distance of one of them
+    from it (m)."""
+
+    centre: complex
+    radius: float
+    deviation: float
+
+
+def fit_ring(points: Sequence[complex]) -> Ring | None:
+    """The least-squares circle through ``points`` (complex, m; three or more): Kasa's algebraic fit, minimising
+    sum (2 a x + 2 b y + c - x^2 - y^2)^2 over the points measured from their mean; None when they are (nearly)
+    collinear. Its normal equations are solved in closed form on Python numbers: for a ring's handful of points
+    ``numpy.linalg.lstsq``'s overhead per call is most of the time (the tests hold the two to each other)."""
+    count = len(points)
+    if count < 3:
+        return None
+    mean = sum(points, 0j) / count
+    xs, ys = [p.real - mean.real for p in points], [p.imag - mean.imag for p in points]
+    sxx = syy = sxy = sxz = syz = sz = 0.0
+    for x, y in zip(xs, ys, strict=True):
+        z = x * x + y * y
+        sxx += x * x
+        syy += y * y
+        sxy += x * y
+        sxz += x * z
+        syz += y * z
+        sz += z
+    det = sxx * syy - sxy * sxy
+    if det <= _COLLINEAR * (sxx + syy) ** 2:
+        return None
+    a = (sxz * syy - syz * sxy) / (2.0 * det)
+    b = (syz * sxx - sxz * sxy) / (2.0 * det)
+    radius = math.sqrt(sz / count + a * a + b * b)
+    deviation = max(abs(math.hypot(x - a, y - b) - radius) for x, y in zip(xs, ys, strict=True))
+    return Ring(complex(a, b) + mean, radius, deviation)
+
+
+def joined_rings(
+    members: list[list[int]],
+    centres: list[complex],
+    positions: Sequence[complex],
+    facing: Sequence[complex],
+    slack: float,
+    model: RingModel,
+) -> tuple[list[list[int]], list[complex]]:
+    """``members`` (indices into ``positions``, m, and ``facing``, complex unit or NaN when unknown; groups in order
+    of their lowest index) and their ``centres`` (complex, m) after joining, while two groups, or a group and someone
+    alone with a known facing, make a ring (module docstring): the join whose ring fits best first (lowest
+    deviation, then lowest indices); a joined group's centre is its ring's. ``slack``: the facings' cone half-width
+    (rad)."""
+    groups, centres = [list(g) for g in members], list(centres)
+    if model.radius_max <= 0:
+        return groups, centres
+    grouped = {j for g in groups for j in g}
+    alone = [j for j, f in enumerate(facing) if j not in grouped and f == f]  # may join a ring, never make one
+    diameter = 2.0 * (model.radius_max + model.tolerance)
+    while True:
+        # Members' means: two sets whose people all stand within a diameter of each other have means that close.
+        means = [sum((positions[j] for j in g), 0j) / len(g) for g in groups]
+        best: tuple[Ring, int, int] | None = None
+        for g in range(len(groups)):
+            # Another group (h >= 0) or someone alone (h = -1 - their index).
+            for h in [*range(g + 1, len(groups)), *(-1 - j for j in alone)]:
+                other = groups[h] if h >= 0 else [-1 - h]
+                if len(groups[g]) + len(other) < MIN_MEMBERS:
+                    continue
+                if abs(means[g] - (means[h] if h >= 0 else positions[-1 - h])) > diameter:
+                    continue
+                if not all(abs(positions[a] - positions[b]) <= diameter for a in groups[g] for b in other):
+                    continue
+                ring = _ring(sorted(groups[g] + other), positions, facing, slack, model)
+                if ring is not None and (best is None or ring.deviation < best[0].deviation * (1.0 - 1e-9)):
+                    best = (ring, g, h)
+        if best is None:
+            return groups, centres
+        ring, g, h = best
+        if h >= 0:
+            groups[g], centres[g] = sorted(groups[g] + groups[h]), ring.centre
+            del groups[h], centres[h]
+        else:
+            groups[g], centres[g] = sorted([*groups[g], -1 - h]), ring.centre
+            alone.remove(-1 - h)
+
+
+def _ring(
+    union: list[int], positions: Sequence[complex], facing: Sequence[complex], slack: float, model: RingModel
+) -> Ring | None:
+    """The ring ``union`` makes, or None where it is no ring (too wide, a member off the circle or looking away from
+    the centre, someone else inside)."""
+    ring = fit_ring([positions[j] for j in union])
+    if ring is None or ring.radius > model.radius_max * (1.0 + 1e-9) or ring.deviation > model.tolerance:
+        return None
+    limit = max(slack, model.facing_tolerance) + _ANGLE_TIE
+    for j in union:
+        f = facing[j]
+        if f == f:  # a known facing: within ``limit`` of the direction to the centre
+            towards = ring.centre - positions[j]
+            along, across = f.real * towards.real + f.imag * towards.imag, f.real * towards.imag - f.imag * towards.real
+            if abs(math.atan2(across, along)) > limit:
+                return None
+    inside = ring.radius - model.tolerance
+    chosen = set(union)
+    if any(abs(p - ring.centre) < inside for k, p in enumerate(positions) if k not in chosen):
+        return None
+    return ring
