@@ -1,8 +1,9 @@
 """Multi-person tracking on the ground plane: stable ids, constant-velocity motion, standing / walking.
 
 Per frame (``PeopleTracker.update``): every track is predicted to the frame's timestamp (``sid.tracking.motion``);
-tracks not detected for longer than their timeout are deleted (``timeout`` in the camera's view,
-``out_of_view_timeout`` out of it or behind someone detected nearer to a camera: nobody looked there); detections are
+tracks are deleted when undetected for longer than ``timeout`` while in the camera's view (time out of it or
+behind someone detected nearer to the camera does not count: nobody looked there) or for longer than
+``out_of_view_timeout`` in all; detections are
 assigned to tracks by position alone, the least total distance to the predictions within a gate that grows with the
 track's uncertainty (``sid.tracking.assignment``); matched tracks are corrected; a tentative track that is missed is
 deleted, and one detected ``confirm_hits`` times (or twice in a row ``confirm_time`` apart) is confirmed; every
@@ -47,12 +48,12 @@ class TrackerParams:
     gate_sigmas, min_gate, max_gate: a detection may join a track when it lies within gate_sigmas standard
     deviations of the prediction, bounded to [min_gate, max_gate] (m). confirm_hits: detections that confirm a
     track; confirm_time: two detections in a row at least this far apart (s) confirm it too, so that a slow detector
-    (a few Hz) does not hold a person back for confirm_hits long frames. timeout: seconds a confirmed track in view
-    survives without a detection; out_of_view_timeout: the same outside the camera's view or behind someone detected
-    nearer to it. walk_speed, stand_speed: speeds (m/s) above which a standing track walks and below which a walking
-    track stands (hysteresis). facing_tau: time constant (s) of the facing average. heading_gate: a walking track
-    faster than walk_speed, missed in the last frame, takes no detection facing more than this (rad) away from its
-    velocity.
+    (a few Hz) does not hold a person back for confirm_hits long frames. timeout: seconds a confirmed track
+    survives undetected while in the camera's view (not behind someone detected nearer to it); out_of_view_timeout:
+    seconds it survives undetected in all. walk_speed, stand_speed: speeds (m/s) above which a standing track walks
+    and below which a walking track stands (hysteresis). facing_tau: time constant (s) of the facing average.
+    heading_gate: a walking track faster than walk_speed, missed in the last frame, takes no detection facing more
+    than this (rad) away from its velocity.
     """
 
     measurement_sigma: float = 0.15
@@ -100,6 +101,7 @@ class PeopleTracker:
         self._confirmed = np.zeros(0, dtype=bool)
         self._walking = np.zeros(0, dtype=bool)
         self._last_hit = np.zeros(0)
+        self._unseen = np.zeros(0)  # seconds undetected since the last hit while the camera could see the track
         self._first_hit = np.zeros(0)
         self._facing = np.zeros((0, 2))  # unit vectors, NaN while unknown
         self._detection = np.zeros(0, dtype=np.intp)  # index of this frame's matched detection, -1: none
@@ -133,12 +135,14 @@ class PeopleTracker:
         self._time = float(timestamp)
         self._motion.predict(dt, q)
         self._in_view = np.ones(len(self._ids), dtype=bool) if view is None else view.contains(self._motion.position)
-        self._keep(~self._expired(timestamp, self._in_view & ~_behind(view, self._motion.position, positions)))
+        self._unseen += np.where(self._in_view & ~_behind(view, self._motion.position, positions), dt, 0.0)
+        self._keep(~self._expired(timestamp))
         rows, cols = self._assign(positions, facing, r)
         self._motion.correct(rows, positions[cols], r)
         self._smooth_facing(rows, facing[cols], dt)
         self._hits[rows] += 1
         self._last_hit[rows] = timestamp
+        self._unseen[rows] = 0.0
         self._confirmed |= (self._hits >= p.confirm_hits) | (
             (self._hits >= 2) & (timestamp - self._first_hit >= p.confirm_time - 1e-9)
         )
@@ -155,11 +159,13 @@ class PeopleTracker:
         self._walking = np.where(self._walking, speed > p.stand_speed, speed - speed_sigma > p.walk_speed)
         return self._report(ids)
 
-    def _expired(self, now: float, watched: np.ndarray) -> np.ndarray:
-        """(N,) bool: the tracks undetected for longer than their timeout: ``timeout`` where the camera could see them
-        (``watched``), else ``out_of_view_timeout``."""
+    def _expired(self, now: float) -> np.ndarray:
+        """(N,) bool: the tracks undetected for longer than ``timeout`` while the camera could see them, or for longer
+        than ``out_of_view_timeout`` in all. Time hidden (out of view, behind someone) does not count towards
+        ``timeout``: a walker hidden behind a group for longer than it, then in view a moment before being detected
+        again, keeps the track."""
         p = self.params
-        return now - self._last_hit > np.where(watched, p.timeout, p.out_of_view_timeout)
+        return (self._unseen > p.timeout) | (now - self._last_hit > p.out_of_view_timeout)
 
     def _assign(self, positions: np.ndarray, facing: np.ndarray, r: float) -> tuple[np.ndarray, np.ndarray]:
         """Rows of tracks and columns of detections matched by minimum total distance, each within its gate.
@@ -208,6 +214,7 @@ class PeopleTracker:
         self._confirmed = np.concatenate((self._confirmed, np.full(k, p.confirm_hits <= 1)))
         self._walking = np.concatenate((self._walking, np.zeros(k, dtype=bool)))
         self._last_hit = np.concatenate((self._last_hit, np.full(k, timestamp)))
+        self._unseen = np.concatenate((self._unseen, np.zeros(k)))
         self._first_hit = np.concatenate((self._first_hit, np.full(k, timestamp)))
         self._detection = np.concatenate((self._detection, cols))
         self._in_view = np.concatenate((self._in_view, np.ones(k, dtype=bool)))  # just detected
@@ -223,6 +230,7 @@ class PeopleTracker:
             self._last_hit[mask],
             self._first_hit[mask],
         )
+        self._unseen = self._unseen[mask]
         self._detection, self._facing, self._in_view = self._detection[mask], self._facing[mask], self._in_view[mask]
 
     def _report(self, ids: list[int]) -> list[TrackedPerson]:
