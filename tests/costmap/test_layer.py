@@ -9,6 +9,7 @@ import numpy as np
 from costmap.grid import FREE_SPACE, INSCRIBED, LETHAL, GridSpec, Window, union
 from costmap.layer import Layer, LayerInputs
 from costmap.layered import LayeredCostmap
+from costmap.layers.social import PEOPLE
 from costmap.plugins import PLUGINS, CostmapParams, layered_costmap
 from sid.perception.people import Person
 from tests.costmap.scenes import Unknown, frames
@@ -88,7 +89,7 @@ def test_a_new_layer_is_one_class_and_one_line_of_configuration():
 
 
 def test_a_layer_writes_with_its_combination_method_in_its_place_in_the_order():
-    inputs = LayerInputs([Person(1, 2.0, 2.0, 0.0)])  # no scan: only the person's body and personal space
+    inputs = LayerInputs({PEOPLE: [Person(1, 2.0, 2.0, 0.0)]})  # no scan: only the person's body and personal space
     square, ahead = SPEC.window((1.5, 1.5), (2.45, 2.45)), [[3.0, 2.0]]
 
     def build(combination: str, order: tuple[str, ...]) -> LayeredCostmap:
