@@ -8,8 +8,8 @@ there with its combination method (Nav2's ``updateCosts``; methods in ``costmap.
 master in ``write`` (inflation does).
 
 As a Nav2 plugin subscribes to its own sources, each layer declares the kinds of input it reads (``Layer.reads``,
-``Input`` keys); the keys are declared beside the layers or records they concern (people and groups in
-``costmap.layers.social``, the scan in ``costmap.scan``, tracks in ``costmap.layers.tracked``), never here.
+``Input`` keys), and each key is declared beside a layer that reads it (``costmap.layers``, or a plugin of one's
+own): this module and ``costmap.layered`` know no kind of input, so a new one edits neither.
 """
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
 """The layered costmap: windowed updates against a full recombination, windows far apart, people updates with and
-without the social layer."""
+without the social layer, the inputs its layers read."""
 
 from __future__ import annotations
 
@@ -8,11 +8,12 @@ import pytest
 import shapely
 
 from costmap.grid import LETHAL, NO_INFORMATION, GridSpec, union
-from costmap.layer import LayerInputs
+from costmap.layer import Input, LayerInputs
 from costmap.layered import LayeredCostmap
 from costmap.layers.inflation import InflationLayer, InflationParams
 from costmap.layers.obstacle import SCAN, ObstacleParams
 from costmap.layers.social import GROUPS, PEOPLE, group_zone_polygon
+from costmap.layers.tracked import TRACKS
 from costmap.plugins import CostmapParams, layered_costmap
 from sid.perception.group import Group
 from sid.perception.groups import detect_groups
@@ -176,9 +177,23 @@ def test_update_rejects_nan_people_duplicate_ids_and_a_sensor_off_the_map_before
 def test_unknown_space_stays_unknown_around_people_when_tracked():
     spec = GridSpec(0.05, 0.0, 0.0, 100, 100)
     layered = layered_costmap(spec, CostmapParams(obstacle=ObstacleParams(track_unknown_space=True)))
-    layered.update(
-        LayerInputs({PEOPLE: [Person(1, 2.5, 2.5, 0.0)]})
-    )  # no scan: everything unknown except the social costs
+    layered.update(LayerInputs({PEOPLE: [Person(1, 2.5, 2.5, 0.0)]}))  # no scan: all unknown but the social costs
     costs = layered.master.costs
     assert costs[0, 0] == NO_INFORMATION
     assert costs[50, 50] == LETHAL and costs[50, 62] not in (0, NO_INFORMATION)
+
+
+def test_a_costmap_reads_what_its_layers_read_and_refuses_a_stranger_named_as_one_of_them():
+    assert layered_costmap(SPEC).reads == (SCAN, PEOPLE, GROUPS)  # static and inflation read no input
+    assert layered_costmap(SPEC, CostmapParams(plugins=("tracked_people", "inflation"))).reads == (TRACKS,)
+    people, group = triad()
+    layered = social_costmap()
+    layered.update(LayerInputs({PEOPLE: people, GROUPS: [group]}))
+    before = layered.master.costs.copy()
+    stranger = Input("people", ())  # another key of the same name: the layers would never see its people
+    with pytest.raises(ValueError, match=r"inputs \['people'\]: not the keys"):
+        layered.update(LayerInputs({stranger: [Person(9, 1.0, 1.0)]}))
+    np.testing.assert_array_equal(layered.master.costs, before)
+    assert layered.inputs[GROUPS] == (group,)
+    layered.update(LayerInputs({Input("doorways", ()): [(1.0, 1.0)]}))  # read by no layer: kept, nothing to paint
+    assert not (layered.master.costs > 0).any()

@@ -112,10 +112,9 @@ def test_lidar_layer_reports_only_what_changed():
     people = [Person(1, 4.0, 0.0, np.pi)]
     layer = ObstacleLayer(SPEC, people_clear_radius=0.3)
     scan = simulate_scan((0.0, 0.0, 0.0), [SegmentObstacle(((-1.0, 2.5), (9.0, 2.5)))], people, beams=720)
-    assert layer.update(LayerInputs({PEOPLE: people, SCAN: scan}), None) is not None
-    assert (
-        layer.update(LayerInputs({PEOPLE: people, SCAN: scan}), None) is None
-    )  # the same scene again: nothing changed
+    scene = LayerInputs({PEOPLE: people, SCAN: scan})
+    assert layer.update(scene, None) is not None
+    assert layer.update(scene, None) is None  # the same scene again: nothing changed
     moved = [Person(1, 4.0, -1.0, np.pi)]
     window = layer.update(
         LayerInputs({PEOPLE: moved, SCAN: simulate_scan((0.0, 0.0, 0.0), [], moved, beams=720)}), None
@@ -140,12 +139,11 @@ def test_the_lidar_layer_clears_people_marks_by_its_own_parameter():
         window = layer.update(LayerInputs({PEOPLE: people, SCAN: scan}), None)
         assert ((layer.costs[near.slices] == LETHAL).any()) == marks
         assert (layer.costs == LETHAL).any() and window is not None
-        assert layer.update(LayerInputs({PEOPLE: people}), None) is None  # no scan and nothing left to clear: no change
+        no_scan = LayerInputs({PEOPLE: people})
+        assert layer.update(no_scan, None) is None  # no scan and nothing left to clear: no change
         mark = SPEC.window((4.1, 0.05), (4.1, 0.05))
         assert mark is not None
         layer.costs[mark.slices] = LETHAL  # within 0.3 m of the person: theirs when the layer clears people's marks
-        assert layer.update(LayerInputs({PEOPLE: people}), None) == (
-            None if radius == 0 else mark
-        )  # the window of what changed
+        assert layer.update(no_scan, None) == (None if radius == 0 else mark)  # the window of what changed
     with pytest.raises(ValueError, match="people_clear_radius"):
         ObstacleLayer(SPEC, people_clear_radius=-1.0)

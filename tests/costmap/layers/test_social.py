@@ -188,9 +188,8 @@ def test_people_groups_and_bodies_painted_together_equal_each_painted_alone(seed
 
 def test_social_layer_clips_people_outside_the_map():
     layer = SocialLayer(SPEC, SocialParams())
-    layer.update(
-        LayerInputs({PEOPLE: [Person(1, 9.3, 0.0, np.pi)]}), None
-    )  # 0.3 m beyond the right edge, facing into the map
+    beyond = [Person(1, 9.3, 0.0, np.pi)]  # 0.3 m beyond the right edge, facing into the map
+    layer.update(LayerInputs({PEOPLE: beyond}), None)
     assert layer.costs[:, -1].max() > 0
     assert not (layer.costs == LETHAL).any()  # the body itself is outside
 
