@@ -6,59 +6,98 @@ layer whose changes lie far apart, as people in distant groups, spares the costm
 master grid is then reset over those windows (``costmap.grid.disjoint``) and every layer, in order, writes its grid
 there with its combination method (Nav2's ``updateCosts``; methods in ``costmap.combine``). A layer may read the
 master in ``write`` (inflation does).
+
+As a Nav2 plugin subscribes to its own sources, each layer declares the kinds of input it reads (``Layer.reads``,
+``Input`` keys), and each key is declared beside a layer that reads it (``costmap.layers``, or a plugin of one's
+own): this module and ``costmap.layered`` know no kind of input, so a new one edits neither.
 """
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from collections.abc import Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any, Generic, TypeVar, overload
 
 import numpy as np
 
 from costmap.combine import CombinationMethod, check_method, combine
 from costmap.grid import FREE_SPACE, GridSpec, Window, union
-from costmap.scan import LaserScan
-from sid.checks import check_numbers
-from sid.perception.group import Group
-from sid.perception.people import Person
-from sid.tracking.records import Tracks
 
-__all__ = ["Layer", "LayerInputs", "RepaintedLayer"]
+__all__ = ["Input", "Layer", "LayerInputs", "RepaintedLayer"]
+
+_T = TypeVar("_T")  # what an input carries
+_D = TypeVar("_D")  # a default given to ``LayerInputs.get``
 
 
-@dataclass(frozen=True)
-class LayerInputs:
-    """What the layers see in one frame: people and their groups (world frame), when there is one a 2D scan, and
-    when a tracker runs its tracked people and groups (``tracks``, same frame; read by the tracked-people layer).
+@dataclass(frozen=True, eq=False)  # a key is itself: compared and hashed by identity, as a ContextVar
+class Input(Generic[_T]):
+    """One kind of layer input, the key of its value in ``LayerInputs``; its type parameter is what it carries.
 
-    People need finite poses and distinct ids. New kinds of input (tracked people, a robot pose, ...) are new fields
-    with a default, so existing layers and callers are unaffected.
+    ``name``: what messages call it (distinct among the keys of one ``LayerInputs``). ``default``: its value in a
+    frame that does not give it (what means nothing to paint). ``check``: makes a given value the one the layers read
+    (e.g. a tuple of a sequence), raising ValueError when it cannot be used; None: the value as given.
     """
 
-    people: Sequence[Person] = ()
-    groups: Sequence[Group] = ()
-    scan: LaserScan | None = None
-    tracks: Tracks | None = None
+    name: str
+    default: _T
+    check: Callable[[Any], _T] | None = None
 
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "people", tuple(self.people))
-        object.__setattr__(self, "groups", tuple(self.groups))
-        seen = set()
-        for p in self.people:
-            check_numbers(f"person {p.id}", p, ("x", "y") if p.theta is None else ("x", "y", "theta"))
-            if p.id in seen:
-                raise ValueError(f"person id {p.id} appears twice")
-            seen.add(p.id)
+    def __repr__(self) -> str:
+        return f"Input({self.name!r})"
+
+
+class LayerInputs(Mapping[Input[Any], Any]):
+    """What the layers see in one frame: a value for each kind of input given (immutable; each value passed through
+    its key's ``check`` here). ``inputs[KEY]`` is the value given (KeyError when none is), ``inputs.get(KEY)`` the
+    value or the key's default."""
+
+    __slots__ = ("_values",)
+
+    def __init__(self, values: Mapping[Input[Any], Any] | None = None) -> None:
+        checked: dict[Input[Any], Any] = {}
+        names: dict[str, Input[Any]] = {}
+        for key, value in (values or {}).items():
+            if not isinstance(key, Input):
+                raise TypeError(f"layer inputs are keyed by Input, got {type(key).__name__}")
+            if names.setdefault(key.name, key) is not key:
+                raise ValueError(f"two different inputs are named {key.name!r}")
+            checked[key] = value if key.check is None else key.check(value)
+        self._values = checked
+
+    def __getitem__(self, key: Input[_T]) -> _T:
+        value: _T = self._values[key]
+        return value
+
+    @overload
+    def get(self, key: Input[_T], /) -> _T: ...
+    @overload
+    def get(self, key: Input[_T], default: _D, /) -> _T | _D: ...
+    def get(self, key: Input[Any], *default: Any) -> Any:
+        """The value given for ``key``, else ``default`` when given, else the key's own default."""
+        if key in self._values:
+            return self._values[key]
+        return default[0] if default else key.default
+
+    def __iter__(self) -> Iterator[Input[Any]]:
+        return iter(self._values)
+
+    def __len__(self) -> int:
+        return len(self._values)
+
+    def __repr__(self) -> str:
+        return "LayerInputs({" + ", ".join(f"{key.name}: {value!r}" for key, value in self._values.items()) + "})"
 
 
 class Layer(ABC):
     """One layer: its own uint8 grid ``costs`` over ``spec`` (Nav2 cost values), written into the master grid with
-    ``combination``. Subclasses set ``name`` (unique within a costmap) and ``combination``, and implement ``update``.
+    ``combination``. Subclasses set ``name`` (unique within a costmap), ``combination`` and ``reads`` (the inputs
+    ``update`` reads; none by default), and implement ``update``.
     """
 
     name: str
     combination: CombinationMethod
+    reads: tuple[Input[Any], ...] = ()
 
     def __init__(self, spec: GridSpec, fill: int = FREE_SPACE) -> None:
         check_method(self.combination)

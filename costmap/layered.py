@@ -4,11 +4,12 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
 from costmap.grid import FREE_SPACE, Costmap2D, GridSpec, Window, disjoint, union
-from costmap.layer import Layer, LayerInputs
+from costmap.layer import Input, Layer, LayerInputs
 
 __all__ = ["LayeredCostmap"]
 
@@ -20,6 +21,7 @@ class LayeredCostmap:
     (``Layer.update_windows``), merged where they overlap or lie close (``disjoint``); the master is then reset to
     ``default_value`` (FREE, or NO_INFORMATION when unknown space is tracked) over those windows (``windows``) and
     every layer, in order, writes its costs there. Windows of an update that raised are written at the next one.
+    ``reads``: the inputs its layers read; a frame without one of them reads as its default (nothing to paint).
     """
 
     def __init__(self, spec: GridSpec, layers: Sequence[Layer], default_value: int = FREE_SPACE) -> None:
@@ -42,13 +44,24 @@ class LayeredCostmap:
         return next((layer for layer in self.layers if layer.name == name), None)
 
     @property
+    def reads(self) -> tuple[Input[Any], ...]:
+        """The inputs its layers read, each once, in layer order (Nav2: the sources its plugins subscribe to)."""
+        return tuple(dict.fromkeys(key for layer in self.layers for key in layer.reads))
+
+    @property
     def grids(self) -> dict[str, np.ndarray]:
         """Each layer's own uint8 grid by name, in combination order."""
         return {layer.name: layer.costs for layer in self.layers}
 
     def update(self, inputs: LayerInputs) -> Window | None:
         """Bring every layer to ``inputs``, then recombine the master where anything changed (``windows``); returns
-        the smallest window holding those (Nav2's update bounds), None when nothing changed."""
+        the smallest window holding those (Nav2's update bounds), None when nothing changed. An input the layers do
+        not read is kept (``inputs``) but read by none; one named as an input they read but another key is refused
+        (ValueError, nothing changed): the layers would not see it."""
+        read = {key.name: key for key in self.reads}
+        strangers = [key.name for key in inputs if read.get(key.name, key) is not key]
+        if strangers:
+            raise ValueError(f"inputs {strangers}: not the keys of these names that the layers read")
         for layer in self.layers:
             changed = layer.update_windows(inputs, self._pending)
             self._pending = disjoint([*self._pending, *changed])

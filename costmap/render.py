@@ -22,7 +22,8 @@ from numpy.typing import ArrayLike
 
 from costmap.grid import INSCRIBED, LETHAL, MAX_NON_OBSTACLE, NO_INFORMATION, Costmap2D, GridSpec
 from costmap.layered import LayeredCostmap
-from costmap.layers.social import SocialLayer, SocialParams, group_zone_polygon
+from costmap.layers.obstacle import SCAN as SCAN_INPUT  # SCAN is the scan's colour here
+from costmap.layers.social import GROUPS, PEOPLE, SocialLayer, SocialParams, group_zone_polygon
 from costmap.scan import LaserScan
 from sid.labels import place_labels
 from sid.perception.group import Group
@@ -422,9 +423,9 @@ def render_costmap(
     """
     if isinstance(source, LayeredCostmap):
         costmap = source.master
-        people = source.inputs.people if people is None else people
-        groups = source.inputs.groups if groups is None else groups
-        scan = source.inputs.scan if scan is None else scan
+        people = source.inputs.get(PEOPLE) if people is None else people
+        groups = source.inputs.get(GROUPS) if groups is None else groups
+        scan = source.inputs.get(SCAN_INPUT) if scan is None else scan
         social = next((layer for layer in source.layers if isinstance(layer, SocialLayer)), None)
         if social is not None:
             body_radius = social.body_radius if body_radius is None else body_radius

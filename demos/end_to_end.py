@@ -10,6 +10,8 @@ from __future__ import annotations
 
 from costmap.grid import GridSpec
 from costmap.layer import LayerInputs
+from costmap.layers.obstacle import SCAN
+from costmap.layers.social import GROUPS, PEOPLE
 from costmap.plugins import layered_costmap
 from planner.facade import plan
 from planner.problem import PlanningProblem
@@ -34,7 +36,9 @@ print("stage times (ms):", {stage: round(ms, 2) for stage, ms in result.timing_m
 # 2. Costmap: a 6 m x 5 m map around the camera, a LiDAR scan of the people, their social zones, inflation.
 spec = GridSpec.from_size(0.05, origin=(-1.0, -2.5), size_m=(6.0, 5.0))
 costmap = layered_costmap(spec, robot_radius=0.25)
-costmap.update(LayerInputs(result.people, result.groups, simulate_scan((0.0, 0.0, 0.0), [], result.people)))
+costmap.update(
+    LayerInputs({PEOPLE: result.people, GROUPS: result.groups, SCAN: simulate_scan((0.0, 0.0, 0.0), [], result.people)})
+)
 
 # 3. Planning: from the camera's position to a goal behind the group.
 start, goal = (0.0, 0.0), (4.5, 0.0)

@@ -14,7 +14,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from costmap.layers.social import group_zone_polygon
+from costmap.layers.social import GROUPS, PEOPLE, group_zone_polygon
 from costmap.render import render_costmap
 from sid.scenario.build import build_costmap
 from sid.scenario.loader import load_scenario
@@ -28,13 +28,14 @@ def main() -> None:
     social = build_costmap(scenario)  # groups detected from the people's positions and facing
 
     print(f"{scenario.name}: {scenario.grid.width}x{scenario.grid.height} cells, {len(scenario.people)} people")
-    for group in social.inputs.groups:
-        zone = group_zone_polygon(group, social.inputs.people, scenario.layers.social.group_margin)
+    people, groups = social.inputs[PEOPLE], social.inputs[GROUPS]
+    for group in groups:
+        zone = group_zone_polygon(group, people, scenario.layers.social.group_margin)
         print(f"group {group.members}: interaction zone {zone.area:.2f} m^2 around {np.round(group.interest_point, 2)}")
 
     # What a planner would pay to cut through the conversation: the o-space centre and the gaps between members.
-    by_id = {p.id: p for p in social.inputs.people}
-    for group in social.inputs.groups:
+    by_id = {p.id: p for p in people}
+    for group in groups:
         members = [by_id[m] for m in group.members]
         gaps = [((a.x + b.x) / 2, (a.y + b.y) / 2) for i, a in enumerate(members) for b in members[i + 1 :]]
         probes = np.array([group.interest_point, *gaps])

@@ -19,6 +19,9 @@ from dataclasses import dataclass
 from costmap.grid import GridSpec
 from costmap.layer import LayerInputs
 from costmap.layered import LayeredCostmap
+from costmap.layers.obstacle import SCAN
+from costmap.layers.social import GROUPS, PEOPLE
+from costmap.layers.tracked import TRACKS
 from costmap.plugins import CostmapParams, layered_costmap
 from costmap.scan import LaserScan
 from sid.perception.frame import Frame
@@ -60,7 +63,7 @@ class StreamUpdate:
 class SocialStream:
     """Pipeline -> trackers -> costmap, frame after frame.
 
-    ``costmap``: a ready ``LayeredCostmap`` (its layers read ``LayerInputs.tracks``, or people and groups, which
+    ``costmap``: a ready ``LayeredCostmap`` (its layers read ``TRACKS``, or ``PEOPLE`` and ``GROUPS``, which
     the stream fills with the tracks: a "social" layer draws tracked people too), or a ``GridSpec`` (in the frame
     of the positions, the map when poses are given) from which one is built with ``costmap_params`` (default:
     ``STREAM_PLUGINS`` with default parameters). ``params``: the trackers' (``sid.tracking.session``).
@@ -97,7 +100,8 @@ class SocialStream:
         t0 = time.perf_counter()
         conversations = [g.as_group() for g in tracked.groups if g.kind == "conversation"]
         tracks = Tracks(tracked.people, tracked.groups)
-        self.costmap.update(LayerInputs([p.as_person() for p in tracked.people], conversations, scan, tracks))
+        people = [p.as_person() for p in tracked.people]
+        self.costmap.update(LayerInputs({PEOPLE: people, GROUPS: conversations, SCAN: scan, TRACKS: tracks}))
         t1 = time.perf_counter()
         timing = result.timing_ms | tracked.timing_ms | {"costmap": (t1 - t0) * 1e3, "total": (t1 - start) * 1e3}
         return StreamUpdate(

@@ -28,11 +28,15 @@ import numpy as np
 
 from costmap.combine import CombinationMethod
 from costmap.grid import FREE_SPACE, LETHAL, NO_INFORMATION, GridSpec, Window, nonzero_cells
-from costmap.layer import Layer, LayerInputs
+from costmap.layer import Input, Layer, LayerInputs
+from costmap.layers.social import PEOPLE
 from costmap.scan import LaserScan
 from sid.checks import check_number, check_numbers
 
-__all__ = ["ObstacleLayer", "ObstacleParams", "trace_cells"]
+__all__ = ["SCAN", "ObstacleLayer", "ObstacleParams", "trace_cells"]
+
+SCAN: Input[LaserScan | None] = Input("scan", None)
+"""The frame's 2D scan, in the costmap's frame (None: no scan this frame): applied by the obstacle (LiDAR) layer."""
 
 
 @dataclass(frozen=True)
@@ -185,6 +189,7 @@ class ObstacleLayer(Layer):
 
     name = "lidar"
     combination: CombinationMethod = "max"
+    reads = (SCAN, PEOPLE)
 
     def __init__(self, spec: GridSpec, params: ObstacleParams | None = None, people_clear_radius: float = 0.0) -> None:
         check_number("lidar layer", "people_clear_radius", people_clear_radius, low=0, unit="metres")
@@ -195,11 +200,12 @@ class ObstacleLayer(Layer):
         self._hits = np.zeros(0, dtype=np.int64)  # the last scan's hit cells (flat indices)
 
     def update(self, inputs: LayerInputs, changed: Window | None) -> Window | None:
-        """Apply the scan (if any), then clear the people's marks; returns the window of the cells whose value
-        changed (a new scan of an unchanged scene changes none: the costmap recombines nothing for it)."""
-        scan = None if inputs.scan is None else self._scan_marks(inputs.scan)
-        people = [(p.x, p.y) for p in inputs.people] if self.people_clear_radius > 0 else []
-        return self._apply(scan, np.array(people, dtype=float).reshape(-1, 2))
+        """Apply the ``SCAN`` (if any), then clear the marks of the ``PEOPLE``; returns the window of the cells whose
+        value changed (a new scan of an unchanged scene changes none: the costmap recombines nothing for it)."""
+        scan = inputs.get(SCAN)
+        marks = None if scan is None else self._scan_marks(scan)
+        people = [(p.x, p.y) for p in inputs.get(PEOPLE)] if self.people_clear_radius > 0 else []
+        return self._apply(marks, np.array(people, dtype=float).reshape(-1, 2))
 
     def apply_scan(self, scan: LaserScan) -> Window | None:
         """Clear along every beam, then mark every hit (Nav2's raytraceFreespace + marking); returns the window of

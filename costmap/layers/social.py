@@ -34,12 +34,14 @@ from shapely.geometry.base import BaseGeometry
 
 from costmap.combine import CombinationMethod
 from costmap.grid import FREE_SPACE, LETHAL, MAX_NON_OBSTACLE, GridSpec, Window, disjoint
-from costmap.layer import LayerInputs, RepaintedLayer
+from costmap.layer import Input, LayerInputs, RepaintedLayer
 from sid.checks import check_number, check_numbers
 from sid.perception.group import Group
 from sid.perception.people import Person
 
 __all__ = [
+    "GROUPS",
+    "PEOPLE",
     "SIGMA_RANGE",
     "SocialLayer",
     "SocialParams",
@@ -53,6 +55,26 @@ __all__ = [
     "repaint",
     "zone_hull",
 ]
+
+
+def _people(people: Sequence[Person]) -> tuple[Person, ...]:
+    """``people`` as the layers read them: a tuple; each needs a finite pose and an id of its own (else ValueError)."""
+    people = tuple(people)
+    seen = set()
+    for p in people:
+        check_numbers(f"person {p.id}", p, ("x", "y") if p.theta is None else ("x", "y", "theta"))
+        if p.id in seen:
+            raise ValueError(f"person id {p.id} appears twice")
+        seen.add(p.id)
+    return people
+
+
+PEOPLE: Input[tuple[Person, ...]] = Input("people", (), _people)
+"""The frame's people (world frame; any sequence, read as a tuple): drawn by the social layer, their LiDAR marks
+cleared by the obstacle layer."""
+
+GROUPS: Input[tuple[Group, ...]] = Input("groups", (), tuple)
+"""Their groups (members among ``PEOPLE``; any sequence, read as a tuple): zones drawn by the social layer."""
 
 SIGMA_RANGE = (1e-3, 1e3)
 """The spreads (m) a Gaussian of the social layer may have: 1 mm to 1 km, whose exponents stay well inside float32
@@ -543,6 +565,7 @@ class SocialLayer(RepaintedLayer):
 
     name = "social"
     combination: CombinationMethod = "max_nonzero"
+    reads = (PEOPLE, GROUPS)
 
     def __init__(self, spec: GridSpec, params: SocialParams | None = None, body_radius: float = 0.2) -> None:
         check_number("social layer", "body_radius", body_radius, low=0, low_open=True, unit="metres")
@@ -552,10 +575,11 @@ class SocialLayer(RepaintedLayer):
         self._painted: list[Window] = []  # windows holding the cells the last update may have painted
 
     def update_windows(self, inputs: LayerInputs, changed: Sequence[Window]) -> list[Window]:
-        """Repaint the layer for the people (world frame) and groups of ``inputs``; returns the windows of the last
-        update's paint (now cleared) and of this one's."""
-        by_id = _people_by_id(inputs.people)
-        hulls = [zone_hull(group, by_id) for group in inputs.groups]  # raises on a bad group before any change
+        """Repaint the layer for the ``PEOPLE`` (world frame) and ``GROUPS`` of ``inputs`` (none: an empty layer);
+        returns the windows of the last update's paint (now cleared) and of this one's."""
+        people = inputs.get(PEOPLE)
+        by_id = _people_by_id(people)
+        hulls = [zone_hull(group, by_id) for group in inputs.get(GROUPS)]  # raises on a bad group before any change
         previous = self._painted
-        self._painted = repaint(self.costs, self.spec, previous, hulls, inputs.people, self.params, self.body_radius)
+        self._painted = repaint(self.costs, self.spec, previous, hulls, people, self.params, self.body_radius)
         return [*previous, *self._painted]

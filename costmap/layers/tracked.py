@@ -1,4 +1,4 @@
-"""The tracked-people layer: the social layer's costs drawn from tracks (``LayerInputs.tracks``), not detections.
+"""The tracked-people layer: the social layer's costs drawn from tracks (the ``TRACKS`` input), not detections.
 
 It reads the tracker's people and groups (``sid.tracking``), so a person missed for a frame, or a facing that jitters,
 does not make the costs blink: tracks persist through short misses and their positions and facings are smoothed.
@@ -22,11 +22,16 @@ from dataclasses import dataclass
 
 from costmap.combine import CombinationMethod
 from costmap.grid import GridSpec, Window
-from costmap.layer import LayerInputs, RepaintedLayer
+from costmap.layer import Input, LayerInputs, RepaintedLayer
 from costmap.layers.social import SocialParams, repaint, zone_hull
 from sid.checks import check_number
+from sid.tracking.records import Tracks
 
-__all__ = ["MAX_LOOKAHEAD", "TrackedPeopleLayer", "TrackedPeopleParams"]
+__all__ = ["MAX_LOOKAHEAD", "TRACKS", "TrackedPeopleLayer", "TrackedPeopleParams"]
+
+TRACKS: Input[Tracks | None] = Input("tracks", None)
+"""The trackers' confirmed people and groups at the frame (world frame; None: no tracker runs): drawn by the
+tracked-people layer."""
 
 MAX_LOOKAHEAD = 10.0
 """The longest ``lookahead`` (s): a walker's cost stretched 14 m ahead at 1.4 m/s; beyond it the windows would grow
@@ -52,6 +57,7 @@ class TrackedPeopleLayer(RepaintedLayer):
 
     name = "tracked_people"
     combination: CombinationMethod = "max_nonzero"
+    reads = (TRACKS,)
 
     def __init__(
         self,
@@ -68,9 +74,9 @@ class TrackedPeopleLayer(RepaintedLayer):
         self._painted: list[Window] = []  # windows holding the cells the last update may have painted
 
     def update_windows(self, inputs: LayerInputs, changed: Sequence[Window]) -> list[Window]:
-        """Repaint the layer for the tracked people and groups of ``inputs.tracks``; returns the windows of the last
-        update's paint (now cleared) and of this one's."""
-        tracks = inputs.tracks
+        """Repaint the layer for the tracked people and groups of the ``TRACKS`` of ``inputs``; returns the windows of
+        the last update's paint (now cleared) and of this one's."""
+        tracks = inputs.get(TRACKS)
         people = [] if tracks is None else [p.as_person() for p in tracks.people]
         by_id = {p.id: p for p in people}
         conversations = [] if tracks is None else [g.as_group() for g in tracks.groups if g.kind == "conversation"]

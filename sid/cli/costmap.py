@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from costmap.export import export_costmap
+from costmap.layers.social import GROUPS, PEOPLE
 from costmap.mapfile import MapFileError
 from sid.cli.common import OutputFolderError, check_output_folder, fail, plain_text, print_written, staged_output
 from sid.cli.planning import add_scenario_arguments
@@ -48,10 +49,10 @@ def run(args: argparse.Namespace) -> int:
         return fail("sid costmap", exc)
     paths = {key: staged.final(path) for key, path in written.items()}
     counts = {name: int((grid > 0).sum()) for name, grid in layered.grids.items()}
+    people, groups = layered.inputs.get(PEOPLE), layered.inputs.get(GROUPS)
     print(
         f"{scenario.name}: {layered.spec.width}x{layered.spec.height} cells at {layered.spec.resolution} m, "
-        f"{plural(len(layered.inputs.people), 'person', 'people')}, {plural(len(layered.inputs.groups), 'group')} "
-        f"({kind})"
+        f"{plural(len(people), 'person', 'people')}, {plural(len(groups), 'group')} ({kind})"
     )
     print("non-zero cells per layer: " + ", ".join(f"{k} {v}" for k, v in counts.items()))
     print_written(paths.values())

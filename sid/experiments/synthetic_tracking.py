@@ -39,6 +39,7 @@ from scipy.optimize import linear_sum_assignment
 
 from costmap.grid import GridSpec
 from costmap.layer import LayerInputs
+from costmap.layers.social import GROUPS, PEOPLE
 from costmap.plugins import CostmapParams, layered_costmap
 from sid.checks import check_number
 from sid.distribution import MissingDependencyError, install_hint
@@ -319,7 +320,7 @@ def measure_flicker(settings: TrackingEvalSettings | None = None, progress: Prog
     previous: dict[str, np.ndarray] = {}
     for index, frame in enumerate(source):
         update = stream.update(frame)
-        per_frame.update(LayerInputs(update.result.people, update.result.groups))
+        per_frame.update(LayerInputs({PEOPLE: update.result.people, GROUPS: update.result.groups}))
         for name, grid in (("per_frame", per_frame.master.costs), ("tracked", update.costmap.master.costs)):
             grid = grid.astype(np.int16)
             if name in previous and index * 1.0 / settings.fps >= settings.settle_time:

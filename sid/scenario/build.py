@@ -6,6 +6,8 @@ from __future__ import annotations
 from costmap.grid import Costmap2D
 from costmap.layer import LayerInputs
 from costmap.layered import LayeredCostmap
+from costmap.layers.obstacle import SCAN
+from costmap.layers.social import GROUPS, PEOPLE
 from costmap.layers.static import static_costs
 from costmap.mapfile import read_map
 from costmap.plugins import CostmapParams, layered_costmap
@@ -63,7 +65,7 @@ def build_costmap(
     )
     if groups is None:
         groups = detect_groups(scenario.people, scenario.group_params) if social else []
-    layered.update(LayerInputs(scenario.people, groups, scan))
+    layered.update(LayerInputs({PEOPLE: scenario.people, GROUPS: groups, SCAN: scan}))
     return layered
 
 

@@ -114,7 +114,8 @@ class TrackedGroup:
 
 @dataclass(frozen=True)
 class Tracks:
-    """What the trackers hold at one frame: confirmed people and groups (``costmap.layer.LayerInputs.tracks``).
+    """What the trackers hold at one frame: confirmed people and groups (the costmap's input
+    ``costmap.layers.tracked.TRACKS``).
 
     Every group member must be one of the people; ids are distinct.
     """

@@ -7,6 +7,8 @@ import numpy as np
 
 from costmap.grid import NO_INFORMATION, GridSpec, Window
 from costmap.layer import Layer, LayerInputs
+from costmap.layers.obstacle import SCAN
+from costmap.layers.social import GROUPS, PEOPLE
 from sid.perception.group import Group
 from sid.perception.groups import detect_groups
 from sid.perception.people import Person
@@ -23,7 +25,7 @@ def frames() -> list[LayerInputs]:
     for step in range(6):
         moved = [Person(p.id, p.x + 0.2 * step, p.y - 0.1 * step, p.theta) for p in people[: 4 - step // 3]]
         scan = None if step in (2, 4) else simulate_scan((0.3 * step, 0.0, 0.0), WALLS, moved, beams=360)
-        out.append(LayerInputs(moved, detect_groups(moved), scan))
+        out.append(LayerInputs({PEOPLE: moved, GROUPS: detect_groups(moved), SCAN: scan}))
     return out
 
 

@@ -10,6 +10,7 @@ import yaml
 from costmap.export import export_costmap
 from costmap.grid import Costmap2D, GridSpec
 from costmap.layered import LayeredCostmap
+from costmap.layers.social import GROUPS, PEOPLE
 from costmap.layers.static import static_costs
 from costmap.mapfile import MapFileError, read_map, write_map
 from costmap.npz import load_npz, save_npz
@@ -297,5 +298,5 @@ def test_sid_costmap_reports_a_bad_scenario(tmp_path, capsys):
 
 def test_people_without_recognition_are_only_lidar_obstacles():
     layered = example_layered(social=False)
-    assert set(layered.grids) == {"static", "lidar", "inflation"} and layered.inputs.groups == ()
-    assert isinstance(layered.inputs.people[0], Person)
+    assert set(layered.grids) == {"static", "lidar", "inflation"} and layered.inputs[GROUPS] == ()
+    assert isinstance(layered.inputs[PEOPLE][0], Person)

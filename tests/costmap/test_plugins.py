@@ -10,7 +10,7 @@ from costmap.grid import FREE_SPACE, LETHAL, GridSpec
 from costmap.layer import LayerInputs
 from costmap.layered import LayeredCostmap
 from costmap.layers.inflation import InflationLayer, InflationParams
-from costmap.layers.obstacle import ObstacleLayer, ObstacleParams
+from costmap.layers.obstacle import SCAN, ObstacleLayer, ObstacleParams
 from costmap.plugins import PLUGINS, CostmapParams, LayerInstance, layered_costmap
 from costmap.scan import LaserScan
 from sid.scenario.build import build_costmap
@@ -40,7 +40,7 @@ def test_two_lidar_layers_with_their_own_parameters_in_one_costmap() -> None:
     near, far = layered.layer("near_lidar"), layered.layer("lidar")
     assert isinstance(near, ObstacleLayer) and isinstance(far, ObstacleLayer)
     assert near.params == NEAR and far.params == params.obstacle  # a plugin's own name: the costmap's section
-    layered.update(LayerInputs(scan=_scan()))
+    layered.update(LayerInputs({SCAN: _scan()}))
     far_hit = (6.0 * np.cos(0.1), 6.0 * np.sin(0.1))
     assert _lethal_at(layered, "near_lidar", 2.0, 0.0) and not _lethal_at(layered, "near_lidar", *far_hit)
     assert _lethal_at(layered, "lidar", 2.0, 0.0) and _lethal_at(layered, "lidar", *far_hit)

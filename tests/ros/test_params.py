@@ -15,7 +15,8 @@ import yaml
 
 from costmap.layer import LayerInputs
 from costmap.layers.inflation import InflationParams
-from costmap.layers.tracked import TrackedPeopleLayer, TrackedPeopleParams
+from costmap.layers.social import PEOPLE
+from costmap.layers.tracked import TRACKS, TrackedPeopleLayer, TrackedPeopleParams
 from costmap.plugins import CostmapParams, LayerInstance, layered_costmap
 from sid.ros.params import NODE_NAME, NodeParams, read_params
 from sid.tracking import TrackedPerson, Tracks
@@ -70,7 +71,7 @@ def test_a_parameters_file_names_two_tracked_people_layers_with_their_own_lookah
     layered = layered_costmap(params.grid, layers)
     assert [layer.name for layer in layered.layers] == ["tracked_people", "walkers", "inflation"]
     walker = TrackedPerson(1, 0.0, 0.0, 1.3, 0.0, None, "walking", True, True, 0.0, None, 0.05, 0.1)
-    layered.update(LayerInputs([walker.as_person()], tracks=Tracks([walker])))
+    layered.update(LayerInputs({PEOPLE: [walker.as_person()], TRACKS: Tracks([walker])}))
     for name, lookahead in (("tracked_people", 0.5), ("walkers", 1.5)):  # each layer stretches by its own lookahead
         layer = layered.layer(name)
         assert isinstance(layer, TrackedPeopleLayer)

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from costmap.grid import FREE_SPACE, LETHAL, NO_INFORMATION, GridSpec
+from costmap.layers.obstacle import SCAN
 from costmap.mapfile import write_map
 from costmap.occupancy import OCC_OCCUPIED, OCC_UNKNOWN, OccupancyGrid
 from planner.facade import plan
@@ -39,7 +40,7 @@ def cells_of(xy) -> tuple[int, int]:
 
 def test_a_box_is_lethal_whole_although_the_scan_sees_only_its_near_face():
     layered = build_costmap(scenario([BOX]), social=False)
-    hits = layered.inputs.scan.hit_points()
+    hits = layered.inputs[SCAN].hit_points()
     on_box = hits[(hits[:, 0] > 4.9) & (hits[:, 0] < 6.1) & (hits[:, 1] > 1.9) & (hits[:, 1] < 4.1)]
     assert len(on_box) > 10 and on_box[:, 0].max() < 5.05  # the scan hits only the face x = 5 it sees
     far_face = [cells_of((6.0, y)) for y in np.arange(2.05, 4.0, 0.1)]

@@ -641,6 +641,8 @@ def _costmap_setup(ctx: Context) -> dict[str, Any]:
 
     def build() -> dict[str, Any]:
         from costmap.grid import GridSpec
+        from costmap.layers.obstacle import SCAN
+        from costmap.layers.social import GROUPS, PEOPLE
         from sid.experiments.bench.scenes import bench_scene
         from sid.scenario.lidar import simulate_scan
 
@@ -648,7 +650,9 @@ def _costmap_setup(ctx: Context) -> dict[str, Any]:
         frames = []
         for shift in (0.0, 0.05):
             obstacles, people, groups = bench_scene(20.0, shift=shift)
-            frames.append((people, groups, simulate_scan((0.0, 0.0, 0.0), obstacles, people, beams=720)))
+            frames.append(
+                {PEOPLE: people, GROUPS: groups, SCAN: simulate_scan((0.0, 0.0, 0.0), obstacles, people, beams=720)}
+            )
         return {"spec": spec, "frames": frames}
 
     return ctx.cached("costmap", build)
@@ -657,15 +661,16 @@ def _costmap_setup(ctx: Context) -> dict[str, Any]:
 def _bench_costmap_update(social: bool) -> Callable[[Context], Records]:
     def run(ctx: Context) -> Records:
         from costmap.layer import LayerInputs
+        from costmap.layers.social import GROUPS, PEOPLE
         from costmap.plugins import CostmapParams, layered_costmap
 
         setup = _costmap_setup(ctx)
         params = CostmapParams() if social else CostmapParams().without("social")
         layered = layered_costmap(setup["spec"], params)
         frames, counter = setup["frames"], iter(range(10**9))
-        stats = measure(lambda: layered.update(LayerInputs(*frames[next(counter) % 2])), ctx.settings)
+        stats = measure(lambda: layered.update(LayerInputs(frames[next(counter) % 2])), ctx.settings)
         name = "costmap/update" if social else "costmap/update_no_social"
-        people, groups, _ = frames[0]
+        people, groups = frames[0][PEOPLE], frames[0][GROUPS]
         return {name: record(stats, cells=setup["spec"].width * setup["spec"].height, beams=720,
                              people=len(people), groups=len(groups))}  # fmt: skip
 
@@ -676,6 +681,8 @@ def _bench_costmap_large(ctx: Context) -> Records:
     """An 80 m x 80 m map at 5 cm (1600 x 1600): one scan builds it, then only the 3 groups move (5 cm a frame)."""
     from costmap.grid import GridSpec
     from costmap.layer import LayerInputs
+    from costmap.layers.obstacle import SCAN
+    from costmap.layers.social import GROUPS, PEOPLE
     from costmap.plugins import CostmapParams, layered_costmap
     from sid.experiments.bench.scenes import bench_scene
     from sid.scenario.lidar import simulate_scan
@@ -683,8 +690,15 @@ def _bench_costmap_large(ctx: Context) -> Records:
     spec = GridSpec.from_size(0.05, (-40.0, -40.0), (80.0, 80.0))
     obstacles, people, groups = bench_scene(80.0)
     layered = layered_costmap(spec, CostmapParams())
-    layered.update(LayerInputs(people, groups, simulate_scan((0.0, 0.0, 0.0), obstacles, people, beams=720)))
-    moved = [LayerInputs(*bench_scene(80.0, shift=shift)[1:]) for shift in (0.05, 0.0)]
+    layered.update(
+        LayerInputs(
+            {PEOPLE: people, GROUPS: groups, SCAN: simulate_scan((0.0, 0.0, 0.0), obstacles, people, beams=720)}
+        )
+    )
+    moved = []
+    for shift in (0.05, 0.0):
+        _, moved_people, moved_groups = bench_scene(80.0, shift=shift)
+        moved.append(LayerInputs({PEOPLE: moved_people, GROUPS: moved_groups}))
     counter = iter(range(10**9))
     stats = measure(lambda: layered.update(moved[next(counter) % 2]), ctx.settings)
     window = layered.update(moved[0])
@@ -701,7 +715,7 @@ def _bench_inflation(ctx: Context) -> Records:
     setup = _costmap_setup(ctx)
     spec = setup["spec"]
     layered = layered_costmap(spec)
-    layered.update(LayerInputs(*setup["frames"][0]))
+    layered.update(LayerInputs(setup["frames"][0]))
     master = layered.master.costs.copy()  # walls and bodies (and their inflation, which does not change the result)
     work = master.copy()
 
@@ -788,7 +802,7 @@ def _bench_track(n: int) -> Callable[[Context], Records]:
 
         from costmap.grid import GridSpec
         from costmap.layer import LayerInputs
-        from costmap.layers.tracked import TrackedPeopleLayer
+        from costmap.layers.tracked import TRACKS, TrackedPeopleLayer
         from sid.perception.pipeline import FrameResult
         from sid.tracking import TrackingSession, Tracks
 
@@ -814,7 +828,7 @@ def _bench_track(n: int) -> Callable[[Context], Records]:
             result = FrameResult(k, k / TRACK_FPS, [], frames[k % len(frames)], [])
             tracked = session.update(result)
             t0 = time.perf_counter()
-            layer.update(LayerInputs(tracks=Tracks(tracked.people, tracked.groups)), None)
+            layer.update(LayerInputs({TRACKS: Tracks(tracked.people, tracked.groups)}), None)
             layer_ms = (time.perf_counter() - t0) * 1e3
             seen.update(people=len(tracked.people), groups=len(tracked.groups))
             parts = {
@@ -876,7 +890,7 @@ def _bench_crowd(n: int) -> Callable[[Context], Records]:
     def run(ctx: Context) -> Records:
         from costmap.grid import GridSpec
         from costmap.layer import LayerInputs
-        from costmap.layers.tracked import TrackedPeopleLayer
+        from costmap.layers.tracked import TRACKS, TrackedPeopleLayer
         from sid.tracking import TrackingSession, Tracks, scene_view
         from sid.tracking.coherent import CoherentMotion
 
@@ -896,7 +910,7 @@ def _bench_crowd(n: int) -> Callable[[Context], Records]:
             frame = next(frames)
             tracked = session.track(frame.detections, frame.timestamp, view)
             t0 = time.perf_counter_ns()
-            layer.update(LayerInputs(tracks=Tracks(tracked.people, tracked.groups)), None)
+            layer.update(LayerInputs({TRACKS: Tracks(tracked.people, tracked.groups)}), None)
             t1 = time.perf_counter_ns()
             coherent = reference.update(tracked.people, frame.timestamp)
             t2 = time.perf_counter_ns()

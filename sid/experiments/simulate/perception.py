@@ -28,6 +28,8 @@ import numpy as np
 
 from costmap.layer import LayerInputs
 from costmap.layered import LayeredCostmap
+from costmap.layers.obstacle import SCAN
+from costmap.layers.social import GROUPS, PEOPLE
 from costmap.scan import LaserScan
 from sid.perception.camera import Calibration, Extrinsics, Intrinsics
 from sid.perception.group import Group
@@ -94,7 +96,7 @@ class LidarSensing:
     costmap: LayeredCostmap
 
     def __call__(self, step: int, pose: RobotPose, people: list[Person], scan: LaserScan) -> Seen:
-        self.costmap.update(LayerInputs(scan=scan))
+        self.costmap.update(LayerInputs({SCAN: scan}))
         return Seen()
 
 
@@ -127,7 +129,7 @@ class ExactSensing:
             if any(self._clear(pose, person, others, side) for side in (0.0, -0.8, 0.8)):
                 seen.append(person)
         groups = detect_groups(seen, self.group_params)
-        self.costmap.update(LayerInputs(seen, groups, scan))
+        self.costmap.update(LayerInputs({PEOPLE: seen, GROUPS: groups, SCAN: scan}))
         return Seen(seen, groups)
 
     def _clear(self, pose: RobotPose, person: Person, others: list[Person], side: float) -> bool:
@@ -160,7 +162,7 @@ class CameraSensing:
 
     def __call__(self, step: int, pose: RobotPose, people: list[Person], scan: LaserScan) -> Seen:
         if self.sequence is None:  # nobody to see: the scan alone
-            self.costmap.update(LayerInputs(scan=scan))
+            self.costmap.update(LayerInputs({SCAN: scan}))
             return Seen()
         here = dataclasses.replace(self.sequence, robot=Trajectory(pose.x, pose.y, pose.yaw))
         frame = self.camera.capture(here, step, self.seed)

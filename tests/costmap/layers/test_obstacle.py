@@ -7,7 +7,8 @@ import pytest
 
 from costmap.grid import FREE_SPACE, LETHAL, NO_INFORMATION, GridSpec
 from costmap.layer import LayerInputs
-from costmap.layers.obstacle import ObstacleLayer, ObstacleParams, trace_cells
+from costmap.layers.obstacle import SCAN, ObstacleLayer, ObstacleParams, trace_cells
+from costmap.layers.social import PEOPLE
 from costmap.scan import LaserScan
 from sid.perception.people import Person
 from sid.scenario.lidar import simulate_scan
@@ -82,7 +83,7 @@ def test_lidar_layer_writes_what_clearing_every_beam_then_marking_would(seed):
         people = [Person(p.id, p.x + rng.normal(0, 0.05), p.y + rng.normal(0, 0.05), 0.0) for p in people]
         scan = simulate_scan(pose, walls, people, beams=360, range_max=10.0)
         before = layer.costs.copy()
-        window = layer.update(LayerInputs(people, (), scan), None)
+        window = layer.update(LayerInputs({PEOPLE: people, SCAN: scan}), None)
         r = scan.valid_ranges()  # no return (inf): cleared to the 10 m raytrace range, not marked
         origin = np.array(pose[:2])
         clear_to = np.where(np.isinf(r), 10.0, r)
@@ -111,10 +112,13 @@ def test_lidar_layer_reports_only_what_changed():
     people = [Person(1, 4.0, 0.0, np.pi)]
     layer = ObstacleLayer(SPEC, people_clear_radius=0.3)
     scan = simulate_scan((0.0, 0.0, 0.0), [SegmentObstacle(((-1.0, 2.5), (9.0, 2.5)))], people, beams=720)
-    assert layer.update(LayerInputs(people, (), scan), None) is not None
-    assert layer.update(LayerInputs(people, (), scan), None) is None  # the same scene again: nothing changed
+    scene = LayerInputs({PEOPLE: people, SCAN: scan})
+    assert layer.update(scene, None) is not None
+    assert layer.update(scene, None) is None  # the same scene again: nothing changed
     moved = [Person(1, 4.0, -1.0, np.pi)]
-    window = layer.update(LayerInputs(moved, (), simulate_scan((0.0, 0.0, 0.0), [], moved, beams=720)), None)
+    window = layer.update(
+        LayerInputs({PEOPLE: moved, SCAN: simulate_scan((0.0, 0.0, 0.0), [], moved, beams=720)}), None
+    )
     assert window is not None  # the wall is gone: its marks were cleared, only there
     assert window.row0 <= SPEC.world_to_cell([[0.0, 2.5]])[0, 0] < window.row1
     assert window.row0 >= SPEC.world_to_cell([[0.0, 2.0]])[0, 0]
@@ -132,13 +136,14 @@ def test_the_lidar_layer_clears_people_marks_by_its_own_parameter():
     near = SPEC.window((3.5, -0.5), (4.5, 0.5))
     for radius, marks in ((0.0, True), (0.3, False)):
         layer = ObstacleLayer(SPEC, people_clear_radius=radius)
-        window = layer.update(LayerInputs(people, (), scan), None)
+        window = layer.update(LayerInputs({PEOPLE: people, SCAN: scan}), None)
         assert ((layer.costs[near.slices] == LETHAL).any()) == marks
         assert (layer.costs == LETHAL).any() and window is not None
-        assert layer.update(LayerInputs(people), None) is None  # no scan and nothing left to clear: no change
+        no_scan = LayerInputs({PEOPLE: people})
+        assert layer.update(no_scan, None) is None  # no scan and nothing left to clear: no change
         mark = SPEC.window((4.1, 0.05), (4.1, 0.05))
         assert mark is not None
         layer.costs[mark.slices] = LETHAL  # within 0.3 m of the person: theirs when the layer clears people's marks
-        assert layer.update(LayerInputs(people), None) == (None if radius == 0 else mark)  # the window of what changed
+        assert layer.update(no_scan, None) == (None if radius == 0 else mark)  # the window of what changed
     with pytest.raises(ValueError, match="people_clear_radius"):
         ObstacleLayer(SPEC, people_clear_radius=-1.0)

@@ -11,6 +11,8 @@ from shapely.geometry import LineString, MultiPoint, Point
 from costmap.grid import FREE_SPACE, INSCRIBED, LETHAL, NO_INFORMATION, Costmap2D, GridSpec
 from costmap.layer import LayerInputs
 from costmap.layers.social import (
+    GROUPS,
+    PEOPLE,
     SocialLayer,
     SocialParams,
     _distance_to_hull,
@@ -58,7 +60,7 @@ def test_every_cell_inside_the_group_zone_costs_at_least_group_cost():
     people, group = triad()
     params = SocialParams()
     layer = SocialLayer(SPEC, params)
-    layer.update(LayerInputs(people, [group]), None)
+    layer.update(LayerInputs({PEOPLE: people, GROUPS: [group]}), None)
     xs, ys = SPEC.cell_centres()
     inside = shapely.contains_xy(group_zone_polygon(group, people, params.group_margin), xs, ys)
     assert inside.sum() > 300
@@ -70,7 +72,7 @@ def test_every_cell_inside_the_group_zone_costs_at_least_group_cost():
 
 def test_personal_space_is_larger_in_front_and_circular_without_orientation():
     layer = SocialLayer(SPEC, SocialParams())
-    layer.update(LayerInputs([Person(1, 2.0, 0.0, 0.0), Person(2, 6.0, 0.0, None)]), None)
+    layer.update(LayerInputs({PEOPLE: [Person(1, 2.0, 0.0, 0.0), Person(2, 6.0, 0.0, None)]}), None)
     costmap = Costmap2D(SPEC, layer.costs)
     front, back = costmap.cost_at([[2.8, 0.0], [1.2, 0.0]])
     assert front > back > 0
@@ -186,7 +188,8 @@ def test_people_groups_and_bodies_painted_together_equal_each_painted_alone(seed
 
 def test_social_layer_clips_people_outside_the_map():
     layer = SocialLayer(SPEC, SocialParams())
-    layer.update(LayerInputs([Person(1, 9.3, 0.0, np.pi)]), None)  # 0.3 m beyond the right edge, facing into the map
+    beyond = [Person(1, 9.3, 0.0, np.pi)]  # 0.3 m beyond the right edge, facing into the map
+    layer.update(LayerInputs({PEOPLE: beyond}), None)
     assert layer.costs[:, -1].max() > 0
     assert not (layer.costs == LETHAL).any()  # the body itself is outside
 

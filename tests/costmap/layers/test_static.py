@@ -7,7 +7,8 @@ import pytest
 
 from costmap.grid import FREE_SPACE, INSCRIBED, LETHAL, NO_INFORMATION, GridSpec
 from costmap.layer import LayerInputs
-from costmap.layers.obstacle import ObstacleParams
+from costmap.layers.obstacle import SCAN, ObstacleParams
+from costmap.layers.social import PEOPLE
 from costmap.mapfile import write_map
 from costmap.occupancy import OccupancyGrid
 from costmap.plugins import CostmapParams, layered_costmap
@@ -28,13 +29,13 @@ def test_the_static_layer_writes_its_map_at_the_first_update_only():
     assert list(layered.grids) == ["static", "lidar", "social", "inflation"]
     off_map = simulate_scan((20.0, 0.0, 0.0), [], beams=8)
     with pytest.raises(ValueError, match="outside the costmap"):  # after the static layer reported its map
-        layered.update(LayerInputs(scan=off_map))
+        layered.update(LayerInputs({SCAN: off_map}))
     assert (layered.master.costs == NO_INFORMATION).all()
     assert layered.update(LayerInputs()) == SPEC.whole  # no scan, nobody: the map alone, still to be written
     master = layered.master.costs
     assert (master[100, 10:] == LETHAL).all() and (master[:90, :10] == NO_INFORMATION).all()
     assert (master[:85, 10:] == FREE_SPACE).all() and master[95, 50] == INSCRIBED
-    window = layered.update(LayerInputs([Person(1, 4.0, -2.0, 0.0)]))
+    window = layered.update(LayerInputs({PEOPLE: [Person(1, 4.0, -2.0, 0.0)]}))
     assert window is not None and window != SPEC.whole
     assert (layered.master.costs[100, 10:] == LETHAL).all()
     assert layered.layer("static").update(LayerInputs(), None) is None
@@ -61,5 +62,5 @@ def test_static_map_walls_survive_and_lidar_adds_to_them(tmp_path):
     assert (master[50, :] == LETHAL).all()  # static wall, also where the LiDAR saw nothing
     assert (layered.grids["lidar"][10:40, 80] == LETHAL).any()  # the LiDAR-only wall at x = 4.0
     assert (master[56:, :5] == NO_INFORMATION).all()  # unknown in the static map, never seen
-    scan = layered.inputs.scan
+    scan = layered.inputs[SCAN]
     assert scan is not None and scan.ranges[np.argmin(np.abs(scan.angles - np.pi / 2))] == pytest.approx(1.5, abs=0.05)

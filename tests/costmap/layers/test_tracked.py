@@ -9,8 +9,8 @@ import pytest
 
 from costmap.grid import FREE_SPACE, LETHAL, GridSpec
 from costmap.layer import LayerInputs
-from costmap.layers.social import SocialLayer, SocialParams
-from costmap.layers.tracked import TrackedPeopleLayer, TrackedPeopleParams
+from costmap.layers.social import GROUPS, PEOPLE, SocialLayer, SocialParams
+from costmap.layers.tracked import TRACKS, TrackedPeopleLayer, TrackedPeopleParams
 from costmap.plugins import CostmapParams, layered_costmap
 from sid.perception.group import Group
 from sid.perception.people import Person
@@ -35,32 +35,32 @@ def test_standing_people_and_their_group_cost_what_the_social_layer_draws() -> N
     zone = np.array([[4.0, 0.2], [3.83, -0.1], [4.17, -0.1]])
     group = TrackedGroup(3, "conversation", (7, 8, 9), (4.0, 0.0), zone, 0.05, 0.6, (0.0, 0.0), 0.0)
     tracked = TrackedPeopleLayer(SPEC)
-    tracked.update(LayerInputs(tracks=Tracks(tracks, [group])), None)
+    tracked.update(LayerInputs({TRACKS: Tracks(tracks, [group])}), None)
     social = SocialLayer(SPEC)
     people = [Person(t.id, t.x, t.y, t.theta, 1.0) for t in tracks]
-    social.update(LayerInputs(people, [Group((7, 8, 9), (4.0, 0.0), 0.05, zone, 0.6)]), None)
+    social.update(LayerInputs({PEOPLE: people, GROUPS: [Group((7, 8, 9), (4.0, 0.0), 0.05, zone, 0.6)]}), None)
     np.testing.assert_array_equal(tracked.costs, social.costs)
     assert _cost(tracked, 4.0, 0.0) == 240
     people_only = TrackedPeopleLayer(SPEC)  # the zone is drawn: without the group the centre costs less
-    people_only.update(LayerInputs(tracks=Tracks(tracks, [])), None)
+    people_only.update(LayerInputs({TRACKS: Tracks(tracks, [])}), None)
     assert _cost(people_only, 4.0, 0.0) < 240
     assert np.count_nonzero(tracked.costs > people_only.costs) > 1000
 
 
 def test_a_walker_costs_more_ahead_than_behind_and_than_standing() -> None:
     walking, standing = TrackedPeopleLayer(SPEC), TrackedPeopleLayer(SPEC)
-    walking.update(LayerInputs(tracks=Tracks([_track(1, 4.0, 0.0, math.pi / 2, (1.3, 0.0))])), None)
-    standing.update(LayerInputs(tracks=Tracks([_track(1, 4.0, 0.0, 0.0)])), None)
+    walking.update(LayerInputs({TRACKS: Tracks([_track(1, 4.0, 0.0, math.pi / 2, (1.3, 0.0))])}), None)
+    standing.update(LayerInputs({TRACKS: Tracks([_track(1, 4.0, 0.0, 0.0)])}), None)
     for ahead in (0.8, 1.5, 2.5):  # along the velocity (+x), whatever the facing (+y)
         assert _cost(walking, 4.0 + ahead, 0.0) > _cost(standing, 4.0 + ahead, 0.0)
         assert _cost(walking, 4.0 + ahead, 0.0) > _cost(walking, 4.0 - ahead, 0.0)
     assert _cost(walking, 4.0, 0.0) == LETHAL
     far = TrackedPeopleLayer(SPEC)  # the cost reaches (sigma_front + lookahead * speed) * sqrt(2 ln 200) ahead
-    far.update(LayerInputs(tracks=Tracks([_track(1, 0.0, 0.0, None, (1.3, 0.0))])), None)
+    far.update(LayerInputs({TRACKS: Tracks([_track(1, 0.0, 0.0, None, (1.3, 0.0))])}), None)
     reach = (0.8 + 1.0 * 1.3) * math.sqrt(2 * math.log(200))
     assert _cost(far, reach - 0.1, 0.0) > 0 and _cost(far, reach + 0.1, 0.0) == 0
     longer = TrackedPeopleLayer(SPEC, TrackedPeopleParams(lookahead=2.0))
-    longer.update(LayerInputs(tracks=Tracks([_track(1, 4.0, 0.0, None, (1.3, 0.0))])), None)
+    longer.update(LayerInputs({TRACKS: Tracks([_track(1, 4.0, 0.0, None, (1.3, 0.0))])}), None)
     assert _cost(longer, 6.5, 0.0) > _cost(walking, 6.5, 0.0)
 
 
@@ -69,14 +69,14 @@ def test_walking_groups_get_no_zone() -> None:
     tracks = [_track(1, 4.0, 0.4, -math.pi / 2, v), _track(2, 4.0, -0.4, math.pi / 2, v)]
     group = TrackedGroup(1, "walking", (1, 2), (4.0, 0.0), np.zeros((0, 2)), 0.0, 0.4, v, 0.0)
     with_group, without = TrackedPeopleLayer(SPEC), TrackedPeopleLayer(SPEC)
-    with_group.update(LayerInputs(tracks=Tracks(tracks, [group])), None)
-    without.update(LayerInputs(tracks=Tracks(tracks)), None)
+    with_group.update(LayerInputs({TRACKS: Tracks(tracks, [group])}), None)
+    without.update(LayerInputs({TRACKS: Tracks(tracks)}), None)
     np.testing.assert_array_equal(with_group.costs, without.costs)
 
 
 def test_the_layer_is_cleared_when_the_tracks_go() -> None:
     layer = TrackedPeopleLayer(SPEC)
-    layer.update(LayerInputs(tracks=Tracks([_track(1, 4.0, 0.0, 0.0)])), None)
+    layer.update(LayerInputs({TRACKS: Tracks([_track(1, 4.0, 0.0, 0.0)])}), None)
     assert layer.costs.any()
     window = layer.update(LayerInputs(), None)
     assert window is not None and not layer.costs.any()
@@ -94,7 +94,7 @@ def test_the_plugin_builds_the_layer_and_clears_lidar_marks_around_people() -> N
     layered = layered_costmap(SPEC, CostmapParams(plugins=("lidar", "tracked_people", "inflation")))
     assert isinstance(layered.layer("tracked_people"), TrackedPeopleLayer)
     track = _track(1, 4.0, 0.0, 0.0)
-    layered.update(LayerInputs([track.as_person()], tracks=Tracks([track])))
+    layered.update(LayerInputs({PEOPLE: [track.as_person()], TRACKS: Tracks([track])}))
     (row, col) = SPEC.world_to_cell(np.array([4.0, 0.0]))[0]
     assert layered.master.costs[row, col] == LETHAL
 
