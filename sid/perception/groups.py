@@ -237,6 +237,12 @@ class GroupParams:
             raise ValueError(message) from None
 
     @cached_property
+    def as_paper(self) -> GroupParams:
+        """These parameters with ``meeting_radius`` infinite, as the ``paper`` method runs them; built once per
+        record (a record checks all its fields when built)."""
+        return replace(self, meeting_radius=math.inf)
+
+    @cached_property
     def ring_model(self) -> RingModel:
         """When the o-space method joins arcs into one wide ring (ValueError naming a bad field)."""
         try:
@@ -284,7 +290,7 @@ def detect_groups(people: Sequence[Person], params: GroupParams = GroupParams())
     if params.method == "gcff":
         return _gcff_groups(people, positions, facing, params)
     if params.method == "paper" and not math.isinf(params.meeting_radius):
-        params = replace(params, meeting_radius=math.inf)
+        params = params.as_paper
     position_array, facing_array = np.array(positions, dtype=complex), np.array(facing, dtype=complex)
     labels = dbscan_labels(np.column_stack((position_array.real, position_array.imag)), params.eps, params.min_samples)
     has_ray = ~np.isnan(facing_array)

@@ -100,7 +100,7 @@ def joined_rings(
     deviation, then lowest indices); a joined group's centre is its ring's. ``slack``: the facings' cone half-width
     (rad)."""
     groups, centres = [list(g) for g in members], list(centres)
-    if model.radius_max <= 0:
+    if model.radius_max <= 0 or len(positions) < MIN_MEMBERS:
         return groups, centres
     grouped = {j for g in groups for j in g}
     alone = [j for j, f in enumerate(facing) if j not in grouped and f == f]  # may join a ring, never make one
