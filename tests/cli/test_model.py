@@ -4,12 +4,14 @@
 from __future__ import annotations
 
 import json
+import sys
 
 import numpy as np
 import pytest
 
 from sid.cli import main
 from sid.cli.common import ExitCode
+from sid.distribution import install_hint
 from sid.perception.pose import load_pose_estimator
 from tests.conftest import shared_path
 from tests.pose_models import build_yolo_pose_model
@@ -19,7 +21,7 @@ INTRINSICS = {"fx": 500.0, "fy": 500.0, "cx": 31.5, "cy": 23.5, "width": 64, "he
 
 def _error(capsys: pytest.CaptureFixture[str]) -> str:
     err = capsys.readouterr().err.strip().splitlines()
-    assert err and err[0].startswith("sid model ")
+    assert err and err[0].startswith("sid model ") and err[0].count("sid model") == 1  # the command named once
     return err[0]
 
 
@@ -72,6 +74,16 @@ def test_a_model_with_nothing_to_quantize_is_named(tmp_path, capsys):
     code = main(["model", "quantize", str(model), str(tmp_path / "out.onnx"), "--calibrate", "synthetic:S1",
                  "--frames", "1"])  # fmt: skip
     assert code == 2 and "no Conv" in _error(capsys)
+
+
+def test_without_onnx_each_task_says_which_extra_to_install(tmp_path, capsys, monkeypatch):
+    model = build_yolo_pose_model(tmp_path / "tiny.onnx", np.zeros((56, 4), np.float32))
+    monkeypatch.setitem(sys.modules, "onnx", None)  # import onnx now raises ImportError, as without the extra
+    for task, *rest in (["simplify"], ["quantize", "--calibrate", "synthetic:S1", "--frames", "1"]):
+        code = main(["model", task, str(model), str(tmp_path / "out.onnx"), *rest])
+        line = _error(capsys)
+        assert code == ExitCode.MISSING_DEPENDENCY and line.startswith(f"sid model {task}: ")
+        assert install_hint("quantize") in line and not (tmp_path / "out.onnx").exists()
 
 
 def test_simplify_writes_a_model_with_the_same_contract(tmp_path, capsys):

@@ -55,7 +55,7 @@ WEIGHTED_OPS = ("Conv", "ConvTranspose", "MatMul", "Gemm")
 FLOAT_LAYERS = 4
 """``quantize_model``'s default: the last 4 weighted layers on every path to the outputs stay float, with the decoding
 after them (docs/models.md has the measurements that chose it)."""
-ONNX_MISSING = f"sid model: quantizing needs the onnx package: {install_hint('quantize')} (or pip install onnx)"
+ONNX_MISSING = f"editing ONNX graphs needs the onnx package: {install_hint('quantize')} (or pip install onnx)"
 
 
 @dataclass(frozen=True)
@@ -218,14 +218,14 @@ def quantize_model(
     from sid.perception.pose import load_pose_estimator
 
     if isinstance(float_layers, bool) or not isinstance(float_layers, int) or float_layers < 0:
-        raise ValueError(f"sid model: float_layers must be a whole number >= 0, got {float_layers!r}")
+        raise ValueError(f"float_layers must be a whole number >= 0, got {float_layers!r}")
     started = time.perf_counter()
     source, output = check_paths(source, output)
     estimator = load_pose_estimator(source, threads=1)
     input_name = estimator.model.signature.inputs[0].name
     tensors = [estimator.preprocess(image)[0] for image in _first(images, max_images)]
     if not tensors:
-        raise ValueError("sid model: no calibration image: the calibration source gave no frames")
+        raise ValueError("no calibration image: the calibration source gave no frames")
     model = onnx.load(str(source))
     removed = simplify_graph(model)
     weighted = sum(node.op_type in WEIGHTED_OPS for node in model.graph.node)
@@ -290,11 +290,11 @@ def check_paths(source: str | Path, output: str | Path) -> tuple[Path, Path]:
     does not exist (checked before any work)."""
     source, output = Path(source), Path(output)
     if source.exists() and output.exists() and source.resolve() == output.resolve():
-        raise ValueError(f"sid model: the output {output} is the input model; write to another file")
+        raise ValueError(f"the output {output} is the input model; write to another file")
     if output.is_dir():
-        raise ValueError(f"sid model: the output {output} is a folder; name a .onnx file")
+        raise ValueError(f"the output {output} is a folder; name a .onnx file")
     if not output.parent.is_dir():
-        raise ValueError(f"sid model: cannot write {output}: the folder {output.parent} does not exist")
+        raise ValueError(f"cannot write {output}: the folder {output.parent} does not exist")
     return source, output
 
 
