@@ -102,6 +102,39 @@ def test_scalar_and_vectorised_segment_costs_agree(coords):
     assert field.segment_cost(x0, y0, x1, y1) == pytest.approx(vectorised, rel=1e-9, abs=1e-9)
 
 
+def plain_segment_cost(field: CostField, spec: GridSpec, x0: float, y0: float, x1: float, y1: float) -> float:
+    """J of a segment by its definition: length x (1 + the mean weight of the cells under n midpoints, n = the
+    length in cells rounded up), each midpoint's cell found on its own (floor, clamped at the map's upper edge)."""
+    length = math.hypot(x1 - x0, y1 - y0)
+    n = max(1, math.ceil(length / spec.resolution))
+    total = 0.0
+    for i in range(n):
+        t = (i + 0.5) / n
+        x, y = x0 + t * (x1 - x0), y0 + t * (y1 - y0)
+        col = min(math.floor((x - spec.origin_x) / spec.resolution), field.weight.shape[1] - 1)
+        row = min(math.floor((y - spec.origin_y) / spec.resolution), field.weight.shape[0] - 1)
+        total += field.weight[row, col]
+    return length * (1.0 + total / n)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_both_segment_cost_paths_are_the_definition(seed: int) -> None:
+    # Short segments (the scalar loop), long ones (its numpy branch) and the vectorised lookup, all held to the
+    # plain rule on random segments inside the map.
+    costmap = walled_map(blob_cost=200)
+    field = CostField(PlanningProblem(costmap, (1.0, 2.0), (9.0, 6.0), RADIUS))
+    rng = np.random.default_rng(seed)
+    spec = costmap.spec
+    width, height = spec.shape[1] * spec.resolution, spec.shape[0] * spec.resolution
+    for _ in range(40):
+        start = rng.uniform((0.01, 0.01), (width - 0.01, height - 0.01))
+        end = start + rng.normal(0, 0.3 if rng.random() < 0.5 else 3.0, 2)
+        end = np.clip(end, 0.01, (width - 0.01, height - 0.01))
+        expected = plain_segment_cost(field, spec, *start, *end)
+        assert field.segment_cost(*start, *end) == pytest.approx(expected, rel=1e-9)
+        assert field.segments(start[None], end[None])[0][0] == pytest.approx(expected, rel=1e-9)
+
+
 def test_zero_weight_cost_is_length():
     problem = PlanningProblem(walled_map(blob_cost=200), (1.0, 2.0), (9.0, 6.0), RADIUS, cost_weight=0.0)
     field = CostField(problem)
