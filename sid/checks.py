@@ -9,6 +9,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import math
+import numbers
 import os
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
@@ -24,6 +25,7 @@ __all__ = [
     "check_limit",
     "check_number",
     "check_numbers",
+    "check_whole",
     "limits",
     "limits_from_environment",
     "use_limits",
@@ -139,6 +141,34 @@ def check_number(
     ok = ok and (high is None or (number < high if high_open else number <= high))
     if not ok:
         raise error(f"{owner}: {name} must be {_rule(low, high, low_open, high_open, allow_inf, unit)}, got {value}")
+
+
+def check_whole(
+    owner: str,
+    name: str,
+    value: object,
+    *,
+    low: int | None = None,
+    high: int | None = None,
+    error: type[Exception] = ValueError,
+) -> int:
+    """``value`` as an int; raise ``error`` unless it is a whole number (an integer, or a real number without a
+    fraction; not a bool, not a string) within [low, high] (bounds optional). NaN and infinities get the same
+    message, not a conversion error."""
+    number = float(value) if isinstance(value, numbers.Real) and not isinstance(value, bool) else math.nan
+    ok = math.isfinite(number) and number == math.floor(number)
+    ok = ok and (low is None or number >= low) and (high is None or number <= high)
+    if not ok:
+        if low is not None and high is not None:
+            rule = f"a whole number from {low} to {high}"
+        elif low is not None:
+            rule = f"a whole number >= {low}"
+        elif high is not None:
+            rule = f"a whole number <= {high}"
+        else:
+            rule = "a whole number"
+        raise error(f"{owner}: {name} must be {rule}, got {value!r}")
+    return int(number)
 
 
 def check_numbers(owner: str, record: object, names: Iterable[str], **bounds: Any) -> None:

@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 
+import numpy as np
 import pytest
 
-from sid.checks import check_number, check_numbers
+from sid.checks import check_number, check_numbers, check_whole
 
 
 @pytest.mark.parametrize(
@@ -95,3 +97,17 @@ def test_a_malformed_sid_limits_is_named(monkeypatch, text, message):
     monkeypatch.setenv("SID_LIMITS", text)
     with pytest.raises(ValueError, match=rf"\$SID_LIMITS: .*{message}"):
         limits_from_environment()
+
+
+@pytest.mark.parametrize("value", [0, 10, 2.5, True, float("nan"), float("inf"), "3", None])
+def test_whole_numbers_are_checked_with_one_message(value: object) -> None:
+    # inf, NaN and strings included: int(inf) raises OverflowError, int("x") a conversion error of its own.
+    with pytest.raises(ValueError, match=re.escape(f"owner: count must be a whole number from 1 to 9, got {value!r}")):
+        check_whole("owner", "count", value, low=1, high=9)
+
+
+def test_a_whole_number_comes_back_as_an_int() -> None:
+    assert check_whole("owner", "count", 4.0, low=1) == 4 and isinstance(check_whole("owner", "count", 4.0), int)
+    assert check_whole("owner", "count", np.int64(7), high=7) == 7
+    with pytest.raises(KeyError, match="owner: count must be a whole number >= 0"):
+        check_whole("owner", "count", -1, low=0, error=KeyError)

@@ -32,7 +32,7 @@ import numpy as np
 
 from planner.facade import DEFAULT_PLANNER, resolve_planner
 from planner.problem import DEFAULT_COST_WEIGHT, PlanningError
-from sid.checks import check_number
+from sid.checks import check_number, check_whole
 from sid.experiments.demo import DEMO_SCENARIO
 from sid.experiments.harness import Comparison, compare_with_without, prepare
 from sid.scenario.loader import Scenario, scenario_from_dict
@@ -137,8 +137,7 @@ def navigation_tasks(
     seeds: int, layouts: Sequence[str] | None = None, directions: Sequence[str] = DIRECTIONS, base_seed: int = 0
 ) -> list[NavTask]:
     """Tasks for every layout x draw seed 1..``seeds`` x direction."""
-    if isinstance(seeds, bool) or int(seeds) != seeds or seeds < 1:
-        raise ValueError(f"navigation: seeds must be a whole number >= 1, got {seeds}")
+    check_whole("navigation", "seeds", seeds, low=1)
     names = list(NAV_LAYOUTS) if layouts is None else list(layouts)
     return [
         NavTask(

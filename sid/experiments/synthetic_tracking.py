@@ -41,7 +41,7 @@ from costmap.grid import GridSpec
 from costmap.layer import LayerInputs
 from costmap.layers.social import GROUPS, PEOPLE
 from costmap.plugins import CostmapParams, layered_costmap
-from sid.checks import check_number
+from sid.checks import check_number, check_whole
 from sid.distribution import MissingDependencyError, install_hint
 from sid.experiments.fformation import LabelledFrame, format_threshold, score
 from sid.perception.frame import Frame
@@ -96,8 +96,8 @@ class TrackingEvalSettings:
         check_number("tracking evaluation", "flicker_miss_rate", self.flicker_miss_rate, low=0, high=1, high_open=True)
         for name, low in (("frames", 1), ("flicker_frames", 2)):
             value = getattr(self, name)
-            if value is not None and (isinstance(value, bool) or int(value) != value or value < low):
-                raise ValueError(f"tracking evaluation: {name} must be a whole number >= {low}, got {value}")
+            if value is not None:
+                check_whole("tracking evaluation", name, value, low=low)
         unknown = [name for name in self.sequences if name not in SEQUENCES]
         if unknown or not self.sequences:
             raise ValueError(f"tracking evaluation: unknown sequences {unknown}; known: {', '.join(SEQUENCES)}")

@@ -31,7 +31,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from sid.checks import check_number
+from sid.checks import check_number, check_whole
 from sid.perception.group import Group
 from sid.perception.groups import GroupParams
 from sid.perception.lifting import LiftParams
@@ -95,8 +95,7 @@ class Table1Settings:
         unknown = [s for s in self.scenarios if s.upper() not in LAYOUTS]
         if unknown or not self.scenarios:
             raise ValueError(f"table1: unknown scenario(s) {unknown or '(none given)'}; known: {', '.join(LAYOUTS)}")
-        if isinstance(self.frames, bool) or int(self.frames) != self.frames or self.frames < 1:
-            raise ValueError(f"table1: frames must be a whole number >= 1, got {self.frames}")
+        check_whole("table1", "frames", self.frames, low=1)
         if not 1 <= self.variations <= len(VARIATIONS):
             raise ValueError(f"table1: variations must be 1..{len(VARIATIONS)}, got {self.variations}")
         check_number("table1", "match_radius", self.match_radius, low=0, low_open=True, unit="metres")

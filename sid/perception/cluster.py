@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from sid.checks import check_number
+from sid.checks import check_number, check_whole
 
 __all__ = ["SMALL_N_MAX", "dbscan_labels"]
 
@@ -42,8 +42,7 @@ def dbscan_labels(points: np.ndarray, eps: float, min_samples: int) -> np.ndarra
     if points.ndim != 2:
         raise ValueError(f"dbscan: points must be an (N, D) array, got shape {points.shape}")
     check_number("dbscan", "eps", eps, low=0, low_open=True)
-    if int(min_samples) != min_samples or min_samples < 1:
-        raise ValueError(f"dbscan: min_samples must be an integer >= 1, got {min_samples}")
+    check_whole("dbscan", "min_samples", min_samples, low=1)
     if not np.all(np.isfinite(points)):
         bad = int(np.flatnonzero(~np.all(np.isfinite(points), axis=1))[0])
         raise ValueError(f"dbscan: point {bad} is not finite: {points[bad].tolist()}")

@@ -66,7 +66,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sid.checks import check_limit, check_number
+from sid.checks import check_limit, check_number, check_whole
 
 __all__ = ["GCFF_ORDERS", "GCFFParams", "gcff_labels"]
 
@@ -118,9 +118,7 @@ class GCFFParams:
         check_number("gcff", "visibility_cosine", self.visibility_cosine, low=-1, high=1)
         check_number("gcff", "visibility_base", self.visibility_base, low=1)
         check_number("gcff", "visibility_unit", self.visibility_unit, low=0, unit="square metres")
-        rounds = self.max_rounds
-        if isinstance(rounds, bool) or not isinstance(rounds, int | np.integer) or rounds < 1:
-            raise ValueError(f"gcff: max_rounds must be an integer >= 1, got {rounds!r}")
+        check_whole("gcff", "max_rounds", self.max_rounds, low=1)
         if self.order not in GCFF_ORDERS:
             raise ValueError(f"gcff: order must be one of {', '.join(GCFF_ORDERS)}, got {self.order!r}")
 

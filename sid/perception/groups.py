@@ -50,7 +50,7 @@ from functools import cached_property, lru_cache
 
 import numpy as np
 
-from sid.checks import check_number, check_numbers
+from sid.checks import check_number, check_numbers, check_whole
 from sid.documents import summary
 from sid.perception.cluster import dbscan_labels
 from sid.perception.gcff import GCFFParams, gcff_labels
@@ -198,8 +198,7 @@ class GroupParams:
         check_number("groups", "facing_slack", self.facing_slack, low=0, high=math.pi)
         check_numbers("groups", self, ("eps", "spread_threshold", "ray_length"), low=0, low_open=True, unit="metres")
         check_number("groups", "area_threshold", self.area_threshold, low=0, unit="square metres")
-        if isinstance(self.min_samples, bool) or int(self.min_samples) != self.min_samples or self.min_samples < 1:
-            raise ValueError(f"groups: min_samples must be an integer >= 1, got {self.min_samples}")
+        check_whole("groups", "min_samples", self.min_samples, low=1)
         # math.inf: one candidate per cluster, as in the paper.
         check_number(
             "groups", "meeting_radius", self.meeting_radius, low=0, low_open=True, allow_inf=True, unit="metres"

@@ -43,7 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sid.checks import check_limit, check_number, check_numbers
+from sid.checks import check_limit, check_number, check_numbers, check_whole
 from sid.perception.align import Search, depth_at_color_pixels
 from sid.perception.camera import Calibration
 from sid.perception.keypoints import KP, NUM_KEYPOINTS, PoseDetection
@@ -132,9 +132,8 @@ class LiftParams:
 
     def __post_init__(self) -> None:
         check_number("lift", "min_score", self.min_score, low=0, high=1)
-        if int(self.min_keypoints) != self.min_keypoints or not 1 <= self.min_keypoints <= NUM_KEYPOINTS:
-            raise ValueError(f"lift: min_keypoints must be an integer in 1..{NUM_KEYPOINTS}, got {self.min_keypoints}")
-        if int(self.patch) != self.patch or self.patch < 1 or self.patch % 2 == 0:
+        check_whole("lift", "min_keypoints", self.min_keypoints, low=1, high=NUM_KEYPOINTS)
+        if check_whole("lift", "patch", self.patch, low=1) % 2 == 0:
             raise ValueError(f"lift: patch must be a positive odd number of pixels, got {self.patch}")
         if self.depth_search not in ("exact", "window"):
             raise ValueError(f"lift: depth_search must be 'exact' or 'window', got {self.depth_search!r}")

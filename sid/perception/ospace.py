@@ -59,7 +59,7 @@ import numpy as np
 if TYPE_CHECKING:  # imported where a crowd needs it: scipy.spatial is ~0.3 s of a command's start-up
     from scipy.spatial import cKDTree
 
-from sid.checks import check_number
+from sid.checks import check_number, check_whole
 
 __all__ = ["MAX_LENGTH", "MAX_RADIUS_STEPS", "OSpace", "OSpaceModel", "TIE", "find_ospaces"]
 
@@ -104,9 +104,7 @@ class OSpaceModel:
         check_number("ospace", "body_radius", self.body_radius, low=0, high=far, unit="metres")
         check_number("ospace", "angular_weight", self.angular_weight, low=0, low_open=True)
         check_number("ospace", "pair_reach", self.pair_reach, low=0, high=far, unit="metres")
-        steps = self.radius_steps
-        if isinstance(steps, bool) or int(steps) != steps or not 1 <= steps <= MAX_RADIUS_STEPS:
-            raise ValueError(f"ospace: radius_steps must be an integer in [1, {MAX_RADIUS_STEPS}], got {steps}")
+        check_whole("ospace", "radius_steps", self.radius_steps, low=1, high=MAX_RADIUS_STEPS)
 
     @cached_property
     def radii(self) -> np.ndarray:

@@ -17,6 +17,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+from sid.checks import check_whole
 from sid.perception.frame import Frame
 from sid.scenario.loader import Scenario
 from sid.sources import SourceError
@@ -92,8 +93,7 @@ class SyntheticSource:
         if frames is None:
             duration = self.scene.duration if isinstance(self.scene, SyntheticSequence) else 0.0
             frames = round(duration * self.camera.fps) + 1 if duration > 0 else DEFAULT_FRAMES
-        if int(frames) != frames or frames < 0:
-            raise ValueError(f"synthetic source: frames must be a whole number >= 0, got {frames}")
+        check_whole("synthetic source", "frames", frames, low=0)
         self.frames = int(frames)
 
     def __len__(self) -> int:

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sid.checks import check_number
+from sid.checks import check_number, check_whole
 from sid.tracking.groups import connected_components
 from sid.tracking.records import TrackedPerson
 
@@ -38,8 +38,7 @@ class CoherentMotionParams:
         check_number("coherent motion", "velocity_difference", self.velocity_difference, low=0, unit="m/s")
         check_number("coherent motion", "window", self.window, low=0, unit="seconds")
         check_number("coherent motion", "share", self.share, low=0, high=1, low_open=True)
-        if isinstance(self.min_frames, bool) or int(self.min_frames) != self.min_frames or self.min_frames < 1:
-            raise ValueError(f"coherent motion: min_frames must be a whole number >= 1, got {self.min_frames}")
+        check_whole("coherent motion", "min_frames", self.min_frames, low=1)
 
 
 @dataclass(frozen=True)

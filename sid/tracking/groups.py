@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from sid.checks import check_number, check_numbers
+from sid.checks import check_number, check_numbers, check_whole
 from sid.perception.groups import GroupParams, detect_groups
 from sid.tracking.assignment import gated_assignment
 from sid.tracking.records import GroupKind, TrackedGroup, TrackedPerson
@@ -68,9 +68,7 @@ class GroupTrackerParams:
 
     def __post_init__(self) -> None:
         for name in ("confirm_hits", "confirm_window"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or int(value) != value or value < 1:
-                raise ValueError(f"group tracker: {name} must be a whole number >= 1, got {value}")
+            check_whole("group tracker", name, getattr(self, name), low=1)
         if self.confirm_hits > self.confirm_window:
             raise ValueError(
                 f"group tracker: confirm_hits ({self.confirm_hits}) must not exceed confirm_window "

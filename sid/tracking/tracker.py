@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sid.checks import check_number, check_numbers
+from sid.checks import check_number, check_numbers, check_whole
 from sid.errors import SidError
 from sid.perception.people import Person
 from sid.tracking.assignment import gated_assignment
@@ -80,8 +80,7 @@ class TrackerParams:
         check_number("tracker", "heading_gate", self.heading_gate, low=0, high=math.pi, low_open=True, unit="radians")
         check_number("tracker", "walk_speed", self.walk_speed, low=0, low_open=True, unit="m/s")
         check_number("tracker", "stand_speed", self.stand_speed, low=0, high=self.walk_speed, unit="m/s")
-        if isinstance(self.confirm_hits, bool) or int(self.confirm_hits) != self.confirm_hits or self.confirm_hits < 1:
-            raise ValueError(f"tracker: confirm_hits must be a whole number >= 1, got {self.confirm_hits}")
+        check_whole("tracker", "confirm_hits", self.confirm_hits, low=1)
 
 
 class PeopleTracker:

@@ -196,7 +196,7 @@ OUT_OF_RANGE = [  # field, value, what the one-line error says
     ("lidar.body_radius", 1e300, "lidar.body_radius: 1e+300 m is more than the map's diagonal (12.8062 m)"),
     ("robot.radius", 1e300, "robot.radius: 1e+300 m is more than the map's diagonal (12.8062 m)"),
     ("map.origin", [1e300, -4.0], "map: origin_x must be a finite number of metres in [-1e+07, 1e+07], got 1e+300"),
-    ("groups.radius_steps", 1000000, "groups: radius_steps must be an integer in [1, 100], got 1000000"),
+    ("groups.radius_steps", 1000000, "groups: radius_steps must be a whole number from 1 to 100, got 1000000"),
     ("groups.body_radius", 1e300, "groups: body_radius must be a finite number of metres in [0, 1000]"),
     ("groups.unknown_facing_cost", 1e300, "groups: unknown_facing_cost must be a finite number of metres in [0, 1000]"),
     ("layers.obstacle.raytrace_max_range", 1e300, "720 beams x 2e+301 cells of range (1e+300 m at 0.05 m) = 1.44e+304"),

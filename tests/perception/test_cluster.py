@@ -91,8 +91,8 @@ def test_empty_input_gives_no_labels():
         (np.array([[0.0, 0.0], [np.nan, 1.0]]), 1.0, 2, "point 1 is not finite"),
         (np.zeros((3, 2)), 0.0, 2, "eps must be a positive"),
         (np.zeros((3, 2)), float("nan"), 2, "eps must be a positive"),
-        (np.zeros((3, 2)), 1.0, 0, "min_samples must be an integer"),
-        (np.zeros((3, 2)), 1.0, 1.5, "min_samples must be an integer"),
+        (np.zeros((3, 2)), 1.0, 0, "min_samples must be a whole number"),
+        (np.zeros((3, 2)), 1.0, 1.5, "min_samples must be a whole number"),
         (np.zeros(3), 1.0, 2, r"\(N, D\) array"),
     ],
 )

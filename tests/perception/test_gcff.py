@@ -259,9 +259,9 @@ def test_too_many_people_is_a_limit_error():
         ("visibility_cosine", 1.5, "visibility_cosine must be a finite number in"),
         ("visibility_base", 0.5, "visibility_base must be a finite number >= 1"),
         ("visibility_unit", -1e-4, "visibility_unit must be"),
-        ("max_rounds", 0, "max_rounds must be an integer >= 1"),
-        ("max_rounds", 2.5, "max_rounds must be an integer >= 1"),
-        ("max_rounds", True, "max_rounds must be an integer >= 1"),
+        ("max_rounds", 0, "max_rounds must be a whole number >= 1"),
+        ("max_rounds", 2.5, "max_rounds must be a whole number >= 1"),
+        ("max_rounds", True, "max_rounds must be a whole number >= 1"),
         ("order", "random", "order must be one of best, input"),
     ],
 )

@@ -22,7 +22,7 @@ from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
 
-from sid.checks import Limits, limits, use_limits
+from sid.checks import Limits, check_whole, limits, use_limits
 from sid.cpu import keep_freed_memory
 from sid.distribution import MissingDependencyError, install_hint
 from sid.experiments.harness import summarise
@@ -50,8 +50,7 @@ class Job:
 def sweep_jobs(scenes: Sequence[str], seeds: int, options: RunOptions | None = None) -> list[Job]:
     """Every scene x seeds 1..``seeds`` x without / with the social layer (other options from ``options``)."""
     options = options or RunOptions()
-    if isinstance(seeds, bool) or int(seeds) != seeds or seeds < 1:
-        raise ValueError(f"sweep: seeds must be a whole number >= 1, got {seeds}")
+    check_whole("sweep", "seeds", seeds, low=1)
     for scene in scenes:
         load_scene(scene)  # a bad scene fails here, before any run
     return [
