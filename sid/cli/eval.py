@@ -245,7 +245,7 @@ def add_tracking_parser(tasks: argparse._SubParsersAction) -> None:
         description="Renders the built-in synthetic sequences, runs the per-frame pipeline and the tracking stream on "
         "them and prints MOTA / IDF1 (py-motmetrics), group F1 with and without tracking, frames in which walkers "
         "are called a conversation, and the costmap flicker of the per-frame and the tracked layers "
-        "(docs/tracking.md). Takes a few minutes; progress on stderr.",
+        "(docs/tracking.md). Takes 15-40 s on two cores; progress on stderr.",
     )
     parser.add_argument(
         "--sequences", nargs="+", choices=SEQUENCES, default=list(defaults.sequences), metavar="NAME",

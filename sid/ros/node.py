@@ -109,6 +109,11 @@ class SocialCostmapNode:
             f"{p.grid.resolution} m); robot pose from {self.pose_source}; filter info: "
             f"{'on ' + p.filter_info_topic if info_type else 'off (nav2_msgs not importable)'}"
         )
+        if camera_topics:  # nothing more is logged until the first colour and depth pair arrives
+            self.node.get_logger().info(
+                f"waiting for {p.camera_info_topic}, {p.color_topic} and {p.depth_topic} (realsense2_camera's topics; "
+                "remap them with --ros-args -p color_topic:=... if yours differ)"
+            )
 
     def _new_stream(self) -> SocialStream:
         pipeline = Pipeline(self.pose, self.params.mount, group=False)
