@@ -18,6 +18,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from sid.checks import check_number
+from sid.perception.ospace import TIE
 
 __all__ = ["MIN_MEMBERS", "Ring", "RingModel", "fit_ring", "joined_rings"]
 
@@ -26,9 +27,10 @@ MIN_MEMBERS = 6
 within the o-space search's radii (0.85 m) up to five; wider circles hold six or more."""
 _COLLINEAR = 1e-9
 """Points whose spread matrix's determinant is below this share of its squared trace lie on a line: no circle."""
-_ANGLE_TIE = 1e-9
+_ANGLE_TIE = TIE
 """rad: a facing this close to the edge of its cone is inside it, so that a rigid motion's rounding (~1e-15)
-cannot move a member out."""
+cannot move a member out (the o-space search's relative ``TIE`` serves the radius bound and the ranking of joins
+too)."""
 
 
 @dataclass(frozen=True)
@@ -120,7 +122,7 @@ def joined_rings(
                 if not all(abs(positions[a] - positions[b]) <= diameter for a in groups[g] for b in other):
                     continue
                 ring = _ring(sorted(groups[g] + other), positions, facing, slack, model)
-                if ring is not None and (best is None or ring.deviation < best[0].deviation * (1.0 - 1e-9)):
+                if ring is not None and (best is None or ring.deviation < best[0].deviation * (1.0 - TIE)):
                     best = (ring, g, h)
         if best is None:
             return groups, centres
@@ -139,7 +141,7 @@ def _ring(
     """The ring ``union`` makes, or None where it is no ring (too wide, a member off the circle or looking away from
     the centre, someone else inside)."""
     ring = fit_ring([positions[j] for j in union])
-    if ring is None or ring.radius > model.radius_max * (1.0 + 1e-9) or ring.deviation > model.tolerance:
+    if ring is None or ring.radius > model.radius_max * (1.0 + TIE) or ring.deviation > model.tolerance:
         return None
     limit = max(slack, model.facing_tolerance) + _ANGLE_TIE
     for j in union:
