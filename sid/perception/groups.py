@@ -276,9 +276,9 @@ class _Geometry:
 def detect_groups(people: Sequence[Person], params: GroupParams = GroupParams()) -> list[Group]:
     """Interacting groups among ``people`` (world frame) by ``params.method``.
 
-    Members are listed in input order; groups in order of their first member (``ospace``) or of their DBSCAN
-    clusters (``rays``, ``paper``). Raises ValueError naming the person for a non-finite position or yaw, and for
-    duplicate ids. Fewer than two people give no group.
+    Members are listed in input order, groups in order of their first member. Every method but ``gcff`` sees the
+    people sorted by id, so that the same people in another order give the same groups. Raises ValueError naming
+    the person for a non-finite position or yaw, and for duplicate ids. Fewer than two people give no group.
     """
     people = list(people)
     ids, positions, facing = _validated(people)
@@ -290,7 +290,18 @@ def detect_groups(people: Sequence[Person], params: GroupParams = GroupParams())
         return _gcff_groups(people, positions, facing, params)
     if params.method == "paper" and not math.isinf(params.meeting_radius):
         params = params.as_paper
-    position_array, facing_array = np.array(positions, dtype=complex), np.array(facing, dtype=complex)
+    return _clustered_groups(ids, positions, facing, params)
+
+
+def _clustered_groups(
+    ids: list[int], positions: list[complex], facing: list[complex], params: GroupParams
+) -> list[Group]:
+    """The ``rays`` and ``paper`` methods' groups: DBSCAN clusters of the people sorted by id (DBSCAN numbers its
+    clusters, and the pruning breaks its ties, in the order it is given), each pruned to its groups; members and
+    groups then listed in input order."""
+    order = sorted(range(len(ids)), key=ids.__getitem__)
+    position_array = np.array([positions[i] for i in order], dtype=complex)
+    facing_array = np.array([facing[i] for i in order], dtype=complex)
     labels = dbscan_labels(np.column_stack((position_array.real, position_array.imag)), params.eps, params.min_samples)
     has_ray = ~np.isnan(facing_array)
     groups: list[Group] = []
@@ -298,9 +309,14 @@ def detect_groups(people: Sequence[Person], params: GroupParams = GroupParams())
         cluster = np.flatnonzero((labels == label) & has_ray)
         if len(cluster) >= 2:
             groups.extend(
-                _groups_in_cluster([ids[i] for i in cluster], position_array[cluster], facing_array[cluster], params)
+                _groups_in_cluster(
+                    [ids[order[i]] for i in cluster], position_array[cluster], facing_array[cluster], params
+                )
             )
-    return groups
+    index = {person: k for k, person in enumerate(ids)}
+    for group in groups:
+        group.members = tuple(sorted(group.members, key=index.__getitem__))
+    return sorted(groups, key=lambda group: index[group.members[0]])
 
 
 def _ospace_groups(
