@@ -20,6 +20,7 @@ from sid.errors import SidError
 __all__ = [
     "LIMITS_ENV",
     "LimitError",
+    "MAX_COORDINATE",
     "Limits",
     "amount",
     "check_limit",
@@ -33,6 +34,11 @@ __all__ = [
 
 LIMITS_ENV = "SID_LIMITS"
 """The environment variable that raises (or lowers) limits: ``SID_LIMITS="map_cells=16000000,people=300"``."""
+
+MAX_COORDINATE = 1e8
+"""The largest |x| or |y| (m) of a person's position: 100 000 km, beyond any map frame on Earth (UTM northings reach
+1e7 m). Squared and summed, such coordinates stay finite and precise to about 1e-8 m; past ~1e154 m a squared
+distance overflows to infinity and the answers would be silent garbage."""
 
 
 @dataclass(frozen=True)

@@ -50,7 +50,7 @@ from functools import cached_property, lru_cache
 
 import numpy as np
 
-from sid.checks import check_number, check_numbers, check_whole
+from sid.checks import MAX_COORDINATE, check_number, check_numbers, check_whole
 from sid.documents import summary
 from sid.perception.cluster import dbscan_labels
 from sid.perception.gcff import GCFFParams, gcff_labels
@@ -437,6 +437,11 @@ def _validated(people: list[Person]) -> tuple[list[int], list[complex], list[com
     for person in people:
         if not (math.isfinite(person.x) and math.isfinite(person.y)):
             raise ValueError(f"groups: person {person.id} has a non-finite position ({person.x}, {person.y})")
+        if max(abs(person.x), abs(person.y)) > MAX_COORDINATE:
+            raise ValueError(
+                f"groups: person {person.id} at ({person.x}, {person.y}) is farther than {MAX_COORDINATE:g} m from "
+                "the frame's origin along x or y"
+            )
         positions.append(complex(person.x, person.y))
         if person.theta is None:
             facing.append(_UNKNOWN_FACING)

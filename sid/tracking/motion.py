@@ -31,6 +31,8 @@ class MotionStates:
 
     def predict(self, dt: float, q: float) -> None:
         """Advance every track by ``dt`` seconds at constant velocity, growing the covariance by the process noise."""
+        if not len(self.position):
+            return  # nothing to advance; dt may be any gap then (a Python float's dt**3 overflows past ~1e102 s)
         self.position += self.velocity * dt
         c = self.covariance  # in place, pp first: each line reads the columns after it before they change
         c[:, 0] += 2 * dt * c[:, 1] + dt * dt * c[:, 2] + q * dt**3 / 3

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sid.checks import check_number, check_numbers, check_whole
+from sid.checks import MAX_COORDINATE, check_number, check_numbers, check_whole
 from sid.errors import SidError
 from sid.perception.people import Person
 from sid.tracking.assignment import gated_assignment
@@ -132,6 +132,9 @@ class PeopleTracker:
         r, q = p.measurement_sigma**2, p.acceleration_sigma**2
         dt = 0.0 if self._time is None else timestamp - self._time
         self._time = float(timestamp)
+        # Tracks undetected for longer than out_of_view_timeout expire below whatever their prediction says: dropped
+        # first, so that the prediction never spans more than that (a gap of 1e308 s would overflow it).
+        self._keep(timestamp - self._last_hit <= p.out_of_view_timeout)
         self._motion.predict(dt, q)
         self._in_view = np.ones(len(self._ids), dtype=bool) if view is None else view.contains(self._motion.position)
         self._unseen += np.where(self._in_view & ~_behind(view, self._motion.position, positions), dt, 0.0)
@@ -290,10 +293,16 @@ def _measurements(people: Sequence[Person]) -> tuple[np.ndarray, np.ndarray, lis
         known = [p.theta is not None for p in people]
     except (TypeError, ValueError):
         positions, theta, known = np.full((len(people), 2), np.nan), np.full(len(people), np.nan), [True] * len(people)
-    if not (np.isfinite(positions).all() and np.isfinite(theta[known]).all()):
+    if not (np.isfinite(positions).all() and np.isfinite(theta[known]).all()) or (
+        len(positions) and np.abs(positions).max() > MAX_COORDINATE
+    ):
         for person in people:  # name the first bad one
-            names = ("x", "y") if person.theta is None else ("x", "y", "theta")
-            check_numbers(f"tracker: person {person.id}", person, names, error=TrackingError)
+            owner = f"tracker: person {person.id}"
+            check_numbers(
+                owner, person, ("x", "y"), low=-MAX_COORDINATE, high=MAX_COORDINATE, unit="metres", error=TrackingError
+            )
+            if person.theta is not None:
+                check_numbers(owner, person, ("theta",), error=TrackingError)
     if len(set(ids)) != len(ids):
         twice = sorted({i for i in ids if ids.count(i) > 1})
         raise TrackingError(f"tracker: person id {twice[0]} appears twice in one frame")

@@ -12,6 +12,7 @@ import shapely
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
+from sid.checks import MAX_COORDINATE
 from sid.perception.group import Group
 from sid.perception.groups import (
     GROUP_METHODS,
@@ -343,11 +344,21 @@ def test_empty_and_single_person_give_no_group():
         ([Person(3, float("inf"), 0.0, 0.0)], "person 3 has a non-finite position"),
         ([Person(1, 0.0, 0.0, 0.0), Person(2, 1.0, 0.0, float("nan"))], "person 2 has a non-finite theta"),
         ([Person(1, 0.0, 0.0, 0.0), Person(1, 1.0, 0.0, 0.0)], r"ids must be unique, repeated: \[1\]"),
+        ([Person(1, 0.0, 0.0, 0.0), Person(4, 1.0, -1e200, 0.0)], "person 4 at .* is farther than 1e\\+08 m"),
     ],
 )
-def test_bad_people_are_rejected_naming_the_person(people, message):
+@pytest.mark.parametrize("method", ["ospace", "gcff", "rays", "paper"])
+def test_bad_people_are_rejected_naming_the_person(people, message, method):
     with pytest.raises(ValueError, match=message):
-        detect_groups(people)
+        detect_groups(people, GroupParams(method=method))
+
+
+@pytest.mark.parametrize("method", ["ospace", "gcff", "rays", "paper"])
+def test_a_face_to_face_pair_far_out_in_a_map_frame_is_a_pair(method):
+    # UTM-sized coordinates (5000 km north) are within MAX_COORDINATE and keep their centimetres.
+    for x, y in ((0.0, 0.0), (5e6, -1e6), (-MAX_COORDINATE + 1.0, MAX_COORDINATE - 1.0)):
+        people = [Person(1, x, y, 0.0), Person(2, x + 0.8, y, math.pi)]
+        assert [g.members for g in detect_groups(people, GroupParams(method=method))] == [(1, 2)]
 
 
 @pytest.mark.parametrize(

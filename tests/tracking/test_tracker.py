@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -136,6 +137,7 @@ def test_frames_out_of_time_order_are_refused_and_change_nothing() -> None:
         ([Person(0, math.nan, 0.0)], "person 0: x must be a finite number"),
         ([Person(3, 1.0, 0.0, math.inf)], "person 3: theta must be a finite number"),
         ([Person(1, 1.0, 0.0), Person(1, 3.0, 0.0)], "person id 1 appears twice"),
+        ([Person(2, 1.0, -1e200)], r"person 2: y must be a finite number of metres in \[-1e\+08, 1e\+08\]"),
     ],
 )
 def test_bad_detections_are_refused_naming_the_problem(people: list[Person], message: str) -> None:
@@ -143,6 +145,17 @@ def test_bad_detections_are_refused_naming_the_problem(people: list[Person], mes
     with pytest.raises(TrackingError, match=message):
         tracker.update(people, 0.0)
     assert len(tracker) == 0 and tracker.timestamp is None
+
+
+def test_a_gap_of_any_length_ends_the_tracks_without_overflowing_the_prediction() -> None:
+    # A Kalman prediction over 1e308 s overflows (dt cubed): tracks past out_of_view_timeout are dropped before it.
+    tracker = PeopleTracker()
+    _confirmed(tracker, 2.0, 0.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no overflow warning either
+        assert tracker.update([Person(0, 2.0, 0.0)], 1e308) == []
+        assert len(tracker) == 1 and tracker.timestamp == 1e308  # a new, tentative track
+    assert tracker.update([], 1.7e308) == [] and len(tracker) == 0  # the tentative track dies at its first miss
 
 
 def test_empty_frames_age_the_tracks() -> None:
