@@ -27,6 +27,7 @@ __all__ = [
     "check_number",
     "check_numbers",
     "check_whole",
+    "is_real",
     "limits",
     "limits_from_environment",
     "use_limits",
@@ -147,6 +148,12 @@ def check_number(
     ok = ok and (high is None or (number < high if high_open else number <= high))
     if not ok:
         raise error(f"{owner}: {name} must be {_rule(low, high, low_open, high_open, allow_inf, unit)}, got {value}")
+
+
+def is_real(value: object) -> bool:
+    """Whether ``value`` is a real number (Python's or numpy's int or float; not a bool, numpy's or Python's, a string
+    or None). NaN and infinities are real numbers here: finiteness is checked apart, with its own message."""
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
 
 
 def check_whole(

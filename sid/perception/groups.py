@@ -50,7 +50,7 @@ from functools import cached_property, lru_cache
 
 import numpy as np
 
-from sid.checks import MAX_COORDINATE, check_number, check_numbers, check_whole
+from sid.checks import MAX_COORDINATE, check_number, check_numbers, check_whole, is_real
 from sid.documents import summary
 from sid.perception.cluster import dbscan_labels
 from sid.perception.gcff import GCFFParams, gcff_labels
@@ -435,8 +435,18 @@ def _validated(people: list[Person]) -> tuple[list[int], list[complex], list[com
     positions = []
     facing = []
     for person in people:
+        if not (is_real(person.x) and is_real(person.y)):
+            raise ValueError(
+                f"groups: person {person.id} has a position that is not a pair of numbers: ({person.x!r}, {person.y!r})"
+            )
         if not (math.isfinite(person.x) and math.isfinite(person.y)):
             raise ValueError(f"groups: person {person.id} has a non-finite position ({person.x}, {person.y})")
+        quality = person.orientation_quality
+        if not (is_real(quality) and math.isfinite(quality)):
+            raise ValueError(
+                f"groups: person {person.id} has orientation_quality {quality!r}: a finite number is needed (values "
+                "outside [0, 1] count as the nearer end)"
+            )
         if max(abs(person.x), abs(person.y)) > MAX_COORDINATE:
             raise ValueError(
                 f"groups: person {person.id} at ({person.x}, {person.y}) is farther than {MAX_COORDINATE:g} m from "
@@ -445,6 +455,10 @@ def _validated(people: list[Person]) -> tuple[list[int], list[complex], list[com
         positions.append(complex(person.x, person.y))
         if person.theta is None:
             facing.append(_UNKNOWN_FACING)
+        elif not is_real(person.theta):
+            raise ValueError(
+                f"groups: person {person.id} has a theta that is not a number: {person.theta!r} (use None)"
+            )
         elif not math.isfinite(person.theta):
             raise ValueError(f"groups: person {person.id} has a non-finite theta {person.theta} (use None)")
         else:

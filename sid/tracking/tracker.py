@@ -16,12 +16,13 @@ Only confirmed tracks are reported. Track ids count up from 1 and are never reus
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from sid.checks import MAX_COORDINATE, check_number, check_numbers, check_whole
+from sid.checks import MAX_COORDINATE, check_number, check_numbers, check_whole, is_real
 from sid.errors import SidError
 from sid.perception.people import Person
 from sid.tracking.assignment import gated_assignment
@@ -286,13 +287,16 @@ def _behind(view: View | None, positions: np.ndarray, detections: np.ndarray) ->
 def _measurements(people: Sequence[Person]) -> tuple[np.ndarray, np.ndarray, list[int]]:
     """Positions (N, 2) m, facings (N, 2) unit vectors (NaN: unknown) and ids of ``people``; TrackingError on bad
     values."""
+    for person in people:  # before numpy, which would read "1.5" as a number
+        if isinstance(person.id, bool) or not isinstance(person.id, numbers.Integral):
+            raise TrackingError(f"tracker: person id {person.id!r} is not a whole number")
+        for name in ("x", "y") if person.theta is None else ("x", "y", "theta"):
+            if not is_real(getattr(person, name)):
+                raise TrackingError(f"tracker: person {person.id}: {name} is not a number: {getattr(person, name)!r}")
     ids = [int(p.id) for p in people]
-    try:
-        positions = np.array([(p.x, p.y) for p in people], dtype=float).reshape(-1, 2)
-        theta = np.array([np.nan if p.theta is None else p.theta for p in people], dtype=float)
-        known = [p.theta is not None for p in people]
-    except (TypeError, ValueError):
-        positions, theta, known = np.full((len(people), 2), np.nan), np.full(len(people), np.nan), [True] * len(people)
+    positions = np.array([(p.x, p.y) for p in people], dtype=float).reshape(-1, 2)
+    theta = np.array([np.nan if p.theta is None else p.theta for p in people], dtype=float)
+    known = [p.theta is not None for p in people]
     if not (np.isfinite(positions).all() and np.isfinite(theta[known]).all()) or (
         len(positions) and np.abs(positions).max() > MAX_COORDINATE
     ):

@@ -345,6 +345,9 @@ def test_empty_and_single_person_give_no_group():
         ([Person(1, 0.0, 0.0, 0.0), Person(2, 1.0, 0.0, float("nan"))], "person 2 has a non-finite theta"),
         ([Person(1, 0.0, 0.0, 0.0), Person(1, 1.0, 0.0, 0.0)], r"ids must be unique, repeated: \[1\]"),
         ([Person(1, 0.0, 0.0, 0.0), Person(4, 1.0, -1e200, 0.0)], "person 4 at .* is farther than 1e\\+08 m"),
+        ([Person(1, "1", 0.0, 0.0), Person(2, 1.0, 0.0, 3.0)], "person 1 has a position that is not a pair of numbers"),
+        ([Person(1, 0.0, 0.0, "0"), Person(2, 1.0, 0.0, 3.0)], "person 1 has a theta that is not a number"),
+        ([Person(1, 0.0, 0.0, 0.0, math.nan), Person(2, 0.8, 0.0, 3.1, 1.0)], "person 1 has orientation_quality nan"),
     ],
 )
 @pytest.mark.parametrize("method", ["ospace", "gcff", "rays", "paper"])

@@ -137,6 +137,9 @@ def test_frames_out_of_time_order_are_refused_and_change_nothing() -> None:
         ([Person(0, math.nan, 0.0)], "person 0: x must be a finite number"),
         ([Person(3, 1.0, 0.0, math.inf)], "person 3: theta must be a finite number"),
         ([Person(1, 1.0, 0.0), Person(1, 3.0, 0.0)], "person id 1 appears twice"),
+        ([Person(0, "1.5", 0.0)], "person 0: x is not a number: '1.5'"),
+        ([Person(0, 1.0, 0.0, "0")], "person 0: theta is not a number"),
+        ([Person("a", 1.0, 0.0)], "person id 'a' is not a whole number"),
         ([Person(2, 1.0, -1e200)], r"person 2: y must be a finite number of metres in \[-1e\+08, 1e\+08\]"),
     ],
 )
