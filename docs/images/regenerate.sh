@@ -2,8 +2,8 @@
 # Redraws the pictures in docs/images with the commands that make them, each beside the record that command wrote
 # (comparison.json: sid demo's metrics.json; simulate_*.json: the run's run.json). tests/test_doc_images.py checks
 # them against what the commands draw today. About a minute; run from anywhere, with SID set to another way of
-# calling sid if needed (SID="python -m sid"). simulate_sweep.png is the chart of the 31-minute sweep in
-# docs/simulate.md (`sid simulate --sweep all --seeds 15 --workers 2`) and is not redrawn here.
+# calling sid if needed (SID="python -m sid"). simulate_sweep.png is the chart of the 28-minute sweep in
+# docs/simulate.md (`sid simulate --sweep all --seeds 15 --workers 1`, 5 December 2026) and is not redrawn here.
 set -eu
 SID=${SID:-sid}
 cd "$(dirname "$0")"

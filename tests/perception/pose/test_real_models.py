@@ -66,6 +66,7 @@ def test_movenet_singlepose_on_each_crop_puts_shoulders_and_hips_on_the_body(yol
 
 def test_overlay_of_the_real_frame(yolo_people, color, tmp_path):
     picture = draw_detections(color, yolo_people)
-    assert picture.shape == color.shape and picture.dtype == np.uint8
-    assert np.count_nonzero(np.any(picture != color[..., ::-1], axis=-1)) > 5000  # skeletons and boxes drawn
+    h, w = color.shape[:2]
+    assert picture.shape[1:] == color.shape[1:] and picture.shape[0] > h and picture.dtype == np.uint8  # and a legend
+    assert np.count_nonzero(np.any(picture[:h] != color[..., ::-1], axis=-1)) > 5000  # skeletons and boxes drawn
     assert cv2.imwrite(str(tmp_path / "five_people_pose.png"), picture)
