@@ -182,15 +182,19 @@ class StampPairer(Generic[T]):
             queue.append(new)
             return None
         color, depth = (new, match) if stream == "color" else (match, new)
-        self._forget_until(color.stamp, depth.stamp)
+        self._forget_until(color, depth)
         self._paired_color = color.stamp
         return color, depth
 
-    def _forget_until(self, color_stamp: float, depth_stamp: float) -> None:
+    def _forget_until(self, color: Stamped[T], depth: Stamped[T]) -> None:
+        """Take the pair out of the queues, and every message older than its own half (older colours into
+        ``dropped_colors``). The queues keep arrival order, which need not be stamp order (a driver's header stamps
+        can go back): the whole queue is sifted, not only its front."""
         colors, depths = self.waiting["color"], self.waiting["depth"]
-        while colors and colors[0].stamp <= color_stamp:
-            stale = colors.popleft()
-            if stale.stamp < color_stamp:
-                self.dropped_colors.append(stale)
-        while depths and depths[0].stamp <= depth_stamp:
-            depths.popleft()
+        self.dropped_colors.extend(m for m in colors if m is not color and m.stamp < color.stamp)
+        kept = [m for m in colors if m is not color and m.stamp > color.stamp]
+        colors.clear()
+        colors.extend(kept)
+        kept = [m for m in depths if m is not depth and m.stamp > depth.stamp]
+        depths.clear()
+        depths.extend(kept)

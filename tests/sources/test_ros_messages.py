@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections import deque
 from types import SimpleNamespace
 
 import numpy as np
@@ -99,3 +100,17 @@ def test_a_colour_image_older_than_a_paired_one_is_dropped_not_paired() -> None:
     assert pairer.add("depth", 100.0, "d old") is None  # waits: it may still find a colour image
     assert pairer.add("color", 100.0, "c back in time") is None  # older than c1, paired: never a frame
     assert [m.item for m in pairer.dropped_colors] == ["c back in time"] and pairer.duplicate_colors == []
+
+
+def test_colour_images_waiting_out_of_stamp_order_each_end_once() -> None:
+    """Colour images arrive in bag order, which need not be stamp order: the one a depth image pairs leaves the queue
+    wherever it waits (it was left waiting behind a later stamp and reported a second time as unpaired), and the older
+    ones behind it are dropped once."""
+    pairer: StampPairer[str] = StampPairer(0.015)
+    for stamp, item in ((100.3, "c late"), (100.0, "c early"), (100.1, "c middle")):
+        assert pairer.add("color", stamp, item) is None
+    pair = pairer.add("depth", 100.1, "d")
+    assert pair is not None and pair[0].item == "c middle"
+    assert [m.item for m in pairer.waiting["color"]] == ["c late"]
+    assert [m.item for m in pairer.dropped_colors] == ["c early"]
+    assert pairer.waiting["depth"] == deque()
