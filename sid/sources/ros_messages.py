@@ -182,11 +182,11 @@ class StampPairer(Generic[T]):
             queue.append(new)
             return None
         color, depth = (new, match) if stream == "color" else (match, new)
-        self._forget_until(color, depth)
+        self._take_pair(color, depth)
         self._paired_color = color.stamp
         return color, depth
 
-    def _forget_until(self, color: Stamped[T], depth: Stamped[T]) -> None:
+    def _take_pair(self, color: Stamped[T], depth: Stamped[T]) -> None:
         """Take the pair out of the queues, and every message older than its own half (older colours into
         ``dropped_colors``). The queues keep arrival order, which need not be stamp order (a driver's header stamps
         can go back): the whole queue is sifted, not only its front."""
