@@ -131,10 +131,15 @@ _UniqueKeyLoader.add_implicit_resolver(
 )
 
 
+_LINE_BREAKS_ESCAPED = {ord(c): f"\\u{ord(c):04x}" for c in "\x85\u2028\u2029"}
+"""The characters that end a line for ``str.splitlines`` (and for terminals and log readers) but that JSON writes
+as they are: an error message quoting them would come out on several lines."""
+
+
 def summary(value: Any, limit: int = 80) -> str:
-    """A parsed JSON / YAML value written as JSON (``null``, ``[525]``, ``"abc"``) for an error message, cut to
-    ``limit`` characters. Only as much of the value is visited as is written, so a value that is huge once expanded
-    (a YAML alias bomb: a few hundred bytes naming one list thousands of times over) stays short and cheap."""
+    """A parsed JSON / YAML value written as JSON (``null``, ``[525]``, ``"abc"``) for an error message, on one line,
+    cut to ``limit`` characters. Only as much of the value is visited as is written, so a value that is huge once
+    expanded (a YAML alias bomb: a few hundred bytes naming one list thousands of times over) stays short and cheap."""
     parts: list[str] = []
     room = limit + 1  # one past the limit: the text was cut
 
@@ -159,7 +164,7 @@ def summary(value: Any, limit: int = 80) -> str:
                 walk(v)
             put("}" if isinstance(item, dict) else "]")
         elif isinstance(item, str):
-            put(json.dumps(item[:room], ensure_ascii=False))
+            put(json.dumps(item[:room], ensure_ascii=False).translate(_LINE_BREAKS_ESCAPED))
         else:
             try:
                 put(json.dumps(item))

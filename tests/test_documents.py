@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import stat
 
@@ -159,3 +160,22 @@ def test_costmap_says_one_group_not_one_groups(tmp_path, capsys):
 
     assert main(["costmap", str(REPO_ROOT / "examples" / "conversation.json"), "--out", str(tmp_path)]) == 0
     assert ", 1 group (social)" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("breaker", ["\x85", "\u2028", "\u2029", "\n", "\r", "\x0b", "\x0c", "\x1c", "\x1e"])
+def test_summary_quotes_a_value_on_one_line_whatever_its_characters(breaker):
+    from sid.documents import summary
+
+    text = summary({f"key{breaker}": [f"value{breaker}"], "other": breaker})
+    assert len(text.splitlines()) == 1
+    assert json.loads(text) == {f"key{breaker}": [f"value{breaker}"], "other": breaker}  # still the value, as JSON
+
+
+def test_groups_error_quoting_a_line_separator_is_one_line(tmp_path, capsys):
+    from sid.cli import main
+
+    lines = tmp_path / "people.jsonl"
+    lines.write_text(json.dumps({"people": [{"id": {"\u2028": 1}, "x": 0.0, "y": 0.0, "theta": 0.0}]}) + "\n")
+    main(["groups", str(lines)])
+    errors = [line for line in capsys.readouterr().err.splitlines() if "id must be an integer" in line]
+    assert len(errors) == 1 and errors[0].endswith('got {"\\u2028": 1}')
