@@ -46,9 +46,10 @@ distance overflows to infinity and the answers would be silent garbage."""
 class Limits:
     """The largest inputs sid accepts; each bounds the memory and time one value can make a command spend.
 
-    map_cells: cells of a grid (a scenario's map, a map image's pixels); 4e6 is 100 x 100 m at 5 cm, where
-    ``sid plan --planner grid`` peaks near 1.5 GB (docs/robustness.md).
-    lidar_beams: beams of a simulated scan (100000 beams: about 0.6 GB and 20 s for ``sid costmap``).
+    What the largest accepted inputs cost in memory and time is measured in docs/parameters.md, "Input limits".
+
+    map_cells: cells of a grid (a scenario's map, a map image's pixels); 4e6 is 100 x 100 m at 5 cm.
+    lidar_beams: beams of a simulated scan.
     scan_cells: beams x the longest LiDAR range in cells (``lidar.range_max`` or ``raytrace_max_range``), the
     samples a simulated scan and the LiDAR layer's ray tracing take (720 beams x 10 m at 5 cm: 144000).
     people: people in one frame (a scenario, a ``sid groups`` or ``sid track`` line, a frame of an F-formation

@@ -139,8 +139,8 @@ class Letterbox:
         (``cv2.resize`` would round the resized size and scale the two axes slightly differently). When the image
         shrinks to fill whole pixels of the input exactly (640x480 into 256x256: 256x192 at scale 0.4, 32-pixel bands),
         ``cv2.resize`` samples at the same positions and is faster (docs/benchmarks.md, "Pose models");
-        its fixed-point weights round differently, by at most one grey level (6 % of the pixels of the real
-        five-people frame). It then resizes straight into the new input array, of which only the bands are filled.
+        its fixed-point weights round differently, by at most one grey level. It then resizes straight into the new
+        input array, of which only the bands are filled.
         """
         in_h, in_w = self.input_size
         resize = _resize_plan(self, *color.shape[:2])
