@@ -21,7 +21,7 @@ from sid.experiments.fformation import (
     LabelledFrame,
     cross_validate,
     gcff_settings,
-    load_dataset,
+    load_dataset_any_yaw,
     load_dataset_in_metres,
     missing_members,
     parse_threshold,
@@ -58,7 +58,18 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "from a person to their nearest neighbour is plausible for people (0.1-5 m), said on stderr when it is not "
         "metres; a warning names the scale that fits when the scaled positions are implausible",
     )
-    ff.add_argument("--degrees", action="store_true", help="the files' theta is in degrees (default: radians)")
+    angles = ff.add_mutually_exclusive_group()
+    angles.add_argument(
+        "--degrees",
+        dest="degrees",
+        action="store_const",
+        const=True,
+        help="the files' theta is in degrees (default: radians, or degrees when a theta reaches beyond two turns, "
+        "said on stderr)",
+    )
+    angles.add_argument(
+        "--radians", dest="degrees", action="store_const", const=False, help="the files' theta is in radians"
+    )
     ff.add_argument(
         "--T",
         dest="thresholds",
@@ -144,11 +155,14 @@ def run(args: argparse.Namespace) -> int:
         for folder, scale in zip(args.dirs, scales, strict=True):
             name = _dataset_name(folder, datasets)
             if scale == "auto":
-                datasets[name], unit, scale = load_dataset_in_metres(folder, args.degrees)
+                datasets[name], unit, scale, degrees = load_dataset_in_metres(folder, args.degrees)
                 if unit != "metres":
                     print(f"sid eval fformation: {name}: positions read as {unit} (--scale {scale:g})", file=sys.stderr)
             else:
-                datasets[name] = load_dataset(folder, scale, args.degrees)
+                datasets[name], degrees = load_dataset_any_yaw(folder, scale, args.degrees)
+            if degrees and args.degrees is None:
+                reason = "as radians it reaches beyond two turns"
+                print(f"sid eval fformation: {name}: theta read as degrees ({reason})", file=sys.stderr)
             _warn_about_data(name, datasets[name], scale)
             if args.facing_noise:
                 datasets[name] = with_facing_noise(datasets[name], math.radians(args.facing_noise))

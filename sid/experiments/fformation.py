@@ -46,6 +46,7 @@ __all__ = [
     "Score",
     "UNIT_SCALES",
     "YAW_LIMIT_RAD",
+    "YawUnitError",
     "cross_validate",
     "evaluate",
     "fitting_unit",
@@ -54,6 +55,7 @@ __all__ = [
     "frame_precision_recall",
     "gcff_settings",
     "load_dataset",
+    "load_dataset_any_yaw",
     "load_dataset_in_metres",
     "load_sequence",
     "load_settings_gc",
@@ -81,6 +83,10 @@ defaults (docs/groups.md)."""
 YAW_LIMIT_RAD = 4 * math.pi
 """No yaw in radians is written beyond two turns (an unwrapped ``a + pi`` stays well within); a file whose yaws go
 beyond is in degrees."""
+
+
+class YawUnitError(ValueError):
+    """A yaw beyond ``YAW_LIMIT_RAD`` read as radians: the file is in degrees, most likely."""
 
 
 @dataclass
@@ -254,13 +260,30 @@ def unit_warning(frames: Sequence[LabelledFrame], scale: float) -> str | None:
     )
 
 
-def load_dataset_in_metres(folder: str | Path, degrees: bool = False) -> tuple[list[LabelledFrame], str, float]:
+def load_dataset_any_yaw(
+    folder: str | Path, scale: float = 1.0, degrees: bool | None = None
+) -> tuple[list[LabelledFrame], bool]:
+    """``load_dataset``, with ``degrees`` None (the default) reading the yaws as radians unless one of the dataset
+    reaches beyond two turns (``YAW_LIMIT_RAD``), then all of them as degrees: facings span every direction, so a
+    file in degrees has yaws of tens of degrees or more. Returns the frames and whether they were read as degrees."""
+    if degrees is not None:
+        return load_dataset(folder, scale, degrees), degrees
+    try:
+        return load_dataset(folder, scale, False), False
+    except YawUnitError:
+        return load_dataset(folder, scale, True), True
+
+
+def load_dataset_in_metres(
+    folder: str | Path, degrees: bool | None = None
+) -> tuple[list[LabelledFrame], str, float, bool]:
     """``load_dataset`` in the unit its positions fit (``fitting_unit``: metres when they look like metres, else
-    centimetres or millimetres): the frames in metres, the unit's name and its scale. Positions that fit no unit are
-    loaded as metres (``unit_warning`` says why)."""
-    frames = load_dataset(folder, 1.0, degrees)
+    centimetres or millimetres), its yaws read as ``load_dataset_any_yaw`` does: the frames in metres, the unit's
+    name, its scale and whether the yaws were read as degrees. Positions that fit no unit are loaded as metres
+    (``unit_warning`` says why)."""
+    frames, degrees = load_dataset_any_yaw(folder, 1.0, degrees)
     unit, scale = fitting_unit(frames) or ("metres", 1.0)
-    return (frames if scale == 1.0 else load_dataset(folder, scale, degrees)), unit, scale
+    return (frames if scale == 1.0 else load_dataset(folder, scale, degrees)), unit, scale, degrees
 
 
 def missing_members(frames: Sequence[LabelledFrame]) -> tuple[int, int]:
@@ -524,9 +547,9 @@ def _people(cell: np.ndarray, scale: float, degrees: bool, where: str) -> list[P
     yaw = np.radians(rows[:, 3]) if degrees else rows[:, 3]
     reach = float(np.abs(yaw[np.isfinite(yaw)]).max(initial=0.0))
     if reach > YAW_LIMIT_RAD:
-        raise ValueError(
+        raise YawUnitError(
             f"fformation: {where}: theta reaches {reach:g}, beyond two turns: not radians; for a file in degrees "
-            "load it with degrees=True (sid eval fformation --degrees)"
+            "load it with degrees=True (sid eval fformation --degrees, or without --radians)"
         )
     # An annotated facing is taken at full quality (1), a missing one is unknown (None, quality 0).
     return [

@@ -282,11 +282,17 @@ def test_eval_fformation_warns_when_scaled_positions_are_not_metres(tmp_path, ca
 def test_eval_fformation_reads_degrees_and_warns_about_truth_ids_it_cannot_find(tmp_path, capsys):
     frames = [np.column_stack([f[:, :3], np.degrees(f[:, 3])]) for f in tiny_frames()]
     folder = write_sequence(tmp_path / "Degrees", frames, {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[5, 6]]})
-    code, _, err = run_sid(["eval", "fformation", str(folder), "--scale", "0.01"], capsys)
+    code, _, err = run_sid(["eval", "fformation", str(folder), "--scale", "0.01", "--radians"], capsys)
     assert code == 2 and "theta reaches 180, beyond two turns" in err and "--degrees" in err
     code, out, err = run_sid(["eval", "fformation", str(folder), "--scale", "0.01", "--degrees", "--table"], capsys)
-    assert code == 0 and out[1].split()[:3] == ["Degrees", "2/3", "3"]
+    assert code == 0 and out[1].split()[:3] == ["Degrees", "2/3", "3"] and "theta read as" not in err
     assert "Degrees: 1 of the 7 ground-truth group members are not among their frame's people" in err
+    for scale in (["--scale", "0.01"], []):  # by default, with the scale given or read off the spacing as well
+        code, read, err = run_sid(["eval", "fformation", str(folder), *scale, "--table"], capsys)
+        assert code == 0 and read == out and "Degrees: theta read as degrees" in err
+    with pytest.raises(SystemExit) as usage:
+        run_sid(["eval", "fformation", str(folder), "--degrees", "--radians"], capsys)
+    assert usage.value.code == 2 and "--radians: not allowed with argument --degrees" in capsys.readouterr().err
 
 
 def test_eval_fformation_scores_gcff_with_each_sequences_own_settings(tmp_path, capsys):

@@ -12,11 +12,14 @@ import scipy.io
 
 from sid.experiments.fformation import (
     PLAUSIBLE_NEIGHBOUR_M,
+    YawUnitError,
     cross_validate,
     evaluate,
     format_threshold,
     frame_precision_recall,
     load_dataset,
+    load_dataset_any_yaw,
+    load_dataset_in_metres,
     load_sequence,
     median_neighbour_distance,
     missing_members,
@@ -209,6 +212,16 @@ def test_yaws_in_degrees_are_refused_as_radians_and_read_with_degrees(tmp_path):
     assert yaws == pytest.approx([p.theta for f in expected for p in f.people])
     # Unwrapped radians (the triangle's a + pi reaches 8.9 rad) are still radians.
     assert max(abs(p.theta) for f in expected for p in f.people if p.theta is not None) > 2 * math.pi
+    # Left to the data, each dataset is read in the unit its yaws fit.
+    assert load_dataset_any_yaw(folder, 0.01) == (read, True)
+    assert load_dataset_any_yaw(tmp_path / "Radians", 0.01) == (expected, False)
+    assert load_dataset_in_metres(folder)[0] == read and load_dataset_in_metres(folder)[1:] == (
+        "centimetres",
+        0.01,
+        True,
+    )
+    with pytest.raises(YawUnitError):
+        load_dataset_any_yaw(folder, 0.01, degrees=False)
 
 
 def test_ground_truth_encodings_and_single_precision_timestamps(tmp_path):
