@@ -138,9 +138,10 @@ class Letterbox:
         One ``cv2.warpAffine`` both resizes and pads, so the pixels follow exactly the map of ``to_input``
         (``cv2.resize`` would round the resized size and scale the two axes slightly differently). When the image
         shrinks to fill whole pixels of the input exactly (640x480 into 256x256: 256x192 at scale 0.4, 32-pixel bands),
-        ``cv2.resize`` samples at the same positions and is faster (docs/benchmarks.md, "Pose models");
-        its fixed-point weights round differently, by at most one grey level. It then resizes straight into the new
-        input array, of which only the bands are filled.
+        ``cv2.resize`` samples at the same positions; its fixed-point weights round differently, by at most one grey
+        level. It resizes straight into the new input array, of which only the bands are filled. It was chosen as
+        the faster where it was measured first, is not on every host, and is what the INT8 models were calibrated
+        and checked on (docs/benchmarks.md, "Pose models").
         """
         in_h, in_w = self.input_size
         resize = _resize_plan(self, *color.shape[:2])
