@@ -589,9 +589,9 @@ class _SmallScene:
             if distance2 >= bound:
                 return False
             dot = rx * ox + ry * oy
-            if inner < dot < outer and self._within_reach(b, cx, cy):
+            if inner < dot < outer:
                 cross = rx * oy - ry * ox
-                if cross * cross < wide:
+                if cross * cross < wide and self._within_reach(b, cx, cy):
                     return True
         return False
 
