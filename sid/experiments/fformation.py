@@ -33,6 +33,7 @@ import scipy.io
 
 from sid.checks import check_limit, check_number
 from sid.documents import special_file
+from sid.errors import SidError
 from sid.perception.gcff import GCFFParams
 from sid.perception.groups import GroupParams, detect_groups
 from sid.perception.people import Person
@@ -85,7 +86,7 @@ YAW_LIMIT_RAD = 4 * math.pi
 beyond is in degrees."""
 
 
-class YawUnitError(ValueError):
+class YawUnitError(SidError, ValueError):
     """A yaw beyond ``YAW_LIMIT_RAD`` read as radians: the file is in degrees, most likely."""
 
 
