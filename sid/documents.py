@@ -131,15 +131,20 @@ _UniqueKeyLoader.add_implicit_resolver(
 )
 
 
-_LINE_BREAKS_ESCAPED = {ord(c): f"\\u{ord(c):04x}" for c in "\x85\u2028\u2029"}
-"""The characters that end a line for ``str.splitlines`` (and for terminals and log readers) but that JSON writes
-as they are: an error message quoting them would come out on several lines."""
+def _printable(text: str) -> str:
+    """``text`` with every character that is not printable written as its JSON escape (``\\u0085``): JSON escapes
+    only the C0 controls, while U+0085 and U+2028/9 end a line for ``str.splitlines`` (and for log readers), a C1
+    control such as U+009B may drive a terminal, and format characters (U+200B, U+FEFF) are invisible."""
+    if text.isprintable():
+        return text
+    return "".join(ch if ch.isprintable() else json.dumps(ch)[1:-1] for ch in text)
 
 
 def summary(value: Any, limit: int = 80) -> str:
-    """A parsed JSON / YAML value written as JSON (``null``, ``[525]``, ``"abc"``) for an error message, on one line,
-    cut to ``limit`` characters. Only as much of the value is visited as is written, so a value that is huge once
-    expanded (a YAML alias bomb: a few hundred bytes naming one list thousands of times over) stays short and cheap."""
+    """A parsed JSON / YAML value written as JSON (``null``, ``[525]``, ``"abc"``) for an error message, on one
+    printable line, cut to ``limit`` characters. Only as much of the value is visited as is written, so a value that
+    is huge once expanded (a YAML alias bomb: a few hundred bytes naming one list thousands of times over) stays short
+    and cheap."""
     parts: list[str] = []
     room = limit + 1  # one past the limit: the text was cut
 
@@ -164,7 +169,7 @@ def summary(value: Any, limit: int = 80) -> str:
                 walk(v)
             put("}" if isinstance(item, dict) else "]")
         elif isinstance(item, str):
-            put(json.dumps(item[:room], ensure_ascii=False).translate(_LINE_BREAKS_ESCAPED))
+            put(_printable(json.dumps(item[:room], ensure_ascii=False)))
         else:
             try:
                 put(json.dumps(item))

@@ -162,13 +162,19 @@ def test_costmap_says_one_group_not_one_groups(tmp_path, capsys):
     assert ", 1 group (social)" in capsys.readouterr().out
 
 
-@pytest.mark.parametrize("breaker", ["\x85", "\u2028", "\u2029", "\n", "\r", "\x0b", "\x0c", "\x1c", "\x1e"])
-def test_summary_quotes_a_value_on_one_line_whatever_its_characters(breaker):
+@pytest.mark.parametrize(
+    "character",
+    ["\x85", "\u2028", "\u2029", "\n", "\r", "\x0b", "\x0c", "\x1c", "\x1e", "\x9b", "\u200b", "\ufeff", "\U000e0001"],
+)
+def test_summary_quotes_a_value_on_one_printable_line_whatever_its_characters(character):
+    """Line breaks to ``str.splitlines``, a C1 control that drives terminals, invisible format characters: each is
+    escaped, and the text still reads back as the value."""
     from sid.documents import summary
 
-    text = summary({f"key{breaker}": [f"value{breaker}"], "other": breaker})
-    assert len(text.splitlines()) == 1
-    assert json.loads(text) == {f"key{breaker}": [f"value{breaker}"], "other": breaker}  # still the value, as JSON
+    text = summary({f"key{character}": [f"valué{character}"], "other": character})
+    assert len(text.splitlines()) == 1 and text.isprintable()
+    assert json.loads(text) == {f"key{character}": [f"valué{character}"], "other": character}
+    assert "é" in text  # printable characters stay as they are
 
 
 def test_groups_error_quoting_a_line_separator_is_one_line(tmp_path, capsys):
