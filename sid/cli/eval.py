@@ -17,10 +17,13 @@ from sid.distribution import MissingDependencyError
 from sid.experiments.fformation import (
     DEFAULT_GRID,
     DEFAULT_THRESHOLDS,
+    GROUP_ERRORS,
     Fold,
     LabelledFrame,
     cross_validate,
+    detect_all,
     gcff_settings,
+    group_errors,
     load_dataset_any_yaw,
     load_dataset_in_metres,
     missing_members,
@@ -80,6 +83,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="tolerances in (0, 1], e.g. --T 2/3 1 after the DIRs (default: 2/3 1)",
     )
     ff.add_argument("--table", action="store_true", help="print a readable table instead of JSON")
+    ff.add_argument(
+        "--errors",
+        action="store_true",
+        help="also count how each true group came out: exact, all its members and one other or more, only some of "
+        "them, some and others, missed; and the detected groups that match no true group",
+    )
     ff.add_argument(
         "--grid",
         nargs="+",
@@ -169,6 +178,8 @@ def run(args: argparse.Namespace) -> int:
         grid = args.grid or ([(k, list(v)) for k, v in DEFAULT_GRID.items()] if args.cross_validate else None)
         if grid and args.gcff_settings:
             raise ValueError("--gcff-settings scores GCFF's own settings: it takes no --grid or --cross-validate")
+        if grid and args.errors:
+            raise ValueError("--errors counts one detector's groups: it takes no --grid or --cross-validate")
         if grid:
             folds, table = cross_validate(datasets, dict(grid), params, args.thresholds[0])
             print(_folds(folds, table) if args.table else json.dumps(_folds_json(folds, table, grid), indent=2))
@@ -178,16 +189,25 @@ def run(args: argparse.Namespace) -> int:
             per_sequence = {name: gcff_settings(folder) for name, folder in zip(datasets, args.dirs, strict=True)}
             params = dataclasses.replace(params, method="gcff")
         scores = evaluate_fformation(datasets, params, args.thresholds, per_sequence)
+        errors = None
+        if args.errors:
+            detected = detect_all(datasets, params, per_sequence)
+            errors = {name: group_errors(frames, detected[name]) for name, frames in datasets.items()}
     except ValueError as exc:
         print(f"sid eval fformation: {exc}", file=sys.stderr)
         return 2
     if args.table:
         print(_table(scores))
+        if errors is not None:
+            print(f"\n{_errors_table(errors)}")
     else:
         settings = {
             k: v if isinstance(v, str) or math.isfinite(v) else str(v) for k, v in dataclasses.asdict(params).items()
         }
-        print(json.dumps({"params": settings, "scores": scores}, indent=2))
+        report: dict[str, object] = {"params": settings, "scores": scores}
+        if errors is not None:
+            report["group_errors"] = errors
+        print(json.dumps(report, indent=2))
     return 0
 
 
@@ -235,6 +255,19 @@ def _folds_json(
         "folds": [dataclasses.asdict(fold) for fold in folds],
         "grid": [dict(zip(names, values, strict=True)) | {"f1": scores} for values, scores in table.items()],
     }
+
+
+def _errors_table(errors: dict[str, dict[str, int]]) -> str:
+    """How the true groups came out, per dataset: counts and, for the true groups, their shares."""
+    columns = [*GROUP_ERRORS, "false_groups"]
+    lines = [f"{'dataset':<16} {'true groups':>11} " + " ".join(f"{c.replace('_', ' '):>13}" for c in columns)]
+    for name, counts in errors.items():
+        true = sum(counts[c] for c in GROUP_ERRORS)
+        cells = [
+            f"{counts[c]} ({counts[c] / true:.0%})" if true and c in GROUP_ERRORS else str(counts[c]) for c in columns
+        ]
+        lines.append(f"{name:<16} {true:>11} " + " ".join(f"{cell:>13}" for cell in cells))
+    return "\n".join(lines)
 
 
 def _table(scores: dict[str, dict[str, dict[str, float]]]) -> str:

@@ -41,6 +41,7 @@ from sid.perception.people import Person
 __all__ = [
     "DEFAULT_GRID",
     "DEFAULT_THRESHOLDS",
+    "GROUP_ERRORS",
     "Fold",
     "LabelledFrame",
     "PLAUSIBLE_NEIGHBOUR_M",
@@ -49,12 +50,14 @@ __all__ = [
     "YAW_LIMIT_RAD",
     "YawUnitError",
     "cross_validate",
+    "detect_all",
     "evaluate",
     "fitting_unit",
     "format_threshold",
     "frame_matches",
     "frame_precision_recall",
     "gcff_settings",
+    "group_errors",
     "load_dataset",
     "load_dataset_any_yaw",
     "load_dataset_in_metres",
@@ -352,6 +355,53 @@ def score(frames: Sequence[LabelledFrame], detections: Sequence[Sequence[Iterabl
     return Score(precision, recall, f1, len(frames))
 
 
+def detect_all(
+    datasets: Mapping[str, Sequence[LabelledFrame]],
+    params: GroupParams | None = None,
+    per_sequence: Mapping[str, Mapping[str, GroupParams]] | None = None,
+) -> dict[str, list[list[tuple[int, ...]]]]:
+    """The groups ``detect_groups`` finds (member ids) in every frame of each dataset, with ``params`` (the defaults
+    unless given) or, sequence by sequence, ``per_sequence``'s (dataset -> sequence -> parameters)."""
+    params = params or GroupParams()
+    per_sequence = per_sequence or {}
+    return {
+        name: [
+            [g.members for g in detect_groups(f.people, per_sequence.get(name, {}).get(f.sequence, params))]
+            for f in frames
+        ]
+        for name, frames in datasets.items()
+    }
+
+
+GROUP_ERRORS = ("exact", "one_too_many", "more_too_many", "lacking", "mixed", "missed")
+"""How a true group can come out (``group_errors``), best first."""
+
+
+def group_errors(frames: Sequence[LabelledFrame], detections: Sequence[Sequence[Iterable[int]]]) -> dict[str, int]:
+    """How each true group of two or more people came out in ``detections`` (member ids per frame, as ``frames``):
+    ``exact``; else, by the detected group sharing most of its members (ties: the one with fewest others), all of
+    them and one other (``one_too_many``) or more (``more_too_many``), two or more of them and nobody else
+    (``lacking``), two or more of them and others (``mixed``), or no detected group holds two of them (``missed``).
+    Also ``false_groups``: detected groups of two or more that hold two members of no true group."""
+    if len(detections) != len(frames):
+        raise ValueError(f"fformation: {len(detections)} detection lists for {len(frames)} frames")
+    counts = dict.fromkeys((*GROUP_ERRORS, "false_groups"), 0)
+    for frame, found in zip(frames, detections, strict=True):
+        groups = [frozenset(g) for g in found if len(frozenset(g)) > 1]
+        truth = [t for t in frame.truth if len(t) > 1]
+        for true in truth:
+            best = max(groups, key=lambda g: (len(g & true), -len(g - true)), default=frozenset())
+            shared, others = len(best & true), len(best - true)
+            if shared < 2:
+                counts["missed"] += 1
+            elif shared == len(true):
+                counts["exact" if not others else "one_too_many" if others == 1 else "more_too_many"] += 1
+            else:
+                counts["mixed" if others else "lacking"] += 1
+        counts["false_groups"] += sum(all(len(g & t) < 2 for t in truth) for g in groups)
+    return counts
+
+
 def evaluate(
     datasets: Mapping[str, Sequence[LabelledFrame]],
     params: GroupParams | None = None,
@@ -364,16 +414,7 @@ def evaluate(
 
     Returns ``{dataset or "pooled": {format_threshold(T): Score.to_dict()}}``.
     """
-    params = params or GroupParams()
-    per_sequence = per_sequence or {}
-
-    def chosen(name: str, frame: LabelledFrame) -> GroupParams:
-        return per_sequence.get(name, {}).get(frame.sequence, params)
-
-    detected = {
-        name: [[g.members for g in detect_groups(f.people, chosen(name, f))] for f in frames]
-        for name, frames in datasets.items()
-    }
+    detected = detect_all(datasets, params, per_sequence)
     result = {
         name: {format_threshold(t): score(frames, detected[name], t).to_dict() for t in thresholds}
         for name, frames in datasets.items()

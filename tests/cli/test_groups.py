@@ -183,6 +183,20 @@ def test_eval_fformation_prints_json_and_a_table(tmp_path, capsys):
     assert out[1].split() == ["Tiny", "1/2", "3", "1.000", "0.667", "0.800"]
 
 
+def test_eval_fformation_counts_how_each_true_group_came_out(tmp_path, capsys):
+    tiny = write_sequence(tmp_path / "Tiny", tiny_frames(), {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]})
+    code, out, _ = run_sid(["eval", "fformation", str(tiny), "--errors"], capsys)
+    assert code == 0
+    assert json.loads("\n".join(out))["group_errors"]["Tiny"] == {
+        "exact": 2, "one_too_many": 0, "more_too_many": 0, "lacking": 0, "mixed": 0, "missed": 1, "false_groups": 0
+    }  # fmt: skip
+    code, out, _ = run_sid(["eval", "fformation", str(tiny), "--errors", "--table"], capsys)
+    assert code == 0 and out[-2].split()[:4] == ["dataset", "true", "groups", "exact"]
+    assert out[-1].split() == ["Tiny", "3", "2", "(67%)", *["0", "(0%)"] * 4, "1", "(33%)", "0"]
+    code, _, err = run_sid(["eval", "fformation", str(tiny), "--errors", "--grid", "alone_price=0.5,0.65"], capsys)
+    assert code == 2 and "--errors counts one detector's groups" in err
+
+
 def test_eval_fformation_reads_the_unit_by_default(tmp_path, capsys):
     """Without --scale the positions' unit is read off the people's spacing: centimetres here, said on stderr."""
     tiny = write_sequence(tmp_path / "Tiny", tiny_frames(), {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]})

@@ -12,11 +12,13 @@ import scipy.io
 
 from sid.experiments.fformation import (
     PLAUSIBLE_NEIGHBOUR_M,
+    LabelledFrame,
     YawUnitError,
     cross_validate,
     evaluate,
     format_threshold,
     frame_precision_recall,
+    group_errors,
     load_dataset,
     load_dataset_any_yaw,
     load_dataset_in_metres,
@@ -363,3 +365,24 @@ def test_stamps_beyond_single_precision_load_without_a_numpy_warning(tmp_path, r
     )
     assert [f.timestamp for f in load_sequence(folder, scale=0.01)] == [1.0, 1e300]
     assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]
+
+
+def test_group_errors_name_how_each_true_group_came_out():
+    """One frame per kind; the detected group sharing most members is the one judged (ties: fewest others)."""
+    truth = [frozenset({1, 2, 3})]
+    frame = LabelledFrame("s", 0.0, [], truth)
+    cases = {
+        "exact": [[1, 2, 3]],
+        "one_too_many": [[1, 2, 3, 4]],
+        "more_too_many": [[1, 2, 3, 4, 5]],
+        "lacking": [[1, 2], [3, 9]],  # the pair shares two, the other one
+        "mixed": [[1, 2, 7]],
+        "missed": [[1, 8], [2, 9]],  # no group holds two of them: and each is a false group
+    }
+    for kind, found in cases.items():
+        counts = group_errors([frame], [found])
+        assert counts[kind] == 1 and sum(counts[k] for k in cases) == 1, kind
+    assert group_errors([frame], [[[1, 8], [2, 9]]])["false_groups"] == 2
+    assert group_errors([frame], [[[1, 2, 3, 4], [1, 2, 3]]])["exact"] == 1  # a tie on shared members: fewest others
+    with pytest.raises(ValueError, match="2 detection lists for 1 frames"):
+        group_errors([frame], [[], []])
