@@ -504,7 +504,9 @@ def _ray_meetings(
     facing_j = dx * fix + dy * fiy >= reach
     facing_i = -(dx * fjx + dy * fjy) >= reach
     face_to_face = facing_j & facing_i & (distance > 0) & (distance <= 4 * half)
-    with np.errstate(divide="ignore", invalid="ignore"):
+    # A denominator next to 0 (facings parallel to within ~1e-300) overflows s and t to inf; such pairs are not
+    # crossings (|denom| <= _PARALLEL) and take the midpoint, so the inf is never used.
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         s = (dx * fjy - dy * fjx) / denom
         t = (dx * fiy - dy * fix) / denom
         crossing = (np.abs(denom) > _PARALLEL) & (np.maximum(np.abs(s - half), np.abs(t - half)) <= half)

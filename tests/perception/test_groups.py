@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import warnings
 from dataclasses import replace
 
 import numpy as np
@@ -454,3 +455,17 @@ def test_gcff_is_a_method_with_zones_like_the_others():
     assert group.interest_point == pytest.approx((2.0, 1.0), abs=0.05)
     with pytest.raises(ValueError, match="groups: gcff_stride"):
         GroupParams(gcff_stride=-1.0)
+
+
+@pytest.mark.parametrize("method", GROUP_METHODS)
+@pytest.mark.parametrize("tiny", [1e-310, 5e-324, 1e-300])
+def test_facings_parallel_to_a_denormal_raise_no_overflow_warning(method, tiny):
+    # The ray methods divided by cross(f_i, f_j) ~ 1e-310 and numpy warned "overflow encountered in divide" (a random
+    # permutation test in the fresh-install run); the pair is parallel, not a crossing, whatever the division gives.
+    people = [Person(1, 0.0, 0.0, 0.0, 1.0), Person(2, 0.0, 1.0, tiny, 1.0), Person(3, 0.5, 0.5, 3.0, 1.0)]
+    params = GroupParams(method=method)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        groups = detect_groups(people, params)
+    parallel = detect_groups([*people[:1], replace(people[1], theta=0.0), *people[2:]], params)
+    assert [g.members for g in groups] == [g.members for g in parallel]
