@@ -28,10 +28,10 @@ from sid.experiments.fformation import (
     load_dataset_in_metres,
     missing_members,
     parse_threshold,
+    score_all,
     unit_warning,
     with_facing_noise,
 )
-from sid.experiments.fformation import evaluate as evaluate_fformation
 
 __all__ = ["add_parser", "add_tracking_parser", "run", "run_tracking"]
 
@@ -188,10 +188,10 @@ def run(args: argparse.Namespace) -> int:
         if args.gcff_settings:
             per_sequence = {name: gcff_settings(folder) for name, folder in zip(datasets, args.dirs, strict=True)}
             params = dataclasses.replace(params, method="gcff")
-        scores = evaluate_fformation(datasets, params, args.thresholds, per_sequence)
+        detected = detect_all(datasets, params, per_sequence)
+        scores = score_all(datasets, detected, args.thresholds)
         errors = None
         if args.errors:
-            detected = detect_all(datasets, params, per_sequence)
             errors = {name: group_errors(frames, detected[name]) for name, frames in datasets.items()}
     except ValueError as exc:
         print(f"sid eval fformation: {exc}", file=sys.stderr)

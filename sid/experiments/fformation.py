@@ -67,6 +67,7 @@ __all__ = [
     "missing_members",
     "parse_threshold",
     "score",
+    "score_all",
     "sequence_folders",
     "unit_warning",
     "with_facing_noise",
@@ -414,7 +415,15 @@ def evaluate(
 
     Returns ``{dataset or "pooled": {format_threshold(T): Score.to_dict()}}``.
     """
-    detected = detect_all(datasets, params, per_sequence)
+    return score_all(datasets, detect_all(datasets, params, per_sequence), thresholds)
+
+
+def score_all(
+    datasets: Mapping[str, Sequence[LabelledFrame]],
+    detected: Mapping[str, Sequence[Sequence[Iterable[int]]]],
+    thresholds: Sequence[float] = DEFAULT_THRESHOLDS,
+) -> dict[str, dict[str, dict[str, float | int]]]:
+    """``evaluate``'s scores of groups already found (``detect_all``'s, dataset -> member ids per frame)."""
     result = {
         name: {format_threshold(t): score(frames, detected[name], t).to_dict() for t in thresholds}
         for name, frames in datasets.items()
