@@ -14,6 +14,7 @@ from sid.cli.common import fail
 from sid.cli.eval_crowd import add_crowd_parser
 from sid.cli.grouping import add_group_params, group_params_from
 from sid.distribution import MissingDependencyError
+from sid.documents import plural
 from sid.experiments.fformation import (
     DEFAULT_GRID,
     DEFAULT_THRESHOLDS,
@@ -212,10 +213,17 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _warn_about_data(name: str, frames: list[LabelledFrame], scale: float) -> None:
-    """On stderr: positions implausible as metres once scaled (with the --scale that fits), and ground-truth
-    members missing from their frame's people."""
+    """On stderr: positions implausible as metres once scaled (with the --scale that fits), people left out for a
+    non-finite position, and ground-truth members missing from their frame's people."""
     if reason := unit_warning(frames, scale):
         print(f"sid eval fformation: warning: {name}: {reason} (set it with --scale)", file=sys.stderr)
+    unplaced = sum(f.unplaced for f in frames)
+    if unplaced:
+        print(
+            f"sid eval fformation: warning: {name}: {plural(unplaced, 'person', 'people')} without a finite position "
+            f"left out (in {plural(sum(f.unplaced > 0 for f in frames), 'frame')})",
+            file=sys.stderr,
+        )
     missing, total = missing_members(frames)
     if missing:
         print(

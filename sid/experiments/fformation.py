@@ -96,12 +96,14 @@ class YawUnitError(SidError, ValueError):
 
 @dataclass
 class LabelledFrame:
-    """One scored frame: the people (world frame, metres after scaling) and the true groups (member ids)."""
+    """One scored frame: the people (world frame, metres after scaling) and the true groups (member ids);
+    ``unplaced``: people of the file's frame left out for a non-finite position (a lost track)."""
 
     sequence: str
     timestamp: float
     people: list[Person]
     truth: list[frozenset[int]]
+    unplaced: int = 0
 
 
 @dataclass
@@ -121,7 +123,8 @@ def load_sequence(folder: str | Path, scale: float = 1.0, degrees: bool = False)
     """The ground-truth frames of one sequence folder (``features.mat`` + ``groundtruth.mat``).
 
     Positions are multiplied by ``scale`` (0.01 turns the datasets' centimetres into metres); yaws are radians, or
-    degrees with ``degrees=True``. A NaN yaw becomes an unknown facing (theta None). Raises ValueError naming the
+    degrees with ``degrees=True``. A NaN yaw becomes an unknown facing (theta None); a person with a non-finite
+    position is left out and counted in the frame's ``unplaced``. Raises ValueError naming the
     file (and the frame) for anything malformed: among others a yaw beyond two turns (4 pi) taken as radians
     (degrees, most likely), a repeated timestamp, an id that is not a whole number or repeats within a frame.
     """
@@ -152,9 +155,9 @@ def load_sequence(folder: str | Path, scale: float = 1.0, degrees: bool = False)
         if k is None:
             raise ValueError(f"fformation: {truth_path}: GTtimestamp {stamp} has no frame in {features_path.name}")
         where = f"{features_path} frame at timestamp {timestamps[k]:g}"
-        people = _people(frames_people[k], scale, degrees, where)
+        people, unplaced = _people(frames_people[k], scale, degrees, where)
         groups = [g for g in _groups(groups_cell, f"{truth_path} at timestamp {stamp:g}") if len(g) > 1]
-        frames.append(LabelledFrame(folder.name, float(timestamps[k]), people, groups))
+        frames.append(LabelledFrame(folder.name, float(timestamps[k]), people, groups, unplaced))
     return frames
 
 
@@ -574,18 +577,20 @@ def _numbers(value: np.ndarray, path: Path, name: str) -> np.ndarray:
     return numbers
 
 
-def _people(cell: np.ndarray, scale: float, degrees: bool, where: str) -> list[Person]:
+def _people(cell: np.ndarray, scale: float, degrees: bool, where: str) -> tuple[list[Person], int]:
+    """The people of a features cell, and how many rows were left out for a non-finite position."""
     try:
         rows = np.asarray(cell, dtype=float)
     except (TypeError, ValueError):
         raise ValueError(f"fformation: {where}: features must be a numeric N x 4 array") from None
     if rows.size == 0:
-        return []
+        return [], 0
     if rows.ndim != 2 or rows.shape[1] < 4:
         raise ValueError(f"fformation: {where}: features must be N x 4 [id, x, y, theta], got shape {rows.shape}")
     check_limit(f"fformation: {where}: features", len(rows), "people", "people")  # as sid groups, before grouping
-    if not np.all(np.isfinite(rows[:, :3])):
-        raise ValueError(f"fformation: {where}: non-finite id or position")
+    if not np.all(np.isfinite(rows[:, 0])):
+        raise ValueError(f"fformation: {where}: non-finite person id")
+    placed = np.isfinite(rows[:, 1:3]).all(axis=1)  # a person without a position (a lost track) is left out
     ids = rows[:, 0]
     if not np.array_equal(ids, np.round(ids)):
         raise ValueError(
@@ -595,6 +600,8 @@ def _people(cell: np.ndarray, scale: float, degrees: bool, where: str) -> list[P
     values, counts = np.unique(ids, return_counts=True)
     if (counts > 1).any():
         raise ValueError(f"fformation: {where}: person id {values[counts > 1][0]:g} appears more than once")
+    unplaced = int(len(rows) - placed.sum())
+    rows = rows[placed]
     yaw = np.radians(rows[:, 3]) if degrees else rows[:, 3]
     reach = float(np.abs(yaw[np.isfinite(yaw)]).max(initial=0.0))
     if reach > YAW_LIMIT_RAD:
@@ -603,10 +610,13 @@ def _people(cell: np.ndarray, scale: float, degrees: bool, where: str) -> list[P
             "load it with degrees=True (sid eval fformation --degrees, or without --radians)"
         )
     # An annotated facing is taken at full quality (1), a missing one is unknown (None, quality 0).
-    return [
+    people = [
         Person(int(i), x * scale, y * scale, *((theta, 1.0) if math.isfinite(theta) else (None, 0.0)))
-        for i, x, y, theta in zip(ids.tolist(), rows[:, 1].tolist(), rows[:, 2].tolist(), yaw.tolist(), strict=True)
+        for i, x, y, theta in zip(
+            rows[:, 0].tolist(), rows[:, 1].tolist(), rows[:, 2].tolist(), yaw.tolist(), strict=True
+        )
     ]
+    return people, unplaced
 
 
 def _groups(cell: object, where: str) -> list[frozenset[int]]:

@@ -106,6 +106,8 @@ def load_trajectory_set(folder: str | Path, interval: float = 0.4) -> Trajectory
         if not path.exists():
             raise TrajectoryError(f"{folder}: no {path.name} (a trajectory set holds obsmat.txt and groups.txt)")
     rows = _read_obsmat(obsmat)
+    rows, repeated = np.unique(rows, axis=0, return_counts=True)  # a row written twice is one annotation
+    notes = [f"{obsmat.name}: {int((repeated - 1).sum())} repeated rows read once"] if (repeated > 1).any() else []
     frames = rows[:, 0].astype(np.int64)
     steps, counts = np.unique(np.diff(np.unique(frames)), return_counts=True)
     step = int(steps[np.argmax(counts)]) if len(steps) else 1
@@ -119,7 +121,7 @@ def load_trajectory_set(folder: str | Path, interval: float = 0.4) -> Trajectory
     bounds = np.r_[starts, len(frames)]
     times = (frames[starts] - frames[0]) / step * interval
     position, velocity = rows[:, [2, 4]], rows[:, [5, 7]]
-    groups, notes = _read_groups(groups_file, set(ids.tolist()))
+    groups, group_notes = _read_groups(groups_file, set(ids.tolist()))
     return TrajectorySet(
         folder.name,
         times,
@@ -127,7 +129,7 @@ def load_trajectory_set(folder: str | Path, interval: float = 0.4) -> Trajectory
         tuple(position[a:b] for a, b in zip(bounds[:-1], bounds[1:], strict=True)),
         tuple(velocity[a:b] for a, b in zip(bounds[:-1], bounds[1:], strict=True)),
         groups,
-        notes,
+        (*notes, *group_notes),
     )
 
 
@@ -196,8 +198,10 @@ def _read_obsmat(path: Path) -> np.ndarray:
 
 def _read_groups(path: Path, known: set[int]) -> tuple[tuple[frozenset[int], ...], tuple[str, ...]]:
     """The groups of ``groups.txt`` and notes on it. Lines that share a person are one group (a person walks in one
-    group; the public seq_eth lists some people on two lines): they are joined, and a note says which."""
+    group; the public seq_eth lists some people on two lines): they are joined, and a note says which. Ids that
+    obsmat.txt never annotates (an annotation slip: nobody to score) are left out, and a note says which."""
     lines: list[tuple[int, frozenset[int]]] = []
+    notes: list[str] = []
     for number, line in _lines(path):
         try:
             members = frozenset(int(v) for v in line.split())
@@ -205,7 +209,9 @@ def _read_groups(path: Path, known: set[int]) -> tuple[tuple[frozenset[int], ...
             raise TrajectoryError(f"{path}:{number}: pedestrian ids must be whole numbers") from None
         unknown = sorted(members - known)
         if unknown:
-            raise TrajectoryError(f"{path}:{number}: pedestrian {unknown[0]} is not in obsmat.txt")
+            who = f"pedestrian{'s' if len(unknown) > 1 else ''} {', '.join(map(str, unknown))}"
+            notes.append(f"{path.name}:{number}: {who} not in obsmat.txt: left out")
+            members -= frozenset(unknown)
         lines.append((number, members))
     joined: list[tuple[list[int], frozenset[int]]] = []
     for number, members in lines:
@@ -213,13 +219,13 @@ def _read_groups(path: Path, known: set[int]) -> tuple[tuple[frozenset[int], ...
         numbers = [number] + [n for j in overlapping for n in j[0]]
         union = members.union(*(j[1] for j in overlapping))
         joined = [j for j in joined if not j[1] & members] + [(sorted(numbers), union)]
-    notes = tuple(
+    notes += [
         f"{path.name}: lines {', '.join(map(str, numbers))} share people: taken as one group of {len(members)}"
         for numbers, members in joined
         if len(numbers) > 1
-    )
-    groups = [members for _, members in sorted(joined) if len(members) >= 2]
-    return tuple(groups), notes
+    ]
+    groups = [members for _, members in sorted(joined, key=lambda j: j[0]) if len(members) >= 2]
+    return tuple(groups), tuple(notes)
 
 
 _LARGEST_ID = 2**53  # frame numbers and ids are read as floats: whole numbers beyond this are not exact

@@ -197,6 +197,16 @@ def test_eval_fformation_counts_how_each_true_group_came_out(tmp_path, capsys):
     assert code == 2 and "--errors counts one detector's groups" in err
 
 
+def test_eval_fformation_warns_of_people_left_out_without_a_position(tmp_path, capsys):
+    frames = tiny_frames()
+    frames[0] = np.vstack([frames[0], [7, np.nan, 0.0, 0.0], [8, 0.0, np.inf, 0.0]])
+    frames[1] = np.vstack([frames[1], [9, np.nan, np.nan, np.nan]])
+    tiny = write_sequence(tmp_path / "Tiny", frames, {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]})
+    code, out, err = run_sid(["eval", "fformation", str(tiny)], capsys)
+    assert code == 0 and "warning: Tiny: 3 people without a finite position left out (in 2 frames)" in err
+    assert json.loads("\n".join(out))["scores"]["Tiny"]["2/3"]["f1"] == pytest.approx(0.8)  # as without them
+
+
 def test_eval_fformation_reads_the_unit_by_default(tmp_path, capsys):
     """Without --scale the positions' unit is read off the people's spacing: centimetres here, said on stderr."""
     tiny = write_sequence(tmp_path / "Tiny", tiny_frames(), {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]})

@@ -256,6 +256,17 @@ def test_unit_warning_names_the_scale_that_fits(tiny):
     assert "is 0 m, implausible for people" in str(unit_warning(stacked, 0.01))  # no scale mends it
 
 
+def test_people_without_a_finite_position_are_left_out_and_counted(tmp_path):
+    lost = np.array([[1, 100.0, 0.0, 0.0], [2, np.nan, np.nan, math.pi], [3, 600.0, np.inf, 1.0]])
+    frames = load_sequence(write_sequence(tmp_path / "Lost", [lost, tiny_frames()[0]], {1: [[1, 2]], 2: [[1, 2]]}))
+    assert [[p.id for p in f.people] for f in frames] == [[1], [1, 2, 3]]
+    assert [f.unplaced for f in frames] == [2, 0]
+    assert missing_members(frames) == (1, 4)  # person 2's group membership is not scored in frame 1
+    bad_id = np.array([[np.nan, 100.0, 0.0, 0.0]])
+    with pytest.raises(ValueError, match="non-finite person id"):
+        load_sequence(write_sequence(tmp_path / "BadId", [bad_id], {1: [[1, 2]]}))
+
+
 def test_missing_members_counts_truth_ids_absent_from_their_frame(tiny):
     frames = load_dataset(tiny, 0.01)
     assert missing_members(frames) == (0, 7)

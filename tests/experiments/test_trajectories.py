@@ -50,6 +50,26 @@ def test_lines_sharing_a_person_are_one_group_with_a_note(tmp_path: Path) -> Non
     assert trajectories.notes == ("groups.txt: lines 1, 2 share people: taken as one group of 3",)
 
 
+def test_group_members_never_annotated_are_left_out_with_a_note(tmp_path: Path) -> None:
+    folder = write_set(tmp_path / "s", _walkers(), "1 2 7\n3 8 9\n")
+    trajectories = load_trajectory_set(folder)
+    assert trajectories.groups == (frozenset({1, 2}),)  # 3 alone once 8 and 9 are gone: no group
+    assert trajectories.notes == (
+        "groups.txt:1: pedestrian 7 not in obsmat.txt: left out",
+        "groups.txt:2: pedestrians 8, 9 not in obsmat.txt: left out",
+    )
+
+
+def test_a_row_written_twice_is_read_once_with_a_note(tmp_path: Path) -> None:
+    rows = _walkers()
+    folder = write_set(tmp_path / "s", [*rows, rows[4], rows[4], rows[0]], "1 2\n")
+    trajectories = load_trajectory_set(folder)
+    clean = load_trajectory_set(write_set(tmp_path / "clean", rows, "1 2\n"))
+    assert [ids.tolist() for ids in trajectories.ids] == [ids.tolist() for ids in clean.ids]
+    assert all(np.array_equal(a, b) for a, b in zip(trajectories.positions, clean.positions, strict=True))
+    assert trajectories.notes == ("obsmat.txt: 3 repeated rows read once",)
+
+
 @pytest.mark.parametrize(
     ("obsmat", "groups", "problem"),
     [
@@ -59,8 +79,8 @@ def test_lines_sharing_a_person_are_one_group_with_a_note(tmp_path: Path) -> Non
         ("0.5 1 0 0 0 0 0 0\n", "", "obsmat.txt:1: frame and pedestrian id must be whole numbers"),
         ("0 1e300 0 0 0 0 0 0\n", "", "obsmat.txt:1: frame and pedestrian id must be whole numbers up to 2^53"),
         ("0 1 0 0 0 0 0 0\n0 1 1 0 0 0 0 0\n", "", "obsmat.txt: pedestrian 1 appears twice in frame 0"),
+        ("0 1 0 0 0 0 0 0\n0 1 0 0 0 0 0 0\n0 1 1 0 0 0 0 0\n", "", "pedestrian 1 appears twice in frame 0"),
         ("\n\n", "", "obsmat.txt: no annotations"),
-        ("0 1 0 0 0 0 0 0\n", "1 7\n", "groups.txt:1: pedestrian 7 is not in obsmat.txt"),
         ("0 1 0 0 0 0 0 0\n", "1 two\n", "groups.txt:1: pedestrian ids must be whole numbers"),
     ],
 )
