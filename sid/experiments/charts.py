@@ -93,6 +93,8 @@ def _draw_panel(ax: Axes, rows: Sequence[dict], panel: Panel) -> None:
         ax.set_ylim(min(low, 0.0) - (0.1 * span if low < 0 else 0.0), max(high, 0.0) + 0.15 * span)
     for x in missing:
         ax.text(x, 0.0, "n/a", ha="center", va="bottom", fontsize=8, color="0.45")
+        ax.update_datalim([(x - width / 2, 0.0), (x + width / 2, 0.0)])  # its slot, as a bar's, inside the x-limits
+    ax.autoscale_view(scaley=False)
     ax.axhline(0.0, color="0.2", linewidth=0.8)
     ax.set_xticks(range(len(planners)), [p.replace("_", "\n") for p in planners])
     ax.set_title(panel.title, loc="left", fontsize=10)
