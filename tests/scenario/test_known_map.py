@@ -12,6 +12,7 @@ from costmap.mapfile import write_map
 from costmap.occupancy import OCC_OCCUPIED, OCC_UNKNOWN, OccupancyGrid
 from planner.facade import plan
 from planner.problem import PlanningError
+from sid.documents import InputWarning
 from sid.scenario.build import build_costmap, planning_problem
 from sid.scenario.known_map import known_map, obstacle_mask
 from sid.scenario.loader import scenario_from_dict
@@ -96,7 +97,9 @@ def test_a_map_file_and_the_obstacles_combine(tmp_path):
     assert grid.data[cells_of((5.5, 3.0))] == OCC_OCCUPIED  # the box, half over the file's free cells
     assert grid.data[cells_of((4.98, 3.0))] == 0 and grid.data[cells_of((5.02, 3.0))] == OCC_OCCUPIED
 
-    layered = build_costmap(scenario([BOX], goal=(3.0, 3.0), base_dir=tmp_path, static_map="room.yaml"), social=False)
+    with pytest.warns(InputWarning, match=r"0.1 m cells sampled onto the scenario's 0.05 m cells"):
+        loaded = scenario([BOX], goal=(3.0, 3.0), base_dir=tmp_path, static_map="room.yaml")
+    layered = build_costmap(loaded, social=False)
     master = layered.master.costs
     assert master[cells_of((5.5, 3.0))] == LETHAL and master[cells_of((1.05, 5.0))] == LETHAL
     assert master[cells_of((3.0, 3.0))] == FREE_SPACE
