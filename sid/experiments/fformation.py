@@ -23,6 +23,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import math
+import warnings
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,7 +33,7 @@ import numpy as np
 import scipy.io
 
 from sid.checks import check_limit, check_number
-from sid.documents import special_file
+from sid.documents import InputWarning, plural, special_file
 from sid.errors import SidError
 from sid.perception.gcff import GCFFParams
 from sid.perception.groups import GroupParams, detect_groups
@@ -124,7 +125,8 @@ def load_sequence(folder: str | Path, scale: float = 1.0, degrees: bool = False)
 
     Positions are multiplied by ``scale`` (0.01 turns the datasets' centimetres into metres); yaws are radians, or
     degrees with ``degrees=True``. A NaN yaw becomes an unknown facing (theta None); a person with a non-finite
-    position is left out and counted in the frame's ``unplaced``. Raises ValueError naming the
+    position is left out and counted in the frame's ``unplaced``; ground-truth frames whose timestamp has no
+    features frame are not scored, with an ``InputWarning`` (none matching: ValueError). Raises ValueError naming the
     file (and the frame) for anything malformed: among others a yaw beyond two turns (4 pi) taken as radians
     (degrees, most likely), a repeated timestamp, an id that is not a whole number or repeats within a frame.
     """
@@ -148,16 +150,30 @@ def load_sequence(folder: str | Path, scale: float = 1.0, degrees: bool = False)
     _check_unique(timestamps, features_path, "timestamp")
     _check_unique(truth_timestamps, truth_path, "GTtimestamp")
     index = _frame_index(timestamps)
-    frames = []
+    frames, unmatched = [], []
     for groups_cell, stamp in zip(truth_groups, truth_timestamps, strict=True):
         with np.errstate(over="ignore"):  # a stamp beyond single precision's range rounds to inf: no frame
             k = index.get(float(stamp), index.get(float(np.float32(stamp))))
         if k is None:
-            raise ValueError(f"fformation: {truth_path}: GTtimestamp {stamp} has no frame in {features_path.name}")
+            unmatched.append(stamp)
+            continue
         where = f"{features_path} frame at timestamp {timestamps[k]:g}"
         people, unplaced = _people(frames_people[k], scale, degrees, where)
         groups = [g for g in _groups(groups_cell, f"{truth_path} at timestamp {stamp:g}") if len(g) > 1]
         frames.append(LabelledFrame(folder.name, float(timestamps[k]), people, groups, unplaced))
+    if unmatched and not frames:  # nothing matches: other clocks or units, not a slip
+        raise ValueError(
+            f"fformation: {truth_path}: GTtimestamp {unmatched[0]} has no frame in {features_path.name}"
+            + (f" (nor do the other {len(unmatched) - 1})" if len(unmatched) > 1 else "")
+        )
+    if unmatched:
+        warnings.warn(
+            InputWarning(
+                f"fformation: {truth_path}: {plural(len(unmatched), 'ground-truth frame')} of {len(truth_timestamps)} "
+                f"without a frame in {features_path.name} (first GTtimestamp {unmatched[0]:g}): not scored"
+            ),
+            stacklevel=2,
+        )
     return frames
 
 

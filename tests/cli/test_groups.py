@@ -207,6 +207,13 @@ def test_eval_fformation_warns_of_people_left_out_without_a_position(tmp_path, c
     assert json.loads("\n".join(out))["scores"]["Tiny"]["2/3"]["f1"] == pytest.approx(0.8)  # as without them
 
 
+def test_eval_fformation_scores_past_ground_truth_frames_without_features(tmp_path, capsys):
+    slip = write_sequence(tmp_path / "Slip", tiny_frames(), {1: [[1, 2]], 9: [[4, 5]], 2: [[1, 2, 3]]})
+    code, out, err = run_sid(["eval", "fformation", str(slip)], capsys)
+    assert code == 0 and "1 ground-truth frame of 3 without a frame in features.mat (first GTtimestamp 9)" in err
+    assert json.loads("\n".join(out))["scores"]["Slip"]["2/3"]["frames"] == 2
+
+
 def test_eval_fformation_reads_the_unit_by_default(tmp_path, capsys):
     """Without --scale the positions' unit is read off the people's spacing: centimetres here, said on stderr."""
     tiny = write_sequence(tmp_path / "Tiny", tiny_frames(), {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]})

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 import scipy.io
 
+from sid.documents import InputWarning
 from sid.experiments.fformation import (
     PLAUSIBLE_NEIGHBOUR_M,
     LabelledFrame,
@@ -364,6 +365,16 @@ def test_files_that_disagree_are_named_with_the_fformation_prefix(tmp_path):
         ValueError, match=r"^fformation: .*groundtruth.mat: GTtimestamp 9.0 has no frame in features.mat$"
     ):
         load_sequence(folder)
+    write_sequence(folder, tiny_frames(), {9: [[1, 2]], 10: [[1, 2]]})
+    with pytest.raises(ValueError, match=r"GTtimestamp 9.0 has no frame in features.mat \(nor do the other 1\)$"):
+        load_sequence(folder)
+
+
+def test_ground_truth_frames_without_features_are_not_scored_with_a_warning(tmp_path):
+    folder = write_sequence(tmp_path / "Slip", tiny_frames(), {1: [[1, 2]], 9: [[4, 5]], 2: [[1, 2, 3]]})
+    with pytest.warns(InputWarning, match=r"groundtruth.mat: 1 ground-truth frame of 3 without a frame in features"):
+        frames = load_sequence(folder)
+    assert [f.timestamp for f in frames] == [1.0, 2.0]
 
 
 def test_stamps_beyond_single_precision_load_without_a_numpy_warning(tmp_path, recwarn):
