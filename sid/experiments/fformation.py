@@ -606,7 +606,6 @@ def _people(cell: np.ndarray, scale: float, degrees: bool, where: str) -> tuple[
     check_limit(f"fformation: {where}: features", len(rows), "people", "people")  # as sid groups, before grouping
     if not np.all(np.isfinite(rows[:, 0])):
         raise ValueError(f"fformation: {where}: non-finite person id")
-    placed = np.isfinite(rows[:, 1:3]).all(axis=1)  # a person without a position (a lost track) is left out
     ids = rows[:, 0]
     if not np.array_equal(ids, np.round(ids)):
         raise ValueError(
@@ -616,6 +615,7 @@ def _people(cell: np.ndarray, scale: float, degrees: bool, where: str) -> tuple[
     values, counts = np.unique(ids, return_counts=True)
     if (counts > 1).any():
         raise ValueError(f"fformation: {where}: person id {values[counts > 1][0]:g} appears more than once")
+    placed = np.isfinite(rows[:, 1:3]).all(axis=1)  # a person without a position (a lost track) is left out
     unplaced = int(len(rows) - placed.sum())
     rows = rows[placed]
     yaw = np.radians(rows[:, 3]) if degrees else rows[:, 3]

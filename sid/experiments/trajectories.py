@@ -106,13 +106,12 @@ def load_trajectory_set(folder: str | Path, interval: float = 0.4) -> Trajectory
         if not path.exists():
             raise TrajectoryError(f"{folder}: no {path.name} (a trajectory set holds obsmat.txt and groups.txt)")
     rows = _read_obsmat(obsmat)
-    rows, repeated = np.unique(rows, axis=0, return_counts=True)  # a row written twice is one annotation
+    # Sorted by frame, then pedestrian (then the rest); a row written twice is one annotation.
+    rows, repeated = np.unique(rows, axis=0, return_counts=True)
     notes = [f"{obsmat.name}: {int((repeated - 1).sum())} repeated rows read once"] if (repeated > 1).any() else []
     frames = rows[:, 0].astype(np.int64)
     steps, counts = np.unique(np.diff(np.unique(frames)), return_counts=True)
     step = int(steps[np.argmax(counts)]) if len(steps) else 1
-    order = np.lexsort((rows[:, 1], frames))
-    rows, frames = rows[order], frames[order]
     ids = rows[:, 1].astype(np.int64)
     twice = np.flatnonzero((frames[1:] == frames[:-1]) & (ids[1:] == ids[:-1]))  # sorted: repeats are neighbours
     if len(twice):
