@@ -306,9 +306,12 @@ def run(args: argparse.Namespace) -> int:
     try:
         lift = LiftParams() if args.keypoint_threshold is None else LiftParams(min_score=args.keypoint_threshold)
         mount = CameraMount(args.camera_height, args.camera_tilt)
-        pipeline = Pipeline(_pose(args), mount, lift, GroupParams(method=args.group_method))
-        options = _source_options(args)
-        source = open_source(args.source, **options)
+        pose = _pose(args)
+        source = open_source(args.source, **_source_options(args))
+        single = isinstance(source, Sized) and len(source) == 1
+        tracking = not (args.no_tracking or single)
+        # With tracking the groups come from the group tracker, so the frame's own grouping would be thrown away.
+        pipeline = Pipeline(pose, mount, lift, GroupParams(method=args.group_method), group=not tracking)
     except MissingDependencyError as exc:  # --provider openvino without it
         return fail("sid detect", exc)
     except (SourceError, PoseModelError, ValueError, OSError) as exc:
@@ -331,8 +334,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"detect: frame {index}: skipped, {reason}", file=sys.stderr)
 
     interrupted = 0  # the exit code of the signal that stopped the run
-    single = isinstance(source, Sized) and len(source) == 1
-    stream = None if args.no_tracking or single else PeopleStream(pipeline)
+    stream = PeopleStream(pipeline) if tracking else None
     totals: list[float] = []
     started = time.perf_counter()
     try:

@@ -26,6 +26,7 @@ def test_detect_reports_tracks_with_stable_ids_velocities_and_groups(capsys) -> 
     assert {"id", "interest_point", "zone", "velocity"} <= group.keys()
     assert len({r["groups"][0]["id"] for r in records if r["groups"]}) == 1
     assert {"track", "track_groups"} <= records[-1]["timing_ms"].keys()
+    assert "group" not in records[-1]["timing_ms"]  # the frame's own grouping, unused with tracking, is skipped
 
 
 def test_detect_keeps_each_persons_keypoints_from_the_matched_detection(capsys) -> None:
@@ -40,6 +41,7 @@ def test_no_tracking_gives_each_frames_own_detections(capsys) -> None:
     for record in records:
         assert sorted(p["id"] for p in record["people"]) == [0, 1]
         assert "velocity" not in record["people"][0] and "id" not in record["groups"][0]
+        assert "group" in record["timing_ms"]
 
 
 def test_pictures_draw_the_records_of_the_json_line(tmp_path, capsys, monkeypatch) -> None:
