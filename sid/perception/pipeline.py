@@ -82,10 +82,16 @@ def _person_json(person: Person, keypoints: bool) -> dict:
     }
     if keypoints:
         kps = person.keypoints_world
-        record["keypoints"] = (
-            None if kps is None else [None if np.isnan(k).any() else [round(float(v), 4) for v in k] for k in kps]
-        )
+        record["keypoints"] = None if kps is None else _keypoints_json(kps)
     return record
+
+
+def _keypoints_json(keypoints: np.ndarray) -> list[list[float] | None]:
+    """(17, 3) keypoints (m) -> rows rounded to 0.1 mm, None where a keypoint is missing (NaN). np.round rather
+    than round() per value: a tenth of the time, and the same digits except for values within a rounding error of
+    a half (np.round scales, then rounds half to even)."""
+    missing = np.isnan(keypoints).any(axis=1).tolist()
+    return [None if gone else row for row, gone in zip(np.round(keypoints, 4).tolist(), missing, strict=True)]
 
 
 @dataclass(frozen=True)
