@@ -87,9 +87,9 @@ def _person_json(person: Person, keypoints: bool) -> dict:
 
 
 def _keypoints_json(keypoints: np.ndarray) -> list[list[float] | None]:
-    """(17, 3) keypoints (m) -> rows rounded to 0.1 mm, None where a keypoint is missing (NaN). np.round rather
-    than round() per value: a tenth of the time, and the same digits except for values within a rounding error of
-    a half (np.round scales, then rounds half to even)."""
+    """(17, 3) keypoints (m) -> rows rounded to 0.1 mm, None where a keypoint is missing (NaN). One np.round per
+    person rather than round() per value (docs/benchmarks.md, "Start-up and the detect loop"): the same digits except
+    for values within a rounding error of a half (np.round scales, then rounds half to even)."""
     missing = np.isnan(keypoints).any(axis=1).tolist()
     return [None if gone else row for row, gone in zip(np.round(keypoints, 4).tolist(), missing, strict=True)]
 
