@@ -32,6 +32,7 @@ from sid.experiments.fformation import (
     score_all,
     unit_warning,
     with_facing_noise,
+    without_facings,
 )
 
 __all__ = ["add_parser", "add_tracking_parser", "run", "run_tracking"]
@@ -117,6 +118,14 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         metavar="DEG",
         help="add seeded Gaussian noise of this standard deviation (degrees) to every facing first (default 0)",
     )
+    ff.add_argument(
+        "--facing-missing",
+        type=float,
+        default=0.0,
+        metavar="SHARE",
+        help="make this share (0-1) of the facings unknown first, at random and seeded, as people half hidden "
+        "behind others get none from the pipeline (default 0)",
+    )
     add_group_params(ff)
     ff.set_defaults(func=run)
     add_tracking_parser(tasks)
@@ -174,6 +183,8 @@ def run(args: argparse.Namespace) -> int:
                 reason = "as radians it reaches beyond two turns"
                 print(f"sid eval fformation: {name}: theta read as degrees ({reason})", file=sys.stderr)
             _warn_about_data(name, datasets[name], scale)
+            if args.facing_missing:
+                datasets[name] = without_facings(datasets[name], args.facing_missing)
             if args.facing_noise:
                 datasets[name] = with_facing_noise(datasets[name], math.radians(args.facing_noise))
         grid = args.grid or ([(k, list(v)) for k, v in DEFAULT_GRID.items()] if args.cross_validate else None)

@@ -72,6 +72,7 @@ __all__ = [
     "sequence_folders",
     "unit_warning",
     "with_facing_noise",
+    "without_facings",
 ]
 
 DEFAULT_THRESHOLDS: tuple[float, ...] = (2 / 3, 1.0)
@@ -209,6 +210,20 @@ def with_facing_noise(frames: Sequence[LabelledFrame], sigma: float, seed: int =
         ]
         noisy.append(dataclasses.replace(frame, people=people))
     return noisy
+
+
+def without_facings(frames: Sequence[LabelledFrame], share: float, seed: int = 0) -> list[LabelledFrame]:
+    """``frames`` with each facing made unknown (theta None) with probability ``share``, as a person half hidden
+    behind another gets no facing from the pipeline; one generator seeded with ``seed`` draws for everyone, frame by
+    frame and person by person in order (the same facings on every run)."""
+    check_number("fformation", "share of facings missing", share, low=0, high=1)
+    rng = np.random.default_rng(seed)
+    kept = []
+    for frame in frames:
+        gone = (rng.random(len(frame.people)) < share).tolist()
+        people = [dataclasses.replace(p, theta=None) if g else p for p, g in zip(frame.people, gone, strict=True)]
+        kept.append(dataclasses.replace(frame, people=people))
+    return kept
 
 
 def sequence_folders(folder: str | Path) -> list[Path]:

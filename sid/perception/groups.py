@@ -129,10 +129,14 @@ class GroupParams:
     ring_facing_tolerance: how far (rad) a member's facing may point from a joined ring's centre (or the facings'
       slack when wider). 0.6 (34 degrees): 10 degrees of facing noise stays inside at three standard deviations;
       neighbouring conversations, whose members face their own centres, stay out.
-    unknown_facing_cost: a person without facing may join a group formed by others when standing on its circle; the
-      unexplained facing costs as much as a proposal this far (m) from the centre. 0.5: its square, 0.25 m^2, leaves
-      room under the price for standing 0.6 m off the circle; a doubtful facing then gains nothing over a clear one
-      that points 0.5 m wide.
+    unknown_facing_cost: a person without facing may join a group when standing on its circle; the unexplained
+      facing costs as much as a proposal this far (m) from the centre. 0.5: its square, 0.25 m^2, leaves room under
+      the price for standing 0.6 m off the circle; a doubtful facing then gains nothing over a clear one that points
+      0.5 m wide.
+    unknown_facing_tolerance: a person without facing counts towards opening a group (with at least one member of
+      known facing: someone facing a partner half hidden behind them, whose facing the camera cannot tell) only when
+      standing within this distance (m) of its circle; farther off they may still join an open one. 0.2, a body's
+      depth; chosen by cross-validation on the benchmarks with a share of their facings removed (docs/groups.md).
     body_radius: a member's line to the centre must pass farther than this (m) from everyone else (the o-space is
       exclusive). Chosen by cross-validation (docs/groups.md).
     facing_weight_floor: the facing weight is floor + (1 - floor) x orientation_quality: a doubtful facing counts
@@ -175,6 +179,7 @@ class GroupParams:
     ring_tolerance: float = 0.2
     ring_facing_tolerance: float = 0.6
     unknown_facing_cost: float = 0.5
+    unknown_facing_tolerance: float = 0.2
     body_radius: float = 0.1
     facing_weight_floor: float = 0.5
     gcff_stride: float = 0.45
@@ -227,9 +232,14 @@ class GroupParams:
                 self.body_radius,
                 self.alone_price,
                 self.angular_weight,
+                unknown_tolerance=self.unknown_facing_tolerance,
             )
         except ValueError as exc:
-            names = {"price": "group_price", "unknown_cost": "unknown_facing_cost"}
+            names = {
+                "price": "group_price",
+                "unknown_cost": "unknown_facing_cost",
+                "unknown_tolerance": "unknown_facing_tolerance",
+            }
             message = str(exc).replace("ospace: ", "groups: ", 1)
             for old, new in names.items():
                 message = message.replace(f"groups: {old} ", f"groups: {new} ", 1)

@@ -32,8 +32,10 @@ The first candidates are every known-facing person's proposals at several radii 
 and, for two known facings within ``pair_reach`` of each other, neither facing more than 90 degrees away from the
 other, the o-space of their pair (centre their midpoint, radius half their distance): where facings are coarse the
 proposals ahead miss the centre, and proximity has to carry the decision. Later rounds use the refitted groups plus
-the first proposals of whoever is still alone. Only people with a known facing open an o-space and a group needs
-two of them; people with unknown facing may then join one.
+the first proposals of whoever is still alone. An o-space opens when it lowers the cost of two people or more, one
+at least with a known facing; a person of unknown facing counts towards that only when standing within
+``unknown_tolerance`` of its circle (a member half hidden behind their partner, whose facing the camera cannot
+tell), and may join an open one up to the alone price. A group keeps a known facing among its members.
 
 Two implementations of the same arithmetic, cross-checked by the tests: a crowd runs on numpy arrays,
 candidate-major (row k lists the people within reach of candidate k's centre, a KD-tree's answer), so the work grows
@@ -93,6 +95,7 @@ class OSpaceModel:
     alone_price: float
     angular_weight: float = 1.0
     pair_reach: float = 0.0
+    unknown_tolerance: float = 0.2
 
     def __post_init__(self) -> None:
         far, vast = MAX_LENGTH, MAX_LENGTH**2  # squared and summed downstream: bounded, they stay finite
@@ -104,6 +107,7 @@ class OSpaceModel:
         check_number("ospace", "body_radius", self.body_radius, low=0, high=far, unit="metres")
         check_number("ospace", "angular_weight", self.angular_weight, low=0, low_open=True)
         check_number("ospace", "pair_reach", self.pair_reach, low=0, high=far, unit="metres")
+        check_number("ospace", "unknown_tolerance", self.unknown_tolerance, low=0, high=far, unit="metres")
         check_whole("ospace", "radius_steps", self.radius_steps, low=1, high=MAX_RADIUS_STEPS)
 
     @cached_property
@@ -127,6 +131,12 @@ class OSpaceModel:
         """The o-space two people at ``a`` and ``b`` (complex, m), ``distance2`` (m^2) apart, propose together:
         centre their midpoint, radius half their distance clamped to the model's range."""
         return (a + b) * 0.5, min(max(0.5 * math.sqrt(distance2), self.radius_min), self.radius_max)
+
+    @cached_property
+    def opening_cost(self) -> float:
+        """The highest cost (m^2) at which a person of unknown facing counts towards opening an o-space: standing
+        within ``unknown_tolerance`` of its circle, widened by ``TIE`` as every comparison that decides a group."""
+        return (self.unknown_cost**2 + self.unknown_tolerance**2) * (1.0 + TIE)
 
     @cached_property
     def reach(self) -> float:
@@ -185,7 +195,7 @@ def _find_crowd(
 
     known = ~np.isnan(facing)
     owners = np.flatnonzero(known)
-    if len(owners) < 2:
+    if len(owners) < 1 or len(positions) < 2:
         return []
     f = np.where(known, facing, 0)
     w = np.where(known, weight, 0.0)
@@ -334,20 +344,22 @@ def _assign(cost: np.ndarray, near: np.ndarray, known: np.ndarray, model: OSpace
 
     Each pass opens every candidate with a positive saving that is the favourite (highest saving, then lowest
     index) of all the people it would serve, so candidates opened together serve nobody twice and the best one is
-    always among them; passes repeat until no candidate saves anything. Only known facings count towards opening,
-    and a candidate that would lower the cost of fewer than two of them saves nothing (its o-space would dissolve,
-    and it would keep its one person from a pair). Savings and costs within ``TIE`` (of the alone price) of each
-    other count as equal.
+    always among them; passes repeat until no candidate saves anything. Known facings count towards opening, and
+    unknown ones at most ``OSpaceModel.opening_cost``; a candidate that would lower the cost of fewer than two of
+    them, or of nobody with a known facing, saves nothing (its o-space would dissolve, and it would keep its one
+    person from a pair). Savings and costs within ``TIE`` (of the alone price) of each other count as equal.
     """
     count, tie = len(known), TIE * model.alone_price
     current = np.zeros(count) + model.alone_price
     opened = np.zeros(len(cost), dtype=bool)
-    opener = np.where(known[near], cost, np.inf)
+    known_near = known[near] & (near >= 0)
+    opener = np.where(known_near | (cost <= model.opening_cost), cost, np.inf)
     while True:
         gain = current[near] - opener
         gains = gain > tie
         saving = np.add.reduce(np.where(gains, gain, 0.0), axis=1) - model.price
-        saving[np.add.reduce(gains, axis=1) < 2] = -np.inf  # an o-space needs two known facings
+        # an o-space needs two members, one of them with a known facing
+        saving[(np.add.reduce(gains, axis=1) < 2) | ~(gains & known_near).any(axis=1)] = -np.inf
         if np.maximum.reduce(saving) <= tie:
             break
         candidate, column = np.nonzero(gain > tie)
@@ -376,16 +388,20 @@ def _first_per_person(person: np.ndarray, candidate: np.ndarray, key: np.ndarray
 
 def _canonical(choices: list[int], known: list[bool]) -> tuple[list[int], list[int]]:
     """Group labels 0, 1, ... per person (-1 alone), numbered in order of each group's lowest member index, from the
-    candidate each person chose; candidates chosen by fewer than two known facings dissolve. Also the candidate
-    behind each group. Plain Python: a pass over N small integers, cheaper than numpy's calls for a frame."""
+    candidate each person chose; candidates chosen by fewer than two people, or by nobody with a known facing,
+    dissolve. Also the candidate behind each group. Plain Python: a pass over N small integers, cheaper than numpy's
+    calls for a frame."""
     counts: dict[int, int] = {}
+    facing: set[int] = set()
     for c, k in zip(choices, known, strict=True):
-        if k and c >= 0:
+        if c >= 0:
             counts[c] = counts.get(c, 0) + 1
+            if k:
+                facing.add(c)
     number: dict[int, int] = {}
     labels = []
     for c in choices:
-        if c >= 0 and counts.get(c, 0) >= 2:
+        if c >= 0 and counts.get(c, 0) >= 2 and c in facing:
             labels.append(number.setdefault(c, len(number)))
         else:
             labels.append(-1)
@@ -454,7 +470,8 @@ _SLACK = 1e-9
 
 
 # A candidate o-space's row: (person, cost in m^2) of each person who may join it, ascending by person, and the
-# saving (m^2) of opening it while everyone is alone (-inf when it lowers the cost of fewer than two known facings),
+# saving (m^2) of opening it while everyone is alone (-inf when it lowers the cost of fewer than two of those who
+# count towards opening, or of nobody with a known facing: ``_assign``),
 # the first pass of every ``_assign_small`` call (a candidate's row does not change between rounds, so neither does
 # this).
 _Row = tuple[list[tuple[int, float]], float]
@@ -480,7 +497,7 @@ def _find_small(
         else:
             known.append(False)
             people.append((p.real, p.imag, 0.0, 0.0, 0.0, 1.0, 0.0))
-    if sum(known) < 2:
+    if sum(known) < 1 or len(known) < 2:
         return []
     if model.pair_reach > 0:
         owners, bound = [j for j, k in enumerate(known) if k], model.pair_reach_squared
@@ -542,14 +559,14 @@ class _SmallScene:
         reach2, sqrt = model.reach_squared, math.sqrt
         limit, tie = model.alone_price * (1.0 - TIE), model.alone_price * TIE
         twice_weight = 2.0 * model.angular_weight
-        unknown2, body2 = model.unknown_cost**2, model.body_radius**2
+        unknown2, body2, opening = model.unknown_cost**2, model.body_radius**2, model.opening_cost
         slack = 1.0 + _SLACK
         rows = []
         for centre, radius in candidates:
             cx, cy = centre.real, centre.imag
             turn_weight = twice_weight * radius
             entries = []
-            saving, gaining = 0.0, 0
+            saving, gaining, facing = 0.0, 0, False
             for j, px, py, fx, fy, w, cos_slack, sin_slack, nearest, known in self._table:
                 ox, oy = cx - px, cy - py  # from the person to the centre
                 length2 = ox * ox + oy * oy
@@ -569,10 +586,11 @@ class _SmallScene:
                 # Only someone nearer than sqrt(length2 + body2) can be in the way: most have no such neighbour.
                 if cost < limit and ((length2 + body2) * slack <= nearest or not self._blocked(j, cx, cy)):
                     entries.append((j, cost))
-                    if known and model.alone_price - cost > tie:
+                    if model.alone_price - cost > tie and (known or cost <= opening):
                         saving += model.alone_price - cost
                         gaining += 1
-            rows.append((entries, saving - model.price if gaining >= 2 else -math.inf))
+                        facing = facing or known
+            rows.append((entries, saving - model.price if gaining >= 2 and facing else -math.inf))
         return rows
 
     def _blocked(self, j: int, cx: float, cy: float) -> bool:
@@ -623,9 +641,7 @@ def _assign_small(rows: list[_Row], known: list[bool], model: OSpaceModel) -> li
     count, tie = len(known), TIE * model.alone_price
     current = [model.alone_price] * count
     opened = [False] * len(rows)
-    openers = [entries for entries, _ in rows]
-    if not all(known):
-        openers = [[(j, c) for j, c in entries if known[j]] for entries in openers]
+    openers = [[(j, c) for j, c in entries if known[j] or c <= model.opening_cost] for entries, _ in rows]
     savings = [saving for _, saving in rows]
     active = [k for k, saving in enumerate(savings) if saving > tie]
     while active:
@@ -656,12 +672,13 @@ def _assign_small(rows: list[_Row], known: list[bool], model: OSpaceModel) -> li
                         current[j] = c
         for k in active:
             # (Gains added in order, not by the builtin ``sum``: it rounds differently from Python 3.12 on.)
-            total, gaining = 0.0, 0
+            total, gaining, facing = 0.0, 0, False
             for j, c in openers[k]:
                 if c < current[j] - tie:
                     total += current[j] - c
                     gaining += 1
-            savings[k] = total - model.price if gaining >= 2 else -math.inf
+                    facing = facing or known[j]
+            savings[k] = total - model.price if gaining >= 2 and facing else -math.inf
         active = [k for k in active if savings[k] > tie]
     return _cheapest_opened([entries for entries, _ in rows], opened, count, tie)
 

@@ -276,6 +276,15 @@ def test_eval_fformation_adds_seeded_facing_noise(tmp_path, capsys):
     assert code == 2 and "facing noise" in err
 
 
+def test_eval_fformation_makes_a_seeded_share_of_the_facings_unknown(tmp_path, capsys):
+    tiny = write_sequence(tmp_path / "Tiny", tiny_frames(), {1: [[1, 2]], 2: [[1, 2, 3]]})
+    args = ["eval", "fformation", str(tiny), "--scale", "0.01", "--facing-missing"]
+    first, second = run_sid([*args, "0.5"], capsys), run_sid([*args, "0.5"], capsys)
+    assert first[0] == 0 and first[1] == second[1]
+    code, _, err = run_sid([*args, "2"], capsys)
+    assert code == 2 and "share of facings missing" in err
+
+
 def test_eval_fformation_reports_malformed_data(tmp_path, capsys):
     (tmp_path / "Bad").mkdir()
     (tmp_path / "Bad" / "features.mat").write_text("garbage")

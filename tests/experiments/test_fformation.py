@@ -30,6 +30,7 @@ from sid.experiments.fformation import (
     score,
     unit_warning,
     with_facing_noise,
+    without_facings,
 )
 from sid.perception.groups import GroupParams, detect_groups
 from tests.conftest import shared_path
@@ -312,6 +313,20 @@ def test_facing_noise_is_seeded_and_leaves_unknown_facings_unknown(tiny):
     assert [(a.id, a.x, a.y) for a, _ in pairs] == [(b.id, b.x, b.y) for _, b in pairs]
     with pytest.raises(ValueError, match="facing noise"):
         with_facing_noise(frames, -1.0)
+
+
+def test_missing_facings_are_seeded_and_touch_nothing_else(tiny):
+    frames = load_sequence(tiny, 0.01)
+    thinned, again = without_facings(frames, 0.5, seed=3), without_facings(frames, 0.5, seed=3)
+    assert [[p.theta for p in f.people] for f in thinned] == [[p.theta for p in f.people] for f in again]
+    pairs = [(a, b) for f, g in zip(frames, thinned, strict=True) for a, b in zip(f.people, g.people, strict=True)]
+    assert all(b.theta is None or b.theta == a.theta for a, b in pairs)
+    assert any(b.theta is None for _, b in pairs) and any(b.theta is not None for _, b in pairs)
+    assert [(a.id, a.x, a.y) for a, _ in pairs] == [(b.id, b.x, b.y) for _, b in pairs]
+    assert all(p.theta is None for f in without_facings(frames, 1.0) for p in f.people)
+    assert without_facings(frames, 0.0) == frames
+    with pytest.raises(ValueError, match="share of facings missing"):
+        without_facings(frames, 1.5)
 
 
 def test_one_candidate_per_cluster_is_the_papers_algorithm_and_fails_in_crowds():

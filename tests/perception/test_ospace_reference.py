@@ -128,12 +128,13 @@ def test_the_reference_refuses_someone_behind_a_person_standing_in_the_way() -> 
 
 
 def reference_labels(choices: list[int], known: list[bool]) -> list[int]:
-    """Group labels numbered by each group's lowest member, -1 alone; a candidate needs two known facings."""
+    """Group labels numbered by each group's lowest member, -1 alone; a candidate needs two members, one at least
+    with a known facing."""
     members: dict[int, list[int]] = {}
     for j, c in enumerate(choices):
         if c >= 0:
             members.setdefault(c, []).append(j)
-    kept = [c for c, js in members.items() if sum(known[j] for j in js) >= 2]
+    kept = [c for c, js in members.items() if len(js) >= 2 and any(known[j] for j in js)]
     order = sorted(kept, key=lambda c: members[c][0])
     label = {c: i for i, c in enumerate(order)}
     return [label.get(c, -1) for c in choices]
