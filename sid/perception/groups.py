@@ -425,8 +425,10 @@ _STEP_RESIDUAL = 1e-3  # rad: a difference of facings this close to a whole numb
 def facing_step(thetas: Sequence[float | None]) -> float:
     """The step (rad) to which the known facings among ``thetas`` (yaws, rad) are quantised: the coarsest of
     ``QUANTISED_STEPS`` of which every difference between two of them is a whole multiple, or 0 (continuous
-    facings, or fewer than two known). Differences, not the yaws themselves: turning the scene keeps the step."""
-    known = [t for t in thetas if t is not None]
+    facings, or fewer than two known). Differences, not the yaws themselves: turning the scene keeps the step. Each
+    yaw is first taken to [-pi, pi] (a whole turn is a multiple of every step), so that any finite yaw, 1e308 too,
+    gives a finite difference."""
+    known = [math.remainder(t, math.tau) for t in thetas if t is not None]
     if len(known) < 2:
         return 0.0
     reference = known[0]

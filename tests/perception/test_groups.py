@@ -24,6 +24,7 @@ from sid.perception.groups import (
     _shoelace,
     _spread,
     detect_groups,
+    facing_step,
 )
 from sid.perception.people import Person
 
@@ -355,6 +356,16 @@ def test_empty_and_single_person_give_no_group():
 def test_bad_people_are_rejected_naming_the_person(people, message, method):
     with pytest.raises(ValueError, match=message):
         detect_groups(people, GroupParams(method=method))
+
+
+@pytest.mark.parametrize("method", ["ospace", "gcff", "rays", "paper"])
+def test_any_finite_yaw_is_an_angle(method):
+    # 1e308 - (-1e308) overflowed in facing_step (OverflowError from round(inf)); whole turns change nothing.
+    huge = [Person(1, 0.0, 0.0, 1e308, 1.0), Person(2, 1.0, 0.0, -1e308, 1.0)]
+    detect_groups(huge, GroupParams(method=method))
+    turned = [Person(1, 0.0, 0.0, 4 * math.tau, 1.0), Person(2, 0.8, 0.0, math.pi - 3 * math.tau, 1.0)]
+    assert [g.members for g in detect_groups(turned, GroupParams(method=method))] == [(1, 2)]
+    assert facing_step([0.0, math.pi / 2 + 10 * math.tau, -math.pi - 7 * math.tau]) == pytest.approx(math.pi / 2)
 
 
 @pytest.mark.parametrize("method", ["ospace", "gcff", "rays", "paper"])
