@@ -6,6 +6,7 @@ to the sensor's yaw, counter-clockwise, as in ``sensor_msgs/LaserScan``.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -47,8 +48,10 @@ class LaserScan:
 
     @property
     def angles(self) -> np.ndarray:
-        """World-frame yaw of every beam (N,)."""
-        return self.pose[2] + self.angle_min + self.angle_increment * np.arange(len(self.ranges))
+        """World-frame yaw of every beam (N,). The pose's yaw is taken to [-pi, pi] first: added to a yaw of 1e308,
+        the beams' offsets would vanish and every beam point the same way."""
+        yaw = math.remainder(self.pose[2], math.tau)
+        return yaw + self.angle_min + self.angle_increment * np.arange(len(self.ranges))
 
     @property
     def directions(self) -> np.ndarray:
