@@ -10,7 +10,7 @@ import math
 import sys
 from pathlib import Path
 
-from sid.cli.common import fail
+from sid.cli.common import fail, whole_number
 from sid.cli.eval_crowd import add_crowd_parser
 from sid.cli.grouping import add_group_params, group_params_from
 from sid.distribution import MissingDependencyError
@@ -319,7 +319,7 @@ def add_tracking_parser(tasks: argparse._SubParsersAction) -> None:
     )  # fmt: skip
     parser.add_argument("--fps", type=float, default=defaults.fps, help=f"frame rate in Hz ({defaults.fps:g})")
     parser.add_argument("--frames", type=int, default=None, help="at most this many frames per sequence (all)")
-    parser.add_argument("--seed", type=int, default=defaults.seed, help=f"noise seed ({defaults.seed})")
+    parser.add_argument("--seed", type=whole_number(0), default=defaults.seed, help=f"noise seed ({defaults.seed})")
     parser.add_argument(
         "--flicker-frames", type=int, default=defaults.flicker_frames,
         help=f"frames of the flicker layout {defaults.flicker_layout} ({defaults.flicker_frames})",

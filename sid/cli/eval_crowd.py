@@ -14,7 +14,7 @@ import math
 import sys
 from typing import Any
 
-from sid.cli.common import fail, plain_text
+from sid.cli.common import fail, plain_text, whole_number
 from sid.distribution import MissingDependencyError
 from sid.experiments.crowd import DEFAULT_GRID, CrowdSettings, cross_validate, evaluate_crowd
 from sid.experiments.trajectories import ReplaySettings, TrajectoryError, TrajectorySet, load_trajectory_set
@@ -48,7 +48,9 @@ def add_crowd_parser(tasks: argparse._SubParsersAction) -> None:
         "--miss-rate", type=float, default=defaults.miss_rate, metavar="P",
         help=f"share of detections dropped (default {defaults.miss_rate})",
     )  # fmt: skip
-    parser.add_argument("--seed", type=int, default=defaults.seed, help=f"seed of noise and misses ({defaults.seed})")
+    parser.add_argument(
+        "--seed", type=whole_number(0), default=defaults.seed, help=f"seed of noise and misses ({defaults.seed})"
+    )
     parser.add_argument(
         "--view", type=_view_pose, default=None, metavar="X,Y,YAW",
         help="a robot standing at (X, Y) m in each set's frame, looking along YAW degrees: only the people in its "

@@ -18,6 +18,7 @@ from sid.cli.common import (
     plain_text,
     print_written,
     staged_output,
+    whole_number,
 )
 from sid.experiments.navigation import NAV_LAYOUTS, NavSettings, navigation_tasks, run_navigation
 from sid.experiments.progress import ProgressBar
@@ -85,7 +86,7 @@ def _add_table1(studies: argparse._SubParsersAction) -> None:
         "--variations", type=int, default=None, metavar="K",
         help=f"first K of the {len(VARIATIONS)} documented variations per layout (all)",
     )  # fmt: skip
-    p.add_argument("--seed", type=int, default=0, metavar="S", help="noise seed (0)")
+    p.add_argument("--seed", type=whole_number(0), default=0, metavar="S", help="noise seed (0)")
     p.add_argument("--scenarios", nargs="+", default=list(LAYOUTS), metavar="SN", help="layouts (S1 .. S5)")
     noise = p.add_argument_group("noise (defaults: a D435i on textured clothes, a good pose model)")
     noise_options = (  # flag, default, metavar, help with {:g} for the default

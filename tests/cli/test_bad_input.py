@@ -90,6 +90,16 @@ def test_seed_outside_what_ompl_takes_names_the_range(seed, tmp_path, capsys):
     assert "Traceback" not in err and not (tmp_path / "path.json").exists()
 
 
+@pytest.mark.parametrize("command", [["eval", "crowd", "DIR"], ["eval", "tracking"], ["reproduce", "table1"]])
+@pytest.mark.parametrize("seed", ["-1", "1.5", "abc"])
+def test_a_noise_seed_that_numpy_cannot_take_is_refused_naming_the_option(command, seed, capsys):
+    # numpy's generators take any whole number >= 0; -1 used to end in numpy's "expected non-negative integer".
+    with pytest.raises(SystemExit) as stop:
+        main([*command, "--seed", seed])
+    assert stop.value.code == 2
+    assert f"argument --seed: expected a whole number >= 0, got '{seed}'" in capsys.readouterr().err
+
+
 def test_the_planner_itself_refuses_a_seed_ompl_cannot_take():
     import sid
 
