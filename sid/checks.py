@@ -61,6 +61,8 @@ class Limits:
     image_pixels: pixels of a camera's image (its calibration's width x height; 33 177 600 is 8K UHD), which every
     frame is decoded at.
     sim_steps: steps of one ``sid simulate`` run, ``time_limit_s`` x ``rate_hz`` (each step's people are kept).
+    replay_frames: frames of one trajectory set replayed at a rate (``sid eval crowd --rate``): its time span x the
+    rate (each frame's tracks are kept); the public ETH/UCY sets at the largest rate, 1000 Hz, need up to 773 401.
     Raise one with ``SID_LIMITS="NAME=VALUE,..."`` (an environment variable the command line reads when it starts;
     ``use_limits`` from Python).
     """
@@ -73,6 +75,7 @@ class Limits:
     obstacle_points: int = 100_000
     scan_edges: int = 20_000_000
     sim_steps: int = 6_000
+    replay_frames: int = 1_000_000
     image_pixels: int = 33_177_600
 
 

@@ -32,17 +32,18 @@ from typing import Any
 
 import numpy as np
 
+from sid.checks import check_limit
 from sid.distribution import MissingDependencyError, install_hint
 from sid.experiments.fformation import format_threshold, frame_matches
 from sid.experiments.gmitre import LinkCounts, gmitre_counts
 from sid.experiments.synthetic_tracking import as_truth_ids, identify, mot_scores
-from sid.experiments.trajectories import ReplaySettings, TrajectorySet, replay
+from sid.experiments.trajectories import ReplaySettings, TrajectoryError, TrajectorySet, replay
 from sid.tracking.coherent import CoherentMotion, CoherentMotionParams
 from sid.tracking.groups import GroupTracker, GroupTrackerParams
 from sid.tracking.records import TrackedPerson
 from sid.tracking.session import TrackingParams, TrackingSession
 from sid.tracking.tracker import TrackerParams
-from sid.tracking.view import scene_view
+from sid.tracking.view import View, scene_view
 
 __all__ = [
     "CrowdSettings",
@@ -54,6 +55,7 @@ __all__ = [
     "find_coherent_groups",
     "find_groups",
     "record_tracks",
+    "replay_view",
     "require_motmetrics",
     "score_groups",
     "score_people",
@@ -114,7 +116,7 @@ def record_tracks(
     session = TrackingSession(settings.tracking)
     log = TrackLog(trajectories.name, [], [], [], [])
     total = _frame_count(trajectories, settings.replay)
-    view = settings.replay.view or scene_view(np.concatenate(trajectories.positions))
+    view = replay_view(trajectories, settings.replay)
     for k, frame in enumerate(replay(trajectories, settings.replay)):
         people = session.people.update(frame.detections, frame.timestamp, view)
         log.times.append(frame.timestamp)
@@ -123,7 +125,27 @@ def record_tracks(
         log.tracks.append([p for p in people if p.visible or p.in_view])
         if progress is not None:
             progress(k + 1, total, trajectories.name)
+    if not any(len(ids) for ids in log.truth_ids):
+        raise TrajectoryError(f"{trajectories.name}: nobody annotated is ever inside the view: nothing to score")
     return log
+
+
+def replay_view(trajectories: TrajectorySet, replay_settings: ReplaySettings) -> View:
+    """Where the detector looks in a replay of ``trajectories``: the settings' view, else the scene's (the convex
+    hull of every annotated position). TrajectoryError naming the set when the positions span no area (no scene to
+    draw) or the replay would take more frames than the ``replay_frames`` limit (a long gap in the annotations at
+    a high rate); ``evaluate_crowd`` and ``cross_validate`` check every set with it before any work."""
+    frames = _frame_count(trajectories, replay_settings)
+    if replay_settings.rate is not None:
+        span = float(trajectories.times[-1] - trajectories.times[0])
+        detail = f"{span:g} s at {replay_settings.rate:g} Hz = "
+        check_limit(f"{trajectories.name}: replay", frames, "replay_frames", "frames", detail)
+    if replay_settings.view is not None:
+        return replay_settings.view
+    try:
+        return scene_view(np.concatenate(trajectories.positions))
+    except ValueError as exc:
+        raise TrajectoryError(f"{trajectories.name}: {exc}; set the robot's view instead (--view)") from None
 
 
 def score_groups(
@@ -196,6 +218,8 @@ def evaluate_crowd(
     """Tracking and group scores of every set, sid's group tracker beside the coherent-motion reference."""
     require_motmetrics()
     settings = settings or CrowdSettings()
+    for trajectories in sets:  # every set's replay checked before the first runs
+        replay_view(trajectories, settings.replay)
     out: dict[str, Any] = {"settings": _settings_json(settings), "sets": {}}
     for trajectories in sets:
         log = record_tracks(trajectories, settings, progress)
@@ -221,6 +245,8 @@ def cross_validate(
     held-out set. Ties go to the first point in the grid's order."""
     require_motmetrics()
     settings = settings or CrowdSettings()
+    for trajectories in sets:  # every set's replay checked before the first runs
+        replay_view(trajectories, settings.replay)
     grid = grid if grid is not None else DEFAULT_GRID
     trackers = _points(settings.tracking.tracker, grid.get("tracker", {}))
     candidates = {

@@ -7,10 +7,12 @@ from pathlib import Path
 
 import pytest
 
+from sid.checks import LimitError
 from sid.experiments.crowd import CrowdSettings, cross_validate, evaluate_crowd
-from sid.experiments.trajectories import ReplaySettings, load_trajectory_set
+from sid.experiments.trajectories import ReplaySettings, TrajectoryError, load_trajectory_set
+from sid.tracking.view import ViewCone
 from tests.conftest import shared_path
-from tests.experiments.trajectory_files import pair_and_strangers
+from tests.experiments.trajectory_files import pair_and_strangers, write_set
 
 pytestmark = pytest.mark.skipif(importlib.util.find_spec("motmetrics") is None, reason="py-motmetrics not installed")
 
@@ -25,6 +27,23 @@ def test_a_clean_scene_is_tracked_and_grouped_without_mistakes(tmp_path: Path) -
     assert groups["gmitre"]["precision"] > 0.9 and groups["gmitre"]["recall"] > 0.9
     assert groups["groups_T2/3"]["precision"] == 1.0 and groups["groups_T2/3"]["true_groups"] == 40
     assert result["coherent_motion"]["groups_T2/3"]["precision"] == 1.0
+
+
+def test_a_replay_that_cannot_be_scored_or_would_not_end_is_refused_naming_the_set(tmp_path: Path) -> None:
+    scene = load_trajectory_set(pair_and_strangers(tmp_path / "scene", frames=5))
+    # A robot looking away from everyone: MOTA and IDF1 were NaN (invalid JSON from --json).
+    away = ReplaySettings(view=ViewCone(-5.0, 0.0, 3.14, 1.0))
+    with pytest.raises(TrajectoryError, match="scene: nobody annotated is ever inside the view"):
+        evaluate_crowd([scene], CrowdSettings(replay=away))
+    # Everyone on one line: no scene area to draw (the message used to name neither the set nor a way out).
+    line = load_trajectory_set(write_set(tmp_path / "line", [(k, p, p, 0, p, 0, 0, 0) for k in (0, 6) for p in (1, 2)]))
+    with pytest.raises(TrajectoryError, match=r"line: view: the positions span no area .*\(--view\)"):
+        evaluate_crowd([scene, line])
+    # A gap of 2^53 frames at 1 Hz: 3.6e15 empty frames, a hang; refused before the first set runs.
+    rows = [(k, p, p, 0, p * p, 0, 0, 0) for k in (0, 1, 2**53) for p in (1, 2, 3)]
+    gap = load_trajectory_set(write_set(tmp_path / "gap", rows))
+    with pytest.raises(LimitError, match="gap: replay: .* frames is more than the limit of 1,000,000 frames"):
+        evaluate_crowd([scene, gap], CrowdSettings(replay=ReplaySettings(rate=1.0)))
 
 
 def test_cross_validation_reports_each_held_out_set(tmp_path: Path) -> None:
