@@ -559,10 +559,7 @@ def load_settings_gc(folder: str | Path, base: GCFFParams | None = None) -> GCFF
     data = _load_mat(path, ("stride", "mdl"))
     values = {}
     for name in ("stride", "mdl"):
-        try:
-            array = np.asarray(data[name], dtype=float)
-        except (TypeError, ValueError):
-            raise ValueError(f"fformation: {path}: {name} must be a number") from None
+        array = _real(data[name], f"{path}: {name} must be a number")
         if array.size != 1 or not math.isfinite(float(array.ravel()[0])):
             raise ValueError(f"fformation: {path}: {name} must be one finite number, got {array.ravel()[:4]}")
         values[name] = float(array.ravel()[0])
@@ -598,11 +595,20 @@ def _cells(value: np.ndarray, path: Path, name: str) -> list:
     return list(value.ravel())
 
 
-def _numbers(value: np.ndarray, path: Path, name: str) -> np.ndarray:
+def _real(value: object, problem: str) -> np.ndarray:
+    """``value`` as a float array; ValueError ``fformation: PROBLEM`` unless it holds real numbers (complex ones
+    too, whose imaginary part numpy would drop with only a ComplexWarning)."""
     try:
-        numbers = np.asarray(value, dtype=float).ravel()
+        array = np.asarray(value)
+        if np.iscomplexobj(array):
+            raise ValueError("complex")
+        return np.asarray(array, dtype=float)
     except (TypeError, ValueError):
-        raise ValueError(f"fformation: {path}: {name} must be numeric") from None
+        raise ValueError(f"fformation: {problem}") from None
+
+
+def _numbers(value: np.ndarray, path: Path, name: str) -> np.ndarray:
+    numbers = _real(value, f"{path}: {name} must be real numbers").ravel()
     if not np.all(np.isfinite(numbers)):
         raise ValueError(f"fformation: {path}: {name} holds non-finite values")
     return numbers
@@ -610,10 +616,7 @@ def _numbers(value: np.ndarray, path: Path, name: str) -> np.ndarray:
 
 def _people(cell: np.ndarray, scale: float, degrees: bool, where: str) -> tuple[list[Person], int]:
     """The people of a features cell, and how many rows were left out for a non-finite position."""
-    try:
-        rows = np.asarray(cell, dtype=float)
-    except (TypeError, ValueError):
-        raise ValueError(f"fformation: {where}: features must be a numeric N x 4 array") from None
+    rows = _real(cell, f"{where}: features must be a real N x 4 array")
     if rows.size == 0:
         return [], 0
     if rows.ndim != 2 or rows.shape[1] < 4:
@@ -640,12 +643,16 @@ def _people(cell: np.ndarray, scale: float, degrees: bool, where: str) -> tuple[
             f"fformation: {where}: theta reaches {reach:g}, beyond two turns: not radians; for a file in degrees "
             "load it with degrees=True (sid eval fformation --degrees, or without --radians)"
         )
+    with np.errstate(over="ignore"):
+        xy = rows[:, 1:3] * scale
+    overflow = ~np.isfinite(xy).all(axis=1)
+    if overflow.any():
+        x, y = rows[overflow][0, 1:3].tolist()
+        raise ValueError(f"fformation: {where}: position ({x:g}, {y:g}) scaled by {scale:g} overflows to infinity")
     # An annotated facing is taken at full quality (1), a missing one is unknown (None, quality 0).
     people = [
-        Person(int(i), x * scale, y * scale, *((theta, 1.0) if math.isfinite(theta) else (None, 0.0)))
-        for i, x, y, theta in zip(
-            rows[:, 0].tolist(), rows[:, 1].tolist(), rows[:, 2].tolist(), yaw.tolist(), strict=True
-        )
+        Person(int(i), x, y, *((theta, 1.0) if math.isfinite(theta) else (None, 0.0)))
+        for i, x, y, theta in zip(rows[:, 0].tolist(), xy[:, 0].tolist(), xy[:, 1].tolist(), yaw.tolist(), strict=True)
     ]
     return people, unplaced
 
@@ -655,10 +662,7 @@ def _groups(cell: object, where: str) -> list[frozenset[int]]:
     one group per row (equal sizes), or empty."""
     if isinstance(cell, np.ndarray) and cell.dtype == object:
         return [g for item in cell.ravel() for g in _groups(item, where)]
-    try:
-        ids = np.asarray(cell, dtype=float)
-    except (TypeError, ValueError):
-        raise ValueError(f"fformation: {where}: a group must list numeric ids") from None
+    ids = _real(cell, f"{where}: a group must list real ids")
     if ids.size == 0:
         return []
     if not np.all(np.isfinite(ids)) or not np.array_equal(ids, np.round(ids)):

@@ -269,6 +269,22 @@ def test_people_without_a_finite_position_are_left_out_and_counted(tmp_path):
         load_sequence(write_sequence(tmp_path / "BadId", [bad_id], {1: [[1, 2]]}))
 
 
+def test_complex_numbers_and_scales_that_overflow_are_refused_naming_the_frame(tmp_path, recwarn):
+    # numpy dropped the imaginary part with only a ComplexWarning: x = 100j was read as 0.
+    imaginary = tiny_frames()[0].astype(complex)
+    imaginary[1, 1] = 100j
+    with pytest.raises(ValueError, match="Complex/features.mat frame at timestamp 1: features must be a real N x 4"):
+        load_sequence(write_sequence(tmp_path / "Complex", [imaginary], {1: [[1, 2]]}))
+    folder = write_sequence(tmp_path / "Tiny", tiny_frames(), {1: [[1, 2]]})
+    scipy.io.savemat(folder / "groundtruth.mat", {"GTgroups": cells([np.array([[1, 2j]])]), "GTtimestamp": [[1]]})
+    with pytest.raises(ValueError, match="groundtruth.mat at timestamp 1: a group must list real ids"):
+        load_sequence(folder)
+    # 100 cm x 1e308 is infinity: the group detector's "non-finite position" named no file, after a numpy warning.
+    with pytest.raises(ValueError, match=r"timestamp 1: position \(100, 0\) scaled by 1e\+308 overflows to infinity"):
+        load_sequence(write_sequence(tmp_path / "Far", tiny_frames(), {1: [[1, 2]]}), scale=1e308)
+    assert not [w for w in recwarn if issubclass(w.category, (RuntimeWarning, np.exceptions.ComplexWarning))]
+
+
 def test_missing_members_counts_truth_ids_absent_from_their_frame(tiny):
     frames = load_dataset(tiny, 0.01)
     assert missing_members(frames) == (0, 7)
