@@ -380,14 +380,17 @@ class Terminated(KeyboardInterrupt):
 
 
 def _terminate(signum: int, frame: object) -> None:
+    # The run is stopping: a second SIGTERM (timeout(1) sends one to the process and one to its group) is ignored,
+    # not raised inside the clean-up of the first or the "interrupted" line (a traceback).
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
     raise Terminated()
 
 
 @contextmanager
 def signals_as_interrupts() -> Iterator[None]:
     """While a command runs, SIGTERM raises ``Terminated`` (a KeyboardInterrupt), as SIGINT raises
-    KeyboardInterrupt; the previous handler comes back afterwards. Only the main thread can install handlers: in
-    another one (a command run from a worker thread) this does nothing."""
+    KeyboardInterrupt, once: later SIGTERMs are ignored; the previous handler comes back afterwards. Only the main
+    thread can install handlers: in another one (a command run from a worker thread) this does nothing."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return

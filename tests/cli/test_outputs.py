@@ -17,7 +17,15 @@ import cv2
 import pytest
 
 from sid.cli import main
-from sid.cli.common import LOCK_NAME, OutputFolderInUse, clear_owned, output_folder_lock, staged_output
+from sid.cli.common import (
+    LOCK_NAME,
+    OutputFolderInUse,
+    Terminated,
+    clear_owned,
+    output_folder_lock,
+    signals_as_interrupts,
+    staged_output,
+)
 from sid.documents import TEMPORARY_PREFIX
 from tests.conftest import REPO_ROOT
 
@@ -230,3 +238,19 @@ def test_a_frame_whose_picture_cannot_be_written_gets_no_line(tmp_path):
     assert stdout == b""
     assert sorted(p.name for p in out.iterdir()) == ["detections.jsonl"]
     assert (out / "detections.jsonl").read_bytes() == b""
+
+
+def test_a_second_sigterm_does_not_interrupt_the_first_ones_clean_up():
+    # `timeout 60 sid ...` sends SIGTERM to sid and then to its process group: the second one used to be raised
+    # inside main's "interrupted" line, a traceback instead of exit 143.
+    previous = signal.getsignal(signal.SIGTERM)
+    with signals_as_interrupts():
+        with pytest.raises(Terminated):
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(5)  # the handler raises at the next bytecode
+        try:
+            os.kill(os.getpid(), signal.SIGTERM)  # ignored: no second Terminated
+            time.sleep(0.1)
+        except Terminated:
+            pytest.fail("the second SIGTERM was raised too")
+    assert signal.getsignal(signal.SIGTERM) == previous
