@@ -100,6 +100,16 @@ def test_a_noise_seed_that_numpy_cannot_take_is_refused_naming_the_option(comman
     assert f"argument --seed: expected a whole number >= 0, got '{seed}'" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("still", ["nan", "-1", "inf", "x"])
+def test_a_still_time_that_is_not_a_time_is_refused(still, tmp_path, capsys):
+    # --still nan used to pass silently: run.png showed the first step.
+    with pytest.raises(SystemExit) as stop:
+        main(["simulate", "pair", "--out", str(tmp_path), "--still", still])
+    assert stop.value.code == 2
+    assert f"argument --still: expected a finite number of seconds >= 0, got '{still}'" in capsys.readouterr().err
+    assert not list(tmp_path.iterdir())
+
+
 def test_the_planner_itself_refuses_a_seed_ompl_cannot_take():
     import sid
 
