@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sid.checks import check_number
+from sid.checks import MAX_COORDINATE, check_number
 from sid.documents import special_file
 from sid.errors import SidError
 from sid.perception.people import Person
@@ -189,6 +189,11 @@ def _read_obsmat(path: Path) -> np.ndarray:
             raise TrajectoryError(f"{path}:{number}: a value is not finite")
         if any(v != int(v) or abs(v) > _LARGEST_ID for v in values[:2]):
             raise TrajectoryError(f"{path}:{number}: frame and pedestrian id must be whole numbers up to 2^53")
+        if max(abs(values[2]), abs(values[4])) > MAX_COORDINATE:  # x and y, as the tracker bounds them
+            raise TrajectoryError(
+                f"{path}:{number}: position ({values[2]:g}, {values[4]:g}) is farther than {MAX_COORDINATE:g} m from "
+                "the origin along x or y"
+            )
         rows.append(values)
     if not rows:
         raise TrajectoryError(f"{path}: no annotations")
