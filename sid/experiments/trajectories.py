@@ -236,14 +236,15 @@ _LARGEST_ID = 2**53  # frame numbers and ids are read as floats: whole numbers b
 
 
 def _lines(path: Path) -> Iterator[tuple[int, str]]:
-    """(line number, line) for the non-blank lines of a UTF-8 text file; TrajectoryError naming a line that is not."""
+    """(line number, line) for the non-blank lines of a UTF-8 text file (a byte-order mark first is dropped, as
+    ``sid.documents.load_document`` drops it); TrajectoryError naming a line that is not."""
     special = special_file(path)
     if special:
         raise TrajectoryError(f"{path}: cannot read it: {special}")
     with path.open("rb") as handle:
         for number, raw in enumerate(handle, 1):
             try:
-                line = raw.decode("utf-8")
+                line = raw.decode("utf-8-sig" if number == 1 else "utf-8")  # a byte-order mark first, as Notepad
             except UnicodeDecodeError:
                 raise TrajectoryError(f"{path}:{number}: not UTF-8 text") from None
             if line.strip():

@@ -103,6 +103,14 @@ def test_a_missing_file_or_bytes_that_are_not_text_are_refused(tmp_path: Path) -
         load_trajectory_set(tmp_path)
 
 
+def test_a_byte_order_mark_before_the_first_line_is_dropped(tmp_path: Path) -> None:
+    # An editor's BOM was refused as "not numbers: '\\ufeff0 1 ...'".
+    (tmp_path / "obsmat.txt").write_text("\ufeff0 1 0 0 0 0 0 0\n6 1 0.5 0 0 0 0 0\n", encoding="utf-8")
+    (tmp_path / "groups.txt").write_text("\ufeff1 2\n", encoding="utf-8")
+    trajectories = load_trajectory_set(tmp_path)
+    assert trajectories.people == 1 and len(trajectories.times) == 2
+
+
 def test_replay_is_seeded_noisy_and_drops_detections_at_the_miss_rate(tmp_path: Path) -> None:
     trajectories = load_trajectory_set(write_set(tmp_path / "s", _walkers(frames=200)))
     settings = ReplaySettings(noise=0.1, miss_rate=0.2, seed=4)
