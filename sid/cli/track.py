@@ -52,7 +52,7 @@ def process(
     lines: Iterable[str | bytes], out: TextIO, err: TextIO, session: TrackingSession, strict: bool = False
 ) -> int:
     """Track ``lines`` (text, or bytes decoded line by line) into ``session``, writing one JSON line per good line on
-    ``out`` and each problem on ``err``; the exit code (1 when ``strict`` stopped at a bad line)."""
+    ``out`` and each problem on ``err``; the exit code (2 when ``strict`` stopped at a bad line)."""
     return process_json_lines("sid track", lines, out, err, lambda data: _track_line(data, session), strict=strict)
 
 
