@@ -34,6 +34,7 @@ from sid.scenario.obstacles import BoxObstacle, CircleObstacle, Obstacle
 __all__ = [
     "JITTER_THETA_RAD",
     "JITTER_XY_M",
+    "RATE_HZ",
     "SIM_FIELDS",
     "SimSettings",
     "SimWorld",
@@ -46,6 +47,9 @@ __all__ = [
 
 JITTER_XY_M = 0.05
 JITTER_THETA_RAD = math.radians(5.0)
+RATE_HZ = (0.1, 1000.0)
+"""The range of ``simulation.rate_hz`` (Hz): steps per second and run.mp4's frame rate, which OpenCV's mp4v writer
+cannot open at 1e-3 or 1e5 frames per second."""
 SIM_FIELDS = ("max_speed", "max_turn_rate", "max_accel", "time_limit_s", "rate_hz", "goal_tolerance_m", "description")
 
 
@@ -108,6 +112,9 @@ def _settings(data: Any) -> SimSettings:
     for key, value in data.items():
         if key != "description" and (not is_number(value) or value <= 0):
             raise _fail(f"simulation.{key}", "a positive number", value)
+    rate = data.get("rate_hz", SimSettings.rate_hz)
+    if not RATE_HZ[0] <= rate <= RATE_HZ[1]:  # also run.mp4's frame rate: OpenCV's mp4v writer fails outside
+        raise _fail("simulation.rate_hz", f"a number of Hz in [{RATE_HZ[0]:g}, {RATE_HZ[1]:g}]", rate)
     description = data.get("description", "")
     if not isinstance(description, str):
         raise _fail("simulation.description", "a string", description)

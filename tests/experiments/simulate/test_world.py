@@ -22,6 +22,8 @@ def test_the_simulation_block_sets_the_limits_and_the_robot_radius_comes_from_th
         ({"max_sped": 1.0}, "simulation.max_sped: unknown field"),
         ({"time_limit_s": 0}, "simulation.time_limit_s: expected a positive number"),
         ({"description": 3}, "simulation.description: expected a string"),
+        ({"rate_hz": 1e-300}, r"simulation.rate_hz: expected a number of Hz in \[0.1, 1000\], got 1e-300"),
+        ({"rate_hz": 1e5, "time_limit_s": 0.01}, r"simulation.rate_hz: expected a number of Hz in \[0.1, 1000\]"),
     ],
 )
 def test_a_bad_simulation_block_is_named(simulation, message):
