@@ -67,6 +67,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sid.checks import check_limit, check_number, check_whole
+from sid.perception.ospace import MAX_LENGTH
 
 __all__ = ["GCFF_ORDERS", "GCFFParams", "gcff_labels"]
 
@@ -113,8 +114,9 @@ class GCFFParams:
     order: str = "best"
 
     def __post_init__(self) -> None:
-        check_number("gcff", "stride", self.stride, low=0, unit="metres")
-        check_number("gcff", "mdl", self.mdl, low=0, low_open=True, unit="square metres")
+        # Bounded as the o-space lengths are: squared and summed downstream, 1e308 overflowed to garbage groups.
+        check_number("gcff", "stride", self.stride, low=0, high=MAX_LENGTH, unit="metres")
+        check_number("gcff", "mdl", self.mdl, low=0, low_open=True, high=MAX_LENGTH**2, unit="square metres")
         check_number("gcff", "visibility_cosine", self.visibility_cosine, low=-1, high=1)
         check_number("gcff", "visibility_base", self.visibility_base, low=1)
         check_number("gcff", "visibility_unit", self.visibility_unit, low=0, unit="square metres")

@@ -252,10 +252,12 @@ def test_too_many_people_is_a_limit_error():
 @pytest.mark.parametrize(
     ("field", "value", "message"),
     [
-        ("stride", -0.1, "stride must be a finite number of metres >= 0"),
+        ("stride", -0.1, r"stride must be a finite number of metres in \[0, 1000\], got -0.1"),
         ("stride", math.nan, "stride must be"),
-        ("mdl", 0.0, "mdl must be a positive number of square metres"),
+        ("stride", 1e200, r"stride must be a finite number of metres in \[0, 1000\], got 1e\+200"),
+        ("mdl", 0.0, r"mdl must be a finite number of square metres in \(0, 1e\+06\], got 0.0"),
         ("mdl", math.inf, "mdl must be"),
+        ("mdl", 1e308, r"mdl must be a finite number of square metres in \(0, 1e\+06\]"),
         ("visibility_cosine", 1.5, "visibility_cosine must be a finite number in"),
         ("visibility_base", 0.5, "visibility_base must be a finite number >= 1"),
         ("visibility_unit", -1e-4, "visibility_unit must be"),
@@ -287,8 +289,9 @@ def test_settings_are_read_in_metres(tmp_path):
         ({"stride": 45}, r"lacks the variable\(s\) \['mdl'\]"),
         ({"stride": [[45, 50]], "mdl": 30000}, "stride must be one finite number"),
         ({"stride": 45, "mdl": np.nan}, "mdl must be one finite number"),
-        ({"stride": 45, "mdl": 0}, "mdl must be a positive number"),
-        ({"stride": -5, "mdl": 30000}, "stride must be a finite number of metres >= 0"),
+        ({"stride": 45, "mdl": 0}, r"mdl must be a finite number of square metres in \(0, 1e\+06\]"),
+        ({"stride": -5, "mdl": 30000}, r"stride must be a finite number of metres in \[0, 1000\]"),
+        ({"stride": 1e308, "mdl": 1e308}, r"stride must be a finite number of metres in \[0, 1000\], got 1e\+306"),
         ({"stride": "abc", "mdl": 30000}, "stride must be a number"),
     ],
 )
