@@ -201,10 +201,21 @@ def run_matrix(
     progress: MatrixProgress | None = None,
 ) -> list[Run]:
     """Every planner (grid: once, it is deterministic; the others with OMPL seeds 1..``runs``) for every time limit
-    and task, in each mode, with cost ratios to the grid reference."""
+    and task, in each mode, with cost ratios to the grid reference. The runs are told apart by scenario name and
+    planner: a planner given twice, or two tasks whose scenarios share a name, are refused (ValueError), since their
+    runs would be pooled into one row."""
     names = [resolve_planner(p) for p in planners]
     if runs < 1:
         raise ValueError(f"runs must be at least 1, got {runs}")
+    if len(set(names)) < len(names):
+        twice = next(n for n in names if names.count(n) > 1)
+        raise ValueError(f"planner {twice} is given twice: its runs would be counted twice")
+    scenarios = [task.scenario.name for task in tasks]
+    if len(set(scenarios)) < len(scenarios):
+        twice = next(n for n in scenarios if scenarios.count(n) > 1)
+        raise ValueError(
+            f"two scenarios are named {twice!r}: their runs would be pooled into one row; give each its own 'name'"
+        )
     jobs = [
         (task, limit, name, seed)
         for task in tasks

@@ -56,6 +56,16 @@ def test_run_matrix_plans_grid_once_and_counts_progress(task):
         run_matrix([task], ["grid"], runs=0)
 
 
+def test_runs_that_would_be_pooled_into_one_row_are_refused(task):
+    # Two scenarios of one name (or one planner given twice) were summed into one row of sid compare's table.
+    other = copy.deepcopy(DEMO_SCENARIO)
+    other["robot"]["goal"] = [1.0, 0.0, 0.0]
+    with pytest.raises(ValueError, match=f"two scenarios are named {task.scenario.name!r}"):
+        run_matrix([task, prepare(scenario_from_dict(other))], ["grid"])
+    with pytest.raises(ValueError, match="planner grid is given twice"):
+        run_matrix([task], ["grid", "grid"])
+
+
 def test_an_impossible_task_is_named():
     data = copy.deepcopy(DEMO_SCENARIO)
     data["name"], data["robot"]["goal"] = "walled in", [5.0, -2.9, 0.0]  # the goal is in the wall
