@@ -162,8 +162,10 @@ class NavSettings:
     def __post_init__(self) -> None:
         if not self.planners:
             raise ValueError("navigation: give at least one planner")
-        for name in self.planners:
-            resolve_planner(name)  # raises ValueError naming the unknown planner
+        names = [resolve_planner(name) for name in self.planners]  # raises ValueError naming an unknown planner
+        if len(set(names)) < len(names):  # as run_matrix: its plans would be counted twice in the report
+            twice = next(n for n in names if names.count(n) > 1)
+            raise ValueError(f"navigation: planner {twice} is given twice: its runs would be counted twice")
         check_number("navigation", "time limit", self.time_limit, low=0, low_open=True, unit="seconds")
         if self.max_iterations is not None and self.max_iterations < 1:
             raise ValueError(f"navigation: iteration cap must be >= 1, got {self.max_iterations}")

@@ -179,6 +179,8 @@ def test_navigation_family_covers_sizes_and_finds_every_group():
 def test_navigation_bad_settings_are_refused(capsys):
     with pytest.raises(ValueError, match="planner"):
         NavSettings(planners=("teleport",))
+    with pytest.raises(ValueError, match="planner grid is given twice"):
+        NavSettings(planners=("grid", "bitstar", "grid"))
     with pytest.raises(ValueError, match="time limit"):
         NavSettings(time_limit=0.0)
     with pytest.raises(ValueError, match="seeds"):
