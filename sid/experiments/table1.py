@@ -95,6 +95,9 @@ class Table1Settings:
         unknown = [s for s in self.scenarios if s.upper() not in LAYOUTS]
         if unknown or not self.scenarios:
             raise ValueError(f"table1: unknown scenario(s) {unknown or '(none given)'}; known: {', '.join(LAYOUTS)}")
+        names = [s.upper() for s in self.scenarios]
+        if len(set(names)) < len(names):  # its frames would be pooled twice into the one row
+            raise ValueError(f"table1: scenario {next(n for n in names if names.count(n) > 1)} is given twice")
         check_whole("table1", "frames", self.frames, low=1)
         if not 1 <= self.variations <= len(VARIATIONS):
             raise ValueError(f"table1: variations must be 1..{len(VARIATIONS)}, got {self.variations}")

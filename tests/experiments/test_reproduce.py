@@ -96,6 +96,8 @@ def test_table1_bad_settings_are_refused(tmp_path, capsys):
     )
     with pytest.raises(ValueError, match="frames"):
         Table1Settings(frames=0)
+    with pytest.raises(ValueError, match="table1: scenario S1 is given twice"):  # its frames were pooled twice
+        Table1Settings(scenarios=("S1", "S2", "s1"))
     with pytest.raises(ValueError, match="variations"):
         Table1Settings(variations=8)
     with pytest.raises(ValueError, match="noise"):

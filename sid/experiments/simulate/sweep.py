@@ -53,6 +53,8 @@ def sweep_jobs(scenes: Sequence[str], seeds: int, options: RunOptions | None = N
     check_whole("sweep", "seeds", seeds, low=1)
     for scene in scenes:
         load_scene(scene)  # a bad scene fails here, before any run
+    if len(set(scenes)) < len(scenes):  # the summary would count its runs twice
+        raise ValueError(f"sweep: scene {next(s for s in scenes if list(scenes).count(s) > 1)} is given twice")
     return [
         Job(scene, replace(options, social=social, seed=seed))
         for scene in scenes

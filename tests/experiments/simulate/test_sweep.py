@@ -34,6 +34,8 @@ def test_jobs_cover_scenes_modes_and_seeds(scene):
         sweep_jobs([scene], 0)
     with pytest.raises(ValueError, match="built-in scene"):
         sweep_jobs(["nowhere"], 1)
+    with pytest.raises(ValueError, match="sweep: scene pair is given twice"):  # its runs were counted twice
+        sweep_jobs(["pair", scene, "pair"], 1)
 
 
 def test_workers_give_the_same_runs_as_one_process(scene, tmp_path):
