@@ -101,6 +101,9 @@ class TrackingEvalSettings:
         unknown = [name for name in self.sequences if name not in SEQUENCES]
         if unknown or not self.sequences:
             raise ValueError(f"tracking evaluation: unknown sequences {unknown}; known: {', '.join(SEQUENCES)}")
+        if len(set(self.sequences)) < len(self.sequences):  # "overall" would count its frames twice
+            twice = next(n for n in self.sequences if self.sequences.count(n) > 1)
+            raise ValueError(f"tracking evaluation: sequence {twice} is given twice")
 
 
 @dataclass

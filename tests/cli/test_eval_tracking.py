@@ -31,7 +31,12 @@ def test_json_by_default(capsys: pytest.CaptureFixture[str]) -> None:
 
 @pytest.mark.parametrize(
     ("option", "message"),
-    [(["--fps", "0"], "fps must be a positive number"), (["--frames", "0"], "frames must be a whole number >= 1")],
+    [
+        (["--fps", "0"], "fps must be a positive number"),
+        (["--frames", "0"], "frames must be a whole number >= 1"),
+        # "overall" counted a repeated sequence's frames twice
+        (["--sequences", "walking_pairs", "walking_pairs"], "sequence walking_pairs is given twice"),
+    ],
 )
 def test_bad_settings_are_refused(option: list[str], message: str, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["eval", "tracking", *option]) == 2
