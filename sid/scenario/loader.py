@@ -451,7 +451,8 @@ def _check_scan(grid: GridSpec, lidar: LidarSpec, layers: CostmapParams, edges: 
     _limit("lidar.beams", lidar.beams, "lidar_beams", "beams")
     _limit("lidar", lidar.beams * edges, "scan_edges", "ray tests", f"{lidar.beams} beams x {amount(edges)} edges = ")
     longest = max([lidar.range_max] + [layers.layer_params(n).raytrace_max_range for n in layers.named("lidar")])
-    cells = math.ceil(longest / grid.resolution)
+    ratio = longest / grid.resolution  # infinite for a range near the largest float: refused by the limit below
+    cells = math.ceil(ratio) if math.isfinite(ratio) else math.inf
     detail = f"{lidar.beams} beams x {amount(cells)} cells of range ({longest:g} m at {grid.resolution:g} m) = "
     _limit("lidar", lidar.beams * cells, "scan_cells", "beam cells", detail)
 

@@ -28,6 +28,20 @@ def test_people_limit_counts_before_parsing_them():
         load_scenario(REPO_ROOT / "examples" / "conversation.json")
 
 
+@pytest.mark.parametrize("field", ["lidar.range_max", "layers.obstacle.raytrace_max_range"])
+def test_a_range_near_the_largest_float_is_refused_by_the_scan_limit(tmp_path, field):
+    # 1.7e308 m / 0.05 m is infinite: math.ceil raised OverflowError, a traceback instead of the limit's message.
+    data = json.loads((REPO_ROOT / "examples" / "conversation.json").read_text())
+    section, *rest = field.split(".")
+    node = data.setdefault(section, {})
+    for key in rest[:-1]:
+        node = node.setdefault(key, {})
+    node[rest[-1]] = 1.7e308
+    (tmp_path / "s.json").write_text(json.dumps(data))
+    with pytest.raises(ScenarioError, match=r"720 beams x inf cells of range \(1.7e\+308 m at 0.05 m\).*scan_cells"):
+        load_scenario(tmp_path / "s.json")
+
+
 def _with_static_map(tmp_path, resolution: float) -> str:
     (tmp_path / "room.pgm").write_bytes(b"P5\n20 16\n255\n" + bytes([254] * 320))
     (tmp_path / "room.yaml").write_text(
