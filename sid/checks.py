@@ -115,6 +115,8 @@ def limits_from_environment() -> Limits:
         name, _, value = (part.strip() for part in item.partition("="))
         if name not in names:
             raise ValueError(f"${LIMITS_ENV}: unknown limit {name!r} in {text!r}; known limits: {', '.join(names)}")
+        if name in values:  # as a key given twice in a file: which one was meant?
+            raise ValueError(f"${LIMITS_ENV}: {name} is given twice in {text!r}")
         try:
             number = float(value)
         except ValueError:

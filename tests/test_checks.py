@@ -89,7 +89,12 @@ def test_sid_limits_raises_a_limit_where_an_entry_point_puts_it_in_force(monkeyp
 
 @pytest.mark.parametrize(
     ("text", "message"),
-    [("peple=5", "unknown limit 'peple'"), ("people=0", "people must be a whole number >= 1"), ("people=1.5", "whole")],
+    [
+        ("peple=5", "unknown limit 'peple'"),
+        ("people=0", "people must be a whole number >= 1"),
+        ("people=1.5", "whole"),
+        ("people=5,people=6", "people is given twice"),  # the last one silently won
+    ],
 )
 def test_a_malformed_sid_limits_is_named(monkeypatch, text, message):
     from sid.checks import limits_from_environment
