@@ -638,6 +638,11 @@ def _people(cell: np.ndarray, scale: float, degrees: bool, where: str) -> tuple[
     rows = rows[placed]
     yaw = np.radians(rows[:, 3]) if degrees else rows[:, 3]
     reach = float(np.abs(yaw[np.isfinite(yaw)]).max(initial=0.0))
+    if reach > YAW_LIMIT_RAD and degrees:  # read as degrees already: no unit makes it an angle
+        raise ValueError(
+            f"fformation: {where}: theta reaches {math.degrees(reach):g} degrees, beyond two turns (720): neither "
+            "radians nor degrees"
+        )
     if reach > YAW_LIMIT_RAD:
         raise YawUnitError(
             f"fformation: {where}: theta reaches {reach:g}, beyond two turns: not radians; for a file in degrees "

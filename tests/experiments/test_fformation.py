@@ -226,6 +226,12 @@ def test_yaws_in_degrees_are_refused_as_radians_and_read_with_degrees(tmp_path):
     )
     with pytest.raises(YawUnitError):
         load_dataset_any_yaw(folder, 0.01, degrees=False)
+    # Beyond two turns in degrees too: the message used to ask for degrees=True, which was given.
+    spun = [np.column_stack([f[:, :3], f[:, 3] * 1e4]) for f in in_degrees]
+    write_sequence(folder, spun, {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]})
+    for degrees in (True, None):
+        with pytest.raises(ValueError, match=r"theta reaches 1.8e\+06 degrees, .*: neither radians nor degrees"):
+            load_dataset_any_yaw(folder, 0.01, degrees=degrees)
 
 
 def test_ground_truth_encodings_and_single_precision_timestamps(tmp_path):
