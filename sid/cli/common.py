@@ -10,6 +10,7 @@ import fcntl
 import fnmatch
 import itertools
 import json
+import math
 import os
 import shutil
 import signal
@@ -160,6 +161,18 @@ def whole_number(low: int) -> Callable[[str], int]:
 
 positive_int = whole_number(1)
 """argparse type: a whole number >= 1."""
+
+
+def positive_seconds(text: str) -> float:
+    """argparse type of a time budget: a positive finite number of seconds (refused before any output: a budget of
+    nan was printed in the first progress line before the planner refused it)."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"expected a positive number of seconds, got {text!r}")
+    return value
 
 
 def fail(command: str, error: Exception) -> int:

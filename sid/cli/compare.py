@@ -7,7 +7,15 @@ import argparse
 
 from planner.facade import PLANNERS
 from planner.problem import DEFAULT_COST_WEIGHT
-from sid.cli.common import add_output_option, check_output_folder, fail, plain_text, print_written, staged_output
+from sid.cli.common import (
+    add_output_option,
+    check_output_folder,
+    fail,
+    plain_text,
+    positive_seconds,
+    print_written,
+    staged_output,
+)
 from sid.cli.planning import INPUT_ERRORS
 from sid.documents import plural
 from sid.experiments.compare import BY_SCENARIO, format_summary, write_comparison
@@ -30,8 +38,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--runs", type=int, default=3, metavar="K", help="seeds 1..K per planner (default: %(default)s)"
     )
     parser.add_argument(
-        "--time", type=float, default=0.5, metavar="S", help="time budget per run in s (default: %(default)s)"
-    )
+        "--time", type=positive_seconds, default=0.5, metavar="S",
+        help="time budget per run in s (default: %(default)s)",
+    )  # fmt: skip
     parser.add_argument(
         "--cost-weight", type=float, default=DEFAULT_COST_WEIGHT, metavar="W", help="w of the cost (see sid plan)"
     )

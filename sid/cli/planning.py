@@ -9,7 +9,7 @@ import sys
 from costmap.mapfile import MapFileError
 from planner.facade import DEFAULT_PLANNER, DEFAULT_SOFT_LIMIT_S, MAX_SEED, PLANNERS
 from planner.problem import DEFAULT_COST_WEIGHT, PlanningError
-from sid.cli.common import add_output_option
+from sid.cli.common import add_output_option, positive_seconds
 from sid.experiments.harness import Comparison, goal_zone_warning
 from sid.scenario.loader import ScenarioError
 
@@ -59,7 +59,7 @@ def add_planning_options(
     from the clock; no cap on iterations)."""
     parser.add_argument(
         "--time",
-        type=float,
+        type=positive_seconds,
         default=time_default,
         metavar="S",
         help="planner time budget in seconds (default: %(default)s); without --iterations BIT* stops earlier once it "

@@ -110,6 +110,19 @@ def test_a_still_time_that_is_not_a_time_is_refused(still, tmp_path, capsys):
     assert not list(tmp_path.iterdir())
 
 
+@pytest.mark.parametrize("command", ["plan", "demo", "compare"])
+@pytest.mark.parametrize("budget", ["nan", "-1", "0", "inf"])
+def test_a_time_budget_that_is_not_one_is_refused_before_any_output(command, budget, tmp_path, capsys):
+    # The planner refused it, but only after "planning ... (nan s budget) ..." was on standard output.
+    argv = [command] + ([] if command == "demo" else [SCENARIO])
+    with pytest.raises(SystemExit) as stop:
+        main([*argv, "--out", str(tmp_path / "out"), "--time", budget])
+    assert stop.value.code == 2
+    printed = capsys.readouterr()
+    assert f"argument --time: expected a positive number of seconds, got '{budget}'" in printed.err
+    assert printed.out == "" and not (tmp_path / "out").exists()
+
+
 def test_the_planner_itself_refuses_a_seed_ompl_cannot_take():
     import sid
 

@@ -64,7 +64,6 @@ def test_plan_without_social_layer_crosses_the_conversation(tmp_path):
         ({"goal": [5.0, -2.9, 0.0]}, [], "no path: goal (5.00, -2.90) is in collision", ExitCode.NO_PATH),
         ({}, ["--planner", "prmstar"], "PRM* is not available", ExitCode.USAGE),
         ({}, ["--planner", "dstar"], "unknown planner 'dstar'", ExitCode.USAGE),
-        ({}, ["--time", "-1"], "time_limit must be a positive number", ExitCode.USAGE),
     ],
 )
 def test_plan_refuses_impossible_or_bad_requests(tmp_path, capsys, robot, args, message, expected):
