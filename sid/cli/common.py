@@ -50,6 +50,8 @@ __all__ = [
     "output_folder_lock",
     "plain_text",
     "positive_int",
+    "positive_number",
+    "positive_seconds",
     "print_written",
     "process_json_lines",
     "read_json_lines",
@@ -163,16 +165,24 @@ positive_int = whole_number(1)
 """argparse type: a whole number >= 1."""
 
 
-def positive_seconds(text: str) -> float:
-    """argparse type of a time budget: a positive finite number of seconds (refused before any output: a budget of
-    nan was printed in the first progress line before the planner refused it)."""
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not (math.isfinite(value) and value > 0):
-        raise argparse.ArgumentTypeError(f"expected a positive number of seconds, got {text!r}")
-    return value
+def positive_number(what: str) -> Callable[[str], float]:
+    """argparse type: a positive finite number; ``what`` names it in the error ("expected a positive WHAT")."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not (math.isfinite(value) and value > 0):
+            raise argparse.ArgumentTypeError(f"expected a positive {what}, got {text!r}")
+        return value
+
+    return parse
+
+
+positive_seconds = positive_number("number of seconds")
+"""argparse type of a time budget (refused before any output: a budget of nan was printed in the first progress line
+before the planner refused it)."""
 
 
 def fail(command: str, error: Exception) -> int:

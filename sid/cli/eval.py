@@ -10,7 +10,7 @@ import math
 import sys
 from pathlib import Path
 
-from sid.cli.common import fail, whole_number
+from sid.cli.common import fail, positive_number, whole_number
 from sid.cli.eval_crowd import add_crowd_parser
 from sid.cli.grouping import add_group_params, group_params_from
 from sid.distribution import MissingDependencyError
@@ -141,15 +141,7 @@ def _threshold(text: str) -> float:
 
 def _scale(text: str) -> float | str:
     """'auto', or a positive number."""
-    if text == "auto":
-        return text
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not (math.isfinite(value) and value > 0):
-        raise argparse.ArgumentTypeError(f"expected a positive number or auto, got {text!r}")
-    return value
+    return text if text == "auto" else positive_number("number or auto")(text)
 
 
 def _grid_item(text: str) -> tuple[str, list[float]]:

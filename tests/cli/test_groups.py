@@ -267,22 +267,18 @@ def test_eval_fformation_cross_validates_over_a_grid(tmp_path, capsys):
     assert len(report["grid"]) == math.prod(len(values) for values in DEFAULT_GRID.values())
 
 
-def test_eval_fformation_adds_seeded_facing_noise(tmp_path, capsys):
+@pytest.mark.parametrize(
+    ("option", "value", "bad", "message"),
+    [("--facing-noise", "20", "-5", "facing noise"), ("--facing-missing", "0.5", "2", "share of facings missing")],
+)
+def test_eval_fformation_changes_the_facings_seeded(tmp_path, capsys, option, value, bad, message):
+    """--facing-noise adds seeded noise to every facing, --facing-missing makes a seeded share of them unknown."""
     tiny = write_sequence(tmp_path / "Tiny", tiny_frames(), {1: [[1, 2]], 2: [[1, 2, 3]]})
-    args = ["eval", "fformation", str(tiny), "--scale", "0.01", "--facing-noise"]
-    first, second = run_sid([*args, "20"], capsys), run_sid([*args, "20"], capsys)
+    args = ["eval", "fformation", str(tiny), "--scale", "0.01", option]
+    first, second = run_sid([*args, value], capsys), run_sid([*args, value], capsys)
     assert first[0] == 0 and first[1] == second[1]
-    code, _, err = run_sid([*args, "-5"], capsys)
-    assert code == 2 and "facing noise" in err
-
-
-def test_eval_fformation_makes_a_seeded_share_of_the_facings_unknown(tmp_path, capsys):
-    tiny = write_sequence(tmp_path / "Tiny", tiny_frames(), {1: [[1, 2]], 2: [[1, 2, 3]]})
-    args = ["eval", "fformation", str(tiny), "--scale", "0.01", "--facing-missing"]
-    first, second = run_sid([*args, "0.5"], capsys), run_sid([*args, "0.5"], capsys)
-    assert first[0] == 0 and first[1] == second[1]
-    code, _, err = run_sid([*args, "2"], capsys)
-    assert code == 2 and "share of facings missing" in err
+    code, _, err = run_sid([*args, bad], capsys)
+    assert code == 2 and message in err
 
 
 def test_eval_fformation_reports_malformed_data(tmp_path, capsys):
