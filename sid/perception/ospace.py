@@ -352,14 +352,18 @@ def _assign(cost: np.ndarray, near: np.ndarray, known: np.ndarray, model: OSpace
     count, tie = len(known), TIE * model.alone_price
     current = np.zeros(count) + model.alone_price
     opened = np.zeros(len(cost), dtype=bool)
-    known_near = known[near] & (near >= 0)
-    opener = np.where(known_near | (cost <= model.opening_cost), cost, np.inf)
+    # Unknown facings count only up to opening_cost (where every facing is known, the usual case, nothing to mask).
+    known_near = None if known.all() else known[near] & (near >= 0)
+    opener = cost if known_near is None else np.where(known_near | (cost <= model.opening_cost), cost, np.inf)
     while True:
         gain = current[near] - opener
         gains = gain > tie
         saving = np.add.reduce(np.where(gains, gain, 0.0), axis=1) - model.price
         # an o-space needs two members, one of them with a known facing
-        saving[(np.add.reduce(gains, axis=1) < 2) | ~(gains & known_near).any(axis=1)] = -np.inf
+        unopened = np.add.reduce(gains, axis=1) < 2
+        if known_near is not None:
+            unopened |= ~(gains & known_near).any(axis=1)
+        saving[unopened] = -np.inf
         if np.maximum.reduce(saving) <= tie:
             break
         candidate, column = np.nonzero(gain > tie)
@@ -420,12 +424,13 @@ def _turned(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Each facing (fx, fy) turned within its cone (slack's cosine and sine) as far towards the centre (cx, cy) as
     the cone allows: the direction to the centre when it lies inside the cone, else the cone's nearer edge; a
-    facing with the centre straight behind it (within ``TIE``), or on it, is kept. Positions and centres in m."""
+    facing with the centre straight behind it (within ``TIE``), or on it (within ``TIE`` metres: the direction to a
+    centre on the person is rounding noise), is kept. Positions and centres in m."""
     ox, oy = cx - px, cy - py
     rho = np.sqrt(ox**2 + oy**2)
     along, across = ox * fx + oy * fy, fx * oy - fy * ox  # across > 0: the centre lies counter-clockwise
-    inside = (along >= rho * cos_slack) & (rho > 0)
-    side = np.where(across > TIE * rho, 1.0, np.where(across < -TIE * rho, -1.0, 0.0))
+    inside = (along >= rho * cos_slack) & (rho > TIE)
+    side = np.where((across > TIE * rho) & (rho > TIE), 1.0, np.where((across < -TIE * rho) & (rho > TIE), -1.0, 0.0))
     edge_x = np.where(side == 0, fx, fx * cos_slack - side * fy * sin_slack)
     edge_y = np.where(side == 0, fy, fy * cos_slack + side * fx * sin_slack)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -641,7 +646,9 @@ def _assign_small(rows: list[_Row], known: list[bool], model: OSpaceModel) -> li
     count, tie = len(known), TIE * model.alone_price
     current = [model.alone_price] * count
     opened = [False] * len(rows)
-    openers = [[(j, c) for j, c in entries if known[j] or c <= model.opening_cost] for entries, _ in rows]
+    openers = [entries for entries, _ in rows]
+    if not all(known):  # unknown facings count towards opening only up to opening_cost
+        openers = [[(j, c) for j, c in entries if known[j] or c <= model.opening_cost] for entries in openers]
     savings = [saving for _, saving in rows]
     active = [k for k, saving in enumerate(savings) if saving > tie]
     while active:
@@ -738,7 +745,9 @@ def _turned_small(
     ox, oy = cx - px, cy - py
     rho = math.sqrt(ox * ox + oy * oy)
     along, across = ox * fx + oy * fy, fx * oy - fy * ox
-    if rho > 0 and along >= rho * cos_slack:
+    if rho <= TIE:  # the centre on the person: no direction to turn to
+        return fx, fy
+    if along >= rho * cos_slack:
         return ox / rho, oy / rho
     side = 1.0 if across > TIE * rho else -1.0 if across < -TIE * rho else 0.0
     if side == 0:
