@@ -11,9 +11,10 @@ import dataclasses
 import math
 import numbers
 import os
-from collections.abc import Iterable, Iterator
+from collections import Counter
+from collections.abc import Hashable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar
 
 from sid.errors import SidError
 
@@ -30,8 +31,11 @@ __all__ = [
     "is_real",
     "limits",
     "limits_from_environment",
+    "repeated",
     "use_limits",
 ]
+
+_H = TypeVar("_H", bound=Hashable)
 
 LIMITS_ENV = "SID_LIMITS"
 """The environment variable that raises (or lowers) limits: ``SID_LIMITS="map_cells=16000000,people=300"``."""
@@ -230,3 +234,10 @@ def amount(count: float) -> str:
     """A count for a message: with thousands separators (``20,000,000``), in three digits past 10^15 (``2e+304``),
     so that a number from a file cannot make the message long."""
     return f"{count:,.0f}" if count < 1e15 else f"{count:.3g}"
+
+
+def repeated(items: Sequence[_H]) -> _H | None:
+    """The first of ``items`` (in their order) that is given more than once, None when no item is: a name given
+    twice to a command would have its runs pooled into one row or counted twice."""
+    counts = Counter(items)
+    return next((item for item in items if counts[item] > 1), None)

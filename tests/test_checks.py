@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-from sid.checks import check_number, check_numbers, check_whole
+from sid.checks import check_number, check_numbers, check_whole, repeated
 
 
 @pytest.mark.parametrize(
@@ -116,3 +116,9 @@ def test_a_whole_number_comes_back_as_an_int() -> None:
     assert check_whole("owner", "count", np.int64(7), high=7) == 7
     with pytest.raises(KeyError, match="owner: count must be a whole number >= 0"):
         check_whole("owner", "count", -1, low=0, error=KeyError)
+
+
+def test_repeated_names_the_first_item_given_twice_in_order() -> None:
+    assert repeated(["grid", "bitstar", "rrtstar"]) is None and repeated([]) is None
+    assert repeated(["S2", "S1", "S2", "S1"]) == "S2"
+    assert repeated(["a", "b", "b", "a"]) == "a"  # the first item in order that appears again, not the first repeat

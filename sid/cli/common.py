@@ -165,16 +165,18 @@ positive_int = whole_number(1)
 """argparse type: a whole number >= 1."""
 
 
-def positive_number(what: str) -> Callable[[str], float]:
-    """argparse type: a positive finite number; ``what`` names it in the error ("expected a positive WHAT")."""
+def positive_number(what: str, *, zero: bool = False) -> Callable[[str], float]:
+    """argparse type: a finite number above 0 (with ``zero``, 0 or above); ``what`` names it in the error
+    ("expected a positive WHAT", or "a finite WHAT >= 0")."""
+    expected = f"a finite {what} >= 0" if zero else f"a positive {what}"
 
     def parse(text: str) -> float:
         try:
             value = float(text)
         except ValueError:
             value = math.nan
-        if not (math.isfinite(value) and value > 0):
-            raise argparse.ArgumentTypeError(f"expected a positive {what}, got {text!r}")
+        if not (math.isfinite(value) and (value >= 0 if zero else value > 0)):
+            raise argparse.ArgumentTypeError(f"expected {expected}, got {text!r}")
         return value
 
     return parse

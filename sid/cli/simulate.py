@@ -5,7 +5,6 @@ docs/simulate.md."""
 from __future__ import annotations
 
 import argparse
-import math
 import shlex
 import sys
 import time
@@ -17,6 +16,7 @@ from sid.cli.common import (
     check_output_folder,
     fail,
     plain_text,
+    positive_number,
     print_written,
     staged_output,
 )
@@ -58,17 +58,6 @@ def _seed(text: str) -> int:
     return value
 
 
-def _still_time(text: str) -> float:
-    """argparse type of ``--still``: a finite number of seconds >= 0 (NaN picked the first step without a word)."""
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not (math.isfinite(value) and value >= 0):
-        raise argparse.ArgumentTypeError(f"expected a finite number of seconds >= 0, got {text!r}")
-    return value
-
-
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "simulate",
@@ -92,7 +81,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--unknown-map", action="store_true", help="no known map: the LiDAR discovers obstacles too")
     parser.add_argument("--gif", action="store_true", help="also write run.gif (every other frame)")
     parser.add_argument(
-        "--still", type=_still_time, default=None, metavar="T", help="also write run.png, the picture at T seconds"
+        "--still",
+        type=positive_number("number of seconds", zero=True),  # NaN picked the first step without a word
+        default=None,
+        metavar="T",
+        help="also write run.png, the picture at T seconds",
     )
     parser.add_argument("--list", action="store_true", help="list the built-in scenes and exit")
     sweep = parser.add_argument_group("sweeps")

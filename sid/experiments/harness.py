@@ -27,6 +27,7 @@ from costmap.layered import LayeredCostmap
 from costmap.layers.social import group_zone_polygon
 from planner.facade import PlanResult, plan, resolve_planner
 from planner.problem import DEFAULT_COST_WEIGHT, PlanningError, PlanningProblem
+from sid.checks import repeated
 from sid.experiments.path_metrics import result_metrics
 from sid.perception.group import Group
 from sid.perception.groups import detect_groups
@@ -207,12 +208,11 @@ def run_matrix(
     names = [resolve_planner(p) for p in planners]
     if runs < 1:
         raise ValueError(f"runs must be at least 1, got {runs}")
-    if len(set(names)) < len(names):
-        twice = next(n for n in names if names.count(n) > 1)
+    twice = repeated(names)
+    if twice is not None:
         raise ValueError(f"planner {twice} is given twice: its runs would be counted twice")
-    scenarios = [task.scenario.name for task in tasks]
-    if len(set(scenarios)) < len(scenarios):
-        twice = next(n for n in scenarios if scenarios.count(n) > 1)
+    twice = repeated([task.scenario.name for task in tasks])
+    if twice is not None:
         raise ValueError(
             f"two scenarios are named {twice!r}: their runs would be pooled into one row; give each its own 'name'"
         )

@@ -32,7 +32,7 @@ import numpy as np
 
 from planner.facade import DEFAULT_PLANNER, resolve_planner
 from planner.problem import DEFAULT_COST_WEIGHT, PlanningError
-from sid.checks import check_number, check_whole
+from sid.checks import check_number, check_whole, repeated
 from sid.experiments.demo import DEMO_SCENARIO
 from sid.experiments.harness import Comparison, compare_with_without, prepare
 from sid.scenario.loader import Scenario, scenario_from_dict
@@ -162,9 +162,9 @@ class NavSettings:
     def __post_init__(self) -> None:
         if not self.planners:
             raise ValueError("navigation: give at least one planner")
-        names = [resolve_planner(name) for name in self.planners]  # raises ValueError naming an unknown planner
-        if len(set(names)) < len(names):  # as run_matrix: its plans would be counted twice in the report
-            twice = next(n for n in names if names.count(n) > 1)
+        # resolve_planner raises ValueError naming an unknown planner
+        twice = repeated([resolve_planner(name) for name in self.planners])
+        if twice is not None:  # as run_matrix: its plans would be counted twice in the report
             raise ValueError(f"navigation: planner {twice} is given twice: its runs would be counted twice")
         check_number("navigation", "time limit", self.time_limit, low=0, low_open=True, unit="seconds")
         if self.max_iterations is not None and self.max_iterations < 1:

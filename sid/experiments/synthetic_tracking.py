@@ -41,7 +41,7 @@ from costmap.grid import GridSpec
 from costmap.layer import LayerInputs
 from costmap.layers.social import GROUPS, PEOPLE
 from costmap.plugins import CostmapParams, layered_costmap
-from sid.checks import check_number, check_whole
+from sid.checks import check_number, check_whole, repeated
 from sid.distribution import MissingDependencyError, install_hint
 from sid.experiments.fformation import LabelledFrame, format_threshold, score
 from sid.perception.frame import Frame
@@ -101,8 +101,8 @@ class TrackingEvalSettings:
         unknown = [name for name in self.sequences if name not in SEQUENCES]
         if unknown or not self.sequences:
             raise ValueError(f"tracking evaluation: unknown sequences {unknown}; known: {', '.join(SEQUENCES)}")
-        if len(set(self.sequences)) < len(self.sequences):  # "overall" would count its frames twice
-            twice = next(n for n in self.sequences if self.sequences.count(n) > 1)
+        twice = repeated(list(self.sequences))
+        if twice is not None:  # "overall" would count its frames twice
             raise ValueError(f"tracking evaluation: sequence {twice} is given twice")
 
 

@@ -31,7 +31,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from sid.checks import check_number, check_whole
+from sid.checks import check_number, check_whole, repeated
 from sid.perception.group import Group
 from sid.perception.groups import GroupParams
 from sid.perception.lifting import LiftParams
@@ -95,9 +95,9 @@ class Table1Settings:
         unknown = [s for s in self.scenarios if s.upper() not in LAYOUTS]
         if unknown or not self.scenarios:
             raise ValueError(f"table1: unknown scenario(s) {unknown or '(none given)'}; known: {', '.join(LAYOUTS)}")
-        names = [s.upper() for s in self.scenarios]
-        if len(set(names)) < len(names):  # its frames would be pooled twice into the one row
-            raise ValueError(f"table1: scenario {next(n for n in names if names.count(n) > 1)} is given twice")
+        twice = repeated([s.upper() for s in self.scenarios])
+        if twice is not None:  # its frames would be pooled twice into the one row
+            raise ValueError(f"table1: scenario {twice} is given twice")
         check_whole("table1", "frames", self.frames, low=1)
         if not 1 <= self.variations <= len(VARIATIONS):
             raise ValueError(f"table1: variations must be 1..{len(VARIATIONS)}, got {self.variations}")

@@ -429,8 +429,9 @@ def _turned(
     ox, oy = cx - px, cy - py
     rho = np.sqrt(ox**2 + oy**2)
     along, across = ox * fx + oy * fy, fx * oy - fy * ox  # across > 0: the centre lies counter-clockwise
-    inside = (along >= rho * cos_slack) & (rho > TIE)
-    side = np.where((across > TIE * rho) & (rho > TIE), 1.0, np.where((across < -TIE * rho) & (rho > TIE), -1.0, 0.0))
+    off = rho > TIE  # the centre off the person: there is a direction to turn to
+    inside = (along >= rho * cos_slack) & off
+    side = np.where(across > TIE * rho, 1.0, np.where(across < -TIE * rho, -1.0, 0.0)) * off
     edge_x = np.where(side == 0, fx, fx * cos_slack - side * fy * sin_slack)
     edge_y = np.where(side == 0, fy, fy * cos_slack + side * fx * sin_slack)
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -22,7 +22,7 @@ from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
 
-from sid.checks import Limits, check_whole, limits, use_limits
+from sid.checks import Limits, check_whole, limits, repeated, use_limits
 from sid.cpu import keep_freed_memory
 from sid.distribution import MissingDependencyError, install_hint
 from sid.experiments.harness import summarise
@@ -53,8 +53,9 @@ def sweep_jobs(scenes: Sequence[str], seeds: int, options: RunOptions | None = N
     check_whole("sweep", "seeds", seeds, low=1)
     for scene in scenes:
         load_scene(scene)  # a bad scene fails here, before any run
-    if len(set(scenes)) < len(scenes):  # the summary would count its runs twice
-        raise ValueError(f"sweep: scene {next(s for s in scenes if list(scenes).count(s) > 1)} is given twice")
+    twice = repeated(list(scenes))
+    if twice is not None:  # the summary would count its runs twice
+        raise ValueError(f"sweep: scene {twice} is given twice")
     return [
         Job(scene, replace(options, social=social, seed=seed))
         for scene in scenes
