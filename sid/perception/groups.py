@@ -4,78 +4,37 @@ All coordinates are in the world frame (metres, REP-103, see ``sid.perception.pe
 
 - ``ospace`` (default): people are assigned to shared o-spaces by minimising a description-length cost
   (``sid.perception.ospace``; docs/groups.md); each group's zone, interest point and spread are then those of the
-  paper (below), computed on its members' rays, or the fitted o-space centre when no two members' rays meet.
+  paper, computed on its members' rays (``sid.perception.zone``), or the fitted o-space centre when no two members'
+  rays meet.
 - ``gcff``: the graph-cut detector of Setti et al. 2015 (``sid.perception.gcff``), the literature's reference,
   with one stride and description length for every scene; zones as for ``ospace``.
-- ``rays``: the paper's Algorithm 1 with the two additions described below.
+- ``rays``: the paper's Algorithm 1 with the two additions that ``sid.perception.rays`` describes.
 - ``paper``: the literal Algorithm 1, one candidate per DBSCAN cluster (``rays`` with ``meeting_radius=math.inf``).
-
-The ray method. Per frame: DBSCAN on the people's positions; per cluster, each person with a known facing casts a
-ray (a segment of ``ray_length``) from their position along their facing; where two rays cross, the two people
-look at a common point. The convex hull of the crossings is the interaction zone (area A, centroid = interest
-point), and D is the mean distance of the members to the interest point. While A or D exceed their thresholds, the
-member whose removal helps most is dropped; a cluster that ends under both thresholds is a group.
-
-Choices the paper leaves open, decided here:
-- People with unknown facing (theta None) count in DBSCAN (they are there, and link neighbours) but cast no ray,
-  so they are never members: a ray is the only evidence of taking part in a conversation.
-- A member whose ray meets no other member's ray is dropped before the geometry (it contributes no crossing, so
-  it could only pass the thresholds by standing close, e.g. someone just behind a group facing away).
-- Two people facing each other: their rays are (nearly) anti-parallel and often miss each other (parallel, or
-  crossing behind one of them), and where they do cross, at a shallow angle, the crossing lies anywhere between
-  the two (on one of them when the other looks straight at them) and follows every degree of facing noise. So
-  when each faces the other within ``facing_tolerance`` and their rays are within 20 degrees of anti-parallel, the
-  pair meets at the midpoint between them, crossing or not; a steeper crossing is kept (a face-to-face pair both
-  turned towards one side looks at a spot beside the line between them).
-- The polygon is the convex hull of the crossings (as the authors' code does), vertices counter-clockwise; area
-  and centroid by the shoelace formula. When the hull is degenerate (one crossing, coinciding or
-  collinear crossings; area below 1e-9 m^2) the area is 0 and the interest point is the mean of the crossings.
-- Pruning removes, at each step, the member whose removal minimises max(A / A_thr, D / D_thr); it stops with no
-  group when no removal lowers that value or fewer than two members would remain.
-- A DBSCAN cluster may hold several conversations side by side (a coffee break), and pruning one big set of
-  people member by member then fails. So the crossings of a cluster are first grouped by proximity
-  (``meeting_radius``, single linkage); the people whose rays meet at one spot form a candidate, candidates are
-  pruned in order of their number of crossings (most first), and a person joins at most one group. With one
-  spot (any single conversation) this is exactly the paper's algorithm; ``meeting_radius=math.inf`` forces it.
 """
 
 from __future__ import annotations
 
-import itertools
 import math
-import operator
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
-from functools import cached_property, lru_cache
+from functools import cached_property
 
 import numpy as np
 
 from sid.checks import MAX_COORDINATE, check_number, check_numbers, check_whole, is_real
 from sid.documents import summary
-from sid.perception.cluster import dbscan_labels
 from sid.perception.gcff import GCFFParams, gcff_labels
 from sid.perception.group import Group
 from sid.perception.ospace import OSpaceModel, find_ospaces
 from sid.perception.people import Person
+from sid.perception.rays import clustered_groups
 from sid.perception.rings import RingModel, joined_rings
+from sid.perception.zone import member_crossings, spread, zone_of
 
 __all__ = ["GROUP_METHODS", "GroupParams", "QUANTISED_STEPS", "detect_groups", "facing_step"]
 
-# |sin| of the angle between two rays below which they count as parallel (their crossing is rounding noise).
-_PARALLEL = 1e-9
-# |sin| of the angle between the rays of a face-to-face pair below which they meet at their midpoint, crossing or
-# not (module docstring): 20 degrees from anti-parallel. There a crossing moves ~2 cm per degree of facing noise for
-# people 0.8 m apart (~1 cm at 34 degrees), and the switch to the midpoint moves the point by at most 7 cm.
-_SHALLOW = math.sin(math.radians(20.0))
-# Relative difference below which two removals' excess values tie (rounding, e.g. after moving the scene).
-_TIE = 1e-9
-# Hull area (m^2) below which the polygon of crossings is treated as degenerate (a point or a segment).
-_DEGENERATE_AREA = 1e-9
-# Sort key of a point x + iy: (x, y).
-_BY_X_THEN_Y = operator.attrgetter("real", "imag")
 # The facing of a person whose theta is None.
 _UNKNOWN_FACING = complex(math.nan, math.nan)
-
 
 GROUP_METHODS = ("ospace", "gcff", "rays", "paper")
 
@@ -90,7 +49,7 @@ class GroupParams:
 
     method: 'ospace' (people assigned to shared o-spaces, the default), 'gcff' (Setti et al.'s graph cuts),
       'rays' (the paper's ray crossings with two additions) or 'paper' (Algorithm 1 as written); the module
-      docstring says more.
+      docstring says more, and ``sid.perception.rays`` for the last two.
 
     The graph-cut method (``method='gcff'``, ``sid.perception.gcff``):
 
@@ -268,21 +227,6 @@ class GroupParams:
             raise ValueError(str(exc).replace("ospace: pair_reach", "groups: coarse_pair_reach", 1)) from None
 
 
-@dataclass(frozen=True)
-class _Geometry:
-    """Area (m^2), centre (complex x + iy), (K, 2) zone and spread D (m) of a candidate's crossings."""
-
-    area: float
-    centre: complex
-    zone: np.ndarray
-    spread: float
-
-    def excess(self, params: GroupParams) -> float:
-        """max(A / A_thr, D / D_thr): <= 1 when both are under their thresholds."""
-        area_ratio = self.area / params.area_threshold if params.area_threshold > 0 else (math.inf if self.area else 0)
-        return max(area_ratio, self.spread / params.spread_threshold)
-
-
 def detect_groups(people: Sequence[Person], params: GroupParams = GroupParams()) -> list[Group]:
     """Interacting groups among ``people`` (world frame) by ``params.method``.
 
@@ -300,33 +244,7 @@ def detect_groups(people: Sequence[Person], params: GroupParams = GroupParams())
         return _gcff_groups(people, positions, facing, params)
     if params.method == "paper" and not math.isinf(params.meeting_radius):
         params = params.as_paper
-    return _clustered_groups(ids, positions, facing, params)
-
-
-def _clustered_groups(
-    ids: list[int], positions: list[complex], facing: list[complex], params: GroupParams
-) -> list[Group]:
-    """The ``rays`` and ``paper`` methods' groups: DBSCAN clusters of the people sorted by id (DBSCAN numbers its
-    clusters, and the pruning breaks its ties, in the order it is given), each pruned to its groups; members and
-    groups then listed in input order."""
-    order = sorted(range(len(ids)), key=ids.__getitem__)
-    position_array = np.array([positions[i] for i in order], dtype=complex)
-    facing_array = np.array([facing[i] for i in order], dtype=complex)
-    labels = dbscan_labels(np.column_stack((position_array.real, position_array.imag)), params.eps, params.min_samples)
-    has_ray = ~np.isnan(facing_array)
-    groups: list[Group] = []
-    for label in range(int(labels.max()) + 1):
-        cluster = np.flatnonzero((labels == label) & has_ray)
-        if len(cluster) >= 2:
-            groups.extend(
-                _groups_in_cluster(
-                    [ids[order[i]] for i in cluster], position_array[cluster], facing_array[cluster], params
-                )
-            )
-    index = {person: k for k, person in enumerate(ids)}
-    for group in groups:
-        group.members = tuple(sorted(group.members, key=index.__getitem__))
-    return sorted(groups, key=lambda group: index[group.members[0]])
+    return clustered_groups(ids, positions, facing, params)
 
 
 def _ospace_groups(
@@ -398,10 +316,10 @@ def _zoned(
     docstring), or ``centres`` (complex, m) where no two members' rays meet."""
     groups = []
     for fallback, group, crossings in zip(
-        centres, members, _member_crossings(positions, facing, members, params), strict=True
+        centres, members, member_crossings(positions, facing, members, params), strict=True
     ):
         if crossings:
-            area, centre, zone = _zone(crossings)
+            area, centre, zone = zone_of(crossings)
         else:  # no two members' rays meet: the centre given (fitted o-space, or mean vote)
             area, centre = 0.0, fallback
             zone = np.array([[centre.real, centre.imag]])
@@ -411,7 +329,7 @@ def _zoned(
                 interest_point=(centre.real, centre.imag),
                 area=area,
                 zone=zone,
-                spread=_spread([positions[i] for i in group], centre),
+                spread=spread([positions[i] for i in group], centre),
             )
         )
     return groups
@@ -476,246 +394,3 @@ def _validated(people: list[Person]) -> tuple[list[int], list[complex], list[com
         else:
             facing.append(complex(math.cos(person.theta), math.sin(person.theta)))
     return ids, positions, facing
-
-
-@dataclass(frozen=True)
-class _Meetings:
-    """Pairs of people (indices into the cluster) whose rays meet, and where (complex x + iy)."""
-
-    first: np.ndarray
-    second: np.ndarray
-    points: np.ndarray
-
-
-@lru_cache(maxsize=64)
-def _pairs(k: int) -> tuple[np.ndarray, np.ndarray]:
-    return np.triu_indices(k, 1)
-
-
-def _ray_meetings(
-    positions: np.ndarray,
-    facing: np.ndarray,
-    params: GroupParams,
-    pairs: tuple[np.ndarray, np.ndarray] | None = None,
-) -> _Meetings:
-    """Where the rays of each pair (all pairs unless given, i < j) meet (see the module docstring); positions and
-    facings are complex numbers x + iy. Dot and cross products are written out on the real parts: numpy's complex
-    products fuse multiply-adds on some CPUs, which would make the last bits depend on the machine and differ from
-    ``_member_crossings``' Python arithmetic."""
-    i, j = _pairs(len(positions)) if pairs is None else pairs
-    pi, pj, fi, fj = positions[i], positions[j], facing[i], facing[j]
-    d = pj - pi
-    dx, dy, fix, fiy, fjx, fjy = d.real, d.imag, fi.real, fi.imag, fj.real, fj.imag
-    # Rays p_i + s f_i and p_j + t f_j meet where s f_i - t f_j = d = p_j - p_i: s = cross(d, f_j) / cross(f_i, f_j)
-    # and t = cross(d, f_i) / cross(f_i, f_j); the segments meet when both lie in [0, ray_length].
-    denom = fix * fjy - fiy * fjx
-    half = 0.5 * params.ray_length
-    distance = np.abs(d)
-    # Face to face: each looks at the other within the tolerance (dot(f, d) >= cos(tol) |d|).
-    reach = math.cos(params.facing_tolerance) * distance
-    facing_j = dx * fix + dy * fiy >= reach
-    facing_i = -(dx * fjx + dy * fjy) >= reach
-    face_to_face = facing_j & facing_i & (distance > 0) & (distance <= 4 * half)
-    # A denominator next to 0 (facings parallel to within ~1e-300) overflows s and t to inf; such pairs are not
-    # crossings (|denom| <= _PARALLEL) and take the midpoint, so the inf is never used.
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        s = (dx * fjy - dy * fjx) / denom
-        t = (dx * fiy - dy * fix) / denom
-        crossing = (np.abs(denom) > _PARALLEL) & (np.maximum(np.abs(s - half), np.abs(t - half)) <= half)
-        # A face-to-face pair whose rays are nearly anti-parallel meets at its midpoint, whether or not they cross.
-        points = np.where(crossing & ~(face_to_face & (np.abs(denom) < _SHALLOW)), pi + s * fi, 0.5 * (pi + pj))
-    meet = crossing | face_to_face
-    return _Meetings(i[meet], j[meet], points[meet])
-
-
-def _member_crossings(
-    positions: list[complex], facing: list[complex], groups: list[list[int]], params: GroupParams
-) -> list[list[complex]]:
-    """Per group (member indices into ``positions``), where its members' rays meet, pair by pair in the order of
-    ``itertools.combinations``: ``_ray_meetings`` on Python numbers, for the o-space method's few members (numpy's
-    overhead per call outweighs the work). The same operations in the same order, so the same bits; a test checks
-    it."""
-    half = 0.5 * params.ray_length
-    cos_tolerance = math.cos(params.facing_tolerance)
-    crossings: list[list[complex]] = []
-    for group in groups:
-        found: list[complex] = []
-        for i, j in itertools.combinations(group, 2):
-            pi, fi, fj = positions[i], facing[i], facing[j]
-            d = positions[j] - pi
-            dx, dy, fix, fiy, fjx, fjy = d.real, d.imag, fi.real, fi.imag, fj.real, fj.imag
-            distance = abs(d)
-            reach = cos_tolerance * distance
-            face_to_face = dx * fix + dy * fiy >= reach and -(dx * fjx + dy * fjy) >= reach and 0 < distance <= 4 * half
-            denom = fix * fjy - fiy * fjx
-            if abs(denom) > _PARALLEL and not (face_to_face and abs(denom) < _SHALLOW):
-                s, t = (dx * fjy - dy * fjx) / denom, (dx * fiy - dy * fix) / denom
-                if max(abs(s - half), abs(t - half)) <= half:
-                    found.append(pi + s * fi)
-                    continue
-            if face_to_face:
-                found.append(0.5 * (pi + positions[j]))
-        crossings.append(found)
-    return crossings
-
-
-def _groups_in_cluster(ids: list[int], positions: np.ndarray, facing: np.ndarray, params: GroupParams) -> list[Group]:
-    meetings = _ray_meetings(positions, facing, params)
-    points = meetings.points
-    if len(points) == 0:
-        return []
-    if math.isinf(params.meeting_radius) or np.abs(points[:, None] - points[None, :]).max() <= params.meeting_radius:
-        candidates = [np.ones(len(ids), dtype=bool)]  # all crossings within reach of each other: one spot
-    else:
-        spots = dbscan_labels(np.column_stack((points.real, points.imag)), params.meeting_radius, 1)
-        # Candidates in order of their number of crossings, most first (ties: in order of discovery).
-        order = sorted(range(int(spots.max()) + 1), key=lambda spot: -np.count_nonzero(spots == spot))
-        candidates = []
-        for spot in order:
-            mask = np.zeros(len(ids), dtype=bool)
-            mask[meetings.first[spots == spot]] = True
-            mask[meetings.second[spots == spot]] = True
-            candidates.append(mask)
-    remaining = np.ones(len(ids), dtype=bool)
-    groups = []
-    for mask in candidates:
-        found = _prune(mask & remaining, meetings, positions, ids, params)
-        if found is None:
-            continue
-        members, geometry = found
-        groups.append(
-            Group(
-                members=tuple(ids[i] for i in np.flatnonzero(members)),
-                interest_point=(geometry.centre.real, geometry.centre.imag),
-                area=geometry.area,
-                zone=geometry.zone,
-                spread=geometry.spread,
-            )
-        )
-        remaining &= ~members
-    return groups
-
-
-def _active(members: np.ndarray, meetings: _Meetings) -> np.ndarray:
-    """Which meetings are between two members."""
-    return members[meetings.first] & members[meetings.second]
-
-
-def _with_meetings(members: np.ndarray, meetings: _Meetings) -> np.ndarray:
-    """The members whose ray meets another member's ray."""
-    active = _active(members, meetings)
-    result = np.zeros_like(members)
-    result[meetings.first[active]] = True
-    result[meetings.second[active]] = True
-    return result
-
-
-def _geometry(members: np.ndarray, meetings: _Meetings, positions: np.ndarray) -> _Geometry:
-    """The zone of the crossings between ``members`` (bool mask)."""
-    area, centre, zone = _zone(meetings.points[_active(members, meetings)].tolist())
-    return _Geometry(area, centre, zone, _spread(positions[members].tolist(), centre))
-
-
-def _zone(crossings: list[complex]) -> tuple[float, complex, np.ndarray]:
-    """Hull area (m^2), centre (complex x + iy, m) and (K, 2) zone polygon of ``crossings`` (at least one)."""
-    hull = _convex_hull(crossings) if len(crossings) >= 3 else []
-    area, centre = _shoelace(hull) if len(hull) >= 3 else (0.0, 0j)
-    if area > _DEGENERATE_AREA:
-        return area, centre, np.array([(p.real, p.imag) for p in hull])
-    centre, zone = _degenerate_zone(crossings)
-    return 0.0, centre, zone
-
-
-def _spread(member_positions: list[complex], centre: complex) -> float:
-    """D (m): the mean distance of the members to ``centre``, the distances summed exactly (``math.fsum``), so
-    that the value depends neither on the members' order nor on the machine."""
-    return math.fsum([abs(p - centre) for p in member_positions]) / len(member_positions)
-
-
-def _convex_hull(points: list[complex]) -> list[complex]:
-    """Counter-clockwise convex hull (Andrew's monotone chain), collinear points dropped.
-
-    Hand-written rather than shapely's: the pruning loop builds several hulls of a handful of points per call, where
-    a shapely round trip costs several times more (docs/parameters.md).
-    """
-    ordered = sorted(set(points), key=_BY_X_THEN_Y)
-    if len(ordered) < 3:
-        return ordered
-
-    def chain(sequence: list[complex]) -> list[complex]:
-        kept: list[complex] = []
-        for p in sequence:
-            while len(kept) >= 2 and ((kept[-1] - kept[-2]).conjugate() * (p - kept[-2])).imag <= 0:
-                kept.pop()
-            kept.append(p)
-        return kept[:-1]
-
-    return chain(ordered) + chain(ordered[::-1])
-
-
-def _shoelace(polygon: list[complex]) -> tuple[float, complex]:
-    """Area and centroid of a counter-clockwise polygon (shoelace formula); the centroid is 0 for zero area.
-
-    Computed relative to the first vertex, so a thin polygon far from the origin keeps its precision (the products
-    of absolute coordinates would cancel).
-    """
-    origin = polygon[0]
-    local = [p - origin for p in polygon]
-    twice_area = 0.0
-    moment = 0j
-    for a, b in zip(local, local[1:] + local[:1], strict=True):
-        cross = (a.conjugate() * b).imag
-        twice_area += cross
-        moment += cross * (a + b)
-    if twice_area <= 0:
-        return 0.0, 0j
-    return 0.5 * twice_area, origin + moment / (3.0 * twice_area)
-
-
-def _degenerate_zone(crossings: list[complex]) -> tuple[complex, np.ndarray]:
-    """Centre (the mean) and (K, 2) zone of crossings whose hull has no area: the centre when the crossings
-    coincide, else the two extreme crossings."""
-    if len(crossings) == 1:
-        return crossings[0], np.array([[crossings[0].real, crossings[0].imag]])
-    points = np.array(crossings)
-    centre = complex(points.sum() / len(points))
-    offsets = points - centre
-    far = offsets[int(np.argmax(np.abs(offsets)))]
-    if abs(far) < 1e-6:
-        ends = np.array([centre])
-    else:
-        along = (offsets * far.conjugate()).real
-        ends = points[[int(np.argmin(along)), int(np.argmax(along))]]
-    return centre, np.column_stack((ends.real, ends.imag))
-
-
-def _prune(
-    candidates: np.ndarray, meetings: _Meetings, positions: np.ndarray, ids: list[int], params: GroupParams
-) -> tuple[np.ndarray, _Geometry] | None:
-    """The group left after pruning ``candidates`` (bool mask), with its geometry, or None.
-
-    Removals whose excess ties (within rounding: moving the scene must not change the choice) go to the lowest
-    person id, so that neither the input order nor the scene's placement decides between them."""
-    members = _with_meetings(candidates, meetings)
-    if np.count_nonzero(members) < 2:
-        return None
-    geometry = _geometry(members, meetings, positions)
-    excess = geometry.excess(params)
-    while excess > 1.0:
-        best: tuple[float, np.ndarray, _Geometry, int] | None = None
-        for i in np.flatnonzero(members):
-            trial = members.copy()
-            trial[i] = False
-            trial = _with_meetings(trial, meetings)
-            if np.count_nonzero(trial) < 2:
-                continue
-            trial_geometry = _geometry(trial, meetings, positions)
-            trial_excess = trial_geometry.excess(params)
-            if best is None or trial_excess < best[0] - _TIE * max(1.0, best[0]):
-                best = (trial_excess, trial, trial_geometry, ids[i])
-            elif trial_excess <= best[0] + _TIE * max(1.0, best[0]) and ids[i] < best[3]:
-                best = (min(trial_excess, best[0]), trial, trial_geometry, ids[i])
-        if best is None or best[0] >= excess:
-            return None
-        excess, members, geometry, _ = best
-    return members, geometry

@@ -15,18 +15,10 @@ from hypothesis import strategies as st
 
 from sid.checks import MAX_COORDINATE
 from sid.perception.group import Group
-from sid.perception.groups import (
-    GROUP_METHODS,
-    GroupParams,
-    _convex_hull,
-    _member_crossings,
-    _ray_meetings,
-    _shoelace,
-    _spread,
-    detect_groups,
-    facing_step,
-)
+from sid.perception.groups import GROUP_METHODS, GroupParams, detect_groups, facing_step
 from sid.perception.people import Person
+from sid.perception.rays import ray_meetings
+from sid.perception.zone import convex_hull, member_crossings, shoelace, spread
 
 RAYS = GroupParams(method="rays")
 
@@ -179,11 +171,11 @@ MILLIMETRES = st.integers(-5000, 5000).map(lambda v: v / 1000)
 @given(st.lists(st.tuples(MILLIMETRES, MILLIMETRES), min_size=3, max_size=30))
 def test_hull_area_and_centroid_match_shapely(coords):
     points = [complex(x, y) for x, y in coords]
-    hull = _convex_hull(points)
+    hull = convex_hull(points)
     reference = shapely.convex_hull(shapely.multipoints(np.array(coords)))
     if reference.geom_type != "Polygon" or reference.area < 1e-6:
         return  # degenerate sets are handled apart (area 0, mean of crossings)
-    area, centre = _shoelace(hull)
+    area, centre = shoelace(hull)
     assert area == pytest.approx(reference.area, rel=1e-9, abs=1e-9)
     assert (centre.real, centre.imag) == pytest.approx(reference.centroid.coords[0], abs=1e-6)
 
@@ -316,17 +308,17 @@ def test_the_ospace_zone_arithmetic_on_python_numbers_matches_the_numpy_one(seed
         size = int(rng.integers(2, 9))
         groups.append(sorted(order[:size]))
         order = order[size:]
-    crossings = _member_crossings(positions, facing, groups, RAYS)
+    crossings = member_crossings(positions, facing, groups, RAYS)
     for group, found in zip(groups, crossings, strict=True):
         pairs = tuple(np.array(side, dtype=int) for side in zip(*itertools.combinations(group, 2), strict=True))
         if not pairs:  # a single member
             assert found == []
             continue
-        meetings = _ray_meetings(np.array(positions), np.array(facing), RAYS, pairs)
+        meetings = ray_meetings(np.array(positions), np.array(facing), RAYS, pairs)
         assert found == meetings.points.tolist()
     # D does not depend on the members' order (exact sums).
     centre = complex(*rng.uniform(0, 3, 2))
-    assert _spread([positions[i] for i in order_before], centre) == _spread(
+    assert spread([positions[i] for i in order_before], centre) == spread(
         [positions[i] for i in reversed(order_before)], centre
     )
 

@@ -1,4 +1,4 @@
-"""The ray crossings' two paths (``_ray_meetings`` on numpy arrays, ``_member_crossings`` on Python numbers) held to a
+"""The ray crossings' two paths (``ray_meetings`` on numpy arrays, ``member_crossings`` on Python numbers) held to a
 plain reference: shapely's intersection of the two 1.5 m facing segments, and the face-to-face midpoint rule."""
 
 from __future__ import annotations
@@ -10,7 +10,9 @@ import numpy as np
 import pytest
 from shapely.geometry import LineString, Point
 
-from sid.perception.groups import GroupParams, _member_crossings, _ray_meetings
+from sid.perception.groups import GroupParams
+from sid.perception.rays import ray_meetings
+from sid.perception.zone import member_crossings
 
 RAYS = GroupParams(method="rays")
 
@@ -63,14 +65,14 @@ def test_both_paths_meet_where_the_segments_cross_or_at_the_face_to_face_midpoin
         for i, j in pairs
         if (point := reference_meeting(positions[i], facing[i], positions[j], facing[j], RAYS)) is not None
     }
-    meetings = _ray_meetings(np.array(positions), np.array(facing), RAYS)
+    meetings = ray_meetings(np.array(positions), np.array(facing), RAYS)
     found = dict(
         zip(zip(meetings.first.tolist(), meetings.second.tolist(), strict=True), meetings.points.tolist(), strict=True)
     )
     assert found.keys() == expected.keys()
     for key, point in expected.items():
         assert abs(found[key] - point) < 1e-9, key
-    (small,) = _member_crossings(positions, facing, [list(range(len(positions)))], RAYS)
+    (small,) = member_crossings(positions, facing, [list(range(len(positions)))], RAYS)
     assert small == [found[key] for key in pairs if key in found]
 
 
