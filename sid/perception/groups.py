@@ -49,7 +49,7 @@ class GroupParams:
 
     method: 'ospace' (people assigned to shared o-spaces, the default), 'gcff' (Setti et al.'s graph cuts),
       'rays' (the paper's ray crossings with two additions) or 'paper' (Algorithm 1 as written); the module
-      docstring says more, and ``sid.perception.rays`` for the last two.
+      docstring says more, and that of sid.perception.rays for the last two.
 
     The graph-cut method (``method='gcff'``, ``sid.perception.gcff``):
 
