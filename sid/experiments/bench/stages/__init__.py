@@ -17,70 +17,26 @@ frames, real crowds).
 
 from __future__ import annotations
 
-from sid.experiments.bench.stages.camera import ALIGN_MODES, depth_benchmarks, render_benchmarks
-from sid.experiments.bench.stages.core import (
-    PAPER_GROUP_MS,
-    PAPER_LIFT_MS,
-    PAPER_POSE_MS,
-    PAPER_TOTAL_MS,
-    Benchmark,
-    Context,
-    Records,
-    record,
-)
-from sid.experiments.bench.stages.grouping import (
-    DBSCAN_SIZES,
-    GROUP_SIZES,
-    GROUPING_THREADS,
-    PAPER_GROUP_MAX,
-    grouping_benchmarks,
-)
-from sid.experiments.bench.stages.inputs import CROWD_SPACING, grouping_scene
+from sid.experiments.bench.stages.camera import depth_benchmarks, render_benchmarks
+from sid.experiments.bench.stages.core import Benchmark, Context, Records, record
+from sid.experiments.bench.stages.grouping import grouping_benchmarks
+from sid.experiments.bench.stages.inputs import grouping_scene
 from sid.experiments.bench.stages.navigation import costmap_benchmarks, planning_benchmarks
-from sid.experiments.bench.stages.networks import (
-    FRAME_SIZES,
-    frame_benchmarks,
-    pose_benchmarks,
-    pose_models,
-    real_rgbd_folders,
-)
+from sid.experiments.bench.stages.networks import frame_benchmarks, pose_benchmarks, pose_models, real_rgbd_folders
 from sid.experiments.bench.stages.tracking import (
-    CROWD_FPS,
-    CROWD_RESOLUTION,
     CROWD_SETS,
     CROWD_SIZES,
-    CROWD_TARGET_MS,
-    CROWD_WARMUP_FRAMES,
-    TRACK_FPS,
-    TRACK_SIZES,
     crowd_benchmarks,
     crowd_sets,
     track_benchmarks,
 )
 
 __all__ = [
-    "ALIGN_MODES",
-    "Benchmark",
-    "CROWD_FPS",
-    "CROWD_RESOLUTION",
     "CROWD_SETS",
     "CROWD_SIZES",
-    "CROWD_SPACING",
-    "CROWD_TARGET_MS",
-    "CROWD_WARMUP_FRAMES",
+    "Benchmark",
     "Context",
-    "DBSCAN_SIZES",
-    "FRAME_SIZES",
-    "GROUPING_THREADS",
-    "GROUP_SIZES",
-    "PAPER_GROUP_MAX",
-    "PAPER_GROUP_MS",
-    "PAPER_LIFT_MS",
-    "PAPER_POSE_MS",
-    "PAPER_TOTAL_MS",
     "Records",
-    "TRACK_FPS",
-    "TRACK_SIZES",
     "benchmarks",
     "crowd_sets",
     "grouping_scene",

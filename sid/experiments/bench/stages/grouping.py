@@ -149,44 +149,36 @@ def _bench_dbscan_sklearn(n: int) -> Callable[[Context], Records]:
     return run
 
 
+# The other methods beside the default, each with its rows' description and the largest scene it runs on.
+_COMPARED_METHODS = (
+    ("gcff", "method gcff (graph cuts, the literature's reference)", max(GROUP_SIZES)),
+    ("rays", "method rays", max(GROUP_SIZES)),
+    ("paper", "method paper (Algorithm 1)", PAPER_GROUP_MAX),
+)
+
+
 def grouping_benchmarks() -> list[Benchmark]:
-    """The grouping stages in report order: every method on every size, then DBSCAN."""
+    """The grouping stages in report order: the default on every size, each other method and the authors' approach
+    beside it (with its ratio to the default), then DBSCAN."""
     items = [
         Benchmark(f"group/{n}", f"sid.perception.groups.detect_groups (default: ospace), {n} people", _bench_group(n))
         for n in GROUP_SIZES
     ]
-    items += [
-        Benchmark(
-            f"group_gcff/{n}",
-            f"detect_groups, method gcff (graph cuts, the literature's reference), {n} people",
-            _bench_group(n, "gcff"),
-            needs=(f"group/{n}",),
-        )
-        for n in GROUP_SIZES
-    ]
-    items += [
-        Benchmark(
-            f"group_rays/{n}", f"detect_groups, method rays, {n} people", _bench_group(n, "rays"), needs=(f"group/{n}",)
-        )
-        for n in GROUP_SIZES
-    ]
-    items += [
-        Benchmark(
-            f"group_paper/{n}",
-            f"detect_groups, method paper (Algorithm 1), {n} people",
-            _bench_group(n, "paper"),
-            needs=(f"group/{n}",),
-        )
-        for n in GROUP_SIZES
-        if n <= PAPER_GROUP_MAX
-    ]
+    for method, what, largest in _COMPARED_METHODS:
+        items += [
+            Benchmark(
+                f"group_{method}/{n}", f"detect_groups, {what}, {n} people", _bench_group(n, method), (f"group/{n}",)
+            )
+            for n in GROUP_SIZES
+            if n <= largest
+        ]
     items += [
         Benchmark(
             f"group_baseline/{n}",
             f"authors' approach (sid.experiments.bench.baseline), {n} people",
             _bench_baseline(n),
-            needs=(f"group/{n}",),
-        )  # fmt: skip
+            (f"group/{n}",),
+        )
         for n in GROUP_SIZES
         if n <= PAPER_GROUP_MAX
     ]
