@@ -22,6 +22,7 @@ __all__ = [
     "LIMITS_ENV",
     "LimitError",
     "MAX_COORDINATE",
+    "MAX_LENGTH",
     "Limits",
     "amount",
     "check_limit",
@@ -44,6 +45,9 @@ MAX_COORDINATE = 1e8
 """The largest |x| or |y| (m) of a person's position: 100 000 km, beyond any map frame on Earth (UTM northings reach
 1e7 m). Squared and summed, such coordinates stay finite and precise to about 1e-8 m; past ~1e154 m a squared
 distance overflows to infinity and the answers would be silent garbage."""
+MAX_LENGTH = 1e3
+"""The longest length (m) a group detector's constant may be (an o-space radius or cost length, GCFF's stride), a
+kilometre: far beyond any conversation. Squared and summed downstream, bounded constants stay finite."""
 
 
 @dataclass(frozen=True)

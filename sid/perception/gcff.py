@@ -66,8 +66,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sid.checks import check_limit, check_number, check_whole
-from sid.perception.ospace import MAX_LENGTH
+from sid.checks import MAX_LENGTH, check_limit, check_number, check_whole
 
 __all__ = ["GCFF_ORDERS", "GCFFParams", "gcff_labels"]
 

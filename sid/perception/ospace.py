@@ -61,9 +61,9 @@ import numpy as np
 if TYPE_CHECKING:  # imported where a crowd needs it: scipy.spatial is ~0.3 s of a command's start-up
     from scipy.spatial import cKDTree
 
-from sid.checks import check_number, check_whole
+from sid.checks import MAX_LENGTH, check_number, check_whole
 
-__all__ = ["MAX_LENGTH", "MAX_RADIUS_STEPS", "OSpace", "OSpaceModel", "TIE", "find_ospaces"]
+__all__ = ["MAX_RADIUS_STEPS", "OSpace", "OSpaceModel", "TIE", "find_ospaces"]
 
 # Greedy assignment and refit rounds at most; the partition is stable after 2-4 on the benchmarks.
 _MAX_ROUNDS = 8
@@ -76,8 +76,6 @@ threshold: rounding after a rigid motion of the scene moves them by ~1e-15."""
 _SMALL_PEOPLE_MAX = 16
 
 
-MAX_LENGTH = 1e3
-"""The longest length (m) an o-space constant may be, a kilometre: far beyond any conversation."""
 MAX_RADIUS_STEPS = 100
 """The most proposals per person (one per centimetre over a metre of radii); the search's arrays grow with them."""
 
