@@ -30,8 +30,9 @@ class ProgressBar:
     """``progress(done, total, what)``. On a terminal: a bar (rich) with the count, the elapsed time and an estimate
     of the time left, drawn on one line and left in place when ``done`` reaches ``total``. Off a terminal (a log
     file, a pipe): no redraws, one plain line at the start, at each tenth of the work and at the end, e.g.
-    ``simulate: 120/600 (20 %), 14 s, about 56 s left, t = 12.0 s``. A call with less done than the last starts a
-    new bar (a new stage of the work); the total may change (a run that ends early: ``progress(203, 203, ...)``)."""
+    ``simulate: 120/600 (20 %), 14 s, about 56 s left, t = 12.0 s`` (tenths of a second below 10 s). A call with
+    less done than the last starts a new bar (a new stage of the work); the total may change (a run that ends early:
+    ``progress(203, 203, ...)``)."""
 
     def __init__(self, label: str, stream: TextIO | None = None) -> None:
         self.label = label
@@ -97,6 +98,11 @@ class ProgressBar:
             return
         self._next_line = tenth + 1
         elapsed = time.monotonic() - self.start
-        left = f", about {elapsed * (total - done) / done:.0f} s left" if 0 < done < total else ""
-        line = f"{self.label}: {done}/{total} ({100 * done // total} %), {elapsed:.0f} s{left}, {what}"
+        left = f", about {_seconds(elapsed * (total - done) / done)} left" if 0 < done < total else ""
+        line = f"{self.label}: {done}/{total} ({100 * done // total} %), {_seconds(elapsed)}{left}, {what}"
         print(line, file=self.stream, flush=True)
+
+
+def _seconds(duration: float) -> str:
+    """A duration (s) for a progress line: tenths below 10 s (a run of a few seconds reads "0.4 s", not "0 s")."""
+    return f"{duration:.1f} s" if duration < 9.95 else f"{duration:.0f} s"

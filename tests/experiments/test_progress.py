@@ -5,7 +5,7 @@ from __future__ import annotations
 import io
 import re
 
-from sid.experiments.progress import ProgressBar
+from sid.experiments.progress import ProgressBar, _seconds
 from sid.experiments.simulate.loop import RunOptions
 from sid.experiments.simulate.run import write_run
 from tests.experiments.simulate.tiny import tiny_world
@@ -24,7 +24,7 @@ def test_off_a_terminal_one_line_per_tenth_and_no_redraws() -> None:
     lines = stream.getvalue().splitlines()
     assert "\r" not in stream.getvalue() and len(lines) == 11
     assert lines[0].startswith("work: 0/600 (0 %)") and lines[-1].startswith("work: 600/600 (100 %)")
-    assert all(re.search(r"about \d+ s left", line) for line in lines[1:-1])
+    assert all(re.search(r"about \d+(\.\d)? s left", line) for line in lines[1:-1])
 
 
 def test_on_a_terminal_a_bar_with_the_count_and_the_time_left() -> None:
@@ -44,9 +44,14 @@ def test_a_new_stage_starts_a_new_count() -> None:
             bar(done, 10, stage)
     lines = stream.getvalue().splitlines()
     assert [line for line in lines if "10/10" in line] == [
-        "tracking: 10/10 (100 %), 0 s, a",
-        "tracking: 10/10 (100 %), 0 s, b",
+        "tracking: 10/10 (100 %), 0.0 s, a",
+        "tracking: 10/10 (100 %), 0.0 s, b",
     ]
+
+
+def test_short_runs_read_in_tenths_of_a_second() -> None:
+    """A run of a few seconds said "0 s, about 0 s left" at every tenth."""
+    assert [_seconds(s) for s in (0.04, 0.44, 9.9, 9.96, 56.4)] == ["0.0 s", "0.4 s", "9.9 s", "10 s", "56 s"]
 
 
 def test_a_simulation_that_reaches_its_goal_early_ends_its_count_there() -> None:
