@@ -47,8 +47,9 @@ class GroupTrackerParams:
     two frames in a row at least confirm_time apart (s; a slow detector, as ``TrackerParams.confirm_time``).
     miss_timeout: seconds a reported group survives while not found. min_overlap: the Jaccard index of member sets
     above which a candidate continues a group. leave_distance: a member of a conversation farther than this from
-    its interest point (m) has left. walk_distance (m), walk_velocity_difference (m/s): walkers closer than this,
-    whose velocities differ by less than that, walk together. max_speed_sigma: a standing track joins conversations
+    its interest point (m) has left. walk_distance (m), walk_velocity_difference (m/s): walkers who stayed closer
+    than this to each other over the last walk_window seconds (s) and moved apart slower than that walk together.
+    max_speed_sigma: a standing track joins conversations
     only once its velocity is known within this (m/s, ``TrackedPerson.speed_sigma``): a track just started may be a
     walker whose motion is not yet seen. moving_speed: a track faster than this (m/s) takes part in walking groups
     whatever its walking / standing state.
@@ -251,8 +252,10 @@ def _walking_groups(
     i, j = np.nonzero(np.triu(_pair_distance(position) <= params.walk_distance, 1))
     velocity = np.array([[p.vx, p.vy] for p in walkers])
     alike = _relative_speed(ids, position, velocity, history, params, i, j) <= params.walk_velocity_difference
+    i, j = i[alike], j[alike]
+    close = _stayed_close(ids, history, params.walk_distance, i, j)
     linked = np.zeros((len(walkers), len(walkers)), dtype=bool)
-    linked[i[alike], j[alike]] = True
+    linked[i[close], j[close]] = True
     linked |= linked.T
     out = []
     for rows in connected_components(linked):
@@ -302,6 +305,26 @@ def _relative_speed(
         speed = np.where(both, relative, speed)
         filled |= both
     return speed
+
+
+def _stayed_close(
+    ids: np.ndarray, history: deque[_Positions], distance: float, i: np.ndarray, j: np.ndarray
+) -> np.ndarray:
+    """(P,) bool: each pair (i[k], j[k]) of tracks ``ids`` was within ``distance`` (m) of each other in every frame of
+    ``history`` (the last ``walk_window`` seconds) in which both were tracked. Strangers who close in on each other
+    for a moment are not yet a group; people walking together stay close."""
+    close = np.ones(len(i), dtype=bool)
+    for old in history:
+        if not close.any():
+            break
+        if not len(old.ids):
+            continue
+        rows = np.minimum(np.searchsorted(old.ids, ids), len(old.ids) - 1)
+        present = old.ids[rows] == ids
+        both = present[i] & present[j]
+        apart = old.positions[rows[i]] - old.positions[rows[j]]
+        close &= ~both | (apart[:, 0] ** 2 + apart[:, 1] ** 2 <= distance * distance)
+    return close
 
 
 def _pair_distance(points: np.ndarray) -> np.ndarray:

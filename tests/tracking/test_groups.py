@@ -188,6 +188,22 @@ def test_walkers_who_drift_apart_are_no_group_even_when_their_velocities_look_al
     assert groups == []
 
 
+def test_walkers_closing_in_become_a_group_only_once_close_for_the_whole_walk_window() -> None:
+    # Two walkers abreast at 1.2 m/s, the second closing in sideways at 0.5 m/s (below walk_velocity_difference) from
+    # 2.6 m to 0.8 m apart, reached at t = 3.6 s. They come within walk_distance (1.5 m) at t = 2.2 s, but were
+    # farther apart within the last walk_window (2 s) until t = 4.2 s: a stranger passing close is not yet a group.
+    tracker = GroupTracker(GroupTrackerParams(walk_window=2.0, walk_distance=1.5, walk_velocity_difference=0.8))
+    found = {}
+    for k in range(int(6.0 / DT)):
+        t = k * DT
+        gap = max(2.6 - 0.5 * t, 0.8)
+        lateral = 0.5 if gap > 0.8 else 0.0
+        people = [_person(1, 1.2 * t, 0.4, 0.0, (1.2, 0.0)), _person(2, 1.2 * t, 0.4 - gap, 0.0, (1.2, lateral))]
+        found[round(t, 3)] = [g.members for g in tracker.update(people, t)]
+    assert all(groups == [] for t, groups in found.items() if t <= 4.1)
+    assert all(groups == [(1, 2)] for t, groups in found.items() if t >= 4.6)
+
+
 @pytest.mark.parametrize(("dt", "frames_to_report"), [(1 / 15, 3), (0.4, 2)])
 def test_a_slow_detector_reports_a_group_found_twice_in_a_row_confirm_time_apart(
     dt: float, frames_to_report: int
