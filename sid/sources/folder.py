@@ -9,11 +9,13 @@ Two layouts (the calibration is ``intrinsics.json`` or ``calibration.json`` in t
 
 Depth PNGs are single-channel uint16 in depth units (metres = value * depth_scale; 0 = no reading). Colour is any
 8-bit image OpenCV reads; frames carry it as RGB. A frame whose files are missing, unreadable or of the wrong size
-raises ``FrameReadError`` naming the file, and iteration goes on with the next frame.
+raises ``FrameReadError`` naming the file (and, for a missing one, any file of its name in a format not read, e.g.
+depth in metres as ``1.tiff`` or ``1.npy``), and iteration goes on with the next frame.
 """
 
 from __future__ import annotations
 
+import glob
 import itertools
 import re
 from concurrent.futures import Future, ThreadPoolExecutor
@@ -48,6 +50,7 @@ class FolderSource:
             raise ValueError(f"folder source: fps must be positive, got {fps}")
         self.fps = float(fps)
         self.calibration = calibration if calibration is not None else self._read_calibration()
+        self.single = False  # the one-frame layout (DIR/color.png + DIR/depth.png); set by _find_pairs
         self.pairs = self._find_pairs()
 
     def _read_calibration(self) -> Calibration:
@@ -66,6 +69,7 @@ class FolderSource:
         single_color = [self.path / f"color{suffix}" for suffix in COLOR_SUFFIXES]
         single_color = [p for p in single_color if p.exists()]
         if single_color or (self.path / "depth.png").exists():
+            self.single = True
             depth = self.path / "depth.png"
             return [("color", single_color, [depth] if depth.exists() else [])]
         color_dir, depth_dir = self.path / "color", self.path / "depth"
@@ -93,9 +97,9 @@ class FolderSource:
         """Frame ``index`` (0-based). Raises FrameReadError naming the file when it cannot be used."""
         name, colors, depths = self.pairs[index]
         if not colors:
-            raise FrameReadError(f"frame {name!r}: no colour image in {self.path / 'color'}", index, None)
+            raise FrameReadError(f"frame {name!r}: no colour image {self._missing('color', name)}", index, None)
         if not depths:
-            raise FrameReadError(f"frame {name!r}: no depth image {name}.png next to {colors[0]}", index, None)
+            raise FrameReadError(f"frame {name!r}: no depth image {self._missing('depth', name)}", index, None)
         for kind, paths in (("colour", colors), ("depth", depths)):
             if len(paths) > 1:
                 names = " and ".join(str(p) for p in paths)
@@ -140,6 +144,29 @@ class FolderSource:
 
     def __iter__(self) -> _Reader:
         return _Reader(self)
+
+    def _missing(self, kind: str, name: str) -> str:
+        """Where frame ``name``'s ``kind`` image ("color" or "depth") was looked for, and any file of that name in a
+        format the folder does not read (depth saved as a float TIFF or ``.npy``, colour as BMP), e.g.
+        ``1.png in DIR/depth (DIR/depth/1.npy is not read: ...)``."""
+        folder, stem = (self.path, kind) if self.single else (self.path / kind, name)
+        suffixes, expected = (
+            (COLOR_SUFFIXES, f"{stem}.png, .jpg or .jpeg") if kind == "color" else ((".png",), f"{stem}.png")
+        )
+        others = [
+            path
+            for path in sorted(folder.glob(f"{glob.escape(stem)}.*"))
+            if path.stem == stem and path.suffix.lower() not in suffixes
+        ]
+        if not others:
+            return f"{expected} in {folder}"
+        rule = (
+            "colour images are PNG or JPEG"
+            if kind == "color"
+            else "depth images are single-channel 16-bit PNGs in depth units"
+        )
+        verb = "is" if len(others) == 1 else "are"
+        return f"{expected} in {folder} ({' and '.join(map(str, others))} {verb} not read: {rule})"
 
 
 class _Reader:

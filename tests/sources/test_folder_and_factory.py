@@ -204,3 +204,32 @@ def test_frame_names_that_are_not_plain_numbers_sort_and_play(tmp_path: Path) ->
     source = FolderSource(tmp_path)
     assert [name for name, _, _ in source.pairs] == ["2", "10", "frame1", "x٣", "²"]
     assert len(list(source)) == 5
+
+
+def test_a_missing_image_is_named_with_any_file_of_its_name_that_is_not_read(tmp_path: Path) -> None:
+    """Depth saved as float TIFF or .npy (metres), colour as BMP: the frame is skipped naming the file sid expected,
+    in the layout's own place, and the file of that name it found but does not read, with the format it reads."""
+    write_pair(tmp_path / "color" / "1.png", tmp_path / "depth" / "x.png", 1000)
+    np.save(tmp_path / "depth" / "1.npy", np.ones((48, 64), np.float32))
+    (tmp_path / "depth" / "x.png").unlink()
+    write_pair(tmp_path / "other" / "2.png", tmp_path / "depth" / "2.png", 1000)
+    assert cv2.imwrite(str(tmp_path / "color" / "2.bmp"), np.zeros((48, 64, 3), np.uint8))
+    (tmp_path / "intrinsics.json").write_text(json.dumps(INTR))
+    errors: list[FrameReadError] = []
+    assert list(skip_unreadable(FolderSource(tmp_path), errors.append)) == []
+    assert [str(e) for e in errors] == [
+        f"frame '1': no depth image 1.png in {tmp_path / 'depth'} ({tmp_path / 'depth' / '1.npy'} is not read: "
+        "depth images are single-channel 16-bit PNGs in depth units)",
+        f"frame '2': no colour image 2.png, .jpg or .jpeg in {tmp_path / 'color'} ({tmp_path / 'color' / '2.bmp'} is "
+        "not read: colour images are PNG or JPEG)",
+    ]
+    single = tmp_path / "single"
+    write_pair(single / "color.png", single / "x" / "depth.png", 1000)
+    assert cv2.imwrite(str(single / "depth.tiff"), np.ones((48, 64), np.float32))  # metres, as float
+    (single / "intrinsics.json").write_text(json.dumps(INTR))
+    with pytest.raises(FrameReadError) as raised:
+        list(FolderSource(single))
+    assert str(raised.value) == (
+        f"frame 'color': no depth image depth.png in {single} ({single / 'depth.tiff'} is not read: depth images are "
+        "single-channel 16-bit PNGs in depth units)"
+    )
