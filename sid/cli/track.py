@@ -11,10 +11,11 @@ Output, one line per good input line, flushed as it is written, the tracks as `s
      "groups": [{"id": 1, "kind": "conversation"|"walking", "members": [1, 2], "interest_point": [x, y],
                  "area": a, "spread": d, "zone": [[x, y], ...], "velocity": [vx, vy]}],
      "timing_ms": {"track": ms, "track_groups": ms}}
-A malformed line (not UTF-8 JSON, a key given twice, an unknown field, a missing or non-finite number, a timestamp
-not after the last good line's, two people with one id) is reported on stderr with its line number and skipped,
-or ends the run with --strict (exit 2); everything written before it stays written. The people and group trackers
-run with their defaults; the group detector that finds conversations among the tracks takes the options below.
+A malformed line (not UTF-8 JSON, a key given twice, an unknown field, a missing or non-finite number, a theta
+beyond two turns (in degrees by mistake), a timestamp not after the last good line's, two people with one id) is
+reported on stderr with its line number and skipped, or ends the run with --strict (exit 2); everything written
+before it stays written. The people and group trackers run with their defaults; the group detector that finds
+conversations among the tracks takes the options below.
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ import argparse
 from collections.abc import Iterable
 from typing import Any, TextIO
 
-from sid.checks import check_limit
+from sid.checks import check_limit, check_yaw
 from sid.cli.common import fail, process_json_lines, refuse_unknown_fields, run_json_lines
 from sid.cli.grouping import add_json_lines_command, group_params_from
 from sid.documents import is_number, summary
@@ -107,4 +108,5 @@ def _parse_person(data: Any, index: int) -> Person:
         )
     if theta is None:
         return Person(person_id, float(data["x"]), float(data["y"]))
+    check_yaw(where, "theta", theta)
     return Person(person_id, float(data["x"]), float(data["y"]), float(theta), 1.0)

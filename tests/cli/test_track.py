@@ -241,3 +241,12 @@ def test_help_describes_the_input_and_output(capsys):
     assert text.startswith("usage: sid track [-h] [--strict]")
     for needle in ('"timestamp"', '"detection"', "theta null or absent", "REP-103", "--strict", "--method", "FILE"):
         assert needle in text
+
+
+def test_a_facing_in_degrees_by_mistake_is_a_malformed_line(tmp_path, capsys):
+    """theta 90 read as radians points anywhere: a yaw beyond two turns is refused, naming the unit."""
+    lines = [{"timestamp": 0.0, "people": [{"x": 1.0, "y": 0.0, "theta": 1.5}]}]
+    lines.append({"timestamp": 0.1, "people": [{"x": 1.0, "y": 0.0, "theta": -90}]})
+    code, out, err = run_sid(["track", str(write_lines(tmp_path / "in.jsonl", lines))], capsys)
+    assert code == 0 and [record["timestamp"] for record in out] == [0.0]
+    assert err[0] == "sid track: line 2: people[0]: theta -90 is beyond two turns (4 pi): radians expected, not degrees"
