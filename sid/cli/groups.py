@@ -42,7 +42,7 @@ def run(args: argparse.Namespace) -> int:
         params = group_params_from(args)
     except ValueError as exc:
         return fail("sid groups", exc)
-    return run_json_lines("sid groups", args.file, lambda data: _groups_line(data, params), strict=args.strict)
+    return run_json_lines("sid groups", args.file, lambda data, _note: _groups_line(data, params), strict=args.strict)
 
 
 def process(lines: Iterable[str | bytes], out: TextIO, err: TextIO, params: GroupParams, strict: bool = False) -> int:
@@ -50,7 +50,9 @@ def process(lines: Iterable[str | bytes], out: TextIO, err: TextIO, params: Grou
 
     ``lines`` are text, or bytes decoded here line by line as UTF-8 (a byte-order mark before the first is dropped).
     """
-    return process_json_lines("sid groups", lines, out, err, lambda data: _groups_line(data, params), strict=strict)
+    return process_json_lines(
+        "sid groups", lines, out, err, lambda data, _note: _groups_line(data, params), strict=strict
+    )
 
 
 def _groups_line(data: Any, params: GroupParams) -> dict[str, Any]:

@@ -14,14 +14,15 @@ Output, one line per good input line, flushed as it is written, the tracks as `s
 A malformed line (not UTF-8 JSON, a key given twice, an unknown field, a missing or non-finite number, a theta
 beyond two turns (in degrees by mistake), a timestamp not after the last good line's, two people with one id) is
 reported on stderr with its line number and skipped, or ends the run with --strict (exit 2); everything written
-before it stays written. The people and group trackers run with their defaults; the group detector that finds
-conversations among the tracks takes the options below.
+before it stays written. A line more than the tracker's timeout (1.5 s) after the last good one ends every track, and
+a note on stderr says so (timestamps in milli- or nanoseconds do it at every line). The people and group trackers
+run with their defaults; the group detector that finds conversations among the tracks takes the options below.
 """
 
 from __future__ import annotations
 
 import argparse
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from typing import Any, TextIO
 
 from sid.checks import check_limit, check_yaw
@@ -46,7 +47,9 @@ def run(args: argparse.Namespace) -> int:
         session = TrackingSession(group_params=group_params_from(args))
     except ValueError as exc:
         return fail("sid track", exc)
-    return run_json_lines("sid track", args.file, lambda data: _track_line(data, session), strict=args.strict)
+    return run_json_lines(
+        "sid track", args.file, lambda data, note: _track_line(data, session, note), strict=args.strict
+    )
 
 
 def process(
@@ -54,14 +57,25 @@ def process(
 ) -> int:
     """Track ``lines`` (text, or bytes decoded line by line) into ``session``, writing one JSON line per good line on
     ``out`` and each problem on ``err``; the exit code (2 when ``strict`` stopped at a bad line)."""
-    return process_json_lines("sid track", lines, out, err, lambda data: _track_line(data, session), strict=strict)
+    return process_json_lines(
+        "sid track", lines, out, err, lambda data, note: _track_line(data, session, note), strict=strict
+    )
 
 
-def _track_line(data: Any, session: TrackingSession) -> dict[str, Any]:
+def _track_line(data: Any, session: TrackingSession, note: Callable[[str], None]) -> dict[str, Any]:
     """The output line of one parsed input line, after ``session`` tracked its people (ValueError for a malformed
-    line, the session unchanged)."""
+    line, the session unchanged). A gap since the last line longer than the tracker's timeout ends every track (no
+    view: every track counts as seen): ``note`` says so, since timestamps in milli- or nanoseconds do it at every
+    line and nobody is ever reported."""
     timestamp, people = _parse_line(data)
+    last, alive = session.people.timestamp, len(session.people)
     update = session.track(people, float(timestamp))
+    timeout = session.params.tracker.timeout
+    if alive and last is not None and timestamp - last > timeout:
+        note(
+            f"{timestamp - last:.3g} s after the last line, more than the tracker's timeout ({timeout:g} s): every "
+            "track ended (are the timestamps in seconds?)"
+        )
     return {
         "timestamp": timestamp,
         "people": [person.to_json() | {"detection": person.detection} for person in update.people],
