@@ -8,9 +8,11 @@ Two layouts (the calibration is ``intrinsics.json`` or ``calibration.json`` in t
   (``frame2`` before ``frame10``).
 
 Depth PNGs are single-channel uint16 in depth units (metres = value * depth_scale; 0 = no reading). Colour is any
-8-bit image OpenCV reads; frames carry it as RGB. A frame whose files are missing, unreadable or of the wrong size
-raises ``FrameReadError`` naming the file (and, for a missing one, any file of its name in a format not read, e.g.
-depth in metres as ``1.tiff`` or ``1.npy``), and iteration goes on with the next frame.
+image OpenCV reads (greyscale, RGBA and 16-bit ones become 8-bit RGB), its pixels as stored (a JPEG's EXIF
+orientation is not applied: depth is registered to the stored pixels); frames carry it as RGB. A frame whose files
+are missing, unreadable or of the wrong size raises ``FrameReadError`` naming the file (and, for a missing one, any
+file of its name in a format not read, e.g. depth in metres as ``1.tiff`` or ``1.npy``), and iteration goes on with
+the next frame.
 """
 
 from __future__ import annotations
@@ -112,7 +114,9 @@ class FolderSource:
         grid = calib.depth if calib.depth is not None else calib.color
         _check_size(color_path, "colour image", calib.color.width, calib.color.height, index)  # before decoding
         _check_size(depth_path, "depth image", grid.width, grid.height, index)
-        rgb = cv2.imread(str(color_path), cv2.IMREAD_COLOR_RGB)  # decoded straight to RGB: no conversion pass
+        # Decoded straight to RGB (no conversion pass), as stored: depth is registered to the stored pixels, so a
+        # JPEG's EXIF orientation, which OpenCV would apply, is not.
+        rgb = cv2.imread(str(color_path), cv2.IMREAD_COLOR_RGB | cv2.IMREAD_IGNORE_ORIENTATION)
         if rgb is None:
             raise FrameReadError(f"cannot read colour image {color_path}", index, color_path)
         raw = cv2.imread(str(depth_path), cv2.IMREAD_UNCHANGED)

@@ -233,3 +233,39 @@ def test_a_missing_image_is_named_with_any_file_of_its_name_that_is_not_read(tmp
         f"frame 'color': no depth image depth.png in {single} ({single / 'depth.tiff'} is not read: depth images are "
         "single-channel 16-bit PNGs in depth units)"
     )
+
+
+def test_a_jpeg_orientation_tag_does_not_turn_the_colour_image_away_from_its_depth(tmp_path: Path) -> None:
+    """Depth is registered to the stored pixels: OpenCV turned a JPEG by its EXIF orientation (180 degrees: every
+    person's keypoints looked up at the wrong depth, 'no people'; 90: a 48x64 image against the header's 64x48)."""
+    from PIL import Image
+
+    stored = np.zeros((48, 64, 3), np.uint8)
+    stored[:, 32:] = 255  # left half black, right half white, as stored
+    for orientation in (3, 6):
+        folder = tmp_path / str(orientation)
+        write_pair(folder / "x.png", folder / "depth.png", 1000)
+        exif = Image.Exif()
+        exif[0x0112] = orientation  # EXIF Orientation: 3 = rotate 180, 6 = rotate 90
+        Image.fromarray(stored).save(folder / "color.jpg", exif=exif.tobytes(), quality=100)
+        (folder / "intrinsics.json").write_text(json.dumps(INTR))
+        (frame,) = list(FolderSource(folder))
+        assert frame.color.shape == (48, 64, 3)
+        assert frame.color[:, :30].max() < 30 and frame.color[:, 34:].min() > 225
+
+
+@pytest.mark.parametrize("kind", ["grey", "rgba", "16-bit"])
+def test_grey_rgba_and_16_bit_colour_images_are_read_as_8_bit_rgb(tmp_path: Path, kind: str) -> None:
+    rgb = write_pair(tmp_path / "color.png", tmp_path / "depth.png", 1000)
+    bgr = cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR)
+    stored = {
+        "grey": cv2.cvtColor(bgr, cv2.COLOR_BGR2GRAY),
+        "rgba": cv2.cvtColor(bgr, cv2.COLOR_BGR2BGRA),
+        "16-bit": bgr.astype(np.uint16) * 257,
+    }[kind]
+    assert cv2.imwrite(str(tmp_path / "color.png"), stored)
+    (tmp_path / "intrinsics.json").write_text(json.dumps(INTR))
+    (frame,) = list(FolderSource(tmp_path))
+    assert frame.color.dtype == np.uint8 and frame.color.shape == (48, 64, 3)
+    expected = np.repeat(stored[..., None], 3, axis=2) if kind == "grey" else rgb
+    assert np.abs(frame.color.astype(int) - expected).max() <= 1
