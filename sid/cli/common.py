@@ -314,7 +314,14 @@ def read_json_lines(lines: Iterable[str | bytes]) -> Iterator[tuple[int, Any, st
             continue
         try:
             value = json.loads(line, parse_constant=_reject_constant, object_pairs_hook=unique_keys)
-        except ValueError as exc:  # json.JSONDecodeError, NaN or Infinity, a duplicate key
+        except json.JSONDecodeError as exc:  # its "line 2 column 1" would count lines within this one line
+            text = line.rstrip()
+            where = "the end of the line" if exc.pos >= len(text) else f"character {exc.pos + 1} of the line"
+            if text.strip() in ("{", "["):  # the first line of an indented JSON document
+                where += "; JSON lines hold one whole object per line: is this one JSON document over several lines?"
+            yield number, None, f"not valid JSON ({exc.msg} at {where})"
+            continue
+        except ValueError as exc:  # NaN or Infinity, a duplicate key
             yield number, None, f"not valid JSON ({exc})"
             continue
         except RecursionError:

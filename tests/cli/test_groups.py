@@ -388,3 +388,16 @@ def test_a_facing_in_degrees_by_mistake_is_a_malformed_line(tmp_path, capsys):
     assert err.splitlines()[0] == (
         "sid groups: line 2: people[1] (id 2): theta 180 is beyond two turns (4 pi): radians expected, not degrees"
     )
+
+
+def test_a_json_document_written_over_several_lines_is_named_as_such(tmp_path, capsys):
+    """An indented JSON file is not JSON lines: its first line, a lone brace, said 'line 2 column 1 (char 2)' of a
+    one-line input; the position is now within the line, and the message says what JSON lines are."""
+    source = tmp_path / "frames.json"
+    source.write_text(json.dumps(PAIR, indent=2) + "\n")
+    code, out, err = run_sid(["groups", "--strict", str(source)], capsys)
+    assert code == 2 and out == []
+    assert err == (
+        "sid groups: line 1: not valid JSON (Expecting property name enclosed in double quotes at the end of the line; "
+        "JSON lines hold one whole object per line: is this one JSON document over several lines?)\n"
+    )

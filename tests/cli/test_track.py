@@ -101,7 +101,7 @@ def test_a_walking_pair_and_a_standing_conversation_are_tracked_with_stable_ids(
 
 
 BAD_LINES = [
-    ("{not json", "not valid JSON (Expecting property name enclosed in double quotes: line 1 column 2 (char 1))"),
+    ("{not json", "not valid JSON (Expecting property name enclosed in double quotes at character 2 of the line)"),
     ("[1, 2]", "expected a JSON object with 'timestamp' and 'people'"),
     ('{"people": []}', "missing 'timestamp'"),
     ('{"timestamp": "0.5", "people": []}', "'timestamp' must be a finite number of seconds, got \"0.5\""),
