@@ -26,7 +26,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from sid.documents import read_image_header, special_file
+from sid.documents import image_cut_short, read_image_header, special_file
 from sid.perception.camera import Calibration
 from sid.perception.frame import Frame
 from sid.sources import FrameReadError, SourceError
@@ -112,16 +112,13 @@ class FolderSource:
         color_path, depth_path = colors[0], depths[0]
         calib = self.calibration
         grid = calib.depth if calib.depth is not None else calib.color
-        _check_size(color_path, "colour image", calib.color.width, calib.color.height, index)  # before decoding
-        _check_size(depth_path, "depth image", grid.width, grid.height, index)
+        color_format = _check_size(color_path, "colour image", calib.color.width, calib.color.height, index)
+        depth_format = _check_size(depth_path, "depth image", grid.width, grid.height, index)  # both before decoding
         # Decoded straight to RGB (no conversion pass), as stored: depth is registered to the stored pixels, so a
         # JPEG's EXIF orientation, which OpenCV would apply, is not.
-        rgb = cv2.imread(str(color_path), cv2.IMREAD_COLOR_RGB | cv2.IMREAD_IGNORE_ORIENTATION)
-        if rgb is None:
-            raise FrameReadError(f"cannot read colour image {color_path}", index, color_path)
-        raw = cv2.imread(str(depth_path), cv2.IMREAD_UNCHANGED)
-        if raw is None:
-            raise FrameReadError(f"cannot read depth image {depth_path}", index, depth_path)
+        flags = cv2.IMREAD_COLOR_RGB | cv2.IMREAD_IGNORE_ORIENTATION
+        rgb = _decode(color_path, "colour image", color_format, flags, index)
+        raw = _decode(depth_path, "depth image", depth_format, cv2.IMREAD_UNCHANGED, index)
         if raw.dtype != np.uint16 or raw.ndim != 2:
             raise FrameReadError(
                 f"depth image {depth_path} must be single-channel 16-bit (depth units), got {raw.dtype} "
@@ -202,9 +199,10 @@ class _Reader:
         return current.result()
 
 
-def _check_size(path: Path, what: str, width: int, height: int, index: int) -> None:
-    """FrameReadError unless the image's header declares the calibration's ``width`` x ``height`` pixels, read
-    before any pixel is decoded (a header of 20000 x 20000 would make OpenCV allocate gigabytes first)."""
+def _check_size(path: Path, what: str, width: int, height: int, index: int) -> str:
+    """The image's format (``ImageHeader.format``); FrameReadError unless its header declares the calibration's
+    ``width`` x ``height`` pixels, read before any pixel is decoded (a header of 20000 x 20000 would make OpenCV
+    allocate gigabytes first)."""
     try:
         header = read_image_header(path, what)
     except ValueError as exc:
@@ -213,6 +211,22 @@ def _check_size(path: Path, what: str, width: int, height: int, index: int) -> N
         raise FrameReadError(
             f"{what} {path} is {header.width}x{header.height}, the calibration says {width}x{height}", index, path
         )
+    return header.format
+
+
+def _decode(path: Path, what: str, format: str, flags: int, index: int) -> np.ndarray:
+    """The pixels of the image file ``path`` of ``format``, decoded with OpenCV's imread ``flags``; FrameReadError
+    when it cannot be read, is cut short (a JPEG would decode in part, the rest grey) or does not decode."""
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise FrameReadError(f"cannot read {what} {path} ({exc.strerror or exc})", index, path) from None
+    if image_cut_short(data, format):
+        raise FrameReadError(f"{what} {path} is cut short: it ends before the image does", index, path)
+    image = cv2.imdecode(np.frombuffer(data, np.uint8), flags)
+    if image is None:
+        raise FrameReadError(f"cannot read {what} {path}", index, path)
+    return image
 
 
 def _natural_key(name: str) -> list[int | str]:

@@ -269,3 +269,23 @@ def test_grey_rgba_and_16_bit_colour_images_are_read_as_8_bit_rgb(tmp_path: Path
     assert frame.color.dtype == np.uint8 and frame.color.shape == (48, 64, 3)
     expected = np.repeat(stored[..., None], 3, axis=2) if kind == "grey" else rgb
     assert np.abs(frame.color.astype(int) - expected).max() <= 1
+
+
+def test_an_image_cut_short_in_the_middle_of_a_sequence_is_skipped_naming_it(tmp_path: Path) -> None:
+    """A JPEG cut short decoded in part (the rest grey, only libjpeg's 'Premature end of JPEG file' on stderr) and
+    its frame went on as a good one; a cut PNG failed in libpng. Each is now its frame's FrameReadError, and the
+    frames around it play."""
+    for k in range(1, 5):
+        write_pair(tmp_path / "color" / f"{k}.png", tmp_path / "depth" / f"{k}.png", 1000 * k, seed=k)
+    (tmp_path / "color" / "2.png").unlink()
+    assert cv2.imwrite(str(tmp_path / "color" / "2.jpg"), np.full((48, 64, 3), 200, np.uint8))
+    for path in (tmp_path / "color" / "2.jpg", tmp_path / "depth" / "3.png"):
+        path.write_bytes(path.read_bytes()[:-40])  # the end of the file lost, as a copy cut short
+    (tmp_path / "intrinsics.json").write_text(json.dumps(INTR))
+    errors: list[FrameReadError] = []
+    frames = list(skip_unreadable(FolderSource(tmp_path), errors.append))
+    assert [f.index for f in frames] == [0, 3]
+    assert [(e.index, str(e)) for e in errors] == [
+        (1, f"colour image {tmp_path / 'color' / '2.jpg'} is cut short: it ends before the image does"),
+        (2, f"depth image {tmp_path / 'depth' / '3.png'} is cut short: it ends before the image does"),
+    ]
