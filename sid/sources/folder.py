@@ -112,8 +112,10 @@ class FolderSource:
         color_path, depth_path = colors[0], depths[0]
         calib = self.calibration
         grid = calib.depth if calib.depth is not None else calib.color
+        # both sizes from the headers, before anything is decoded
         color_format = _check_size(color_path, "colour image", calib.color.width, calib.color.height, index)
-        depth_format = _check_size(depth_path, "depth image", grid.width, grid.height, index)  # both before decoding
+        registered = "" if calib.depth is not None else _REGISTERED
+        depth_format = _check_size(depth_path, "depth image", grid.width, grid.height, index, registered)
         # Decoded straight to RGB (no conversion pass), as stored: depth is registered to the stored pixels, so a
         # JPEG's EXIF orientation, which OpenCV would apply, is not.
         flags = cv2.IMREAD_COLOR_RGB | cv2.IMREAD_IGNORE_ORIENTATION
@@ -199,17 +201,23 @@ class _Reader:
         return current.result()
 
 
-def _check_size(path: Path, what: str, width: int, height: int, index: int) -> str:
-    """The image's format (``ImageHeader.format``); FrameReadError unless its header declares the calibration's
-    ``width`` x ``height`` pixels, read before any pixel is decoded (a header of 20000 x 20000 would make OpenCV
-    allocate gigabytes first)."""
+_REGISTERED = (
+    " (depth registered to colour has the colour image's size; depth of its own size needs the calibration's depth "
+    "and depth_to_color sections)"
+)
+
+
+def _check_size(path: Path, what: str, width: int, height: int, index: int, hint: str = "") -> str:
+    """The image's format (``ImageHeader.format``); FrameReadError (``hint`` ending its message) unless its header
+    declares the calibration's ``width`` x ``height`` pixels, read before any pixel is decoded (a header of 20000 x
+    20000 would make OpenCV allocate gigabytes first)."""
     try:
         header = read_image_header(path, what)
     except ValueError as exc:
         raise FrameReadError(str(exc), index, path) from None
     if (header.width, header.height) != (width, height):
         raise FrameReadError(
-            f"{what} {path} is {header.width}x{header.height}, the calibration says {width}x{height}", index, path
+            f"{what} {path} is {header.width}x{header.height}, the calibration says {width}x{height}{hint}", index, path
         )
     return header.format
 

@@ -289,3 +289,15 @@ def test_an_image_cut_short_in_the_middle_of_a_sequence_is_skipped_naming_it(tmp
         (1, f"colour image {tmp_path / 'color' / '2.jpg'} is cut short: it ends before the image does"),
         (2, f"depth image {tmp_path / 'depth' / '3.png'} is cut short: it ends before the image does"),
     ]
+
+
+def test_depth_of_another_size_than_colour_under_a_registered_calibration_says_what_it_needs(tmp_path: Path) -> None:
+    write_pair(tmp_path / "color.png", tmp_path / "x" / "depth.png", 1000)
+    assert cv2.imwrite(str(tmp_path / "depth.png"), np.full((24, 32), 1000, np.uint16))  # half the colour's size
+    (tmp_path / "intrinsics.json").write_text(json.dumps(INTR))  # flat: depth registered to colour
+    with pytest.raises(FrameReadError) as raised:
+        list(FolderSource(tmp_path))
+    assert str(raised.value) == (
+        f"depth image {tmp_path / 'depth.png'} is 32x24, the calibration says 64x48 (depth registered to colour has "
+        "the colour image's size; depth of its own size needs the calibration's depth and depth_to_color sections)"
+    )
