@@ -25,7 +25,7 @@ import argparse
 from collections.abc import Callable, Iterable
 from typing import Any, TextIO
 
-from sid.checks import check_limit, check_yaw
+from sid.checks import check_limit, check_yaw, repeated
 from sid.cli.common import fail, process_json_lines, refuse_unknown_fields, run_json_lines
 from sid.cli.grouping import add_json_lines_command, group_params_from
 from sid.documents import is_number, summary
@@ -98,7 +98,15 @@ def _parse_line(data: Any) -> tuple[int | float, list[Person]]:
     if not isinstance(data["people"], list):
         raise ValueError("'people' must be a list")
     check_limit("people", len(data["people"]), "people", "people")  # before any work on them (sid.checks.Limits)
-    return timestamp, [_parse_person(person, k) for k, person in enumerate(data["people"])]
+    people = [_parse_person(person, k) for k, person in enumerate(data["people"])]
+    ids = [person.id for person in people]
+    twice = repeated(ids)
+    if twice is not None:
+        first, second = [k for k, person_id in enumerate(ids) if person_id == twice][:2]
+        defaults = [f"people[{k}]" for k in (first, second) if "id" not in data["people"][k]]
+        why = f" ({defaults[0]} has no 'id': its index in the list is its id)" if defaults else ""
+        raise ValueError(f"people[{first}] and people[{second}] have one id, {twice}{why}")
+    return timestamp, people
 
 
 def _parse_person(data: Any, index: int) -> Person:

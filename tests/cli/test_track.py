@@ -128,7 +128,7 @@ BAD_LINES = [
     ('{"timestamp": 0.5, "people": [{"id": 1.5, "x": 0, "y": 0}]}', "people[0]: id must be an integer, got 1.5"),
     (
         '{"timestamp": 0.5, "people": [{"id": 4, "x": 0, "y": 0}, {"id": 4, "x": 1, "y": 0}]}',
-        "tracker: person id 4 appears twice in one frame",
+        "people[0] and people[1] have one id, 4",
     ),
 ]
 
@@ -177,7 +177,7 @@ def test_timestamps_out_of_order_are_refused_naming_both(tmp_path, capsys):
     assert err == [
         "sid track: line 2: frame is out of time order: its timestamp 0.5 s is not after the last one, 1.0 s",
         "sid track: line 3: frame is out of time order: its timestamp 1.0 s is not after the last one, 1.0 s",
-        "sid track: line 4: tracker: person id 1 appears twice in one frame",
+        "sid track: line 4: people[0] and people[1] have one id, 1",
         "sid track: skipped 3 malformed lines",
     ]
 
@@ -272,4 +272,23 @@ def test_a_gap_that_ends_every_track_is_noted_so_timestamps_in_another_unit_are_
     assert err == [
         "sid track: line 4: note: 4.8 s after the last line, more than the tracker's timeout (1.5 s): every track "
         "ended (are the timestamps in seconds?)"
+    ]
+
+
+def test_an_id_given_twice_names_both_people_and_a_default_id(tmp_path, capsys):
+    """A person without an id takes its index: beside an explicit id 1 at index 0, the person at index 1 collided
+    with it under 'person id 1 appears twice', an id the line gives once."""
+    lines = [
+        {"timestamp": 0.0, "people": [{"id": 1, "x": 0.0, "y": 0.0}, {"x": 1.0, "y": 0.0}]},
+        {
+            "timestamp": 0.1,
+            "people": [{"id": 4, "x": 0.0, "y": 0.0}, {"x": 1.0, "y": 0.0}, {"id": 4, "x": 2.0, "y": 0.0}],
+        },
+    ]
+    code, out, err = run_sid(["track", str(write_lines(tmp_path / "in.jsonl", lines))], capsys)
+    assert code == 0 and out == []
+    assert err[:2] == [
+        "sid track: line 1: people[0] and people[1] have one id, 1 (people[1] has no 'id': its index in the list is "
+        "its id)",
+        "sid track: line 2: people[0] and people[2] have one id, 4",
     ]
