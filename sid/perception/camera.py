@@ -23,6 +23,7 @@ from sid.documents import InputWarning, is_number, load_document, summary
 __all__ = [
     "Calibration",
     "Extrinsics",
+    "INTRINSICS_FIELDS",
     "Intrinsics",
     "MAX_BASELINE",
     "MAX_FOCAL_PER_PIXEL",
