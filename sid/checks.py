@@ -24,11 +24,13 @@ __all__ = [
     "MAX_COORDINATE",
     "MAX_LENGTH",
     "Limits",
+    "YAW_LIMIT_RAD",
     "amount",
     "check_limit",
     "check_number",
     "check_numbers",
     "check_whole",
+    "check_yaw",
     "is_real",
     "limits",
     "limits_from_environment",
@@ -48,6 +50,9 @@ distance overflows to infinity and the answers would be silent garbage."""
 MAX_LENGTH = 1e3
 """The longest length (m) a group detector's constant may be (an o-space radius or cost length, GCFF's stride), a
 kilometre: far beyond any conversation. Squared and summed downstream, bounded constants stay finite."""
+YAW_LIMIT_RAD = 4 * math.pi
+"""No yaw in radians is written beyond two turns (an unwrapped ``a + pi`` stays well within); a yaw beyond is in
+degrees, most likely (a quarter turn written 90)."""
 
 
 @dataclass(frozen=True)
@@ -198,6 +203,13 @@ def check_whole(
             rule = "a whole number"
         raise error(f"{owner}: {name} must be {rule}, got {value!r}")
     return int(number)
+
+
+def check_yaw(owner: str, name: str, value: float) -> None:
+    """ValueError unless ``value`` is a yaw within two turns of 0 (``YAW_LIMIT_RAD``): 90 or 180 is a facing in
+    degrees, which read as radians points anywhere. ``value`` is a finite number already."""
+    if abs(value) > YAW_LIMIT_RAD:
+        raise ValueError(f"{owner}: {name} {value:g} is beyond two turns (4 pi): radians expected, not degrees")
 
 
 def check_numbers(owner: str, record: object, names: Iterable[str], **bounds: Any) -> None:

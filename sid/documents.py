@@ -24,6 +24,7 @@ __all__ = [
     "InputWarning",
     "TEMPORARY_PREFIX",
     "decode_text",
+    "image_cut_short",
     "is_number",
     "load_document",
     "read_image_header",
@@ -250,6 +251,30 @@ def read_image_header(path: str | Path, what: str) -> ImageHeader:
         f"cannot read {what} {path}: not a PNG, JPEG, PGM/PPM, BMP or TIFF image (the formats whose size sid reads "
         "before decoding)"
     )
+
+
+def image_cut_short(data: bytes, format: str) -> bool:
+    """Whether the encoded image ``data``, of Pillow's ``format`` name (``ImageHeader.format``), ends before its
+    end: a PNG without its whole IEND chunk, a JPEG without an end-of-image marker after its first scan starts (its
+    header's segments, an EXIF thumbnail's own marker among them, are skipped by their lengths; within the scans, FF
+    D9 is that marker and nothing else). A cut JPEG would otherwise decode in part (OpenCV greys the rest, with a
+    libjpeg warning on stderr); a cut PNG fails in libpng. Bytes after the end do not count; other formats are not
+    checked (False)."""
+    if format == "PNG":
+        end = data.rfind(b"\0\0\0\0IEND")  # the last chunk: no data, then its 4-byte CRC
+        return end < 0 or len(data) < end + 12
+    if format != "JPEG":
+        return False
+    pos = 2  # after the start-of-image marker
+    while pos + 3 < len(data) and data[pos] == 0xFF:
+        marker = data[pos + 1]
+        if marker == 0xFF:  # a fill byte
+            pos += 1
+            continue
+        pos += 2 + int.from_bytes(data[pos + 2 : pos + 4], "big")  # the segment, its length included
+        if marker == 0xDA:  # the first scan: its data, and any later scan, end at the end-of-image marker
+            return data.rfind(b"\xff\xd9", pos) < 0  # from the end: at once for a whole file
+    return True  # the header is cut, or not a run of segments
 
 
 def plural(count: int, singular: str, plural_form: str | None = None) -> str:

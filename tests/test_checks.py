@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-from sid.checks import check_number, check_numbers, check_whole, repeated
+from sid.checks import YAW_LIMIT_RAD, check_number, check_numbers, check_whole, check_yaw, repeated
 
 
 @pytest.mark.parametrize(
@@ -122,3 +122,9 @@ def test_repeated_names_the_first_item_given_twice_in_order() -> None:
     assert repeated(["grid", "bitstar", "rrtstar"]) is None and repeated([]) is None
     assert repeated(["S2", "S1", "S2", "S1"]) == "S2"
     assert repeated(["a", "b", "b", "a"]) == "a"  # the first item in order that appears again, not the first repeat
+
+
+def test_a_yaw_beyond_two_turns_is_refused_as_degrees() -> None:
+    check_yaw("people[0]", "theta", -YAW_LIMIT_RAD)  # an unwrapped yaw
+    with pytest.raises(ValueError, match=r"^people\[0\]: theta 90 is beyond two turns \(4 pi\): radians expected"):
+        check_yaw("people[0]", "theta", 90.0)

@@ -185,3 +185,41 @@ def test_groups_error_quoting_a_line_separator_is_one_line(tmp_path, capsys):
     main(["groups", str(lines)])
     errors = [line for line in capsys.readouterr().err.splitlines() if "id must be an integer" in line]
     assert len(errors) == 1 and errors[0].endswith('got {"\\u2028": 1}')
+
+
+def _encoded(kind: str) -> bytes:
+    """A 64 x 48 picture as PNG, or as JPEG (baseline, progressive, with restart markers, or with an EXIF thumbnail:
+    a whole JPEG inside its header, end marker included)."""
+    import io
+
+    import numpy as np
+    from PIL import Image
+
+    pixels = np.random.default_rng(0).integers(0, 255, (48, 64, 3), dtype=np.uint8)
+    out = io.BytesIO()
+    image = Image.fromarray(pixels)
+    if kind == "png":
+        image.save(out, "PNG")
+    elif kind == "thumbnail":
+        thumbnail = io.BytesIO()
+        Image.fromarray(pixels[:8, :8]).save(thumbnail, "JPEG")
+        exif = Image.Exif()
+        exif[0x0112] = 1
+        image.save(out, "JPEG", exif=exif.tobytes() + thumbnail.getvalue())  # inside the APP1 segment
+    else:
+        options = {"progressive": kind == "progressive"} | ({"restart_marker_blocks": 1} if kind == "restart" else {})
+        image.save(out, "JPEG", quality=95, **options)
+    return out.getvalue()
+
+
+@pytest.mark.parametrize("kind", ["png", "baseline", "progressive", "restart", "thumbnail"])
+def test_an_image_cut_short_is_told_from_a_whole_one(kind):
+    from sid.documents import image_cut_short
+
+    data = _encoded(kind)
+    fmt = "PNG" if kind == "png" else "JPEG"
+    assert not image_cut_short(data, fmt)
+    assert not image_cut_short(data + b"\0" * 100, fmt)  # bytes after the end, as some writers pad
+    for keep in (len(data) - 1, len(data) - 2, len(data) * 3 // 4, len(data) // 2, 30):
+        assert image_cut_short(data[:keep], fmt), keep
+    assert not image_cut_short(b"P5 1 1 255 x", "PPM")  # the other formats are not checked

@@ -8,6 +8,7 @@ import argparse
 import contextlib
 import fcntl
 import fnmatch
+import functools
 import itertools
 import json
 import math
@@ -193,8 +194,9 @@ def fail(command: str, error: Exception) -> int:
     return exit_code(error)
 
 
-LineHandler = Callable[[Any], dict[str, Any]]
-"""What a JSON-lines command does with one parsed line: the JSON object it writes for it; ValueError for a bad line."""
+LineHandler = Callable[[Any, Callable[[str], None]], dict[str, Any]]
+"""What a JSON-lines command does with one parsed line: the JSON object it writes for it; ValueError for a bad line.
+Its second argument notes something about a good line on stderr (``COMMAND: line N: note: TEXT``)."""
 
 
 MAX_LINE_BYTES = 16 * 1024**2
@@ -259,13 +261,13 @@ def process_json_lines(
 ) -> int:
     """Write ``handle(value)`` on ``out`` as one JSON line, flushed, for each non-blank line of ``lines``
     (``read_json_lines``). A line that cannot be read, or that ``handle`` refuses (ValueError), is reported on ``err``
-    as ``COMMAND: line N: problem`` and skipped, or, with ``strict``, ends the run: exit code 2 (bad input). Returns
-    the exit code."""
+    as ``COMMAND: line N: problem`` and skipped, or, with ``strict``, ends the run: exit code 2 (bad input); a note
+    ``handle`` makes on a good line as ``COMMAND: line N: note: text``. Returns the exit code."""
     skipped = 0
     for number, value, problem in read_json_lines(lines):
         if problem is None:
             try:
-                record = handle(value)
+                record = handle(value, functools.partial(_note, command, number, err))
             except ValueError as exc:
                 problem = str(exc)
         if problem is not None:
@@ -279,6 +281,11 @@ def process_json_lines(
     if skipped:
         print(f"{command}: skipped {plural(skipped, 'malformed line')}", file=err, flush=True)
     return 0
+
+
+def _note(command: str, number: int, err: TextIO, text: str) -> None:
+    """A note on line ``number`` of a JSON-lines input, on ``err``."""
+    print(f"{command}: line {number}: note: {text}", file=err, flush=True)
 
 
 def read_json_lines(lines: Iterable[str | bytes]) -> Iterator[tuple[int, Any, str | None]]:
@@ -307,7 +314,14 @@ def read_json_lines(lines: Iterable[str | bytes]) -> Iterator[tuple[int, Any, st
             continue
         try:
             value = json.loads(line, parse_constant=_reject_constant, object_pairs_hook=unique_keys)
-        except ValueError as exc:  # json.JSONDecodeError, NaN or Infinity, a duplicate key
+        except json.JSONDecodeError as exc:  # its "line 2 column 1" would count lines within this one line
+            text = line.rstrip()
+            where = "the end of the line" if exc.pos >= len(text) else f"character {exc.pos + 1} of the line"
+            if text.strip() in ("{", "["):  # the first line of an indented JSON document
+                where += "; JSON lines hold one whole object per line: is this one JSON document over several lines?"
+            yield number, None, f"not valid JSON ({exc.msg} at {where})"
+            continue
+        except ValueError as exc:  # NaN or Infinity, a duplicate key
             yield number, None, f"not valid JSON ({exc})"
             continue
         except RecursionError:

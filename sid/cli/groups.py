@@ -6,9 +6,9 @@ orientation_quality in [0, 1] weighs the facing, default 1 when theta is given):
 Output, one line per good input line, flushed as it is written:
     {"frame": 0, "groups": [{"members": [1, 2], "interest_point": [x, y], "area": a, "spread": d,
                              "zone": [[x, y], ...]}]}
-A malformed line (one that is not UTF-8 JSON, gives a key twice or has a field not named above) is reported on
-stderr with its line number and skipped, or ends the run with --strict (exit 2); everything written before it stays
-written.
+A malformed line (one that is not UTF-8 JSON, gives a key twice, has a field not named above or a theta beyond two
+turns, in degrees by mistake) is reported on stderr with its line number and skipped, or ends the run with --strict
+(exit 2); everything written before it stays written.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ import argparse
 from collections.abc import Iterable
 from typing import Any, TextIO
 
-from sid.checks import check_limit
+from sid.checks import check_limit, check_yaw
 from sid.cli.common import fail, process_json_lines, refuse_unknown_fields, run_json_lines
 from sid.cli.grouping import add_json_lines_command, group_params_from
 from sid.documents import is_number, summary
@@ -42,7 +42,7 @@ def run(args: argparse.Namespace) -> int:
         params = group_params_from(args)
     except ValueError as exc:
         return fail("sid groups", exc)
-    return run_json_lines("sid groups", args.file, lambda data: _groups_line(data, params), strict=args.strict)
+    return run_json_lines("sid groups", args.file, lambda data, _note: _groups_line(data, params), strict=args.strict)
 
 
 def process(lines: Iterable[str | bytes], out: TextIO, err: TextIO, params: GroupParams, strict: bool = False) -> int:
@@ -50,7 +50,9 @@ def process(lines: Iterable[str | bytes], out: TextIO, err: TextIO, params: Grou
 
     ``lines`` are text, or bytes decoded here line by line as UTF-8 (a byte-order mark before the first is dropped).
     """
-    return process_json_lines("sid groups", lines, out, err, lambda data: _groups_line(data, params), strict=strict)
+    return process_json_lines(
+        "sid groups", lines, out, err, lambda data, _note: _groups_line(data, params), strict=strict
+    )
 
 
 def _groups_line(data: Any, params: GroupParams) -> dict[str, Any]:
@@ -104,6 +106,8 @@ def _parse_person(data: Any, index: int) -> Person:
             raise ValueError(f"{where} (id {person_id}): {key} must be a finite number, got {summary(value)}")
         values[key] = float(value)
     theta = values.get("theta")
+    if theta is not None:
+        check_yaw(f"{where} (id {person_id})", "theta", theta)
     # A given facing is taken at full quality unless the line says otherwise (as in scenario files).
     quality = values.get("orientation_quality", 0.0 if theta is None else 1.0)
     if not 0.0 <= quality <= 1.0:

@@ -111,8 +111,9 @@ def _frames(args: argparse.Namespace, command: str) -> Iterator[tuple[str, Frame
         options = {"frames": SYNTHETIC_FRAMES} if spec.startswith("synthetic:") else {}
         source = open_source(spec, **options, **{name: getattr(args, name) for name in BAG_TOPICS})
 
-        def report(error: FrameReadError, spec: str = spec) -> None:
-            print(f"{command}: {spec}: skipped, {error}", file=sys.stderr)
+        def report(error: FrameReadError, spec: str = spec) -> None:  # the frame named as the results name it
+            where = spec if error.index is None else f"{spec}#{error.index}"
+            print(f"{command}: {where}: skipped, {error}", file=sys.stderr)
 
         try:
             for frame in skip_unreadable(source, report):

@@ -11,19 +11,21 @@ Output, one line per good input line, flushed as it is written, the tracks as `s
      "groups": [{"id": 1, "kind": "conversation"|"walking", "members": [1, 2], "interest_point": [x, y],
                  "area": a, "spread": d, "zone": [[x, y], ...], "velocity": [vx, vy]}],
      "timing_ms": {"track": ms, "track_groups": ms}}
-A malformed line (not UTF-8 JSON, a key given twice, an unknown field, a missing or non-finite number, a timestamp
-not after the last good line's, two people with one id) is reported on stderr with its line number and skipped,
-or ends the run with --strict (exit 2); everything written before it stays written. The people and group trackers
+A malformed line (not UTF-8 JSON, a key given twice, an unknown field, a missing or non-finite number, a theta
+beyond two turns (in degrees by mistake), a timestamp not after the last good line's, two people with one id) is
+reported on stderr with its line number and skipped, or ends the run with --strict (exit 2); everything written
+before it stays written. A line more than the tracker's timeout (1.5 s) after the last good one ends every track, and
+a note on stderr says so (timestamps in milli- or nanoseconds do it at every line). The people and group trackers
 run with their defaults; the group detector that finds conversations among the tracks takes the options below.
 """
 
 from __future__ import annotations
 
 import argparse
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from typing import Any, TextIO
 
-from sid.checks import check_limit
+from sid.checks import check_limit, check_yaw, repeated
 from sid.cli.common import fail, process_json_lines, refuse_unknown_fields, run_json_lines
 from sid.cli.grouping import add_json_lines_command, group_params_from
 from sid.documents import is_number, summary
@@ -45,7 +47,9 @@ def run(args: argparse.Namespace) -> int:
         session = TrackingSession(group_params=group_params_from(args))
     except ValueError as exc:
         return fail("sid track", exc)
-    return run_json_lines("sid track", args.file, lambda data: _track_line(data, session), strict=args.strict)
+    return run_json_lines(
+        "sid track", args.file, lambda data, note: _track_line(data, session, note), strict=args.strict
+    )
 
 
 def process(
@@ -53,14 +57,25 @@ def process(
 ) -> int:
     """Track ``lines`` (text, or bytes decoded line by line) into ``session``, writing one JSON line per good line on
     ``out`` and each problem on ``err``; the exit code (2 when ``strict`` stopped at a bad line)."""
-    return process_json_lines("sid track", lines, out, err, lambda data: _track_line(data, session), strict=strict)
+    return process_json_lines(
+        "sid track", lines, out, err, lambda data, note: _track_line(data, session, note), strict=strict
+    )
 
 
-def _track_line(data: Any, session: TrackingSession) -> dict[str, Any]:
+def _track_line(data: Any, session: TrackingSession, note: Callable[[str], None]) -> dict[str, Any]:
     """The output line of one parsed input line, after ``session`` tracked its people (ValueError for a malformed
-    line, the session unchanged)."""
+    line, the session unchanged). A gap since the last line longer than the tracker's timeout ends every track (no
+    view: every track counts as seen): ``note`` says so, since timestamps in milli- or nanoseconds do it at every
+    line and nobody is ever reported."""
     timestamp, people = _parse_line(data)
+    last, alive = session.people.timestamp, len(session.people)
     update = session.track(people, float(timestamp))
+    timeout = session.params.tracker.timeout
+    if alive and last is not None and timestamp - last > timeout:
+        note(
+            f"{timestamp - last:.3g} s after the last line, more than the tracker's timeout ({timeout:g} s): every "
+            "track ended (are the timestamps in seconds?)"
+        )
     return {
         "timestamp": timestamp,
         "people": [person.to_json() | {"detection": person.detection} for person in update.people],
@@ -83,7 +98,15 @@ def _parse_line(data: Any) -> tuple[int | float, list[Person]]:
     if not isinstance(data["people"], list):
         raise ValueError("'people' must be a list")
     check_limit("people", len(data["people"]), "people", "people")  # before any work on them (sid.checks.Limits)
-    return timestamp, [_parse_person(person, k) for k, person in enumerate(data["people"])]
+    people = [_parse_person(person, k) for k, person in enumerate(data["people"])]
+    ids = [person.id for person in people]
+    twice = repeated(ids)
+    if twice is not None:
+        first, second = [k for k, person_id in enumerate(ids) if person_id == twice][:2]
+        defaults = [f"people[{k}]" for k in (first, second) if "id" not in data["people"][k]]
+        why = f" ({defaults[0]} has no 'id': its index in the list is its id)" if defaults else ""
+        raise ValueError(f"people[{first}] and people[{second}] have one id, {twice}{why}")
+    return timestamp, people
 
 
 def _parse_person(data: Any, index: int) -> Person:
@@ -107,4 +130,5 @@ def _parse_person(data: Any, index: int) -> Person:
         )
     if theta is None:
         return Person(person_id, float(data["x"]), float(data["y"]))
+    check_yaw(where, "theta", theta)
     return Person(person_id, float(data["x"]), float(data["y"]), float(theta), 1.0)

@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 import scipy.io
 
-from sid.checks import check_limit, check_number
+from sid.checks import YAW_LIMIT_RAD, check_limit, check_number
 from sid.documents import InputWarning, plural, special_file
 from sid.errors import SidError
 from sid.perception.gcff import GCFFParams
@@ -48,7 +48,6 @@ __all__ = [
     "PLAUSIBLE_NEIGHBOUR_M",
     "Score",
     "UNIT_SCALES",
-    "YAW_LIMIT_RAD",
     "YawUnitError",
     "cross_validate",
     "detect_all",
@@ -87,9 +86,6 @@ DEFAULT_GRID: dict[str, tuple[float, ...]] = {
 }
 """The o-space parameters ``sid eval fformation --cross-validate`` chooses among, the grid that chose the
 defaults (docs/groups.md)."""
-YAW_LIMIT_RAD = 4 * math.pi
-"""No yaw in radians is written beyond two turns (an unwrapped ``a + pi`` stays well within); a file whose yaws go
-beyond is in degrees."""
 
 
 class YawUnitError(SidError, ValueError):

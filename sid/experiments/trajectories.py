@@ -182,7 +182,7 @@ def _read_obsmat(path: Path) -> np.ndarray:
         try:
             values = [float(v) for v in line.split()]
         except ValueError:
-            raise TrajectoryError(f"{path}:{number}: not numbers: {line.strip()[:80]!r}") from None
+            raise TrajectoryError(f"{path}:{number}: not numbers: {line.strip()[:80]!r}{_separator(line)}") from None
         if len(values) != 8:
             raise TrajectoryError(f"{path}:{number}: {len(values)} columns, expected 8 (frame id x z y vx vz vy)")
         if not all(math.isfinite(v) for v in values):
@@ -210,7 +210,7 @@ def _read_groups(path: Path, known: set[int]) -> tuple[tuple[frozenset[int], ...
         try:
             members = frozenset(int(v) for v in line.split())
         except ValueError:
-            raise TrajectoryError(f"{path}:{number}: pedestrian ids must be whole numbers") from None
+            raise TrajectoryError(f"{path}:{number}: pedestrian ids must be whole numbers{_separator(line)}") from None
         unknown = sorted(members - known)
         if unknown:
             who = f"pedestrian{'s' if len(unknown) > 1 else ''} {', '.join(map(str, unknown))}"
@@ -230,6 +230,11 @@ def _read_groups(path: Path, known: set[int]) -> tuple[tuple[frozenset[int], ...
     ]
     groups = [members for _, members in sorted(joined, key=lambda j: j[0]) if len(members) >= 2]
     return tuple(groups), tuple(notes)
+
+
+def _separator(line: str) -> str:
+    """A hint for a line that is not numbers: a CSV export's commas or semicolons are not the format's separator."""
+    return " (values are separated by spaces or tabs)" if "," in line or ";" in line else ""
 
 
 _LARGEST_ID = 2**53  # frame numbers and ids are read as floats: whole numbers beyond this are not exact

@@ -10,6 +10,7 @@ function here treats the camera as an ideal pinhole. Undistort images first if y
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -17,11 +18,12 @@ from typing import Any
 import numpy as np
 
 from sid.checks import check_limit, check_number, check_numbers
-from sid.documents import is_number, load_document, summary
+from sid.documents import InputWarning, is_number, load_document, summary
 
 __all__ = [
     "Calibration",
     "Extrinsics",
+    "INTRINSICS_FIELDS",
     "Intrinsics",
     "MAX_BASELINE",
     "MAX_FOCAL_PER_PIXEL",
@@ -40,6 +42,8 @@ MAX_FOCAL_PER_PIXEL = 100.0
 ~0.6 degrees; a larger one is a unit mistake (e.g. micrometres), not a camera."""
 MAX_BASELINE = 1.0
 """Longest depth-to-colour translation (m) a calibration may have: an RGB-D camera's sensors sit centimetres apart."""
+INTRINSICS_FIELDS = ("width", "height", "fx", "fy", "cx", "cy", "ppx", "ppy", "model", "coeffs")
+"""The fields ``Intrinsics.from_dict`` reads (``ppx``/``ppy`` for ``cx``/``cy``)."""
 MIN_FOCAL_PER_PIXEL = 0.01
 """Smallest focal length (pixels) per pixel of image width or height: a field of view of ~178 degrees, as wide as a
 pinhole model goes; below it a viewing ray's slope (pixel offset / focal length) overflows to infinity."""
@@ -217,7 +221,9 @@ class Calibration:
         flat intrinsics dict (``fx, fy, cx, cy, width, height[, depth_scale]``) for a registered RGB-D pair.
         ``depth_scale_m`` is accepted for ``depth_scale``; a flat dict with ``"depth_aligned_to_color": false`` is
         refused (unregistered depth needs the depth intrinsics and extrinsics). Every error is a ValueError naming
-        the file, and the field and its value when one is at fault.
+        the file, and the field and its value when one is at fault. Other fields are ignored, but an InputWarning
+        names those holding numbers (a misspelt ``depth_scale`` would leave depth ten times off), and one names
+        distortion coefficients that are not all zero (they are not applied).
         """
         path = Path(path)
         data = load_document(path, "calibration JSON")  # names the file itself
@@ -227,17 +233,30 @@ class Calibration:
         try:
             if "color" in data:
                 extrinsics = data.get("depth_to_color")
-                return cls(
+                calibration = cls(
                     Intrinsics.from_dict(data["color"], "color"),
                     Intrinsics.from_dict(data["depth"], "depth") if data.get("depth") is not None else None,
                     Extrinsics.from_dict(extrinsics, "depth_to_color") if extrinsics is not None else Extrinsics(),
                     depth_scale,
                 )
-            if data.get("depth_aligned_to_color") is False:
-                raise ValueError("depth is not aligned to colour; give color, depth and depth_to_color sections")
-            return cls(Intrinsics.from_dict(data), depth_scale=depth_scale)
+                sections = [
+                    ("", data, ("color", "depth", "depth_to_color", "depth_scale", "depth_scale_m")),
+                    ("color: ", data["color"], INTRINSICS_FIELDS),
+                    ("depth: ", data.get("depth"), INTRINSICS_FIELDS),
+                    ("depth_to_color: ", extrinsics, ("rotation", "translation")),
+                ]
+            else:
+                if data.get("depth_aligned_to_color") is False:
+                    raise ValueError("depth is not aligned to colour; give color, depth and depth_to_color sections")
+                calibration = cls(Intrinsics.from_dict(data), depth_scale=depth_scale)
+                flat = (*INTRINSICS_FIELDS, "depth_scale", "depth_scale_m", "depth_aligned_to_color")
+                sections = [("", data, flat)]
         except ValueError as exc:
             raise ValueError(f"calibration {path}: {exc}") from None
+        for where, section, known in sections:
+            if isinstance(section, dict):
+                _warn_unused(f"calibration {path}: {where}", section, known)
+        return calibration
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -252,6 +271,35 @@ def _depth_scale(data: dict[str, Any], where: str) -> float:
     """``depth_scale`` (or ``depth_scale_m``), metres per depth unit; 0.001 when absent."""
     key = "depth_scale" if "depth_scale" in data or "depth_scale_m" not in data else "depth_scale_m"
     return _number({key: 0.001} | data, key, where, low=0, low_open=True, high=1, unit="metres per unit")
+
+
+def _warn_unused(where: str, data: dict[str, Any], known: tuple[str, ...]) -> None:
+    """InputWarnings for what a calibration section ``data`` gives that sid does not use: fields not in ``known``
+    that hold numbers (a misspelt field keeps its default silently otherwise; text, such as a note, is let be), and
+    distortion coefficients not all zero (every function here treats the camera as an ideal pinhole)."""
+    unread = [key for key, value in data.items() if key not in known and _numeric(value)]
+    if unread:
+        warnings.warn(
+            f"{where}numbers sid does not read: {summary(unread)} (it reads {', '.join(known)}); a misspelt field "
+            "keeps its default",
+            InputWarning,
+            stacklevel=3,
+        )
+    coeffs = data.get("coeffs") if "coeffs" in known else None
+    if isinstance(coeffs, list) and any(c != 0 for c in coeffs):
+        warnings.warn(
+            f"{where}distortion coefficients {summary(coeffs)} are not applied: sid treats the camera as an ideal "
+            "pinhole; undistort the images first",
+            InputWarning,
+            stacklevel=3,
+        )
+
+
+def _numeric(value: Any) -> bool:
+    """Whether a parsed JSON value is a number, or a non-empty list of numbers or of lists of numbers (a matrix)."""
+    rows = value if isinstance(value, list) else [value]
+    items = [x for row in rows for x in (row if isinstance(row, list) else [row])]
+    return bool(items) and all(is_number(x) for x in items)
 
 
 def _number(data: dict[str, Any], key: str, where: str, **bounds: Any) -> float:

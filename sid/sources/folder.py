@@ -8,12 +8,16 @@ Two layouts (the calibration is ``intrinsics.json`` or ``calibration.json`` in t
   (``frame2`` before ``frame10``).
 
 Depth PNGs are single-channel uint16 in depth units (metres = value * depth_scale; 0 = no reading). Colour is any
-8-bit image OpenCV reads; frames carry it as RGB. A frame whose files are missing, unreadable or of the wrong size
-raises ``FrameReadError`` naming the file, and iteration goes on with the next frame.
+image OpenCV reads (greyscale, RGBA and 16-bit ones become 8-bit RGB), its pixels as stored (a JPEG's EXIF
+orientation is not applied: depth is registered to the stored pixels); frames carry it as RGB. A frame whose files
+are missing, unreadable or of the wrong size raises ``FrameReadError`` naming the file (and, for a missing one, any
+file of its name in a format not read, e.g. depth in metres as ``1.tiff`` or ``1.npy``), and iteration goes on with
+the next frame.
 """
 
 from __future__ import annotations
 
+import glob
 import itertools
 import re
 from concurrent.futures import Future, ThreadPoolExecutor
@@ -22,7 +26,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from sid.documents import read_image_header, special_file
+from sid.documents import image_cut_short, read_image_header, special_file
 from sid.perception.camera import Calibration
 from sid.perception.frame import Frame
 from sid.sources import FrameReadError, SourceError
@@ -48,6 +52,7 @@ class FolderSource:
             raise ValueError(f"folder source: fps must be positive, got {fps}")
         self.fps = float(fps)
         self.calibration = calibration if calibration is not None else self._read_calibration()
+        self.single = False  # the one-frame layout (DIR/color.png + DIR/depth.png); set by _find_pairs
         self.pairs = self._find_pairs()
 
     def _read_calibration(self) -> Calibration:
@@ -66,6 +71,7 @@ class FolderSource:
         single_color = [self.path / f"color{suffix}" for suffix in COLOR_SUFFIXES]
         single_color = [p for p in single_color if p.exists()]
         if single_color or (self.path / "depth.png").exists():
+            self.single = True
             depth = self.path / "depth.png"
             return [("color", single_color, [depth] if depth.exists() else [])]
         color_dir, depth_dir = self.path / "color", self.path / "depth"
@@ -93,9 +99,9 @@ class FolderSource:
         """Frame ``index`` (0-based). Raises FrameReadError naming the file when it cannot be used."""
         name, colors, depths = self.pairs[index]
         if not colors:
-            raise FrameReadError(f"frame {name!r}: no colour image in {self.path / 'color'}", index, None)
+            raise FrameReadError(f"frame {name!r}: no colour image {self._missing('color', name)}", index, None)
         if not depths:
-            raise FrameReadError(f"frame {name!r}: no depth image {name}.png next to {colors[0]}", index, None)
+            raise FrameReadError(f"frame {name!r}: no depth image {self._missing('depth', name)}", index, None)
         for kind, paths in (("colour", colors), ("depth", depths)):
             if len(paths) > 1:
                 names = " and ".join(str(p) for p in paths)
@@ -106,14 +112,15 @@ class FolderSource:
         color_path, depth_path = colors[0], depths[0]
         calib = self.calibration
         grid = calib.depth if calib.depth is not None else calib.color
-        _check_size(color_path, "colour image", calib.color.width, calib.color.height, index)  # before decoding
-        _check_size(depth_path, "depth image", grid.width, grid.height, index)
-        rgb = cv2.imread(str(color_path), cv2.IMREAD_COLOR_RGB)  # decoded straight to RGB: no conversion pass
-        if rgb is None:
-            raise FrameReadError(f"cannot read colour image {color_path}", index, color_path)
-        raw = cv2.imread(str(depth_path), cv2.IMREAD_UNCHANGED)
-        if raw is None:
-            raise FrameReadError(f"cannot read depth image {depth_path}", index, depth_path)
+        # both sizes from the headers, before anything is decoded
+        color_format = _check_size(color_path, "colour image", calib.color.width, calib.color.height, index)
+        registered = "" if calib.depth is not None else _REGISTERED
+        depth_format = _check_size(depth_path, "depth image", grid.width, grid.height, index, registered)
+        # Decoded straight to RGB (no conversion pass), as stored: depth is registered to the stored pixels, so a
+        # JPEG's EXIF orientation, which OpenCV would apply, is not.
+        flags = cv2.IMREAD_COLOR_RGB | cv2.IMREAD_IGNORE_ORIENTATION
+        rgb = _decode(color_path, "colour image", color_format, flags, index)
+        raw = _decode(depth_path, "depth image", depth_format, cv2.IMREAD_UNCHANGED, index)
         if raw.dtype != np.uint16 or raw.ndim != 2:
             raise FrameReadError(
                 f"depth image {depth_path} must be single-channel 16-bit (depth units), got {raw.dtype} "
@@ -140,6 +147,29 @@ class FolderSource:
 
     def __iter__(self) -> _Reader:
         return _Reader(self)
+
+    def _missing(self, kind: str, name: str) -> str:
+        """Where frame ``name``'s ``kind`` image ("color" or "depth") was looked for, and any file of that name in a
+        format the folder does not read (depth saved as a float TIFF or ``.npy``, colour as BMP), e.g.
+        ``1.png in DIR/depth (DIR/depth/1.npy is not read: ...)``."""
+        folder, stem = (self.path, kind) if self.single else (self.path / kind, name)
+        suffixes, expected = (
+            (COLOR_SUFFIXES, f"{stem}.png, .jpg or .jpeg") if kind == "color" else ((".png",), f"{stem}.png")
+        )
+        others = [
+            path
+            for path in sorted(folder.glob(f"{glob.escape(stem)}.*"))
+            if path.stem == stem and path.suffix.lower() not in suffixes
+        ]
+        if not others:
+            return f"{expected} in {folder}"
+        rule = (
+            "colour images are PNG or JPEG"
+            if kind == "color"
+            else "depth images are single-channel 16-bit PNGs in depth units"
+        )
+        verb = "is" if len(others) == 1 else "are"
+        return f"{expected} in {folder} ({' and '.join(map(str, others))} {verb} not read: {rule})"
 
 
 class _Reader:
@@ -171,17 +201,40 @@ class _Reader:
         return current.result()
 
 
-def _check_size(path: Path, what: str, width: int, height: int, index: int) -> None:
-    """FrameReadError unless the image's header declares the calibration's ``width`` x ``height`` pixels, read
-    before any pixel is decoded (a header of 20000 x 20000 would make OpenCV allocate gigabytes first)."""
+_REGISTERED = (
+    " (depth registered to colour has the colour image's size; depth of its own size needs the calibration's depth "
+    "and depth_to_color sections)"
+)
+
+
+def _check_size(path: Path, what: str, width: int, height: int, index: int, hint: str = "") -> str:
+    """The image's format (``ImageHeader.format``); FrameReadError (``hint`` ending its message) unless its header
+    declares the calibration's ``width`` x ``height`` pixels, read before any pixel is decoded (a header of 20000 x
+    20000 would make OpenCV allocate gigabytes first)."""
     try:
         header = read_image_header(path, what)
     except ValueError as exc:
         raise FrameReadError(str(exc), index, path) from None
     if (header.width, header.height) != (width, height):
         raise FrameReadError(
-            f"{what} {path} is {header.width}x{header.height}, the calibration says {width}x{height}", index, path
+            f"{what} {path} is {header.width}x{header.height}, the calibration says {width}x{height}{hint}", index, path
         )
+    return header.format
+
+
+def _decode(path: Path, what: str, format: str, flags: int, index: int) -> np.ndarray:
+    """The pixels of the image file ``path`` of ``format``, decoded with OpenCV's imread ``flags``; FrameReadError
+    when it cannot be read, is cut short (a JPEG would decode in part, the rest grey) or does not decode."""
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise FrameReadError(f"cannot read {what} {path} ({exc.strerror or exc})", index, path) from None
+    if image_cut_short(data, format):
+        raise FrameReadError(f"{what} {path} is cut short: it ends before the image does", index, path)
+    image = cv2.imdecode(np.frombuffer(data, np.uint8), flags)
+    if image is None:
+        raise FrameReadError(f"cannot read {what} {path}", index, path)
+    return image
 
 
 def _natural_key(name: str) -> list[int | str]:

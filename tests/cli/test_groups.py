@@ -371,3 +371,33 @@ def test_keys_given_twice_and_unknown_fields_are_malformed_lines_as_in_scenario_
     assert (
         code == 2 and out == [] and err.splitlines() == ["sid groups: line 1: not valid JSON (duplicate key 'frame')"]
     )
+
+
+def test_a_facing_in_degrees_by_mistake_is_a_malformed_line(tmp_path, capsys):
+    """theta 180 read as radians points anywhere (180 rad is 233 degrees): a yaw beyond two turns is refused, naming
+    the unit, as sid eval fformation reads such a file as degrees; an unwrapped yaw within two turns is kept."""
+    degrees = {
+        "frame": 1,
+        "people": [{"id": 1, "x": 2.0, "y": 0.0, "theta": 0}, {"id": 2, "x": 2.8, "y": 0.0, "theta": 180}],
+    }
+    unwrapped = {"frame": 2, "people": [{"id": 1, "x": 2.0, "y": 0.0, "theta": -2 * math.pi}]}
+    source = tmp_path / "frames.jsonl"
+    source.write_text("".join(json.dumps(line) + "\n" for line in (PAIR, degrees, unwrapped)))
+    code, out, err = run_sid(["groups", str(source)], capsys)
+    assert code == 0 and [json.loads(line)["frame"] for line in out] == [0, 2]
+    assert err.splitlines()[0] == (
+        "sid groups: line 2: people[1] (id 2): theta 180 is beyond two turns (4 pi): radians expected, not degrees"
+    )
+
+
+def test_a_json_document_written_over_several_lines_is_named_as_such(tmp_path, capsys):
+    """An indented JSON file is not JSON lines: its first line, a lone brace, said 'line 2 column 1 (char 2)' of a
+    one-line input; the position is now within the line, and the message says what JSON lines are."""
+    source = tmp_path / "frames.json"
+    source.write_text(json.dumps(PAIR, indent=2) + "\n")
+    code, out, err = run_sid(["groups", "--strict", str(source)], capsys)
+    assert code == 2 and out == []
+    assert err == (
+        "sid groups: line 1: not valid JSON (Expecting property name enclosed in double quotes at the end of the line; "
+        "JSON lines hold one whole object per line: is this one JSON document over several lines?)\n"
+    )

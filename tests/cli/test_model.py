@@ -64,7 +64,9 @@ def test_a_source_without_frames_is_named(tmp_path, capsys):
     (empty / "depth" / "a.png").write_bytes(b"not a png")
     code = main(["model", "quantize", str(model), str(tmp_path / "out.onnx"), "--calibrate", str(empty)])
     err = capsys.readouterr().err.strip().splitlines()
-    assert code == 2 and "skipped" in err[0] and err[-1].startswith(f"sid model quantize: no frames in {empty}")
+    # the frame named as the results name it, DIR#N
+    assert code == 2 and err[0].startswith(f"sid model quantize: {empty}#0: skipped, ")
+    assert err[-1].startswith(f"sid model quantize: no frames in {empty}")
     code = main(["model", "quantize", str(model), str(tmp_path / "out.onnx"), "--calibrate", str(tmp_path / "x")])
     assert code == 2 and "no such file or directory" in _error(capsys)
 

@@ -101,7 +101,7 @@ def test_a_walking_pair_and_a_standing_conversation_are_tracked_with_stable_ids(
 
 
 BAD_LINES = [
-    ("{not json", "not valid JSON (Expecting property name enclosed in double quotes: line 1 column 2 (char 1))"),
+    ("{not json", "not valid JSON (Expecting property name enclosed in double quotes at character 2 of the line)"),
     ("[1, 2]", "expected a JSON object with 'timestamp' and 'people'"),
     ('{"people": []}', "missing 'timestamp'"),
     ('{"timestamp": "0.5", "people": []}', "'timestamp' must be a finite number of seconds, got \"0.5\""),
@@ -128,7 +128,7 @@ BAD_LINES = [
     ('{"timestamp": 0.5, "people": [{"id": 1.5, "x": 0, "y": 0}]}', "people[0]: id must be an integer, got 1.5"),
     (
         '{"timestamp": 0.5, "people": [{"id": 4, "x": 0, "y": 0}, {"id": 4, "x": 1, "y": 0}]}',
-        "tracker: person id 4 appears twice in one frame",
+        "people[0] and people[1] have one id, 4",
     ),
 ]
 
@@ -177,7 +177,7 @@ def test_timestamps_out_of_order_are_refused_naming_both(tmp_path, capsys):
     assert err == [
         "sid track: line 2: frame is out of time order: its timestamp 0.5 s is not after the last one, 1.0 s",
         "sid track: line 3: frame is out of time order: its timestamp 1.0 s is not after the last one, 1.0 s",
-        "sid track: line 4: tracker: person id 1 appears twice in one frame",
+        "sid track: line 4: people[0] and people[1] have one id, 1",
         "sid track: skipped 3 malformed lines",
     ]
 
@@ -241,3 +241,54 @@ def test_help_describes_the_input_and_output(capsys):
     assert text.startswith("usage: sid track [-h] [--strict]")
     for needle in ('"timestamp"', '"detection"', "theta null or absent", "REP-103", "--strict", "--method", "FILE"):
         assert needle in text
+
+
+def test_a_facing_in_degrees_by_mistake_is_a_malformed_line(tmp_path, capsys):
+    """theta 90 read as radians points anywhere: a yaw beyond two turns is refused, naming the unit."""
+    lines = [{"timestamp": 0.0, "people": [{"x": 1.0, "y": 0.0, "theta": 1.5}]}]
+    lines.append({"timestamp": 0.1, "people": [{"x": 1.0, "y": 0.0, "theta": -90}]})
+    code, out, err = run_sid(["track", str(write_lines(tmp_path / "in.jsonl", lines))], capsys)
+    assert code == 0 and [record["timestamp"] for record in out] == [0.0]
+    assert err[0] == "sid track: line 2: people[0]: theta -90 is beyond two turns (4 pi): radians expected, not degrees"
+
+
+def test_a_gap_that_ends_every_track_is_noted_so_timestamps_in_another_unit_are_not_silent(tmp_path, capsys):
+    """Timestamps in nanoseconds (a ROS stamp) put 33 000 000 "s" between frames: every track times out before the
+    next frame, and nobody was ever reported, without a word. Each gap longer than the tracker's timeout that ends
+    tracks is now noted on stderr (the line still tracked); a gap with no track alive, the first line, is not."""
+    step = [{"x": 1.0, "y": 0.0}, {"x": 2.0, "y": 1.0}]
+    lines = [{"timestamp": 1_700_000_000_000_000_000 + k * 33_000_000, "people": step} for k in range(3)]
+    code, out, err = run_sid(["track", str(write_lines(tmp_path / "ns.jsonl", lines))], capsys)
+    assert code == 0 and len(out) == 3 and all(record["people"] == [] for record in out)
+    assert err == [
+        f"sid track: line {n}: note: 3.3e+07 s after the last line, more than the tracker's timeout (1.5 s): every "
+        "track ended (are the timestamps in seconds?)"
+        for n in (2, 3)
+    ]
+    pause = [{"timestamp": t, "people": step} for t in (0.0, 0.1, 0.2, 10.2, 10.3)]
+    pause.insert(3, {"timestamp": 5.0, "people": []})  # tracks alive, none detected: they end at the next line
+    code, out, err = run_sid(["track", str(write_lines(tmp_path / "pause.jsonl", pause))], capsys)
+    assert code == 0 and [len(record["people"]) for record in out] == [0, 0, 2, 0, 0, 0]
+    assert err == [
+        "sid track: line 4: note: 4.8 s after the last line, more than the tracker's timeout (1.5 s): every track "
+        "ended (are the timestamps in seconds?)"
+    ]
+
+
+def test_an_id_given_twice_names_both_people_and_a_default_id(tmp_path, capsys):
+    """A person without an id takes its index: beside an explicit id 1 at index 0, the person at index 1 collided
+    with it under 'person id 1 appears twice', an id the line gives once."""
+    lines = [
+        {"timestamp": 0.0, "people": [{"id": 1, "x": 0.0, "y": 0.0}, {"x": 1.0, "y": 0.0}]},
+        {
+            "timestamp": 0.1,
+            "people": [{"id": 4, "x": 0.0, "y": 0.0}, {"x": 1.0, "y": 0.0}, {"id": 4, "x": 2.0, "y": 0.0}],
+        },
+    ]
+    code, out, err = run_sid(["track", str(write_lines(tmp_path / "in.jsonl", lines))], capsys)
+    assert code == 0 and out == []
+    assert err[:2] == [
+        "sid track: line 1: people[0] and people[1] have one id, 1 (people[1] has no 'id': its index in the list is "
+        "its id)",
+        "sid track: line 2: people[0] and people[2] have one id, 4",
+    ]

@@ -83,6 +83,17 @@ def test_a_row_written_twice_is_read_once_with_a_note(tmp_path: Path) -> None:
         ("0 1 0 0 0 0 0 0\n0 1 0 0 0 0 0 0\n0 1 1 0 0 0 0 0\n", "", "pedestrian 1 appears twice in frame 0"),
         ("\n\n", "", "obsmat.txt: no annotations"),
         ("0 1 0 0 0 0 0 0\n", "1 two\n", "groups.txt:1: pedestrian ids must be whole numbers"),
+        # a CSV export: the separator named
+        (
+            "0,1,0,0,0,0,0,0\n",
+            "",
+            "obsmat.txt:1: not numbers: '0,1,0,0,0,0,0,0' .values are separated by spaces or tabs",
+        ),
+        (
+            "0 1 0 0 0 0 0 0\n",
+            "1,2\n",
+            "groups.txt:1: pedestrian ids must be whole numbers .values are separated by spaces",
+        ),
     ],
 )
 def test_bad_files_are_refused_naming_the_file_line_and_problem(

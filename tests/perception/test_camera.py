@@ -9,6 +9,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from sid.documents import InputWarning
 from sid.perception.camera import Calibration, Extrinsics, Intrinsics, deproject, project
 from sid.perception.mount import CameraMount
 
@@ -181,5 +182,33 @@ def test_calibration_that_is_not_json_text_names_the_file(tmp_path, raw):
 def test_calibration_values_that_are_right_still_load(tmp_path):
     path = tmp_path / "calibration.json"
     path.write_text(json.dumps(FULL | {"depth_scale_m": 0.0001, "color": FLAT | {"ppx": 1.0} | {"coeffs": [0.1] * 5}}))
-    calib = Calibration.from_json(path)
+    with pytest.warns(InputWarning, match="color: distortion coefficients"):
+        calib = Calibration.from_json(path)
     assert calib.depth_scale == 0.0001 and calib.color.coeffs == (0.1,) * 5 and calib.depth is not None
+
+
+def test_calibration_numbers_sid_does_not_use_are_said(tmp_path, recwarn):
+    """A misspelt depth_scale (0.1 mm depth read as millimetres: every depth ten times too far) and distortion sid
+    does not apply were accepted without a word; each is now an InputWarning naming the file and the field. Text
+    fields (a note) and zero coefficients pass quietly."""
+    path = tmp_path / "intrinsics.json"
+    path.write_text(json.dumps(FLAT | {"depth_scal": 0.0001, "k1": 0.2, "note": "Kinect", "coeffs": [0.0] * 5}))
+    with pytest.warns(InputWarning) as warned:
+        calib = Calibration.from_json(path)
+    assert calib.depth_scale == 0.001
+    assert [str(w.message) for w in warned] == [
+        f'calibration {path}: numbers sid does not read: ["depth_scal", "k1"] (it reads width, height, fx, fy, cx, cy, '
+        "ppx, ppy, model, coeffs, depth_scale, depth_scale_m, depth_aligned_to_color); a misspelt field keeps its "
+        "default"
+    ]
+    path.write_text(json.dumps(FULL | {"color": FLAT | {"model": "brown_conrady", "coeffs": [0.2, -0.5, 0, 0, 0.1]}}))
+    with pytest.warns(InputWarning) as warned:
+        Calibration.from_json(path)
+    assert [str(w.message) for w in warned] == [
+        f"calibration {path}: color: distortion coefficients [0.2, -0.5, 0, 0, 0.1] are not applied: sid treats the "
+        "camera as an ideal pinhole; undistort the images first"
+    ]
+    path.write_text(json.dumps(FLAT | {"note": "registered", "depth_aligned_to_color": True, "coeffs": [0] * 5}))
+    recwarn.clear()
+    Calibration.from_json(path)
+    assert not [w for w in recwarn if issubclass(w.category, InputWarning)]

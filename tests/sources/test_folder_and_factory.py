@@ -204,3 +204,100 @@ def test_frame_names_that_are_not_plain_numbers_sort_and_play(tmp_path: Path) ->
     source = FolderSource(tmp_path)
     assert [name for name, _, _ in source.pairs] == ["2", "10", "frame1", "x٣", "²"]
     assert len(list(source)) == 5
+
+
+def test_a_missing_image_is_named_with_any_file_of_its_name_that_is_not_read(tmp_path: Path) -> None:
+    """Depth saved as float TIFF or .npy (metres), colour as BMP: the frame is skipped naming the file sid expected,
+    in the layout's own place, and the file of that name it found but does not read, with the format it reads."""
+    write_pair(tmp_path / "color" / "1.png", tmp_path / "depth" / "x.png", 1000)
+    np.save(tmp_path / "depth" / "1.npy", np.ones((48, 64), np.float32))
+    (tmp_path / "depth" / "x.png").unlink()
+    write_pair(tmp_path / "other" / "2.png", tmp_path / "depth" / "2.png", 1000)
+    assert cv2.imwrite(str(tmp_path / "color" / "2.bmp"), np.zeros((48, 64, 3), np.uint8))
+    (tmp_path / "intrinsics.json").write_text(json.dumps(INTR))
+    errors: list[FrameReadError] = []
+    assert list(skip_unreadable(FolderSource(tmp_path), errors.append)) == []
+    assert [str(e) for e in errors] == [
+        f"frame '1': no depth image 1.png in {tmp_path / 'depth'} ({tmp_path / 'depth' / '1.npy'} is not read: "
+        "depth images are single-channel 16-bit PNGs in depth units)",
+        f"frame '2': no colour image 2.png, .jpg or .jpeg in {tmp_path / 'color'} ({tmp_path / 'color' / '2.bmp'} is "
+        "not read: colour images are PNG or JPEG)",
+    ]
+    single = tmp_path / "single"
+    write_pair(single / "color.png", single / "x" / "depth.png", 1000)
+    assert cv2.imwrite(str(single / "depth.tiff"), np.ones((48, 64), np.float32))  # metres, as float
+    (single / "intrinsics.json").write_text(json.dumps(INTR))
+    with pytest.raises(FrameReadError) as raised:
+        list(FolderSource(single))
+    assert str(raised.value) == (
+        f"frame 'color': no depth image depth.png in {single} ({single / 'depth.tiff'} is not read: depth images are "
+        "single-channel 16-bit PNGs in depth units)"
+    )
+
+
+def test_a_jpeg_orientation_tag_does_not_turn_the_colour_image_away_from_its_depth(tmp_path: Path) -> None:
+    """Depth is registered to the stored pixels: OpenCV turned a JPEG by its EXIF orientation (180 degrees: every
+    person's keypoints looked up at the wrong depth, 'no people'; 90: a 48x64 image against the header's 64x48)."""
+    from PIL import Image
+
+    stored = np.zeros((48, 64, 3), np.uint8)
+    stored[:, 32:] = 255  # left half black, right half white, as stored
+    for orientation in (3, 6):
+        folder = tmp_path / str(orientation)
+        write_pair(folder / "x.png", folder / "depth.png", 1000)
+        exif = Image.Exif()
+        exif[0x0112] = orientation  # EXIF Orientation: 3 = rotate 180, 6 = rotate 90
+        Image.fromarray(stored).save(folder / "color.jpg", exif=exif.tobytes(), quality=100)
+        (folder / "intrinsics.json").write_text(json.dumps(INTR))
+        (frame,) = list(FolderSource(folder))
+        assert frame.color.shape == (48, 64, 3)
+        assert frame.color[:, :30].max() < 30 and frame.color[:, 34:].min() > 225
+
+
+@pytest.mark.parametrize("kind", ["grey", "rgba", "16-bit"])
+def test_grey_rgba_and_16_bit_colour_images_are_read_as_8_bit_rgb(tmp_path: Path, kind: str) -> None:
+    rgb = write_pair(tmp_path / "color.png", tmp_path / "depth.png", 1000)
+    bgr = cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR)
+    stored = {
+        "grey": cv2.cvtColor(bgr, cv2.COLOR_BGR2GRAY),
+        "rgba": cv2.cvtColor(bgr, cv2.COLOR_BGR2BGRA),
+        "16-bit": bgr.astype(np.uint16) * 257,
+    }[kind]
+    assert cv2.imwrite(str(tmp_path / "color.png"), stored)
+    (tmp_path / "intrinsics.json").write_text(json.dumps(INTR))
+    (frame,) = list(FolderSource(tmp_path))
+    assert frame.color.dtype == np.uint8 and frame.color.shape == (48, 64, 3)
+    expected = np.repeat(stored[..., None], 3, axis=2) if kind == "grey" else rgb
+    assert np.abs(frame.color.astype(int) - expected).max() <= 1
+
+
+def test_an_image_cut_short_in_the_middle_of_a_sequence_is_skipped_naming_it(tmp_path: Path) -> None:
+    """A JPEG cut short decoded in part (the rest grey, only libjpeg's 'Premature end of JPEG file' on stderr) and
+    its frame went on as a good one; a cut PNG failed in libpng. Each is now its frame's FrameReadError, and the
+    frames around it play."""
+    for k in range(1, 5):
+        write_pair(tmp_path / "color" / f"{k}.png", tmp_path / "depth" / f"{k}.png", 1000 * k, seed=k)
+    (tmp_path / "color" / "2.png").unlink()
+    assert cv2.imwrite(str(tmp_path / "color" / "2.jpg"), np.full((48, 64, 3), 200, np.uint8))
+    for path in (tmp_path / "color" / "2.jpg", tmp_path / "depth" / "3.png"):
+        path.write_bytes(path.read_bytes()[:-40])  # the end of the file lost, as a copy cut short
+    (tmp_path / "intrinsics.json").write_text(json.dumps(INTR))
+    errors: list[FrameReadError] = []
+    frames = list(skip_unreadable(FolderSource(tmp_path), errors.append))
+    assert [f.index for f in frames] == [0, 3]
+    assert [(e.index, str(e)) for e in errors] == [
+        (1, f"colour image {tmp_path / 'color' / '2.jpg'} is cut short: it ends before the image does"),
+        (2, f"depth image {tmp_path / 'depth' / '3.png'} is cut short: it ends before the image does"),
+    ]
+
+
+def test_depth_of_another_size_than_colour_under_a_registered_calibration_says_what_it_needs(tmp_path: Path) -> None:
+    write_pair(tmp_path / "color.png", tmp_path / "x" / "depth.png", 1000)
+    assert cv2.imwrite(str(tmp_path / "depth.png"), np.full((24, 32), 1000, np.uint16))  # half the colour's size
+    (tmp_path / "intrinsics.json").write_text(json.dumps(INTR))  # flat: depth registered to colour
+    with pytest.raises(FrameReadError) as raised:
+        list(FolderSource(tmp_path))
+    assert str(raised.value) == (
+        f"depth image {tmp_path / 'depth.png'} is 32x24, the calibration says 64x48 (depth registered to colour has "
+        "the colour image's size; depth of its own size needs the calibration's depth and depth_to_color sections)"
+    )
