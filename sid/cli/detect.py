@@ -60,7 +60,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="stream people and groups per frame as JSON lines",
         description="Run pose -> 3D people -> groups on every frame of a source and print one JSON line per frame "
         "(world frame: x forward, y left, metres; theta in radians, null when unknown). Frames without people or "
-        "depth, and unreadable frames, are reported on stderr and skipped.",
+        "depth, and unreadable frames, are reported on stderr and skipped; a source none of whose frames can be read "
+        "is bad input (exit 2).",
     )
     parser.add_argument("--source", required=True, help="realsense | FILE.db3 | FILE.bag | DIR | synthetic:SCENE")
     add_bag_topic_options(parser)
@@ -326,7 +327,7 @@ def run(args: argparse.Namespace) -> int:
         _close_source(source)
         return fail("sid detect", exc)
 
-    done = skipped = 0
+    done = skipped = unreadable = 0  # unreadable: frames whose files could not be read, among the skipped
 
     def skip(index: int | None, reason: object) -> None:
         nonlocal skipped
@@ -342,6 +343,7 @@ def run(args: argparse.Namespace) -> int:
         for item in run_ahead(_posed_frames(source, pipeline)):
             if isinstance(item, FrameReadError):
                 skip(item.index, item)
+                unreadable += 1
                 continue
             if args.frames is not None and done + skipped >= args.frames:
                 break
@@ -387,4 +389,7 @@ def run(args: argparse.Namespace) -> int:
     rate = f" in {seconds:.1f} s ({(done + skipped) / seconds:.1f} frames/s)" if done + skipped else ""
     median = f", median {np.median(totals):.2f} ms per frame" if totals else ""
     print(f"detect: {plural(done, 'frame')} with people, {skipped} skipped{rate}{median}", file=sys.stderr)
+    if not interrupted and unreadable and unreadable == done + skipped:  # bad input, not a scene without people
+        print(f"detect: no frame of the source could be read ({plural(unreadable, 'frame')} tried)", file=sys.stderr)
+        return ExitCode.USAGE
     return interrupted

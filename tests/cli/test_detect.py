@@ -278,6 +278,24 @@ def test_summary_counts_every_skipped_frame(tmp_path, capsys):
     assert "1 frame with people, 3 skipped" in captured.err
 
 
+def test_a_source_none_of_whose_frames_can_be_read_is_bad_input(tmp_path, capsys):
+    """Every frame skipped as unreadable is a bad source (exit 2), not a scene without people (exit 0)."""
+    (tmp_path / "color").mkdir()
+    (tmp_path / "depth").mkdir()
+    (tmp_path / "intrinsics.json").write_text(
+        json.dumps({"fx": 500.0, "fy": 500.0, "cx": 31.5, "cy": 23.5, "width": 64, "height": 48})
+    )
+    for name in ("a", "b"):
+        (tmp_path / "color" / f"{name}.png").write_bytes(b"not a png")
+        (tmp_path / "depth" / f"{name}.png").write_bytes(b"not a png")
+    from tests.pose_models import build_yolo_pose_model
+
+    model = build_yolo_pose_model(tmp_path / "yolo.onnx", np.zeros((56, 10)))
+    assert main(["detect", "--source", str(tmp_path), "--model", str(model)]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert err.count("skipped, ") == 2 and "no frame of the source could be read (2 frames tried)" in err
+
+
 def test_a_frame_is_skipped_for_depth_only_when_no_pixel_has_any():
     from sid.cli.detect import _skip_reason
 
