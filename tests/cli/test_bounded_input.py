@@ -140,7 +140,8 @@ def test_a_frame_whose_header_says_20000_by_20000_is_refused_before_decoding(tmp
     code, lines, peak = sid_measured("detect", "--source", str(folder), "--model", str(model))
     what = "colour" if stream == "color" else "depth"
     assert f"{what} image {folder / f'{stream}.png'} is 20000x20000, the calibration says 64x48" in lines[0]
-    assert code == 0 and "0 frames with people, 1 skipped" in lines[-1]
+    assert code == 2 and "0 frames with people, 1 skipped" in lines[-2]  # its one frame unreadable: bad input
+    assert "no frame of the source could be read" in lines[-1]
     assert peak < 1000  # decoded, the colour image alone is 1.2 GB
 
 
