@@ -41,6 +41,11 @@ def add_crowd_parser(tasks: argparse._SubParsersAction) -> None:
         help="detections per second, interpolated between annotations (default: at the annotation times, 2.5 Hz)",
     )  # fmt: skip
     parser.add_argument(
+        "--interval", type=float, default=None, metavar="S",
+        help="seconds between annotation steps (default: read from the annotated positions and velocities; 0.4 s "
+        "in the ETH and UCY sets)",
+    )  # fmt: skip
+    parser.add_argument(
         "--noise", type=float, default=defaults.noise, metavar="M",
         help=f"standard deviation of the position noise per axis (default {defaults.noise} m)",
     )  # fmt: skip
@@ -78,7 +83,7 @@ def run_crowd(args: argparse.Namespace) -> int:
             x, y, yaw = args.view
             view = ViewCone(x, y, math.radians(yaw), math.radians(args.fov), max_range=args.range)
         replay = ReplaySettings(rate=args.rate, noise=args.noise, miss_rate=args.miss_rate, seed=args.seed, view=view)
-        sets = _load(args.folders)
+        sets = _load(args.folders, args.interval)
         settings = CrowdSettings(replay=replay)
         if args.cross_validate:
             result = cross_validate(sets, settings, DEFAULT_GRID, ProgressBar("cross-validation"))
@@ -96,8 +101,8 @@ def run_crowd(args: argparse.Namespace) -> int:
     return 0
 
 
-def _load(folders: list[str]) -> list[TrajectorySet]:
-    sets = [load_trajectory_set(folder) for folder in folders]
+def _load(folders: list[str], interval: float | None) -> list[TrajectorySet]:
+    sets = [load_trajectory_set(folder, interval) for folder in folders]
     names = [s.name for s in sets]
     twice = sorted({n for n in names if names.count(n) > 1})
     if twice:

@@ -5,7 +5,9 @@ Format (one folder per set): ``obsmat.txt``, one row per annotated person and fr
 ``groups.txt``, one line per group of people who walk together, their ids separated by spaces (people not listed
 walk alone; a group holds for as long as at least two of its members are in the scene). Annotations come every
 ``interval`` seconds (0.4 s in the public sets, whatever their video's frame rate): the most common step between
-frame numbers is taken as one interval (seq_eth has a few odd steps).
+frame numbers is taken as one interval (seq_eth has a few odd steps). Unless given, the interval is read from the
+annotations themselves: the median, over the people walking faster than 0.3 m/s, of how far they move in one step
+over their annotated speed (0.400 s in each public set), to two significant digits.
 
 ``replay`` feeds them as a perception stage would: detections at the annotation times or at a camera's rate by
 linear interpolation (only between annotations one step apart), seeded Gaussian position noise, seeded missed
@@ -28,7 +30,15 @@ from sid.errors import SidError
 from sid.perception.people import Person
 from sid.tracking.view import View
 
-__all__ = ["ReplayFrame", "ReplaySettings", "TrajectoryError", "TrajectorySet", "load_trajectory_set", "replay"]
+__all__ = [
+    "DEFAULT_INTERVAL",
+    "ReplayFrame",
+    "ReplaySettings",
+    "TrajectoryError",
+    "TrajectorySet",
+    "load_trajectory_set",
+    "replay",
+]
 
 
 class TrajectoryError(SidError, ValueError):
@@ -97,10 +107,16 @@ class ReplayFrame:
     truth_positions: np.ndarray
 
 
-def load_trajectory_set(folder: str | Path, interval: float = 0.4) -> TrajectorySet:
-    """The set in ``folder`` (``obsmat.txt``, ``groups.txt``); ``interval``: seconds between annotation steps."""
+DEFAULT_INTERVAL = 0.4
+"""Seconds between annotation steps where the annotations cannot tell (too few people walking): the public sets'."""
+
+
+def load_trajectory_set(folder: str | Path, interval: float | None = None) -> TrajectorySet:
+    """The set in ``folder`` (``obsmat.txt``, ``groups.txt``); ``interval``: seconds between annotation steps (None:
+    read from the annotated positions and velocities, the module docstring; a note says so when it is not 0.4 s)."""
     folder = Path(folder)
-    check_number("trajectories", "interval", interval, low=0, low_open=True, unit="seconds")
+    if interval is not None:
+        check_number("trajectories", "interval", interval, low=0, low_open=True, unit="seconds")
     obsmat, groups_file = folder / "obsmat.txt", folder / "groups.txt"
     for path in (obsmat, groups_file):
         if not path.exists():
@@ -118,8 +134,11 @@ def load_trajectory_set(folder: str | Path, interval: float = 0.4) -> Trajectory
         raise TrajectoryError(f"{obsmat}: pedestrian {ids[twice[0]]} appears twice in frame {frames[twice[0]]}")
     starts = np.flatnonzero(np.r_[True, frames[1:] != frames[:-1]])
     bounds = np.r_[starts, len(frames)]
-    times = (frames[starts] - frames[0]) / step * interval
     position, velocity = rows[:, [2, 4]], rows[:, [5, 7]]
+    if interval is None:
+        interval, note = _read_interval(frames, ids, position, velocity, step)
+        notes += [note] if note else []
+    times = (frames[starts] - frames[0]) / step * interval
     groups, group_notes = _read_groups(groups_file, set(ids.tolist()))
     return TrajectorySet(
         folder.name,
@@ -129,6 +148,32 @@ def load_trajectory_set(folder: str | Path, interval: float = 0.4) -> Trajectory
         tuple(velocity[a:b] for a, b in zip(bounds[:-1], bounds[1:], strict=True)),
         groups,
         (*notes, *group_notes),
+    )
+
+
+def _read_interval(
+    frames: np.ndarray, ids: np.ndarray, position: np.ndarray, velocity: np.ndarray, step: int
+) -> tuple[float, str]:
+    """Seconds between annotation steps, from the rows (sorted by frame, then id): the median of |move| / |velocity|
+    over one-step moves of people annotated faster than 0.3 m/s, to two significant digits; and a note when it is
+    not ``DEFAULT_INTERVAL``, or when fewer than 5 such moves leave it at that."""
+    order = np.lexsort((frames, ids))  # by person, then frame
+    f, i, p, v = frames[order], ids[order], position[order], velocity[order]
+    one_step = (i[1:] == i[:-1]) & (f[1:] - f[:-1] == step)
+    speed = np.hypot(v[:-1, 0], v[:-1, 1])
+    moving = one_step & (speed > 0.3)
+    if moving.sum() < 5:
+        return DEFAULT_INTERVAL, (
+            f"too few people walking to read the time between annotation steps: {DEFAULT_INTERVAL} s taken "
+            "(--interval sets it)"
+        )
+    moved = np.hypot(*(p[1:] - p[:-1])[moving].T)
+    interval = float(f"{np.median(moved / speed[moving]):.2g}")
+    if abs(interval - DEFAULT_INTERVAL) <= 1e-9:
+        return interval, ""
+    return interval, (
+        f"annotations every {interval:g} s (frame step {step}), read from the annotated positions and velocities "
+        "(--interval sets it)"
     )
 
 

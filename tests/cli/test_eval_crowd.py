@@ -31,7 +31,9 @@ def test_json_holds_the_settings_and_every_score(tmp_path: Path, capsys: pytest.
     result = json.loads(capsys.readouterr().out)
     assert result["settings"]["replay"]["rate"] == 5.0 and result["settings"]["replay"]["noise"] == 0.05
     scene = result["sets"]["scene"]
-    assert scene["frames"] == 39  # 19 steps of 0.4 s at 5 Hz, both ends
+    assert scene["frames"] == 39  # 19 steps of 0.4 s (read from the annotations) at 5 Hz, both ends
+    assert main([*argv, "--interval", "0.2"]) == 0  # the set's 19 steps taken as 0.2 s each
+    assert json.loads(capsys.readouterr().out)["sets"]["scene"]["frames"] == 20
     assert {"mota", "idf1", "id_switches", "id_switches_per_100_tracks"} <= set(scene["people"])
     assert set(scene["groups"]) == set(scene["coherent_motion"]) == {"gmitre", "groups_T2/3", "groups_T1"}
 
@@ -55,6 +57,7 @@ def test_cross_validation_prints_one_row_per_stage_and_held_out_set(
         (["--rate", "0"], "replay: rate must be"),
         (["--miss-rate", "1"], "replay: miss_rate must be"),
         (["--fov", "400", "--view", "0,0,0"], "fov"),
+        (["--interval", "0"], "trajectories: interval must be"),
     ],
 )
 def test_bad_settings_are_refused(tmp_path: Path, capsys: pytest.CaptureFixture, argv: list[str], message: str) -> None:

@@ -43,6 +43,22 @@ def test_a_set_is_read_into_frames_with_times_positions_and_groups(tmp_path: Pat
     assert trajectories.truth_groups({1, 3}) == []  # a group holds while two of its members are present
 
 
+def test_the_time_between_annotation_steps_is_read_from_positions_and_velocities(tmp_path: Path) -> None:
+    """Annotated every 0.1 s (frame step 10 at 100 fps): 0.1 s steps, with a note; 0.4 s steps need no note; nobody
+    walking leaves 0.4 s, with a note; a given interval wins."""
+    fast = [(10 * k, i, 0.1 * k, 0, y, 1.0, 0, 0) for k in range(8) for i, y in ((1, 0.0), (2, 0.6))]
+    folder = write_set(tmp_path / "fast", fast)
+    trajectories = load_trajectory_set(folder)
+    assert trajectories.times.tolist() == pytest.approx([0.1 * k for k in range(8)])
+    assert trajectories.notes == ("annotations every 0.1 s (frame step 10), read from the annotated positions and "
+                                  "velocities (--interval sets it)",)  # fmt: skip
+    assert load_trajectory_set(write_set(tmp_path / "usual", _walkers())).notes == ()
+    standing = [(10 * k, 1, 2.0, 0, 1.0, 0, 0, 0) for k in range(5)]
+    still = load_trajectory_set(write_set(tmp_path / "still", standing))
+    assert still.times.tolist() == pytest.approx([0.0, 0.4, 0.8, 1.2, 1.6]) and "0.4 s taken" in still.notes[0]
+    assert load_trajectory_set(folder, interval=0.2).times.tolist() == pytest.approx([0.2 * k for k in range(8)])
+
+
 def test_lines_sharing_a_person_are_one_group_with_a_note(tmp_path: Path) -> None:
     folder = write_set(tmp_path / "s", _walkers(), "1 2\n2 3\n")
     trajectories = load_trajectory_set(folder)
