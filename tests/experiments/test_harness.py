@@ -74,6 +74,17 @@ def test_an_impossible_task_is_named():
         run_matrix([task], ["grid"])
 
 
+def test_a_task_whose_goal_is_its_start_has_no_ratios():
+    # sid compare stopped with a ZeroDivisionError: the grid reference's cost and the "without" length are 0 m.
+    data = copy.deepcopy(DEMO_SCENARIO)
+    data["robot"]["goal"] = data["robot"]["start"]
+    runs = run_matrix([prepare(scenario_from_dict(data))], ["grid", "bitstar"], runs=1)
+    assert [r.result.success for r in runs] == [True] * 4
+    assert all(r.metrics["path_length_m"] == 0.0 for r in runs)
+    assert all(r.cost_ratio is r.raw_cost_ratio is r.detour is None for r in runs)
+    assert summarise([r.record() for r in runs])[1]["median_cost_ratio"] is None
+
+
 def test_goal_zone_warning_names_the_group():
     data = copy.deepcopy(DEMO_SCENARIO)
     data["robot"]["goal"] = [4.5, 0.0, 0.0]  # the conversation's o-space centre
