@@ -453,9 +453,9 @@ def render_costmap(
         _draw_camera(img, spec, scale, camera)
     _draw_outlines(img, spec, scale, outlines)
     ground = img.copy()  # what the labels may cover: costs, the camera's view, outlines
-    if scan is not None:
-        for u, v in (world_to_image(scan.hit_points(), spec, scale)).astype(int):
-            _scan_dot(img, int(u), int(v))
+    hits = np.zeros((0, 2)) if scan is None else scan.hit_points()  # world (x, y) of the returns, metres
+    for u, v in world_to_image(hits, spec, scale).astype(int):
+        _scan_dot(img, int(u), int(v))
     drawn = _draw_groups(img, spec, scale, groups, people, zone_margin)
     _draw_people(img, spec, scale, people, colours, radius)
     if robot is not None:
@@ -468,7 +468,7 @@ def render_costmap(
     drawn |= {
         "unknown facing: id?": any(p.theta is None for p in people),
         "known obstacle": bool(outlines),
-        "LiDAR hits": scan is not None,
+        "LiDAR hits": len(hits) > 0,
         "robot start": robot is not None,
         "goal": robot is not None,
         "camera, field of view": camera is not None,

@@ -9,6 +9,7 @@ import pytest
 import costmap.render as render
 from costmap.grid import Costmap2D, GridSpec
 from costmap.render import GROUP_COLOURS, PERSON, CameraView, render_costmap, world_to_image
+from costmap.scan import LaserScan
 from sid.perception.group import Group
 from sid.perception.people import Person
 
@@ -87,3 +88,14 @@ def test_id_labels_keep_clear_of_each_other_and_of_what_is_drawn(monkeypatch) ->
         assert not avoid[v0:v1, u0:u1].any(), f"label {i} covers a person or an arrow"
         for a0, b0, a1, b1 in blocks[i + 1 :]:
             assert u1 <= a0 or a1 <= u0 or v1 <= b0 or b1 <= v0, "two labels overlap"
+
+
+def test_the_legend_names_lidar_hits_only_when_the_scan_has_some(legend) -> None:
+    # A scan of an empty map (no obstacles, nobody in range) draws no dot, so the legend has no "LiDAR hits" row.
+    ranges = np.full(8, np.inf)
+    empty = LaserScan(ranges, -np.pi, np.pi / 4, 10.0, (1.0, 0.0, 0.0))
+    render_costmap(Costmap2D.filled(SPEC), scan=empty, scale=2)
+    assert "LiDAR hits" not in legend[-1]
+    ranges[0] = 1.0
+    render_costmap(Costmap2D.filled(SPEC), scan=LaserScan(ranges, -np.pi, np.pi / 4, 10.0, (1.0, 0.0, 0.0)), scale=2)
+    assert "LiDAR hits" in legend[-1]
