@@ -3,6 +3,8 @@ other and of what is drawn, and a legend of exactly what is drawn."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -99,3 +101,19 @@ def test_the_legend_names_lidar_hits_only_when_the_scan_has_some(legend) -> None
     ranges[0] = 1.0
     render_costmap(Costmap2D.filled(SPEC), scan=LaserScan(ranges, -np.pi, np.pi / 4, 10.0, (1.0, 0.0, 0.0)), scale=2)
     assert "LiDAR hits" in legend[-1]
+
+
+@pytest.mark.parametrize(
+    ("origin", "size", "x_ticks", "y_ticks"),
+    [
+        ((-1.0, -3.5), (11.0, 7.0), range(-1, 11), range(-3, 4)),  # the demo's map: a tick a metre, as before
+        ((-1.0, -1.5), (22.0, 3.0), range(-1, 22), [-1.0, 0.0, 1.0]),  # a corridor: was one tick, "-0", on y
+        ((0.0, 0.0), (1.0, 0.8), np.arange(0.0, 1.01, 0.2), np.arange(0.0, 0.81, 0.2)),  # was one tick, 0, on y
+        ((-20.0, -20.0), (40.0, 40.0), range(-20, 21, 2), range(-20, 21, 2)),  # labels 40 px apart at 1 px a cell
+    ],
+)
+def test_axis_ticks_are_readable_on_every_map_and_never_negative_zero(origin, size, x_ticks, y_ticks) -> None:
+    spec = GridSpec.from_size(0.05, origin, size)
+    xs, ys = render.axis_ticks(spec, render.default_scale(spec))
+    assert xs == pytest.approx(list(x_ticks)) and ys == pytest.approx(list(y_ticks))
+    assert all(math.copysign(1.0, t) > 0 for t in (*xs, *ys) if t == 0)  # 0, not -0
