@@ -206,7 +206,8 @@ def run_matrix(
     """Every planner (grid: once, it is deterministic; the others with OMPL seeds 1..``runs``) for every time limit
     and task, in each mode, with cost ratios to the grid reference. The runs are told apart by scenario name and
     planner: a planner given twice, or two tasks whose scenarios share a name, are refused (ValueError), since their
-    runs would be pooled into one row."""
+    runs would be pooled into one row. Every task's grid references are planned first, so an impossible task raises
+    ``planner.problem.PlanningError`` naming its scenario before any run."""
     names = [resolve_planner(p) for p in planners]
     if runs < 1:
         raise ValueError(f"runs must be at least 1, got {runs}")
@@ -218,6 +219,9 @@ def run_matrix(
         raise ValueError(
             f"two scenarios are named {twice!r}: their runs would be pooled into one row; give each its own 'name'"
         )
+    for task in tasks:  # an impossible task stops the matrix here, named, before any run is spent
+        for mode in modes:
+            task.reference_cost(mode)
     jobs = [
         (task, limit, name, seed)
         for task in tasks

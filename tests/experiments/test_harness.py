@@ -74,6 +74,17 @@ def test_an_impossible_task_is_named():
         run_matrix([task], ["grid"])
 
 
+def test_an_impossible_task_stops_the_matrix_before_any_run(task):
+    # sid compare on several scenarios planned every earlier one with every planner and seed, then stopped on the
+    # last one's impossible task and wrote nothing.
+    data = copy.deepcopy(DEMO_SCENARIO)
+    data["name"], data["robot"]["goal"] = "walled in", [5.0, -2.9, 0.0]
+    calls: list[str] = []
+    with pytest.raises(PlanningError, match="walled in: no path: goal"):
+        run_matrix([task, prepare(scenario_from_dict(data))], ["rrtconnect"], progress=lambda d, t, w: calls.append(w))
+    assert calls == []
+
+
 def test_a_task_whose_goal_is_its_start_has_no_ratios():
     # sid compare stopped with a ZeroDivisionError: the grid reference's cost and the "without" length are 0 m.
     data = copy.deepcopy(DEMO_SCENARIO)
