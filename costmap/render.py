@@ -11,6 +11,7 @@ top.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Protocol
@@ -48,7 +49,9 @@ __all__ = [
     "Swatch",
     "TEXT",
     "UNKNOWN_COLOUR",
+    "TICK_MIN_PX",
     "ZONE",
+    "axis_ticks",
     "default_scale",
     "person_colours",
     "render_costmap",
@@ -142,15 +145,46 @@ def _text(
     cv2.putText(img, text, org, FONT, size, colour, thick, cv2.LINE_AA)
 
 
-def _axes(img: np.ndarray, spec: GridSpec, scale: int) -> None:
+TICK_MIN_PX = 30
+"""Axis ticks are at least this many pixels apart, so that labels such as "-100" do not touch."""
+_TICK_STEPS = [k * 10.0**e for e in range(-2, 5) for k in (1.0, 2.0, 5.0)]  # metres, the 1-2-5 series
+
+
+def _multiples(lo: float, hi: float, step: float) -> list[float]:
+    """The multiples of ``step`` in [lo, hi] (metres, a nanometre of slack at both ends), 0 never signed."""
+    first, last = math.ceil(lo / step - 1e-9), math.floor(hi / step + 1e-9)
+    return [round(k * step, 9) + 0.0 for k in range(first, last + 1)]  # + 0.0: -0.0 becomes 0.0
+
+
+def axis_ticks(spec: GridSpec, scale: int) -> tuple[list[float], list[float]]:
+    """World x and y (m) of the picture's axis ticks at ``scale`` pixels per cell: the multiples of one step of the
+    1-2-5 series, 1 m unless ticks a metre apart would be closer than ``TICK_MIN_PX`` (a larger step: a large map)
+    or a side of the map would hold fewer than three (a smaller one, still ``TICK_MIN_PX`` apart: a map a metre
+    across)."""
     x0, y0, x1, y1 = spec.bounds
-    step = 1.0 if max(x1 - x0, y1 - y0) <= 20 else 5.0
+    px_per_m = scale / spec.resolution
+    i = _TICK_STEPS.index(1.0)
+    while _TICK_STEPS[i] * px_per_m < TICK_MIN_PX and i + 1 < len(_TICK_STEPS):
+        i += 1
+    while (
+        i > 0
+        and _TICK_STEPS[i - 1] * px_per_m >= TICK_MIN_PX
+        and min(len(_multiples(x0, x1, _TICK_STEPS[i])), len(_multiples(y0, y1, _TICK_STEPS[i]))) < 3
+    ):
+        i -= 1
+    step = _TICK_STEPS[i]
+    return _multiples(x0, x1, step), _multiples(y0, y1, step)
+
+
+def _axes(img: np.ndarray, spec: GridSpec, scale: int) -> None:
+    x0, y0, _, _ = spec.bounds
+    xs, ys = axis_ticks(spec, scale)
     h_px = spec.height * scale
-    for x in np.arange(np.ceil(x0 / step) * step, x1 + 1e-9, step):
+    for x in xs:
         u = int(world_to_image([[x, y0]], spec, scale)[0, 0])
         cv2.line(img, (u, MARGIN_TOP + h_px), (u, MARGIN_TOP + h_px + 5), TEXT, 1)
         _text(img, f"{x:g}", (u - 8, MARGIN_TOP + h_px + 20), 0.4)
-    for y in np.arange(np.ceil(y0 / step) * step, y1 + 1e-9, step):
+    for y in ys:
         v = int(world_to_image([[x0, y]], spec, scale)[0, 1])
         cv2.line(img, (MARGIN_LEFT - 5, v), (MARGIN_LEFT, v), TEXT, 1)
         _text(img, f"{y:g}", (MARGIN_LEFT - 34, v + 5), 0.4)
@@ -453,9 +487,9 @@ def render_costmap(
         _draw_camera(img, spec, scale, camera)
     _draw_outlines(img, spec, scale, outlines)
     ground = img.copy()  # what the labels may cover: costs, the camera's view, outlines
-    if scan is not None:
-        for u, v in (world_to_image(scan.hit_points(), spec, scale)).astype(int):
-            _scan_dot(img, int(u), int(v))
+    hits = np.zeros((0, 2)) if scan is None else scan.hit_points()  # world (x, y) of the returns, metres
+    for u, v in world_to_image(hits, spec, scale).astype(int):
+        _scan_dot(img, int(u), int(v))
     drawn = _draw_groups(img, spec, scale, groups, people, zone_margin)
     _draw_people(img, spec, scale, people, colours, radius)
     if robot is not None:
@@ -468,7 +502,7 @@ def render_costmap(
     drawn |= {
         "unknown facing: id?": any(p.theta is None for p in people),
         "known obstacle": bool(outlines),
-        "LiDAR hits": scan is not None,
+        "LiDAR hits": len(hits) > 0,
         "robot start": robot is not None,
         "goal": robot is not None,
         "camera, field of view": camera is not None,

@@ -107,7 +107,7 @@ def bar_chart(
     rows: Sequence[dict], panels: Sequence[Panel], path: str | Path, title: str, subtitle: str = "", columns: int = 3
 ) -> Path:
     """Write ``rows`` (``harness.summarise`` rows by planner, one costmap mode each) as a grid of ``panels`` to a
-    PNG at ``path``; returns the path. A missing value (no successful run) is marked "n/a"."""
+    PNG at ``path``; returns the path. A missing value (no successful run, or no ratio) is marked "n/a"."""
     # matplotlib loads here, not at import: the CLI imports this module for every command (about 1 s).
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure

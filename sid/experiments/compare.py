@@ -55,7 +55,7 @@ def format_summary(rows: Sequence[dict]) -> str:
 
 CHART_NOTE = (
     "Medians over seeds and scenarios. Cost: the path's cost J over the grid planner's on the same costmap. "
-    "n/a: no successful run."
+    "n/a: no successful run, or a 0 m grid path to compare with."
 )
 
 

@@ -10,7 +10,8 @@ compare``, ``sid reproduce navigation`` and ``sid bench``'s planner stages all p
 
 World frame (REP-103), metres, seconds. A run's ``cost_ratio`` is its path cost J over the grid planner's J on the
 same costmap (``raw_cost_ratio``: the planner's own path before smoothing); ``detour`` is, on a "with" run, its
-length over the same planner's "without" length for the same task and seed.
+length over the same planner's "without" length for the same task and seed. Both are None when their yardstick is 0
+(a goal at the start).
 """
 
 from __future__ import annotations
@@ -173,12 +174,13 @@ def compare_with_without(
             progress(mode, None)
         result = plan(task.problems[mode], name, time_limit=time_limit, seed=seed, max_iterations=max_iterations)
         metrics = result_metrics(result, task.scenario.people, task.groups, measure_on)
-        ratio = raw_ratio = detour = None
-        if reference_cost is not None and result.success:
+        ratio = raw_ratio = detour = None  # also where the yardstick is 0 m long: a goal at the start
+        if reference_cost is not None and reference_cost > 0 and result.success:
             ratio, raw_ratio = result.cost / reference_cost, result.raw_cost / reference_cost
         without = runs.get("without")
         if mode == "with" and result.success and without is not None and without.result.success:
-            detour = metrics["path_length_m"] / without.metrics["path_length_m"]
+            without_length = without.metrics["path_length_m"]
+            detour = metrics["path_length_m"] / without_length if without_length > 0 else None
         runs[mode] = Run(
             task.scenario.name, name, mode, time_limit, max_iterations, result, metrics, task.labels,
             ratio, raw_ratio, detour,
@@ -204,7 +206,8 @@ def run_matrix(
     """Every planner (grid: once, it is deterministic; the others with OMPL seeds 1..``runs``) for every time limit
     and task, in each mode, with cost ratios to the grid reference. The runs are told apart by scenario name and
     planner: a planner given twice, or two tasks whose scenarios share a name, are refused (ValueError), since their
-    runs would be pooled into one row."""
+    runs would be pooled into one row. Every task's grid references are planned first, so an impossible task raises
+    ``planner.problem.PlanningError`` naming its scenario before any run."""
     names = [resolve_planner(p) for p in planners]
     if runs < 1:
         raise ValueError(f"runs must be at least 1, got {runs}")
@@ -216,6 +219,9 @@ def run_matrix(
         raise ValueError(
             f"two scenarios are named {twice!r}: their runs would be pooled into one row; give each its own 'name'"
         )
+    for task in tasks:  # an impossible task stops the matrix here, named, before any run is spent
+        for mode in modes:
+            task.reference_cost(mode)
     jobs = [
         (task, limit, name, seed)
         for task in tasks

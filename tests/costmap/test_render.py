@@ -3,12 +3,15 @@ other and of what is drawn, and a legend of exactly what is drawn."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
 import costmap.render as render
 from costmap.grid import Costmap2D, GridSpec
 from costmap.render import GROUP_COLOURS, PERSON, CameraView, render_costmap, world_to_image
+from costmap.scan import LaserScan
 from sid.perception.group import Group
 from sid.perception.people import Person
 
@@ -87,3 +90,30 @@ def test_id_labels_keep_clear_of_each_other_and_of_what_is_drawn(monkeypatch) ->
         assert not avoid[v0:v1, u0:u1].any(), f"label {i} covers a person or an arrow"
         for a0, b0, a1, b1 in blocks[i + 1 :]:
             assert u1 <= a0 or a1 <= u0 or v1 <= b0 or b1 <= v0, "two labels overlap"
+
+
+def test_the_legend_names_lidar_hits_only_when_the_scan_has_some(legend) -> None:
+    # A scan of an empty map (no obstacles, nobody in range) draws no dot, so the legend has no "LiDAR hits" row.
+    ranges = np.full(8, np.inf)
+    empty = LaserScan(ranges, -np.pi, np.pi / 4, 10.0, (1.0, 0.0, 0.0))
+    render_costmap(Costmap2D.filled(SPEC), scan=empty, scale=2)
+    assert "LiDAR hits" not in legend[-1]
+    ranges[0] = 1.0
+    render_costmap(Costmap2D.filled(SPEC), scan=LaserScan(ranges, -np.pi, np.pi / 4, 10.0, (1.0, 0.0, 0.0)), scale=2)
+    assert "LiDAR hits" in legend[-1]
+
+
+@pytest.mark.parametrize(
+    ("origin", "size", "x_ticks", "y_ticks"),
+    [
+        ((-1.0, -3.5), (11.0, 7.0), range(-1, 11), range(-3, 4)),  # the demo's map: a tick a metre, as before
+        ((-1.0, -1.5), (22.0, 3.0), range(-1, 22), [-1.0, 0.0, 1.0]),  # a corridor: was one tick, "-0", on y
+        ((0.0, 0.0), (1.0, 0.8), np.arange(0.0, 1.01, 0.2), np.arange(0.0, 0.81, 0.2)),  # was one tick, 0, on y
+        ((-20.0, -20.0), (40.0, 40.0), range(-20, 21, 2), range(-20, 21, 2)),  # labels 40 px apart at 1 px a cell
+    ],
+)
+def test_axis_ticks_are_readable_on_every_map_and_never_negative_zero(origin, size, x_ticks, y_ticks) -> None:
+    spec = GridSpec.from_size(0.05, origin, size)
+    xs, ys = render.axis_ticks(spec, render.default_scale(spec))
+    assert xs == pytest.approx(list(x_ticks)) and ys == pytest.approx(list(y_ticks))
+    assert all(math.copysign(1.0, t) > 0 for t in (*xs, *ys) if t == 0)  # 0, not -0

@@ -74,6 +74,28 @@ def test_an_impossible_task_is_named():
         run_matrix([task], ["grid"])
 
 
+def test_an_impossible_task_stops_the_matrix_before_any_run(task):
+    # sid compare on several scenarios planned every earlier one with every planner and seed, then stopped on the
+    # last one's impossible task and wrote nothing.
+    data = copy.deepcopy(DEMO_SCENARIO)
+    data["name"], data["robot"]["goal"] = "walled in", [5.0, -2.9, 0.0]
+    calls: list[str] = []
+    with pytest.raises(PlanningError, match="walled in: no path: goal"):
+        run_matrix([task, prepare(scenario_from_dict(data))], ["rrtconnect"], progress=lambda d, t, w: calls.append(w))
+    assert calls == []
+
+
+def test_a_task_whose_goal_is_its_start_has_no_ratios():
+    # sid compare stopped with a ZeroDivisionError: the grid reference's cost and the "without" length are 0 m.
+    data = copy.deepcopy(DEMO_SCENARIO)
+    data["robot"]["goal"] = data["robot"]["start"]
+    runs = run_matrix([prepare(scenario_from_dict(data))], ["grid", "bitstar"], runs=1)
+    assert [r.result.success for r in runs] == [True] * 4
+    assert all(r.metrics["path_length_m"] == 0.0 for r in runs)
+    assert all(r.cost_ratio is r.raw_cost_ratio is r.detour is None for r in runs)
+    assert summarise([r.record() for r in runs])[1]["median_cost_ratio"] is None
+
+
 def test_goal_zone_warning_names_the_group():
     data = copy.deepcopy(DEMO_SCENARIO)
     data["robot"]["goal"] = [4.5, 0.0, 0.0]  # the conversation's o-space centre

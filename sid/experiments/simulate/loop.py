@@ -4,8 +4,9 @@ collision or the time limit.
 Per step of ``1 / rate_hz`` seconds, at time t (map frame, metres, radians, seconds):
 
 1. the people move to their scripted poses at t (``SimWorld.people_at``); a robot disc overlapping an obstacle or a
-   person's body (``lidar.body_radius``) is a collision and ends the run; the robot within ``goal_tolerance_m`` of
-   the goal ends it with success; t past ``time_limit_s`` ends it without;
+   person's body (``lidar.body_radius``) is a collision and ends the run (also when a walker, who never avoids the
+   robot, walks into it while it stands still; the reason says so); the robot within ``goal_tolerance_m`` of the goal
+   ends it with success; t past ``time_limit_s`` ends it without;
 2. the 2D LiDAR scans from the robot's pose (``sid.scenario.lidar.simulate_scan``: obstacles and people); with the
    social layer the camera sees the people (``sid.experiments.simulate.perception``) and the group detector groups
    them (``sid.perception.groups.detect_groups``);
@@ -277,7 +278,9 @@ def simulate(
         trace.time_s = t
         hit = collision((state.x, state.y), limits.radius, obstacles, people, lidar.body_radius)
         if hit is not None:
-            trace.collisions, trace.reason = 1, f"collision with {hit} at t = {t:.1f} s"
+            # Scripted walkers do not avoid the robot: say when one walked into it while it stood still.
+            still = " (the robot was standing still: the person walked into it)" if state.v == 0.0 else ""
+            trace.collisions, trace.reason = 1, f"collision with {hit} at t = {t:.1f} s{still}"
             break
         if math.hypot(goal[0] - state.x, goal[1] - state.y) <= settings.goal_tolerance_m:
             trace.success, trace.reason = True, f"goal reached at t = {t:.1f} s"

@@ -4,6 +4,8 @@ the run's settings, read from one scenario file; and the ground-truth geometry t
 A simulation file is a scenario file (docs/scenario.md: people may walk along ``people[i].path``) with one more,
 optional block, ``simulation``: ``max_speed`` (m/s, 0.5), ``max_turn_rate`` (rad/s, 1.5), ``max_accel`` (m/s^2,
 1.0), ``time_limit_s`` (60), ``rate_hz`` (10), ``goal_tolerance_m`` (0.25), ``description`` (text for ``--list``).
+Every person who stands (no ``path``) needs a ``theta``: the world is ground truth, and the camera renders each body
+from its facing.
 
 Seeds (``jittered``): seed 0 is the scene as written; seed k >= 1 moves every standing person by Gaussian jitter of
 ``JITTER_XY_M`` and turns them by ``JITTER_THETA_RAD`` (drawn from ``[k, 7]``), so that sweeps over seeds see
@@ -137,6 +139,12 @@ def world_from_dict(data: Any, base_dir: Path | None = None, default_name: str =
     data = copy.deepcopy(data)
     settings = _settings(data.pop("simulation", {}))
     scenario = scenario_from_dict(data, base_dir, default_name)
+    for i, person in enumerate(scenario.people):
+        if person.theta is None and person.id not in scenario.walks:
+            raise ScenarioError(
+                f"people[{i}].theta: a simulated standing person needs a facing (radians): the camera renders their "
+                "body from it; an unknown facing is what perception reports, not part of the world"
+            )
     return SimWorld(scenario, replace(settings, limits=replace(settings.limits, radius=scenario.robot.radius)))
 
 

@@ -70,6 +70,19 @@ def test_a_walker_that_runs_into_the_robot_is_a_collision():
     assert trace.reason.startswith("collision with person 1")
 
 
+def test_a_walker_that_walks_into_a_waiting_robot_is_a_collision_that_says_so():
+    # The goal lies on the walker's way, so the robot waits for it to clear; scripted walkers do not avoid the robot.
+    data = copy.deepcopy(TINY)
+    data["people"] = [{"id": 1, "x": 4.4, "y": 0.0, "theta": 3.1416, "path": [[-0.4, 0.0]], "speed": 1.0,
+                       "start_time": 0.5}]  # fmt: skip
+    data["robot"]["goal"] = [4.0, 0.0, 0.0]
+    trace = simulate(world_from_dict(data), RunOptions(social=False))
+    assert trace.collisions == 1
+    assert trace.reason.startswith("collision with person 1") and trace.reason.endswith(
+        "(the robot was standing still: the person walked into it)"
+    )
+
+
 def test_an_onnx_pose_model_runs_in_the_loop(tmp_path):
     pytest.importorskip("onnx")
     import numpy as np

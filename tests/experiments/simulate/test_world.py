@@ -5,7 +5,7 @@ import pytest
 from sid.experiments.simulate.world import collision, obstacle_geometry, world_from_dict
 from sid.perception.people import Person
 from sid.scenario.loader import BoxObstacle, ScenarioError, SegmentObstacle
-from tests.experiments.simulate.tiny import TINY, tiny_world
+from tests.experiments.simulate.tiny import PAIR, TINY, tiny_world
 
 
 def test_the_simulation_block_sets_the_limits_and_the_robot_radius_comes_from_the_scenario():
@@ -29,6 +29,16 @@ def test_the_simulation_block_sets_the_limits_and_the_robot_radius_comes_from_th
 def test_a_bad_simulation_block_is_named(simulation, message):
     with pytest.raises(ScenarioError, match=message):
         tiny_world(simulation=simulation)
+
+
+def test_a_standing_person_without_a_facing_is_refused_by_name_whatever_the_run():
+    # The world is ground truth: a person stands facing somewhere; "unknown facing" is what perception reports. The
+    # camera cannot render a body without one, so the file is refused on loading, before any run of a sweep.
+    people = [PAIR[0], {"id": 2, "x": 2.0, "y": -0.6}]
+    with pytest.raises(ScenarioError, match=r"people\[1\]\.theta: .*standing person needs a facing"):
+        tiny_world(people=people)
+    walker = {"id": 2, "x": 2.0, "y": -0.6, "path": [[2.0, 1.0]]}  # faces the way it walks
+    assert tiny_world(people=[PAIR[0], walker]).scenario.people[1].theta is None
 
 
 def test_walkers_move_along_their_path_and_face_the_way_they_go():
