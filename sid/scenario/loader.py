@@ -21,7 +21,7 @@ from costmap.grid import GridSpec
 from costmap.mapfile import MapFileError, read_map
 from costmap.occupancy import OccupancyGrid
 from costmap.plugins import PEOPLE_LAYERS, PLUGINS, SECTIONS, CostmapParams, LayerInstance
-from sid.checks import LimitError, amount, check_limit
+from sid.checks import YAW_LIMIT_RAD, LimitError, amount, check_limit
 from sid.documents import InputWarning, is_number, load_document, summary
 from sid.errors import SidError
 from sid.perception.groups import GroupParams
@@ -320,7 +320,7 @@ def _person(value: Any, name: str, index: int) -> Person:
     if theta is not None:
         if not is_number(theta):
             raise _fail(f"{name}.theta", "a finite number of radians, or null when unknown", theta)
-        theta = float(theta)
+        theta = _yaw(float(theta), f"{name}.theta")
     quality = _number(data.get("orientation_quality", 0.0 if theta is None else 1.0), f"{name}.orientation_quality")
     if not 0 <= quality <= 1:
         raise _fail(f"{name}.orientation_quality", "a number in [0, 1]", quality)
@@ -384,7 +384,15 @@ def _conversations(value: Any, people: list[Person]) -> tuple[tuple[int, ...], .
 
 def _pose(value: Any, name: str) -> tuple[float, float, float]:
     pose = _point(value, name, (2, 3))
-    return (pose[0], pose[1], pose[2] if len(pose) == 3 else 0.0)
+    return (pose[0], pose[1], _yaw(pose[2], f"{name}[2]") if len(pose) == 3 else 0.0)
+
+
+def _yaw(value: float, name: str) -> float:
+    """``value`` (rad) unless it lies beyond two turns (``YAW_LIMIT_RAD``): 90 or 180 is a yaw in degrees, which
+    read as radians would point anywhere."""
+    if abs(value) > YAW_LIMIT_RAD:
+        raise _fail(name, "radians (a yaw within two turns of 0), not degrees", value)
+    return value
 
 
 def _inside(grid: GridSpec, xy: tuple[float, ...], name: str) -> None:
