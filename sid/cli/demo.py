@@ -14,7 +14,7 @@ from sid.cli.common import (
     print_written,
     staged_output,
 )
-from sid.cli.planning import INPUT_ERRORS, add_planner_option, add_planning_options, warn_goal_zone
+from sid.cli.planning import INPUT_ERRORS, add_planner_option, add_planning_options, warn_zones
 from sid.experiments.demo import DEMO_ITERATIONS, DEMO_SEED, run_demo
 from sid.experiments.plan_pictures import format_table
 from sid.scenario.loader import load_scenario
@@ -52,7 +52,7 @@ def run(args: argparse.Namespace) -> int:
             )
     except (*INPUT_ERRORS, OSError) as exc:
         return fail("sid demo", exc)
-    warn_goal_zone("sid demo", comparison)
+    warn_zones("sid demo", comparison)
     print()
     print(format_table(comparison))
     print()

@@ -11,7 +11,7 @@ from sid.cli.planning import (
     add_planner_option,
     add_planning_options,
     add_scenario_arguments,
-    warn_goal_zone,
+    warn_zones,
 )
 from sid.experiments.scenario_plan import plan_scenario, write_plan
 from sid.scenario.loader import load_scenario
@@ -51,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
         )
     except INPUT_ERRORS as exc:
         return fail("sid plan", exc)
-    warn_goal_zone("sid plan", comparison)
+    warn_zones("sid plan", comparison)
     try:
         with staged_output(args.out, ()) as staged:
             files = {key: staged.final(path) for key, path in write_plan(comparison, staged.path).items()}

@@ -10,7 +10,7 @@ from costmap.mapfile import MapFileError
 from planner.facade import DEFAULT_PLANNER, DEFAULT_SOFT_LIMIT_S, MAX_SEED, PLANNERS
 from planner.problem import DEFAULT_COST_WEIGHT, PlanningError
 from sid.cli.common import add_output_option, positive_seconds
-from sid.experiments.harness import Comparison, goal_zone_warning
+from sid.experiments.harness import Comparison, zone_warnings
 from sid.scenario.loader import ScenarioError
 
 __all__ = [
@@ -19,7 +19,7 @@ __all__ = [
     "add_planning_options",
     "add_scenario_arguments",
     "seed_number",
-    "warn_goal_zone",
+    "warn_zones",
 ]
 
 INPUT_ERRORS = (ScenarioError, MapFileError, PlanningError, ValueError)
@@ -89,8 +89,7 @@ def add_planning_options(
     )
 
 
-def warn_goal_zone(command: str, comparison: Comparison) -> None:
-    """Warn on stderr when the task's goal lies inside a group zone (the plan is still made and reported)."""
-    warning = goal_zone_warning(comparison.task)
-    if warning:
+def warn_zones(command: str, comparison: Comparison) -> None:
+    """Warn on stderr when the task's start or goal lies inside a group zone (the plan is still made and reported)."""
+    for warning in zone_warnings(comparison.task):
         print(f"{command}: warning: {warning}", file=sys.stderr)

@@ -44,10 +44,10 @@ __all__ = [
     "Run",
     "Task",
     "compare_with_without",
-    "goal_zone_warning",
     "prepare",
     "run_matrix",
     "summarise",
+    "zone_warnings",
 ]
 
 MODES: dict[str, bool] = {"without": False, "with": True}
@@ -85,17 +85,21 @@ def prepare(scenario: Scenario, cost_weight: float = DEFAULT_COST_WEIGHT, labels
     return Task(scenario, groups, costmaps, problems, dict(labels or {}))
 
 
-def goal_zone_warning(task: Task) -> str | None:
-    """A message when the robot's goal lies inside a group's interaction zone, else None. The plan is still made:
-    the robot may have to go there (to join or serve the group), and the metrics report the intrusion."""
-    goal = Point(task.scenario.robot.goal[:2])
-    for group in task.groups:
-        if group_zone_polygon(group, task.scenario.people).covers(goal):
-            return (
-                f"the goal lies inside the interaction zone of group {group.members}: the path has to enter it "
-                "(by the shortest way the costs allow); see ospace_intrusion_m"
-            )
-    return None
+def zone_warnings(task: Task) -> list[str]:
+    """Messages for the robot's start and goal when they lie inside a group's interaction zone. The plan is still
+    made: the robot may stand there, or have to go there (to join or serve the group), and the metrics report the
+    intrusion."""
+    warnings = []
+    for end, pose, verb in (("start", task.scenario.robot.start, "leave"), ("goal", task.scenario.robot.goal, "enter")):
+        point = Point(pose[:2])
+        for group in task.groups:
+            if group_zone_polygon(group, task.scenario.people).covers(point):
+                warnings.append(
+                    f"the {end} lies inside the interaction zone of group {group.members}: the path has to {verb} it "
+                    "(by the shortest way the costs allow); see ospace_intrusion_m"
+                )
+                break
+    return warnings
 
 
 @dataclass(frozen=True)

@@ -9,7 +9,7 @@ import pytest
 
 from planner.problem import PlanningError
 from sid.experiments.demo import DEMO_SCENARIO, demo_scenario
-from sid.experiments.harness import compare_with_without, goal_zone_warning, prepare, run_matrix, summarise
+from sid.experiments.harness import compare_with_without, prepare, run_matrix, summarise, zone_warnings
 from sid.scenario.loader import scenario_from_dict
 
 
@@ -96,11 +96,15 @@ def test_a_task_whose_goal_is_its_start_has_no_ratios():
     assert summarise([r.record() for r in runs])[1]["median_cost_ratio"] is None
 
 
-def test_goal_zone_warning_names_the_group():
+def test_zone_warnings_name_the_end_and_the_group():
     data = copy.deepcopy(DEMO_SCENARIO)
     data["robot"]["goal"] = [4.5, 0.0, 0.0]  # the conversation's o-space centre
-    assert "inside the interaction zone of group (1, 2, 3)" in goal_zone_warning(prepare(scenario_from_dict(data)))
-    assert goal_zone_warning(prepare(demo_scenario())) is None
+    (warning,) = zone_warnings(prepare(scenario_from_dict(data)))
+    assert warning.startswith("the goal lies inside the interaction zone of group (1, 2, 3): the path has to enter it")
+    data["robot"]["start"], data["robot"]["goal"] = data["robot"]["goal"], DEMO_SCENARIO["robot"]["goal"]
+    (warning,) = zone_warnings(prepare(scenario_from_dict(data)))
+    assert warning.startswith("the start lies inside the interaction zone of group (1, 2, 3): the path has to leave it")
+    assert zone_warnings(prepare(demo_scenario())) == []
 
 
 def _record(social: bool, success: bool, **values) -> dict:
