@@ -15,8 +15,9 @@ A malformed line (not UTF-8 JSON, a key given twice, an unknown field, a missing
 beyond two turns (in degrees by mistake), a timestamp not after the last good line's, two people with one id) is
 reported on stderr with its line number and skipped, or ends the run with --strict (exit 2); everything written
 before it stays written. A line more than the tracker's timeout (1.5 s) after the last good one ends every track, and
-a note on stderr says so (timestamps in milli- or nanoseconds do it at every line). The people and group trackers
-run with their defaults; the group detector that finds conversations among the tracks takes the options below.
+a note on stderr says so, once for such lines in a row (timestamps in milli- or nanoseconds make every line one).
+The people and group trackers run with their defaults; the group detector that finds conversations among the tracks
+takes the options below.
 """
 
 from __future__ import annotations
@@ -47,8 +48,9 @@ def run(args: argparse.Namespace) -> int:
         session = TrackingSession(group_params=group_params_from(args))
     except ValueError as exc:
         return fail("sid track", exc)
+    gaps = _Gaps()
     return run_json_lines(
-        "sid track", args.file, lambda data, note: _track_line(data, session, note), strict=args.strict
+        "sid track", args.file, lambda data, note: _track_line(data, session, gaps, note), strict=args.strict
     )
 
 
@@ -57,25 +59,37 @@ def process(
 ) -> int:
     """Track ``lines`` (text, or bytes decoded line by line) into ``session``, writing one JSON line per good line on
     ``out`` and each problem on ``err``; the exit code (2 when ``strict`` stopped at a bad line)."""
+    gaps = _Gaps()
     return process_json_lines(
-        "sid track", lines, out, err, lambda data, note: _track_line(data, session, note), strict=strict
+        "sid track", lines, out, err, lambda data, note: _track_line(data, session, gaps, note), strict=strict
     )
 
 
-def _track_line(data: Any, session: TrackingSession, note: Callable[[str], None]) -> dict[str, Any]:
+class _Gaps:
+    """Whether the last good line came after a gap that ended every track: a run of such lines is noted once
+    (timestamps in milli- or nanoseconds make every line one)."""
+
+    def __init__(self) -> None:
+        self.in_a_row = False
+
+
+def _track_line(data: Any, session: TrackingSession, gaps: _Gaps, note: Callable[[str], None]) -> dict[str, Any]:
     """The output line of one parsed input line, after ``session`` tracked its people (ValueError for a malformed
     line, the session unchanged). A gap since the last line longer than the tracker's timeout ends every track (no
-    view: every track counts as seen): ``note`` says so, since timestamps in milli- or nanoseconds do it at every
-    line and nobody is ever reported."""
+    view: every track counts as seen): ``note`` says so, once per run of such lines, since timestamps in milli- or
+    nanoseconds do it at every line and nobody is ever reported."""
     timestamp, people = _parse_line(data)
     last, alive = session.people.timestamp, len(session.people)
     update = session.track(people, float(timestamp))
     timeout = session.params.tracker.timeout
-    if alive and last is not None and timestamp - last > timeout:
+    elapsed = 0.0 if last is None else timestamp - last  # s since the last good line (none before the first)
+    gap = elapsed > timeout
+    if gap and alive and not gaps.in_a_row:
         note(
-            f"{timestamp - last:.3g} s after the last line, more than the tracker's timeout ({timeout:g} s): every "
-            "track ended (are the timestamps in seconds?)"
+            f"{elapsed:.3g} s after the last line, more than the tracker's timeout ({timeout:g} s): every "
+            "track ended (are the timestamps in seconds?); the lines right after it that do the same are not noted"
         )
+    gaps.in_a_row = gap
     return {
         "timestamp": timestamp,
         "people": [person.to_json() | {"detection": person.detection} for person in update.people],
