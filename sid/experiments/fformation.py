@@ -1,7 +1,7 @@
 """F-formation group benchmarks: load the Verona datasets' ``.mat`` files and score a group detector on them.
 
 Format (``features.mat`` / ``groundtruth.mat``, MATLAB v5, one folder per sequence): ``features{t}`` is an N x 4
-array ``[id, x, y, theta]`` per frame with ``timestamp(t)``; ``GTgroups{t}`` lists the member ids of each group at
+array ``[id, x, y, theta]`` per frame with ``timestamp(t)`` (further columns are not read, with a warning); ``GTgroups{t}`` lists the member ids of each group at
 ``GTtimestamp(t)``. x, y are ground-plane coordinates (centimetres in the public sets: use ``scale=0.01``), theta
 is the facing yaw in radians in the same frame (``degrees=True`` for files in degrees). A dataset is a folder holding
 ``features.mat`` (one sequence) or sub-folders that do (sequences pooled frame by frame). Ids are whole numbers,
@@ -147,7 +147,7 @@ def load_sequence(folder: str | Path, scale: float = 1.0, degrees: bool = False)
     _check_unique(timestamps, features_path, "timestamp")
     _check_unique(truth_timestamps, truth_path, "GTtimestamp")
     index = _frame_index(timestamps)
-    frames, unmatched = [], []
+    frames, unmatched, widest = [], [], 4  # widest: the most columns of a scored frame's features
     for groups_cell, stamp in zip(truth_groups, truth_timestamps, strict=True):
         with np.errstate(over="ignore"):  # a stamp beyond single precision's range rounds to inf: no frame
             k = index.get(float(stamp), index.get(float(np.float32(stamp))))
@@ -156,12 +156,23 @@ def load_sequence(folder: str | Path, scale: float = 1.0, degrees: bool = False)
             continue
         where = f"{features_path} frame at timestamp {timestamps[k]:g}"
         people, unplaced = _people(frames_people[k], scale, degrees, where)
+        shape = np.shape(frames_people[k])
+        widest = max(widest, shape[1] if len(shape) == 2 and shape[0] else 4)
         groups = [g for g in _groups(groups_cell, f"{truth_path} at timestamp {stamp:g}") if len(g) > 1]
         frames.append(LabelledFrame(folder.name, float(timestamps[k]), people, groups, unplaced))
     if unmatched and not frames:  # nothing matches: other clocks or units, not a slip
         raise ValueError(
             f"fformation: {truth_path}: GTtimestamp {unmatched[0]} has no frame in {features_path.name}"
             + (f" (nor do the other {len(unmatched) - 1})" if len(unmatched) > 1 else "")
+        )
+    if widest > 4:
+        warnings.warn(
+            InputWarning(
+                f"fformation: {features_path}: features have {widest} columns: [id, x, y, theta] are read from the "
+                f"first four, the other {widest - 4} not (a second facing, e.g. the body's beside the head's, is not "
+                "used)"
+            ),
+            stacklevel=2,
         )
     if unmatched:
         warnings.warn(

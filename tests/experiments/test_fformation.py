@@ -445,3 +445,15 @@ def test_group_errors_name_how_each_true_group_came_out():
     assert group_errors([frame], [[[1, 2, 3, 4], [1, 2, 3]]])["exact"] == 1  # a tie on shared members: fewest others
     with pytest.raises(ValueError, match="2 detection lists for 1 frames"):
         group_errors([frame], [[], []])
+
+
+def test_features_with_more_than_four_columns_are_read_from_the_first_four_with_a_warning(tmp_path: Path) -> None:
+    """A set with a second facing per person (head and body, as some annotations hold) reads [id, x, y, theta] and
+    says the other columns are not used, instead of dropping them without a word."""
+    plain = load_sequence(write_sequence(tmp_path / "Four", tiny_frames(), {1: [[1, 2]], 2: [[1, 2, 3]]}))
+    wide = [np.column_stack((frame, frame[:, 3] + 0.5)) for frame in tiny_frames()]  # a body facing beside the head's
+    with pytest.warns(InputWarning, match=r"features have 5 columns: \[id, x, y, theta\] are read from the first four"):
+        frames = load_sequence(write_sequence(tmp_path / "Five", wide, {1: [[1, 2]], 2: [[1, 2, 3]]}))
+    assert [[(p.id, p.x, p.y, p.theta) for p in f.people] for f in frames] == [
+        [(p.id, p.x, p.y, p.theta) for p in f.people] for f in plain
+    ]
