@@ -104,11 +104,15 @@ def _pick(
 ) -> Connection:
     """The connection of topic ``wanted``; else ``default``; else the only ``msgtype`` topic whose last names are
     ``ending`` (whole names: ``aligned_depth_to_color/image_raw`` does not end in ``color/image_raw``). ``option``
-    names the setting that chooses the topic (e.g. ``color_topic``), for the error."""
+    names the setting that chooses the topic (e.g. ``color_topic``), for the error, which also names a topic of the
+    right name but another type (image_transport's ``.../image_raw/compressed``, a CompressedImage)."""
     typed = [c for c in connections if c.msgtype == msgtype]
     if wanted is not None:
         named = [c for c in typed if c.topic == wanted]
         if not named:
+            other = next((c for c in connections if c.topic == wanted), None)
+            if other is not None:
+                raise SourceError(f"topic {wanted!r} is a {other.msgtype} topic; sid {_reads_only(msgtype)}")
             raise SourceError(f"no {msgtype} topic {wanted!r} in the bag; it has {_topics(typed, msgtype)}")
         return named[0]
     named = [c for c in typed if c.topic == default] or [
@@ -116,11 +120,26 @@ def _pick(
     ]
     if len({c.topic for c in named}) != 1:
         found = "none" if not named else "several"
+        others = [c for c in connections if c.msgtype != msgtype and f"/{ending}/" in c.topic]
+        if others and not named:
+            described = ", ".join(sorted({f"{c.topic} is a {c.msgtype} topic" for c in others}))
+            raise SourceError(
+                f"none of the bag's {msgtype} topics end in {ending!r} ({_topics(typed, msgtype)}); {described}; "
+                f"sid {_reads_only(msgtype)}"
+            )
         raise SourceError(
             f"{found} of the bag's {msgtype} topics end in {ending!r} ({_topics(typed, msgtype)}); name the topic "
             f"with {option} (sid detect --{option.replace('_', '-')})"
         )
     return named[0]
+
+
+def _reads_only(msgtype: str) -> str:
+    """What sid reads instead of a topic of another type, for the error naming that topic."""
+    return (
+        f"reads only raw {msgtype} (record the raw topics, or republish the compressed ones as raw: docs/ros2.md, "
+        "section 5)"
+    )
 
 
 def _topics(connections: list[Connection], msgtype: str) -> str:
