@@ -146,8 +146,14 @@ class SocialCostmapNode:
             self.node.get_logger().warning(f"colour image at {dropped.stamp:.3f} s has no depth image; skipped")
         for dropped in self.pairer.duplicate_colors:
             self.node.get_logger().warning(f"colour image at {dropped.stamp:.3f} s repeats another's stamp; skipped")
+        for dropped in self.pairer.late_colors:
+            self.node.get_logger().warning(
+                f"colour image at {dropped.stamp:.3f} s is older than the last frame "
+                f"({self.pairer.last_color_stamp:.3f} s): the stamps went back; skipped"
+            )
         self.pairer.dropped_colors.clear()
         self.pairer.duplicate_colors.clear()
+        self.pairer.late_colors.clear()
         if pair is None:
             return
         index, self.frames = self.frames, self.frames + 1

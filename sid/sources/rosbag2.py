@@ -11,7 +11,8 @@ absent the one Image topic whose last names are ``color/image_raw`` and the one 
 and depth images are paired by header stamp.
 
 Frames are numbered by colour image (0-based). A colour image with no depth image within ``sync_tolerance``, one
-whose message is damaged or whose stamp repeats an earlier colour image's, or whose pixels cannot be used, raises
+whose message is damaged, whose stamp repeats an earlier colour image's or is older than a frame already read, or
+whose pixels cannot be used, raises
 ``FrameReadError`` and the source moves on; a file damaged further in ends it with ``SourceError``.
 librealsense's own .db3 recordings (topics under ``/device_0/``) are a different layout:
 ``is_librealsense_recording`` tells them apart and ``sid.sources.open_source`` sends them to
@@ -260,6 +261,7 @@ class Rosbag2Source:
         pair = self._pairer.add(stream, stamp, (index, msg) if stream == "color" else msg)
         dropped, self._pairer.dropped_colors = self._pairer.dropped_colors, []
         duplicates, self._pairer.duplicate_colors = self._pairer.duplicate_colors, []
+        late, self._pairer.late_colors = self._pairer.late_colors, []
         self._ready.extend(
             FrameReadError(
                 f"{self.path}: frame {m.item[0]}: its colour image has the stamp of an earlier one ({m.stamp:.6f} s)",
@@ -267,6 +269,15 @@ class Rosbag2Source:
                 self.path,
             )
             for m in duplicates
+        )
+        self._ready.extend(
+            FrameReadError(
+                f"{self.path}: frame {m.item[0]}: its colour image's stamp ({m.stamp:.6f} s) is older than an earlier "
+                f"frame's ({self._pairer.last_color_stamp:.6f} s): the stamps go back",
+                m.item[0],
+                self.path,
+            )
+            for m in late
         )
         self._ready.extend(self._unpaired(dropped))
         if pair is None:

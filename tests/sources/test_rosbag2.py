@@ -304,3 +304,16 @@ def test_compressed_image_topics_are_named_as_not_read(tmp_path: Path) -> None:
         open_source(str(bag))
     with pytest.raises(SourceError, match=f"topic '{compressed}' is a sensor_msgs/msg/CompressedImage topic; sid"):
         open_source(str(bag), color_topic=compressed)
+
+
+def test_colour_stamps_going_back_are_named_as_such_not_as_missing_depth(tmp_path: Path) -> None:
+    """A recording whose stamps go back (a clock reset, bags spliced): each colour image older than a frame already
+    read is skipped saying so; its depth image is there, so "no depth image" would send the user the wrong way."""
+    pairs, synthetic = synthetic_pairs(3)
+    messages = camera_messages(pairs, synthetic[0].calibration.color, stamps=[100.2, 100.1, 100.3])
+    frames, errors = _frames_and_errors(write_messages(tmp_path / "bag", messages))
+    assert frames == [0, 2] and [e.index for e in errors] == [1]
+    assert "frame 1: its colour image's stamp (100.100000 s) is older than an earlier frame's (100.200000 s)" in str(
+        errors[0]
+    )
+    assert "no depth image" not in str(errors[0])
