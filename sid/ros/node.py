@@ -43,7 +43,7 @@ from sid.sources import FrameReadError, skip_unreadable
 from sid.sources.ros_messages import StampPairer, intrinsics_from_camera_info, rgbd_frame, stamp_seconds
 from sid.stream import SocialStream, StreamUpdate
 
-__all__ = ["LATCHED", "SPIN_WAIT", "SocialCostmapNode", "spin"]
+__all__ = ["LATCHED", "NO_DEPTH_REPORT", "SILENCE_REPORT", "SPIN_WAIT", "SocialCostmapNode", "spin"]
 
 LATCHED = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
@@ -54,6 +54,10 @@ LATCHED = QoSProfile(
 """What map topics offer, and Nav2's costmap filters expect of a mask and its filter info."""
 SPIN_WAIT = 0.2
 """Longest wait (s) for a callback before the spin loop returns to Python (and to its signal handlers)."""
+SILENCE_REPORT = 10.0
+"""Period (s) of the check that each camera topic received something; a silent one is logged with the reason."""
+NO_DEPTH_REPORT = 5.0
+"""Shortest period (s) between two counts of colour images skipped for want of a depth image."""
 
 
 class SocialCostmapNode:
@@ -94,7 +98,13 @@ class SocialCostmapNode:
             self.node.create_subscription(Odometry, p.odom_topic, self._on_odometry, 10)
         self.intrinsics: Intrinsics | None = None
         self.pairer: StampPairer[Image] = StampPairer(p.sync_tolerance)
+        self.received = {"color": 0, "depth": 0, "info": 0}
+        """Messages received per camera topic (``_report_silence`` compares them with the last check's)."""
+        self._checked = dict(self.received)
+        self._no_depth = 0  # colour images skipped for want of depth since the last count was logged
+        self._no_depth_logged = -float("inf")  # time.monotonic() of that log
         if camera_topics:
+            self.node.create_timer(SILENCE_REPORT, self._report_silence)
             self.node.create_subscription(
                 CameraInfo, p.camera_info_topic, self._on_camera_info, qos_profile_sensor_data
             )
@@ -135,15 +145,63 @@ class SocialCostmapNode:
         self.odometry = msg
 
     def _on_camera_info(self, msg: CameraInfo) -> None:
+        self.received["info"] += 1
         try:
             self.intrinsics = intrinsics_from_camera_info(msg)
         except ValueError as exc:
             self.node.get_logger().error(f"{self.params.camera_info_topic}: {exc}", throttle_duration_sec=5.0)
 
+    def _report_silence(self) -> None:
+        """Warn of each camera topic that received nothing since the last check, ``SILENCE_REPORT`` s ago, with the
+        reason the ROS graph gives: no publisher (which topics of the type are published), or publishers of another
+        type (image_transport's CompressedImage)."""
+        p = self.params
+        for stream, topic, expected in (
+            ("color", p.color_topic, "sensor_msgs/msg/Image"),
+            ("depth", p.depth_topic, "sensor_msgs/msg/Image"),
+            ("info", p.camera_info_topic, "sensor_msgs/msg/CameraInfo"),
+        ):
+            if self.received[stream] == self._checked[stream]:
+                name = self.node.resolve_topic_name(topic)
+                reason = self._silence_reason(stream, name, expected)
+                self.node.get_logger().warning(f"nothing arrived on {name} for {SILENCE_REPORT:g} s: {reason}")
+        self._checked = dict(self.received)
+
+    def _silence_reason(self, stream: str, topic: str, expected: str) -> str:
+        """Why nothing arrives on ``topic`` (a resolved name) of type ``expected``, as far as the ROS graph tells."""
+        publishers = self.node.get_publishers_info_by_topic(topic)
+        types = sorted({info.topic_type for info in publishers})
+        if not types:
+            published = sorted(
+                name
+                for name, kinds in self.node.get_topic_names_and_types()
+                if expected in kinds and name != topic and self.node.count_publishers(name)
+            )
+            hint = " (realsense2_camera publishes it with align_depth.enable:=true)" if stream == "depth" else ""
+            return (
+                f"no node publishes it{hint}; {expected} topics published: {', '.join(published) or 'none'} (choose "
+                f"with -p {stream if stream != 'info' else 'camera_info'}_topic:=...)"
+            )
+        if expected not in types:
+            return (
+                f"it is published as {', '.join(types)}, not {expected}; sid reads only raw images (republish them as "
+                "raw: docs/ros2.md, section 5)"
+            )
+        return f"{plural(len(publishers), 'publisher')} of {expected}, but no message came (a QoS or network problem?)"
+
     def _on_image(self, stream: str, msg: Image) -> None:
+        self.received[stream] += 1
         pair = self.pairer.add(stream, stamp_seconds(msg.header), msg)
-        for dropped in self.pairer.dropped_colors:
-            self.node.get_logger().warning(f"colour image at {dropped.stamp:.3f} s has no depth image; skipped")
+        if self.pairer.dropped_colors:
+            self._no_depth += len(self.pairer.dropped_colors)
+            now = time.monotonic()
+            if now - self._no_depth_logged >= NO_DEPTH_REPORT:
+                self.node.get_logger().warning(
+                    f"{plural(self._no_depth, 'colour image')} skipped without a depth image on "
+                    f"{self.params.depth_topic} within {self.pairer.tolerance:g} s of it (the last at "
+                    f"{self.pairer.dropped_colors[-1].stamp:.3f} s)"
+                )
+                self._no_depth, self._no_depth_logged = 0, now
         for dropped in self.pairer.duplicate_colors:
             self.node.get_logger().warning(f"colour image at {dropped.stamp:.3f} s repeats another's stamp; skipped")
         for dropped in self.pairer.late_colors:
