@@ -142,6 +142,16 @@ class SocialCostmapNode:
         return chosen
 
     def _on_odometry(self, msg: Odometry) -> None:
+        """Keep the latest odometry; warn once when its frame is not ``global_frame`` (the pose is used as one in
+        ``global_frame`` all the same: the mask is then off by the transform between the two frames)."""
+        frame = msg.header.frame_id.lstrip("/")
+        if self.odometry is None and frame and frame != self.params.global_frame:
+            self.node.get_logger().warning(
+                f"odometry on {self.params.odom_topic} is in frame {frame!r}, not global_frame "
+                f"{self.params.global_frame!r}: its pose is used as the pose in {self.params.global_frame}, so the "
+                f"mask is off by the {self.params.global_frame} -> {frame} transform; set -p global_frame:={frame} "
+                "to publish the mask in that frame, or -p pose_source:=tf"
+            )
         self.odometry = msg
 
     def _on_camera_info(self, msg: CameraInfo) -> None:
@@ -263,7 +273,8 @@ class SocialCostmapNode:
             pose = self.frame_pose(frame, stamp)
             if pose is None:
                 self.node.get_logger().warning(
-                    f"frame {frame.index}: skipped, no robot pose yet ({self.pose_source})", throttle_duration_sec=5.0
+                    f"frame {frame.index}: skipped, no robot pose yet ({self._pose_origin()})",
+                    throttle_duration_sec=5.0,
                 )
                 return
             update = self.stream.update(frame, pose)
@@ -287,17 +298,22 @@ class SocialCostmapNode:
         log = self.node.get_logger()
         if pose is None and not self.fixed_robot:
             self.fixed_robot = True
-            source = f"odometry on {self.params.odom_topic}" if self.pose_source == "odom" else "a TF transform"
             log.warning(
-                f"frame {frame.index}: no robot pose ({source}, pose_source auto) and none in the frames: the robot "
-                f"is taken as fixed at the origin of {self.params.global_frame} until one arrives. Set pose_source: "
-                "-p pose_source:=none for a fixed camera, odom or tf to wait for the robot's pose"
+                f"frame {frame.index}: no robot pose ({self._pose_origin()}, pose_source auto) and none in the "
+                f"frames: the robot is taken as fixed at the origin of {self.params.global_frame} until one arrives. "
+                "Set pose_source: -p pose_source:=none for a fixed camera, odom or tf to wait for the robot's pose"
             )
         elif pose is not None and self.fixed_robot:
             self.fixed_robot = False
             log.info(f"frame {frame.index}: robot pose from {self.pose_source} from now on; tracking starts afresh")
             self.stream = self._new_stream()
         return pose if pose is not None else RobotPose(0.0, 0.0, 0.0)
+
+    def _pose_origin(self) -> str:
+        """Where the robot pose is awaited from, for a message (``odometry on /odom``)."""
+        if self.pose_source == "odom":
+            return f"odometry on {self.params.odom_topic}"
+        return f"a TF transform {self.params.global_frame} -> {self.params.base_frame}"
 
     def publish(self, update: StreamUpdate, stamp: Any) -> None:
         """The mask, the markers and the groups of one update, stamped ``stamp``."""
