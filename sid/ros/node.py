@@ -340,7 +340,8 @@ class SocialCostmapNode:
             if not rclpy.ok():
                 return
             self.on_frame(frame)
-            time.sleep(max(0.0, period - (time.monotonic() - start)))
+            while rclpy.ok() and (left := period - (time.monotonic() - start)) > 0:
+                time.sleep(min(left, SPIN_WAIT))  # in short waits: a period of 1e300 s would overflow time.sleep
         self.node.get_logger().info("source ended; the last costmap stays published")
 
 
