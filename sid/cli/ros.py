@@ -8,7 +8,7 @@ import sys
 from collections.abc import Iterable
 from pathlib import Path
 
-from sid.cli.common import ExitCode, add_bag_topic_options, positive_int
+from sid.cli.common import ExitCode, add_bag_topic_options, positive_int, positive_number
 from sid.distribution import install_hint
 from sid.perception.frame import Frame
 from sid.perception.pipeline import PoseFn, image_pose
@@ -46,7 +46,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument(
         "--rate",
-        type=float,
+        type=positive_number("frame rate in Hz", zero=True),
         default=0.0,
         metavar="HZ",
         help="play the --source at most this fast (0: as fast as processed)",
@@ -68,6 +68,10 @@ def run(args: argparse.Namespace) -> int:
     if args.share:
         print(SHARE)
         return 0
+    problem = _source_option_without_source(args)
+    if problem:
+        print(f"sid ros: {problem}", file=sys.stderr)
+        return ExitCode.USAGE
     try:
         import rclpy
         from rclpy.signals import SignalHandlerOptions
@@ -101,6 +105,26 @@ def run(args: argparse.Namespace) -> int:
             node.node.destroy_node()
         rclpy.try_shutdown()
     return 0
+
+
+def _source_option_without_source(args: argparse.Namespace) -> str | None:
+    """What is wrong when an option that acts on ``--source`` is given without one (the node would ignore it: the
+    camera topics are ROS parameters, and come at their own rate for as long as the node runs), or None."""
+    if args.source is not None:
+        return None
+    for name in BAG_TOPICS:
+        topic = getattr(args, name)
+        if topic is not None:
+            parameter = "camera_info_topic" if name == "info_topic" else name
+            return (
+                f"--{name.replace('_', '-')}: only a rosbag2 --source has topics to choose; the node subscribes to "
+                f"the topics of its ROS parameters: --ros-args -p {parameter}:={topic}"
+            )
+    if args.rate:
+        return "--rate: plays a --source; the camera topics come at their own rate"
+    if args.frames is not None:
+        return "--frames: stops a --source; without one, stop the node (Ctrl-C)"
+    return None
 
 
 def _pose(model: Path | None, synthetic: bool) -> PoseFn:

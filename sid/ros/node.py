@@ -43,7 +43,7 @@ from sid.sources import FrameReadError, skip_unreadable
 from sid.sources.ros_messages import StampPairer, intrinsics_from_camera_info, rgbd_frame, stamp_seconds
 from sid.stream import SocialStream, StreamUpdate
 
-__all__ = ["LATCHED", "SPIN_WAIT", "SocialCostmapNode", "spin"]
+__all__ = ["LATCHED", "NO_DEPTH_REPORT", "SILENCE_REPORT", "SPIN_WAIT", "SocialCostmapNode", "spin"]
 
 LATCHED = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
@@ -54,6 +54,10 @@ LATCHED = QoSProfile(
 """What map topics offer, and Nav2's costmap filters expect of a mask and its filter info."""
 SPIN_WAIT = 0.2
 """Longest wait (s) for a callback before the spin loop returns to Python (and to its signal handlers)."""
+SILENCE_REPORT = 10.0
+"""Period (s) of the check that each camera topic received something; a silent one is logged with the reason."""
+NO_DEPTH_REPORT = 5.0
+"""Shortest period (s) between two counts of colour images skipped for want of a depth image."""
 
 
 class SocialCostmapNode:
@@ -94,7 +98,13 @@ class SocialCostmapNode:
             self.node.create_subscription(Odometry, p.odom_topic, self._on_odometry, 10)
         self.intrinsics: Intrinsics | None = None
         self.pairer: StampPairer[Image] = StampPairer(p.sync_tolerance)
+        self.received = {"color": 0, "depth": 0, "info": 0}
+        """Messages received per camera topic (``_report_silence`` compares them with the last check's)."""
+        self._checked = dict(self.received)
+        self._no_depth = 0  # colour images skipped for want of depth since the last count was logged
+        self._no_depth_logged = -float("inf")  # time.monotonic() of that log
         if camera_topics:
+            self.node.create_timer(SILENCE_REPORT, self._report_silence)
             self.node.create_subscription(
                 CameraInfo, p.camera_info_topic, self._on_camera_info, qos_profile_sensor_data
             )
@@ -132,22 +142,86 @@ class SocialCostmapNode:
         return chosen
 
     def _on_odometry(self, msg: Odometry) -> None:
+        """Keep the latest odometry; warn once when its frame is not ``global_frame`` (the pose is used as one in
+        ``global_frame`` all the same: the mask is then off by the transform between the two frames)."""
+        frame = msg.header.frame_id.lstrip("/")
+        if self.odometry is None and frame and frame != self.params.global_frame:
+            self.node.get_logger().warning(
+                f"odometry on {self.params.odom_topic} is in frame {frame!r}, not global_frame "
+                f"{self.params.global_frame!r}: its pose is used as the pose in {self.params.global_frame}, so the "
+                f"mask is off by the {self.params.global_frame} -> {frame} transform; set -p global_frame:={frame} "
+                "to publish the mask in that frame, or -p pose_source:=tf"
+            )
         self.odometry = msg
 
     def _on_camera_info(self, msg: CameraInfo) -> None:
+        self.received["info"] += 1
         try:
             self.intrinsics = intrinsics_from_camera_info(msg)
         except ValueError as exc:
             self.node.get_logger().error(f"{self.params.camera_info_topic}: {exc}", throttle_duration_sec=5.0)
 
+    def _report_silence(self) -> None:
+        """Warn of each camera topic that received nothing since the last check, ``SILENCE_REPORT`` s ago, with the
+        reason the ROS graph gives: no publisher (which topics of the type are published), or publishers of another
+        type (image_transport's CompressedImage)."""
+        p = self.params
+        for stream, topic, expected in (
+            ("color", p.color_topic, "sensor_msgs/msg/Image"),
+            ("depth", p.depth_topic, "sensor_msgs/msg/Image"),
+            ("info", p.camera_info_topic, "sensor_msgs/msg/CameraInfo"),
+        ):
+            if self.received[stream] == self._checked[stream]:
+                name = self.node.resolve_topic_name(topic)
+                reason = self._silence_reason(stream, name, expected)
+                self.node.get_logger().warning(f"nothing arrived on {name} for {SILENCE_REPORT:g} s: {reason}")
+        self._checked = dict(self.received)
+
+    def _silence_reason(self, stream: str, topic: str, expected: str) -> str:
+        """Why nothing arrives on ``topic`` (a resolved name) of type ``expected``, as far as the ROS graph tells."""
+        publishers = self.node.get_publishers_info_by_topic(topic)
+        types = sorted({info.topic_type for info in publishers})
+        if not types:
+            published = sorted(
+                name
+                for name, kinds in self.node.get_topic_names_and_types()
+                if expected in kinds and name != topic and self.node.count_publishers(name)
+            )
+            hint = " (realsense2_camera publishes it with align_depth.enable:=true)" if stream == "depth" else ""
+            return (
+                f"no node publishes it{hint}; {expected} topics published: {', '.join(published) or 'none'} (choose "
+                f"with -p {stream if stream != 'info' else 'camera_info'}_topic:=...)"
+            )
+        if expected not in types:
+            return (
+                f"it is published as {', '.join(types)}, not {expected}; sid reads only raw images (republish them as "
+                "raw: docs/ros2.md, section 5)"
+            )
+        return f"{plural(len(publishers), 'publisher')} of {expected}, but no message came (a QoS or network problem?)"
+
     def _on_image(self, stream: str, msg: Image) -> None:
+        self.received[stream] += 1
         pair = self.pairer.add(stream, stamp_seconds(msg.header), msg)
-        for dropped in self.pairer.dropped_colors:
-            self.node.get_logger().warning(f"colour image at {dropped.stamp:.3f} s has no depth image; skipped")
+        if self.pairer.dropped_colors:
+            self._no_depth += len(self.pairer.dropped_colors)
+            now = time.monotonic()
+            if now - self._no_depth_logged >= NO_DEPTH_REPORT:
+                self.node.get_logger().warning(
+                    f"{plural(self._no_depth, 'colour image')} skipped without a depth image on "
+                    f"{self.params.depth_topic} within {self.pairer.tolerance:g} s of it (the last at "
+                    f"{self.pairer.dropped_colors[-1].stamp:.3f} s)"
+                )
+                self._no_depth, self._no_depth_logged = 0, now
         for dropped in self.pairer.duplicate_colors:
             self.node.get_logger().warning(f"colour image at {dropped.stamp:.3f} s repeats another's stamp; skipped")
+        for dropped in self.pairer.late_colors:
+            self.node.get_logger().warning(
+                f"colour image at {dropped.stamp:.3f} s is older than the last frame "
+                f"({self.pairer.last_color_stamp:.3f} s): the stamps went back; skipped"
+            )
         self.pairer.dropped_colors.clear()
         self.pairer.duplicate_colors.clear()
+        self.pairer.late_colors.clear()
         if pair is None:
             return
         index, self.frames = self.frames, self.frames + 1
@@ -199,7 +273,8 @@ class SocialCostmapNode:
             pose = self.frame_pose(frame, stamp)
             if pose is None:
                 self.node.get_logger().warning(
-                    f"frame {frame.index}: skipped, no robot pose yet ({self.pose_source})", throttle_duration_sec=5.0
+                    f"frame {frame.index}: skipped, no robot pose yet ({self._pose_origin()})",
+                    throttle_duration_sec=5.0,
                 )
                 return
             update = self.stream.update(frame, pose)
@@ -223,17 +298,22 @@ class SocialCostmapNode:
         log = self.node.get_logger()
         if pose is None and not self.fixed_robot:
             self.fixed_robot = True
-            source = f"odometry on {self.params.odom_topic}" if self.pose_source == "odom" else "a TF transform"
             log.warning(
-                f"frame {frame.index}: no robot pose ({source}, pose_source auto) and none in the frames: the robot "
-                f"is taken as fixed at the origin of {self.params.global_frame} until one arrives. Set pose_source: "
-                "-p pose_source:=none for a fixed camera, odom or tf to wait for the robot's pose"
+                f"frame {frame.index}: no robot pose ({self._pose_origin()}, pose_source auto) and none in the "
+                f"frames: the robot is taken as fixed at the origin of {self.params.global_frame} until one arrives. "
+                "Set pose_source: -p pose_source:=none for a fixed camera, odom or tf to wait for the robot's pose"
             )
         elif pose is not None and self.fixed_robot:
             self.fixed_robot = False
             log.info(f"frame {frame.index}: robot pose from {self.pose_source} from now on; tracking starts afresh")
             self.stream = self._new_stream()
         return pose if pose is not None else RobotPose(0.0, 0.0, 0.0)
+
+    def _pose_origin(self) -> str:
+        """Where the robot pose is awaited from, for a message (``odometry on /odom``)."""
+        if self.pose_source == "odom":
+            return f"odometry on {self.params.odom_topic}"
+        return f"a TF transform {self.params.global_frame} -> {self.params.base_frame}"
 
     def publish(self, update: StreamUpdate, stamp: Any) -> None:
         """The mask, the markers and the groups of one update, stamped ``stamp``."""
@@ -260,7 +340,8 @@ class SocialCostmapNode:
             if not rclpy.ok():
                 return
             self.on_frame(frame)
-            time.sleep(max(0.0, period - (time.monotonic() - start)))
+            while rclpy.ok() and (left := period - (time.monotonic() - start)) > 0:
+                time.sleep(min(left, SPIN_WAIT))  # in short waits: a period of 1e300 s would overflow time.sleep
         self.node.get_logger().info("source ended; the last costmap stays published")
 
 

@@ -164,10 +164,37 @@ PARAMETERS: tuple[tuple[str, object, str], ...] = tuple(
 names of the default layers; the instances' own parameters are declared by ``read_params``)."""
 
 
-def _typed(value: Any, default: object) -> Any:
-    """A parameter value in the type of its default (a YAML ``20`` for a float parameter is 20.0)."""
-    kind: Any = type(default)
-    return kind(value)
+def _typed(name: str, value: Any, default: object) -> Any:
+    """The value of parameter ``name`` in the type of its default (a YAML ``20`` for a float parameter is 20.0).
+    ValueError naming the parameter for a value of another kind (``true`` or ``'abc'`` for a number, ``5`` for a
+    name)."""
+    if isinstance(default, float):
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise ValueError(f"{name}: expected a number, got {value!r}")
+        return float(value)
+    if not isinstance(value, str):
+        raise ValueError(f"{name}: expected a name (text), got {value!r}")
+    return value
+
+
+def _check_names(node: Node, params: NodeParams) -> None:
+    """ValueError naming the parameter when a topic is not a valid ROS topic name for ``node`` (empty, a space, a
+    ``//``; rcl's own reason is quoted) or a frame id is empty or starts with ``/`` (tf2 refuses such ids)."""
+    from rclpy.impl.implementation_singleton import rclpy_implementation
+
+    for f in fields(params):
+        value = getattr(params, f.name)
+        if f.name.endswith("_topic"):
+            try:
+                node.resolve_topic_name(value)
+            except rclpy_implementation.RCLError as exc:
+                reason = str(exc).removeprefix("failed to resolve name: ").split(", at ")[0]
+                raise ValueError(f"{f.name}: {value!r} is not a valid topic name ({reason})") from None
+        elif f.name.endswith("_frame"):
+            if not value:
+                raise ValueError(f"{f.name}: a frame id must not be empty")
+            if value.startswith("/"):
+                raise ValueError(f"{f.name}: tf2 frame ids do not start with '/', got {value!r}")
 
 
 def _declare(node: Node, name: str, default: object, description: str) -> Any:
@@ -208,12 +235,17 @@ def _layer_parameters(node: Node, names: Sequence[str]) -> dict[str, Any]:
 def read_params(node: Node) -> NodeParams:
     """Declare every parameter of the node on ``node`` (an ``rclpy.node.Node``), each with its description, and read
     them: the fixed ones (``PARAMETERS``), then the layer instances ``costmap.plugins`` lists, Nav2-style (see the
-    module docstring), built by the scenario loader's ``layers_from_dict``. A bad value raises ValueError naming the
-    parameter."""
+    module docstring), built by the scenario loader's ``layers_from_dict``. A bad value (of the wrong type, out of
+    range, an invalid topic name or frame id) raises ValueError naming the parameter."""
     values = {name: _declare(node, name, default, description) for name, default, description in PARAMETERS}
     names = values.pop(LAYERS_PARAMETER)
-    fixed = {f.name: _typed(values[ros_name(f.name)], f.default) for f in fields(NodeParams) if f.name != "layers"}
+    fixed = {
+        f.name: _typed(ros_name(f.name), values[ros_name(f.name)], f.default)
+        for f in fields(NodeParams)
+        if f.name != "layers"
+    }
     params = NodeParams(**fixed)
+    _check_names(node, params)
     listed = names if isinstance(names, list) and all(isinstance(n, str) for n in names) else []
     mapping = {"plugins": names, **_layer_parameters(node, listed)}
     return replace(params, layers=layers_from_dict(mapping, params.grid, where="costmap"))

@@ -148,10 +148,11 @@ class StampPairer(Generic[T]):
     """Pairs colour and depth messages whose stamps differ by at most ``tolerance`` seconds.
 
     Feed each message as it comes (``add("color" | "depth", stamp, item)``); a message that completes a pair
-    returns it as (colour, depth). Messages of one stream older than a paired one can never pair; they are dropped
-    (a colour one at once, when it arrives) and, for colour, kept in ``dropped_colors`` (the caller reports them). A
-    colour message whose stamp is that of one already waiting or paired is dropped at once into ``duplicate_colors``
-    (reported too: one stamp, one frame).
+    returns it as (colour, depth). Messages of one stream older than a paired one can never pair; they are dropped.
+    The caller reports the colour ones, kept by why: ``dropped_colors``, waiting colour messages that found no depth
+    message before a later pair (or the queue's end); ``late_colors``, a colour message that arrives with a stamp
+    older than ``last_color_stamp``, the last paired one (the stamps went back); ``duplicate_colors``, a colour
+    message whose stamp is that of one already waiting or paired (one stamp, one frame).
     At most ``keep`` messages wait per stream.
     """
 
@@ -161,16 +162,20 @@ class StampPairer(Generic[T]):
         self.waiting: dict[str, deque[Stamped[T]]] = {"color": deque(maxlen=keep), "depth": deque(maxlen=keep)}
         self.dropped_colors: list[Stamped[T]] = []
         self.duplicate_colors: list[Stamped[T]] = []
-        self._paired_color: float | None = None  # the stamp of the last colour message paired
+        self.late_colors: list[Stamped[T]] = []
+        self.last_color_stamp: float | None = None
+        """The stamp (s) of the last colour message paired, None before the first pair."""
 
     def add(self, stream: str, stamp: float, item: T) -> tuple[Stamped[T], Stamped[T]] | None:
         if stream not in self.waiting:
             raise ValueError(f"stamp pairing: stream must be 'color' or 'depth', got {stream!r}")
-        if stream == "color" and (stamp == self._paired_color or any(m.stamp == stamp for m in self.waiting["color"])):
+        if stream == "color" and (
+            stamp == self.last_color_stamp or any(m.stamp == stamp for m in self.waiting["color"])
+        ):
             self.duplicate_colors.append(Stamped(stamp, item))
             return None
-        if stream == "color" and self._paired_color is not None and stamp < self._paired_color:
-            self.dropped_colors.append(Stamped(stamp, item))  # older than a frame already given: out of order
+        if stream == "color" and self.last_color_stamp is not None and stamp < self.last_color_stamp:
+            self.late_colors.append(Stamped(stamp, item))  # older than a frame already given: out of order
             return None
         other = self.waiting["depth" if stream == "color" else "color"]
         match = min(other, key=lambda m: abs(m.stamp - stamp), default=None)
@@ -183,7 +188,7 @@ class StampPairer(Generic[T]):
             return None
         color, depth = (new, match) if stream == "color" else (match, new)
         self._take_pair(color, depth)
-        self._paired_color = color.stamp
+        self.last_color_stamp = color.stamp
         return color, depth
 
     def _take_pair(self, color: Stamped[T], depth: Stamped[T]) -> None:

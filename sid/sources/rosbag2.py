@@ -11,7 +11,8 @@ absent the one Image topic whose last names are ``color/image_raw`` and the one 
 and depth images are paired by header stamp.
 
 Frames are numbered by colour image (0-based). A colour image with no depth image within ``sync_tolerance``, one
-whose message is damaged or whose stamp repeats an earlier colour image's, or whose pixels cannot be used, raises
+whose message is damaged, whose stamp repeats an earlier colour image's or is older than a frame already read, or
+whose pixels cannot be used, raises
 ``FrameReadError`` and the source moves on; a file damaged further in ends it with ``SourceError``.
 librealsense's own .db3 recordings (topics under ``/device_0/``) are a different layout:
 ``is_librealsense_recording`` tells them apart and ``sid.sources.open_source`` sends them to
@@ -104,11 +105,15 @@ def _pick(
 ) -> Connection:
     """The connection of topic ``wanted``; else ``default``; else the only ``msgtype`` topic whose last names are
     ``ending`` (whole names: ``aligned_depth_to_color/image_raw`` does not end in ``color/image_raw``). ``option``
-    names the setting that chooses the topic (e.g. ``color_topic``), for the error."""
+    names the setting that chooses the topic (e.g. ``color_topic``), for the error, which also names a topic of the
+    right name but another type (image_transport's ``.../image_raw/compressed``, a CompressedImage)."""
     typed = [c for c in connections if c.msgtype == msgtype]
     if wanted is not None:
         named = [c for c in typed if c.topic == wanted]
         if not named:
+            other = next((c for c in connections if c.topic == wanted), None)
+            if other is not None:
+                raise SourceError(f"topic {wanted!r} is a {other.msgtype} topic; sid {_reads_only(msgtype)}")
             raise SourceError(f"no {msgtype} topic {wanted!r} in the bag; it has {_topics(typed, msgtype)}")
         return named[0]
     named = [c for c in typed if c.topic == default] or [
@@ -116,11 +121,26 @@ def _pick(
     ]
     if len({c.topic for c in named}) != 1:
         found = "none" if not named else "several"
+        others = [c for c in connections if c.msgtype != msgtype and f"/{ending}/" in c.topic]
+        if others and not named:
+            described = ", ".join(sorted({f"{c.topic} is a {c.msgtype} topic" for c in others}))
+            raise SourceError(
+                f"none of the bag's {msgtype} topics end in {ending!r} ({_topics(typed, msgtype)}); {described}; "
+                f"sid {_reads_only(msgtype)}"
+            )
         raise SourceError(
             f"{found} of the bag's {msgtype} topics end in {ending!r} ({_topics(typed, msgtype)}); name the topic "
             f"with {option} (sid detect --{option.replace('_', '-')})"
         )
     return named[0]
+
+
+def _reads_only(msgtype: str) -> str:
+    """What sid reads instead of a topic of another type, for the error naming that topic."""
+    return (
+        f"reads only raw {msgtype} (record the raw topics, or republish the compressed ones as raw: docs/ros2.md, "
+        "section 5)"
+    )
 
 
 def _topics(connections: list[Connection], msgtype: str) -> str:
@@ -241,6 +261,7 @@ class Rosbag2Source:
         pair = self._pairer.add(stream, stamp, (index, msg) if stream == "color" else msg)
         dropped, self._pairer.dropped_colors = self._pairer.dropped_colors, []
         duplicates, self._pairer.duplicate_colors = self._pairer.duplicate_colors, []
+        late, self._pairer.late_colors = self._pairer.late_colors, []
         self._ready.extend(
             FrameReadError(
                 f"{self.path}: frame {m.item[0]}: its colour image has the stamp of an earlier one ({m.stamp:.6f} s)",
@@ -248,6 +269,15 @@ class Rosbag2Source:
                 self.path,
             )
             for m in duplicates
+        )
+        self._ready.extend(
+            FrameReadError(
+                f"{self.path}: frame {m.item[0]}: its colour image's stamp ({m.stamp:.6f} s) is older than an earlier "
+                f"frame's ({self._pairer.last_color_stamp:.6f} s): the stamps go back",
+                m.item[0],
+                self.path,
+            )
+            for m in late
         )
         self._ready.extend(self._unpaired(dropped))
         if pair is None:

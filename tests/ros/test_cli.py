@@ -48,3 +48,63 @@ def test_a_bad_layer_instance_is_reported(capsys: pytest.CaptureFixture[str]) ->
     layers = ["-p", "costmap.plugins:=[tracked_people, near]", "-p", "costmap.near.plugin:=lidar"]
     assert main(["ros", "--source", "synthetic:S4", "--ros-args", *layers]) == ExitCode.USAGE
     assert "costmap.plugins: near is a lidar layer, which the node cannot feed" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--source", "synthetic:S4", "--rate", "nan"], "--rate: expected a finite frame rate in Hz >= 0, got 'nan'"),
+        (["--source", "synthetic:S4", "--rate", "-1"], "--rate: expected a finite frame rate in Hz >= 0, got '-1'"),
+        (
+            ["--model", "pose.onnx", "--color-topic", "/front/color/image_raw"],
+            "--color-topic: only a rosbag2 --source has topics to choose; the node subscribes to the topics of its "
+            "ROS parameters: --ros-args -p color_topic:=/front/color/image_raw",
+        ),
+        (["--model", "pose.onnx", "--rate", "5"], "--rate: plays a --source; the camera topics come at their own rate"),
+        (["--model", "pose.onnx", "--frames", "5"], "--frames: stops a --source; without one, stop the node"),
+    ],
+)
+def test_options_of_a_source_are_refused_without_one_and_a_bad_rate_is_refused(
+    argv: list[str], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--color-topic`` (and the other topic options), ``--rate`` and ``--frames`` act on ``--source`` only:
+    given without one they were ignored in silence (the node subscribed to the default topics). A rate of nan or
+    below 0 was read as "as fast as possible"."""
+    pytest.importorskip("rclpy", reason="rclpy is not installed (pip install 'sid-social[ros]' or source ROS 2)")
+    if "nan" in argv or "-1" in argv:  # refused by argparse
+        with pytest.raises(SystemExit) as stop:
+            main(["ros", *argv])
+        assert stop.value.code == ExitCode.USAGE
+    else:
+        assert main(["ros", *argv]) == ExitCode.USAGE
+    assert message in capsys.readouterr().err
+
+
+def test_a_tiny_rate_waits_without_overflowing_and_stops_with_the_node() -> None:
+    """``--rate 1e-300`` is a period of 1e300 s: time.sleep raised OverflowError in the source's thread."""
+    rclpy = pytest.importorskip("rclpy", reason="rclpy is not installed")
+    import threading
+
+    from sid.ros.node import SocialCostmapNode
+    from sid.sources.synthetic import synthetic_source
+
+    rclpy.init(args=["sid", "--ros-args", "-p", "pose_source:=none"])
+    errors: list[BaseException] = []
+    try:
+        node = SocialCostmapNode(lambda frame: [], camera_topics=False)
+
+        def feed() -> None:
+            try:
+                node.feed(synthetic_source("synthetic:S4", frames=2), rate=1e-300)
+            except BaseException as exc:  # noqa: BLE001 - the test reports whatever the thread raised
+                errors.append(exc)
+
+        thread = threading.Thread(target=feed)
+        thread.start()
+        thread.join(timeout=3)
+        assert thread.is_alive()  # waiting for the next frame
+    finally:
+        rclpy.shutdown()
+    thread.join(timeout=5)
+    node.node.destroy_node()
+    assert not thread.is_alive() and errors == []

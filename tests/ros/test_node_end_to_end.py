@@ -251,3 +251,50 @@ def test_a_source_without_a_robot_pose_publishes_with_default_parameters(tmp_pat
     costs = filter_mask_cost(np.array(grid.data, dtype=np.int8).reshape(grid.info.height, grid.info.width))
     row, col = int((0.0 + 10.0) / 0.05), int((FORMATION_DISTANCE + 10.0) / 0.05)
     assert costs[row, col] >= 230 and costs[200, 200] == 0  # the group zone; the robot's own cell free
+
+
+@pytest.mark.slow
+def test_silent_camera_topics_are_reported_with_the_reason(tmp_path: Path) -> None:
+    """realsense2_camera started without ``align_depth.enable:=true`` publishes no aligned depth, and a camera whose
+    colour comes only compressed publishes no raw Image: the node must say, per topic, that nothing arrives and why
+    (no publisher, or a publisher of another type), and must not log one line per colour image meanwhile."""
+    from sensor_msgs.msg import CompressedImage
+
+    model = build_yolo_pose_model(tmp_path / "pose.onnx", np.zeros((56, 10), dtype=np.float32))
+    domain = 100 + (os.getpid() + 25) % 100
+    env = os.environ | {"ROS_DOMAIN_ID": str(domain), "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
+    log_path = tmp_path / "node.log"
+    command = [sys.executable, "-m", "sid", "ros", "--model", str(model), "--ros-args", "-p", "pose_source:=none"]
+    with log_path.open("w") as node_log:
+        node_process = subprocess.Popen(command, cwd=REPO_ROOT, env=env, stdout=node_log, stderr=subprocess.STDOUT)
+        context = rclpy.Context()
+        rclpy.init(context=context, domain_id=domain)
+        test_node = rclpy.create_node("sid_test_camera", context=context)
+        colour = test_node.create_publisher(Image, "/camera/camera/color/image_raw", 5)
+        depth = test_node.create_publisher(CompressedImage, "/camera/camera/aligned_depth_to_color/image_raw", 5)
+        info = test_node.create_publisher(CameraInfo, "/camera/camera/color/camera_info", 5)
+        pixels = np.zeros((48, 64, 3), dtype=np.uint8)
+        try:
+            start = time.monotonic()
+            while time.monotonic() < start + 25 and node_process.poll() is None:
+                when = stamp(time.time())
+                colour.publish(image(pixels, "rgb8", when))
+                depth.publish(CompressedImage(format="16UC1; compressedDepth png"))
+                message = CameraInfo(width=64, height=48, k=[50.0, 0.0, 32.0, 0.0, 50.0, 24.0, 0.0, 0.0, 1.0])
+                message.header.stamp = when
+                info.publish(message)
+                time.sleep(1 / 30)
+                if "nothing arrived on /camera/camera/aligned" in log_path.read_text():
+                    break
+        finally:
+            node_process.terminate()
+            node_process.wait(timeout=30)
+            test_node.destroy_node()
+            rclpy.shutdown(context=context)
+    log = log_path.read_text()
+    assert (
+        "nothing arrived on /camera/camera/aligned_depth_to_color/image_raw for 10 s: it is published as "
+        "sensor_msgs/msg/CompressedImage, not sensor_msgs/msg/Image" in log
+    ), log[-3000:]
+    assert "nothing arrived on /camera/camera/color/image_raw" not in log  # the colour and camera_info topics are fine
+    assert log.count("without a depth image") <= 3, log[-3000:]  # a count every 5 s, not a line per colour image

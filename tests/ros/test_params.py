@@ -124,3 +124,31 @@ def test_the_node_builds_its_costmap_from_the_layer_instances() -> None:
 def test_a_bad_layer_instance_is_refused_naming_its_parameter(ros_args: list[str], message: str) -> None:
     with ros_node(*ros_args) as node, pytest.raises(ValueError, match=message):
         read_params(node)
+
+
+@pytest.mark.parametrize(
+    ("ros_args", "message"),
+    [
+        (["-p", "depth_scale:=abc"], r"depth_scale: expected a number, got 'abc'"),
+        (["-p", "depth_scale:=[0.001, 0.002]"], r"depth_scale: expected a number, got \[0.001, 0.002\]"),
+        (["-p", "camera_height:=true"], r"camera_height: expected a number, got True"),
+        (["-p", "global_frame:=5"], r"global_frame: expected a name \(text\), got 5"),
+        (["-p", "global_frame:=''"], r"global_frame: a frame id must not be empty"),
+        (["-p", "base_frame:=/base_link"], r"base_frame: tf2 frame ids do not start with '/', got '/base_link'"),
+        (["-p", "color_topic:=''"], r"color_topic: '' is not a valid topic name \(topic name must not be empty"),
+        (["-p", "costmap_topic:=social costmap"], r"costmap_topic: 'social costmap' is not a valid topic name"),
+        (["-p", "odom_topic:=/robot//odom"], r"odom_topic: '/robot//odom' is not a valid topic name"),
+    ],
+)
+def test_a_parameter_of_the_wrong_type_or_an_invalid_name_is_refused_naming_it(
+    ros_args: list[str], message: str
+) -> None:
+    with ros_node(*ros_args) as node, pytest.raises(ValueError, match=message):
+        read_params(node)
+
+
+def test_an_integer_for_a_real_parameter_and_a_relative_topic_are_read() -> None:
+    with ros_node("-p", "costmap.width:=30", "-p", "costmap_topic:=social_costmap") as node:
+        params = read_params(node)
+    assert params.costmap__width == 30.0 and isinstance(params.costmap__width, float)
+    assert params.costmap_topic == "social_costmap"  # ROS resolves it in the node's namespace

@@ -92,14 +92,15 @@ def test_a_colour_stamp_given_twice_is_a_duplicate_not_a_second_frame() -> None:
     assert pairer.dropped_colors == []
 
 
-def test_a_colour_image_older_than_a_paired_one_is_dropped_not_paired() -> None:
+def test_a_colour_image_older_than_a_paired_one_is_late_not_paired() -> None:
     """A stamp going back (a recording spliced, a clock reset) gives no frame out of order: it is dropped once."""
     pairer: StampPairer[str] = StampPairer(0.015)
     for k, stamp in enumerate((100.0, 100.1)):
         assert pairer.add("color", stamp, f"c{k}") is None and pairer.add("depth", stamp, f"d{k}") is not None
     assert pairer.add("depth", 100.0, "d old") is None  # waits: it may still find a colour image
     assert pairer.add("color", 100.0, "c back in time") is None  # older than c1, paired: never a frame
-    assert [m.item for m in pairer.dropped_colors] == ["c back in time"] and pairer.duplicate_colors == []
+    assert [m.item for m in pairer.late_colors] == ["c back in time"] and pairer.last_color_stamp == 100.1
+    assert pairer.dropped_colors == [] and pairer.duplicate_colors == []  # it is late, not without depth
 
 
 def test_colour_images_waiting_out_of_stamp_order_each_end_once() -> None:

@@ -18,7 +18,7 @@ from sid.sources.rosbag2 import Rosbag2Source, is_librealsense_recording
 from sid.sources.synthetic import SyntheticSource
 from sid.synthetic.pose import TruthPose
 from tests.conftest import realsense, shared_path
-from tests.sources.camera_bags import COLOR, INFO, camera_messages, write_camera_bag, write_messages
+from tests.sources.camera_bags import COLOR, INFO, TYPES, camera_messages, header, write_camera_bag, write_messages
 
 
 def synthetic_pairs(count: int) -> tuple[list[tuple[np.ndarray, np.ndarray]], list[Frame]]:
@@ -283,3 +283,37 @@ def test_sid_detect_reports_each_bad_frame_of_a_bag_and_goes_on(tmp_path: Path, 
     )
     assert sorted(line.split()[2] for line in err if " skipped, " in line) == ["0:", "1:", "2:", "3:", "4:"]
     assert err[-1].startswith("detect: 0 frames with people, 5 skipped")
+
+
+def test_compressed_image_topics_are_named_as_not_read(tmp_path: Path) -> None:
+    """image_transport's compressed topics (sensor_msgs/CompressedImage) are not read: the error says so, whether the
+    topic is found by its name or named with --color-topic, instead of saying that there is no colour topic."""
+    pairs, synthetic = synthetic_pairs(1)
+    messages = camera_messages(pairs, synthetic[0].calibration.color)
+    compressed = COLOR + "/compressed"
+    jpeg = cv2.imencode(".jpg", cv2.cvtColor(pairs[0][0], cv2.COLOR_RGB2BGR))[1].ravel()
+    types = TYPES.types
+    message = types["sensor_msgs/msg/CompressedImage"](
+        header=header(100.0), format="rgb8; jpeg compressed bgr8", data=jpeg
+    )
+    raw = TYPES.serialize_cdr(message, "sensor_msgs/msg/CompressedImage")
+    messages = [m for m in messages if m[0] != COLOR] + [(compressed, "sensor_msgs/msg/CompressedImage", 100, raw)]
+    bag = write_messages(tmp_path / "bag", messages)
+    not_read = f"{compressed} is a sensor_msgs/msg/CompressedImage topic; sid reads only raw sensor_msgs/msg/Image"
+    with pytest.raises(SourceError, match=f"none of the bag's .*{not_read}.*docs/ros2.md"):
+        open_source(str(bag))
+    with pytest.raises(SourceError, match=f"topic '{compressed}' is a sensor_msgs/msg/CompressedImage topic; sid"):
+        open_source(str(bag), color_topic=compressed)
+
+
+def test_colour_stamps_going_back_are_named_as_such_not_as_missing_depth(tmp_path: Path) -> None:
+    """A recording whose stamps go back (a clock reset, bags spliced): each colour image older than a frame already
+    read is skipped saying so; its depth image is there, so "no depth image" would send the user the wrong way."""
+    pairs, synthetic = synthetic_pairs(3)
+    messages = camera_messages(pairs, synthetic[0].calibration.color, stamps=[100.2, 100.1, 100.3])
+    frames, errors = _frames_and_errors(write_messages(tmp_path / "bag", messages))
+    assert frames == [0, 2] and [e.index for e in errors] == [1]
+    assert "frame 1: its colour image's stamp (100.100000 s) is older than an earlier frame's (100.200000 s)" in str(
+        errors[0]
+    )
+    assert "no depth image" not in str(errors[0])
