@@ -37,7 +37,7 @@ from sid.distribution import MissingDependencyError, install_hint
 from sid.experiments.fformation import format_threshold, frame_matches
 from sid.experiments.gmitre import LinkCounts, gmitre_counts
 from sid.experiments.synthetic_tracking import as_truth_ids, identify, mot_scores
-from sid.experiments.trajectories import ReplaySettings, TrajectoryError, TrajectorySet, replay
+from sid.experiments.trajectories import ReplaySettings, TrajectoryError, TrajectorySet, replay, replay_length
 from sid.tracking.coherent import CoherentMotion, CoherentMotionParams
 from sid.tracking.groups import GroupTracker, GroupTrackerParams
 from sid.tracking.records import TrackedPerson
@@ -115,7 +115,7 @@ def record_tracks(
     settings = settings or CrowdSettings()
     session = TrackingSession(settings.tracking)
     log = TrackLog(trajectories.name, [], [], [], [])
-    total = _frame_count(trajectories, settings.replay)
+    total = replay_length(trajectories, settings.replay.rate)
     view = replay_view(trajectories, settings.replay)
     for k, frame in enumerate(replay(trajectories, settings.replay)):
         people = session.people.update(frame.detections, frame.timestamp, view)
@@ -135,7 +135,7 @@ def replay_view(trajectories: TrajectorySet, replay_settings: ReplaySettings) ->
     hull of every annotated position). TrajectoryError naming the set when the positions span no area (no scene to
     draw) or the replay would take more frames than the ``replay_frames`` limit (a long gap in the annotations at
     a high rate); ``evaluate_crowd`` and ``cross_validate`` check every set with it before any work."""
-    frames = _frame_count(trajectories, replay_settings)
+    frames = replay_length(trajectories, replay_settings.rate)
     if replay_settings.rate is not None:
         span = float(trajectories.times[-1] - trajectories.times[0])
         detail = f"{span:g} s at {replay_settings.rate:g} Hz = "
@@ -326,12 +326,6 @@ def _accumulate(log: TrackLog, match_distance: float) -> Any:
         )
         accumulator.update(log.truth_ids[k].tolist(), [p.id for p in log.tracks[k]], distances)
     return accumulator
-
-
-def _frame_count(trajectories: TrajectorySet, replay_settings: ReplaySettings) -> int:
-    if replay_settings.rate is None or not len(trajectories.times):
-        return len(trajectories.times)
-    return int((trajectories.times[-1] - trajectories.times[0]) * replay_settings.rate + 1e-9) + 1
 
 
 def _settings_json(settings: CrowdSettings) -> dict[str, Any]:

@@ -4,15 +4,16 @@ Format (one folder per set): ``obsmat.txt``, one row per annotated person and fr
 ``frame pedestrian_id pos_x pos_z pos_y v_x v_z v_y`` (metres and m/s on the ground plane; the z columns are unused);
 ``groups.txt``, one line per group of people who walk together, their ids separated by spaces (people not listed
 walk alone; a group holds for as long as at least two of its members are in the scene). Annotations come every
-``interval`` seconds (0.4 s in the public sets, whatever their video's frame rate): the most common step between
-frame numbers is taken as one interval (seq_eth has a few odd steps). Unless given, the interval is read from the
+``interval`` seconds (0.4 s in the public sets, whatever their video's frame rate): the most common step between a
+person's consecutive frame numbers is taken as one interval (seq_eth has a few odd steps between frames; a set may
+annotate different people on different frames). Unless given, the interval is read from the
 annotations themselves: the median, over the people walking faster than 0.3 m/s, of how far they move in one step
 over their annotated speed (0.400 s in each public set), to two significant digits.
 
 ``replay`` feeds them as a perception stage would: detections at the annotation times or at a camera's rate by
-linear interpolation (only between annotations one step apart), seeded Gaussian position noise, seeded missed
-detections, and optionally only the people inside a robot's field of view. Positions are in the set's own ground
-frame; the facing is unknown (None): the sets have none.
+linear interpolation (each person between their own annotations, only when one step apart), seeded Gaussian
+position noise, seeded missed detections, and optionally only the people inside a robot's field of view. Positions
+are in the set's own ground frame; the facing is unknown (None): the sets have none.
 """
 
 from __future__ import annotations
@@ -38,6 +39,7 @@ __all__ = [
     "TrajectorySet",
     "load_trajectory_set",
     "replay",
+    "replay_length",
 ]
 
 
@@ -51,7 +53,8 @@ class TrajectorySet:
 
     name: the folder's name. times: (F,) annotation times (s, from 0). ids, positions, velocities: per frame, the
     people present, (K,) int, (K, 2) m and (K, 2) m/s in the set's ground frame. groups: the annotated walking
-    groups (member ids; two or more each).
+    groups (member ids; two or more each). notes: what the reader noticed, one line each. interval: seconds between
+    a person's annotation steps.
     """
 
     name: str
@@ -61,6 +64,7 @@ class TrajectorySet:
     velocities: tuple[np.ndarray, ...]
     groups: tuple[frozenset[int], ...]
     notes: tuple[str, ...] = ()
+    interval: float = 0.4
 
     @property
     def people(self) -> int:
@@ -126,9 +130,8 @@ def load_trajectory_set(folder: str | Path, interval: float | None = None) -> Tr
     rows, repeated = np.unique(rows, axis=0, return_counts=True)
     notes = [f"{obsmat.name}: {int((repeated - 1).sum())} repeated rows read once"] if (repeated > 1).any() else []
     frames = rows[:, 0].astype(np.int64)
-    steps, counts = np.unique(np.diff(np.unique(frames)), return_counts=True)
-    step = int(steps[np.argmax(counts)]) if len(steps) else 1
     ids = rows[:, 1].astype(np.int64)
+    step = _frame_step(frames, ids)
     twice = np.flatnonzero((frames[1:] == frames[:-1]) & (ids[1:] == ids[:-1]))  # sorted: repeats are neighbours
     if len(twice):
         raise TrajectoryError(f"{obsmat}: pedestrian {ids[twice[0]]} appears twice in frame {frames[twice[0]]}")
@@ -148,7 +151,18 @@ def load_trajectory_set(folder: str | Path, interval: float | None = None) -> Tr
         tuple(velocity[a:b] for a, b in zip(bounds[:-1], bounds[1:], strict=True)),
         groups,
         (*notes, *group_notes),
+        interval,
     )
+
+
+def _frame_step(frames: np.ndarray, ids: np.ndarray) -> int:
+    """Frame numbers per annotation step: the most common step between a person's consecutive annotations (rows
+    sorted by frame, then id); between the set's frames when nobody is annotated twice; 1 for a single frame."""
+    order = np.lexsort((frames, ids))  # by person, then frame
+    same = ids[order][1:] == ids[order][:-1]
+    moves = np.diff(frames[order])[same]
+    steps, counts = np.unique(moves if len(moves) else np.diff(np.unique(frames)), return_counts=True)
+    return int(steps[np.argmax(counts)]) if len(steps) else 1
 
 
 def _read_interval(
@@ -196,29 +210,42 @@ def replay(trajectories: TrajectorySet, settings: ReplaySettings | None = None) 
 
 
 def _steps(trajectories: TrajectorySet, rate: float | None) -> Iterator[tuple[float, np.ndarray, np.ndarray]]:
-    """(time, ids, true positions) at the annotation times, or every 1 / rate seconds by interpolation."""
+    """(time, ids sorted, true positions) at the annotation times, or every 1 / rate seconds from the first: each
+    person at their annotation at that time, else between their last annotation and their next when that comes
+    within 1.5 annotation steps (linearly; a set may annotate different people on different frames), else absent."""
     times = trajectories.times
-    if rate is None:
-        yield from zip(times.tolist(), trajectories.ids, trajectories.positions, strict=True)
-        return
     if len(times) == 0:
         return
-    interval = float(np.min(np.diff(times))) if len(times) > 1 else 0.0
-    count = int(math.floor((times[-1] - times[0]) * rate + 1e-9)) + 1
-    for k in range(count):
-        t = times[0] + k / rate
-        i = int(np.searchsorted(times, t, side="right")) - 1
-        if i == len(times) - 1 or abs(t - times[i]) < 1e-9:
-            yield t, trajectories.ids[i], trajectories.positions[i]
-            continue
-        a_ids, b_ids = trajectories.ids[i], trajectories.ids[i + 1]
-        if times[i + 1] - times[i] > interval * 1.5:  # a gap in the annotations: nobody to interpolate
-            yield t, a_ids[:0], trajectories.positions[i][:0]
-            continue
-        both, a_rows, b_rows = np.intersect1d(a_ids, b_ids, assume_unique=True, return_indices=True)
-        w = (t - times[i]) / (times[i + 1] - times[i])
-        position = (1 - w) * trajectories.positions[i][a_rows] + w * trajectories.positions[i + 1][b_rows]
-        yield t, both, position
+    instants = times if rate is None else times[0] + np.arange(replay_length(trajectories, rate)) / rate
+    # Every annotation, in time order: when, who, where, and which annotation of the same person comes next (-1:
+    # none within 1.5 steps, a gap with nobody to interpolate).
+    when = np.repeat(times, [len(ids) for ids in trajectories.ids])
+    who, where = np.concatenate(trajectories.ids), np.concatenate(trajectories.positions)
+    reach = 1.5 * trajectories.interval
+    order = np.lexsort((when, who))  # by person, then time
+    follows = (who[order][1:] == who[order][:-1]) & (np.diff(when[order]) <= reach)
+    following = np.full(len(who), -1)
+    following[order[:-1][follows]] = order[1:][follows]
+    for t in instants.tolist():
+        rows = np.arange(np.searchsorted(when, t - reach - 1e-9), np.searchsorted(when, t + 1e-9, side="right"))
+        exact = rows[np.abs(when[rows] - t) < 1e-9]
+        later = following[rows]
+        between = (np.abs(when[rows] - t) >= 1e-9) & (later >= 0)
+        between[between] = when[later[between]] > t + 1e-9  # else the next annotation is in the window itself
+        start, end = rows[between], later[between]
+        w = ((t - when[start]) / (when[end] - when[start]))[:, None]
+        ids = np.concatenate([who[exact], who[start]])
+        positions = np.concatenate([where[exact], (1 - w) * where[start] + w * where[end]])
+        by_id = np.argsort(ids, kind="stable")
+        yield t, ids[by_id], positions[by_id]
+
+
+def replay_length(trajectories: TrajectorySet, rate: float | None) -> int:
+    """How many frames ``replay`` yields at ``rate`` (Hz; None: one per annotation time)."""
+    times = trajectories.times
+    if rate is None or not len(times):
+        return len(times)
+    return int(math.floor((times[-1] - times[0]) * rate + 1e-9)) + 1
 
 
 def _read_obsmat(path: Path) -> np.ndarray:

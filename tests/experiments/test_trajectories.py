@@ -160,6 +160,29 @@ def test_replay_at_a_camera_rate_interpolates_between_annotations(tmp_path: Path
     assert frames[1].truth_positions[0].tolist() == pytest.approx([0.2, 0.0])  # halfway between 0 and 0.4 m
 
 
+def test_a_stray_annotation_between_steps_leaves_the_replay_at_a_camera_rate_whole(tmp_path: Path) -> None:
+    """One extra row half a step after the others (frame 15 among 0, 10, 20, ...) took 0.2 s as the step between
+    annotations: every 0.4 s step was then a gap, and the 5 Hz replay held nobody between annotations."""
+    rows = [*_walkers(), (15, 1, 0.6, 0, 0.0, 1, 0, 0)]
+    trajectories = load_trajectory_set(write_set(tmp_path / "s", rows))
+    frames = list(replay(trajectories, ReplaySettings(rate=5.0, noise=0.0, miss_rate=0.0)))
+    assert len(frames) == 9 and [f.truth_ids.tolist() for f in frames] == [[1, 2, 3]] * 9
+    assert frames[1].truth_positions[2].tolist() == pytest.approx([4.8, 3.0])  # 3 between 5 m and 4.6 m
+
+
+def test_people_annotated_on_different_frames_are_each_replayed_between_their_own_annotations(tmp_path: Path) -> None:
+    """Person 3 annotated 5 frames after 1 and 2 (each every 10 frames): the step is 10 frames, 0.4 s, and every
+    annotation time holds everyone annotated around it, not only those annotated on that frame."""
+    rows = [row if row[1] != 3 else (row[0] + 5, 3, row[2] - 0.2, *row[3:]) for row in _walkers()]
+    trajectories = load_trajectory_set(write_set(tmp_path / "s", rows))
+    assert trajectories.notes == () and trajectories.times.tolist() == pytest.approx([0.2 * k for k in range(10)])
+    frames = list(replay(trajectories, ReplaySettings(noise=0.0, miss_rate=0.0)))
+    assert [f.truth_ids.tolist() for f in frames] == [[1, 2]] + [[1, 2, 3]] * 8 + [[3]]
+    np.testing.assert_allclose(frames[1].truth_positions, [[0.2, 0.0], [0.2, 0.6], [4.8, 3.0]])
+    at_rate = list(replay(trajectories, ReplaySettings(rate=5.0, noise=0.0, miss_rate=0.0)))
+    assert [f.truth_ids.tolist() for f in at_rate] == [f.truth_ids.tolist() for f in frames]
+
+
 def test_replay_in_a_field_of_view_keeps_only_the_people_inside(tmp_path: Path) -> None:
     trajectories = load_trajectory_set(write_set(tmp_path / "s", _walkers(frames=1)))
     view = ViewCone(-1.0, 0.3, 0.0, np.radians(40), max_range=3.0)  # looking along +x from behind the pair
