@@ -8,7 +8,8 @@ walk alone; a group holds for as long as at least two of its members are in the 
 person's consecutive frame numbers is taken as one interval (seq_eth has a few odd steps between frames; a set may
 annotate different people on different frames). Unless given, the interval is read from the
 annotations themselves: the median, over the people walking faster than 0.3 m/s, of how far they move in one step
-over their annotated speed (0.400 s in each public set), to two significant digits.
+over their annotated speed (0.400 s in each public set), to two significant digits. An id annotated again more than
+``REUSED_AFTER_S`` after it left is taken as another person from then on (an id reused).
 
 ``replay`` feeds them as a perception stage would: detections at the annotation times or at a camera's rate by
 linear interpolation (each person between their own annotations, only when one step apart), seeded Gaussian
@@ -26,13 +27,14 @@ from pathlib import Path
 import numpy as np
 
 from sid.checks import MAX_COORDINATE, check_number
-from sid.documents import special_file
+from sid.documents import plural, special_file
 from sid.errors import SidError
 from sid.perception.people import Person
 from sid.tracking.view import View
 
 __all__ = [
     "DEFAULT_INTERVAL",
+    "REUSED_AFTER_S",
     "ReplayFrame",
     "ReplaySettings",
     "TrajectoryError",
@@ -143,6 +145,12 @@ def load_trajectory_set(folder: str | Path, interval: float | None = None) -> Tr
         notes += [note] if note else []
     times = (frames[starts] - frames[0]) / step * interval
     groups, group_notes = _read_groups(groups_file, set(ids.tolist()))
+    ids, aliases, note = _split_returns(frames, ids, step, interval)
+    notes += [note] if note else []
+    if aliases:  # a group of an id reused holds for each of its people, as it did for the one id
+        groups = tuple(frozenset(j for i in group for j in (i, *aliases.get(i, ()))) for group in groups)
+        order = np.lexsort((ids, frames))  # each frame's people by id again
+        ids, position, velocity = ids[order], position[order], velocity[order]
     return TrajectorySet(
         folder.name,
         times,
@@ -153,6 +161,41 @@ def load_trajectory_set(folder: str | Path, interval: float | None = None) -> Tr
         (*notes, *group_notes),
         interval,
     )
+
+
+REUSED_AFTER_S = 10.0
+"""Seconds after which a pedestrian id annotated again is taken as another person (an id reused for someone who came
+later): far longer than a track outlives its person (``TrackerParams.out_of_view_timeout``, 4 s by default)."""
+
+
+def _split_returns(
+    frames: np.ndarray, ids: np.ndarray, step: int, interval: float
+) -> tuple[np.ndarray, dict[int, list[int]], str]:
+    """``ids`` (rows sorted by frame, then id) with each return of an id after more than ``REUSED_AFTER_S`` seconds
+    without it given a new id (above every id of the set), the new ids of each id so split, and a note naming them
+    ("" when none)."""
+    order = np.lexsort((frames, ids))  # by person, then frame
+    f, i = frames[order], ids[order]
+    gap = np.r_[0, np.diff(f)] / step * interval
+    starts = np.r_[True, i[1:] != i[:-1]]
+    returns = ~starts & (gap > REUSED_AFTER_S)
+    if not returns.any():
+        return ids, {}, ""
+    run = np.cumsum(starts | returns)  # each person's stretches between returns, numbered in order
+    later = run > np.maximum.accumulate(np.where(starts, run, 0))  # after a return of the same person
+    split = np.where(later, i.max() + np.cumsum(returns), i)
+    aliases: dict[int, list[int]] = {}
+    for old, new in zip(i[returns].tolist(), split[returns].tolist(), strict=True):
+        aliases.setdefault(old, []).append(new)
+    out = np.empty_like(ids)
+    out[order] = split
+    longest = int(np.argmax(np.where(returns, gap, 0)))
+    note = (
+        f"{plural(len(aliases), 'pedestrian id')} annotated again more than {REUSED_AFTER_S:g} s after leaving "
+        f"(longest: pedestrian {i[longest]}, {gap[longest]:.1f} s): each return is taken as another person (an id "
+        "reused)"
+    )
+    return out, aliases, note
 
 
 def _frame_step(frames: np.ndarray, ids: np.ndarray) -> int:

@@ -76,6 +76,22 @@ def test_group_members_never_annotated_are_left_out_with_a_note(tmp_path: Path) 
     )
 
 
+def test_an_id_annotated_again_long_after_it_left_is_another_person_with_a_note(tmp_path: Path) -> None:
+    """Pedestrian 3 back 22.4 s after leaving (an id reused) is a new person, above every id; pedestrian 1 back
+    after 6.4 s is still pedestrian 1. Either way the groups.txt line holds for whoever carries the id."""
+    later = [(row[0] + 200, row[1], *row[2:]) for row in _walkers(frames=3) if row[1] == 1]  # 1 again at 8 s
+    much_later = [(row[0] + 600, row[1], *row[2:]) for row in _walkers(frames=3) if row[1] == 3]  # 3 at 24 s
+    trajectories = load_trajectory_set(write_set(tmp_path / "s", [*_walkers(), *later, *much_later], "1 3\n"))
+    assert trajectories.people == 4 and sorted(set(np.concatenate(trajectories.ids).tolist())) == [1, 2, 3, 4]
+    back = trajectories.times.tolist().index(pytest.approx(24.0))
+    assert trajectories.ids[back].tolist() == [4]  # 3 again, as someone else
+    assert trajectories.groups == (frozenset({1, 3, 4}),)
+    assert trajectories.notes == (
+        "1 pedestrian id annotated again more than 10 s after leaving (longest: pedestrian 3, 22.4 s): each return is "
+        "taken as another person (an id reused)",
+    )
+
+
 def test_a_row_written_twice_is_read_once_with_a_note(tmp_path: Path) -> None:
     rows = _walkers()
     folder = write_set(tmp_path / "s", [*rows, rows[4], rows[4], rows[0]], "1 2\n")
