@@ -318,7 +318,8 @@ def _read_obsmat(path: Path) -> np.ndarray:
 def _read_groups(path: Path, known: set[int]) -> tuple[tuple[frozenset[int], ...], tuple[str, ...]]:
     """The groups of ``groups.txt`` and notes on it. Lines that share a person are one group (a person walks in one
     group; the public seq_eth lists some people on two lines): they are joined, and a note says which. Ids that
-    obsmat.txt never annotates (an annotation slip: nobody to score) are left out, and a note says which."""
+    obsmat.txt never annotates (an annotation slip: nobody to score) are left out, and a note says which; a note
+    also says when no group is left."""
     lines: list[tuple[int, frozenset[int]]] = []
     notes: list[str] = []
     for number, line in _lines(path):
@@ -344,6 +345,8 @@ def _read_groups(path: Path, known: set[int]) -> tuple[tuple[frozenset[int], ...
         if len(numbers) > 1
     ]
     groups = [members for _, members in sorted(joined, key=lambda j: j[0]) if len(members) >= 2]
+    if not groups:
+        notes.append(f"{path.name} holds no group of two or more annotated people: everyone is scored as walking alone")
     return tuple(groups), tuple(notes)
 
 

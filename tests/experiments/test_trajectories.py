@@ -47,12 +47,12 @@ def test_the_time_between_annotation_steps_is_read_from_positions_and_velocities
     """Annotated every 0.1 s (frame step 10 at 100 fps): 0.1 s steps, with a note; 0.4 s steps need no note; nobody
     walking leaves 0.4 s, with a note; a given interval wins."""
     fast = [(10 * k, i, 0.1 * k, 0, y, 1.0, 0, 0) for k in range(8) for i, y in ((1, 0.0), (2, 0.6))]
-    folder = write_set(tmp_path / "fast", fast)
+    folder = write_set(tmp_path / "fast", fast, "1 2\n")
     trajectories = load_trajectory_set(folder)
     assert trajectories.times.tolist() == pytest.approx([0.1 * k for k in range(8)])
     assert trajectories.notes == ("annotations every 0.1 s (frame step 10), read from the annotated positions and "
                                   "velocities (--interval sets it)",)  # fmt: skip
-    assert load_trajectory_set(write_set(tmp_path / "usual", _walkers())).notes == ()
+    assert load_trajectory_set(write_set(tmp_path / "usual", _walkers(), "1 2\n")).notes == ()
     standing = [(10 * k, 1, 2.0, 0, 1.0, 0, 0, 0) for k in range(5)]
     still = load_trajectory_set(write_set(tmp_path / "still", standing))
     assert still.times.tolist() == pytest.approx([0.0, 0.4, 0.8, 1.2, 1.6]) and "0.4 s taken" in still.notes[0]
@@ -90,6 +90,15 @@ def test_an_id_annotated_again_long_after_it_left_is_another_person_with_a_note(
         "1 pedestrian id annotated again more than 10 s after leaving (longest: pedestrian 3, 22.4 s): each return is "
         "taken as another person (an id reused)",
     )
+
+
+def test_a_groups_file_without_a_group_is_noted(tmp_path: Path) -> None:
+    for groups in ("", "\r\n  \n", "7 8\n"):
+        trajectories = load_trajectory_set(write_set(tmp_path / "s", _walkers(), groups))
+        assert trajectories.groups == ()
+        assert trajectories.notes[-1] == (
+            "groups.txt holds no group of two or more annotated people: everyone is scored as walking alone"
+        )
 
 
 def test_a_row_written_twice_is_read_once_with_a_note(tmp_path: Path) -> None:
@@ -190,7 +199,7 @@ def test_people_annotated_on_different_frames_are_each_replayed_between_their_ow
     """Person 3 annotated 5 frames after 1 and 2 (each every 10 frames): the step is 10 frames, 0.4 s, and every
     annotation time holds everyone annotated around it, not only those annotated on that frame."""
     rows = [row if row[1] != 3 else (row[0] + 5, 3, row[2] - 0.2, *row[3:]) for row in _walkers()]
-    trajectories = load_trajectory_set(write_set(tmp_path / "s", rows))
+    trajectories = load_trajectory_set(write_set(tmp_path / "s", rows, "1 2\n"))
     assert trajectories.notes == () and trajectories.times.tolist() == pytest.approx([0.2 * k for k in range(10)])
     frames = list(replay(trajectories, ReplaySettings(noise=0.0, miss_rate=0.0)))
     assert [f.truth_ids.tolist() for f in frames] == [[1, 2]] + [[1, 2, 3]] * 8 + [[3]]
