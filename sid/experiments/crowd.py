@@ -48,6 +48,7 @@ from sid.tracking.view import View, scene_view
 __all__ = [
     "CrowdSettings",
     "DEFAULT_GRID",
+    "EVALUATION_PASSES",
     "Progress",
     "TrackLog",
     "cross_validate",
@@ -153,12 +154,16 @@ def score_groups(
     log: TrackLog,
     groups: Sequence[Sequence[frozenset[int]]],
     settings: CrowdSettings | None = None,
+    progress: Progress | None = None,
 ) -> dict[str, Any]:
-    """G-MITRE and per-frame matching of ``groups`` (per frame of ``log``: member track ids) against the truth."""
+    """G-MITRE and per-frame matching of ``groups`` (per frame of ``log``: member track ids) against the truth;
+    ``progress`` after each frame."""
     settings = settings or CrowdSettings()
     links = LinkCounts()
     matches = {t: np.zeros(3, dtype=np.int64) for t in settings.thresholds}
     for k, found in enumerate(groups):
+        if progress is not None:
+            progress(k + 1, len(groups), log.name)
         ids = log.truth_ids[k].tolist()
         present = set(ids)
         truth = trajectories.truth_groups(present)
@@ -191,22 +196,41 @@ def score_groups(
     return out
 
 
-def find_groups(log: TrackLog, params: GroupTrackerParams) -> list[list[frozenset[int]]]:
-    """Per frame of ``log``: the group tracker's confirmed groups (any kind), as member track ids."""
+def find_groups(
+    log: TrackLog, params: GroupTrackerParams, progress: Progress | None = None
+) -> list[list[frozenset[int]]]:
+    """Per frame of ``log``: the group tracker's confirmed groups (any kind), as member track ids; ``progress``
+    after each frame."""
     tracker = GroupTracker(params)
-    frames = zip(log.times, log.tracks, strict=True)
-    return [[frozenset(g.members) for g in tracker.update(people, t)] for t, people in frames]
+    found = []
+    for k, (t, people) in enumerate(zip(log.times, log.tracks, strict=True)):
+        found.append([frozenset(g.members) for g in tracker.update(people, t)])
+        if progress is not None:
+            progress(k + 1, len(log.times), log.name)
+    return found
 
 
-def find_coherent_groups(log: TrackLog, params: CoherentMotionParams) -> list[list[frozenset[int]]]:
-    """Per frame of ``log``: the coherent-motion reference's groups, as member track ids."""
+def find_coherent_groups(
+    log: TrackLog, params: CoherentMotionParams, progress: Progress | None = None
+) -> list[list[frozenset[int]]]:
+    """Per frame of ``log``: the coherent-motion reference's groups, as member track ids; ``progress`` after each
+    frame."""
     reference = CoherentMotion(params)
-    return [reference.update(people, t) for t, people in zip(log.times, log.tracks, strict=True)]
+    found = []
+    for k, (t, people) in enumerate(zip(log.times, log.tracks, strict=True)):
+        found.append(reference.update(people, t))
+        if progress is not None:
+            progress(k + 1, len(log.times), log.name)
+    return found
 
 
-def score_people(trajectories: TrajectorySet, log: TrackLog, match_distance: float) -> dict[str, Any]:
-    """MOTA, IDF1, identity switches (also per 100 true tracks) and the other motmetrics counts of ``log``."""
-    people: dict[str, Any] = mot_scores([_accumulate(log, match_distance)], [trajectories.name])[trajectories.name]
+def score_people(
+    trajectories: TrajectorySet, log: TrackLog, match_distance: float, progress: Progress | None = None
+) -> dict[str, Any]:
+    """MOTA, IDF1, identity switches (also per 100 true tracks) and the other motmetrics counts of ``log``;
+    ``progress`` after each frame matched."""
+    accumulator = _accumulate(log, match_distance, progress)
+    people: dict[str, Any] = mot_scores([accumulator], [trajectories.name])[trajectories.name]
     people["true_tracks"] = trajectories.people
     people["id_switches_per_100_tracks"] = 100 * people["id_switches"] / max(trajectories.people, 1)
     return people
@@ -215,22 +239,54 @@ def score_people(trajectories: TrajectorySet, log: TrackLog, match_distance: flo
 def evaluate_crowd(
     sets: Sequence[TrajectorySet], settings: CrowdSettings | None = None, progress: Progress | None = None
 ) -> dict[str, Any]:
-    """Tracking and group scores of every set, sid's group tracker beside the coherent-motion reference."""
+    """Tracking and group scores of every set, sid's group tracker beside the coherent-motion reference;
+    ``progress`` over each set's six passes through its frames (``EVALUATION_PASSES``), one count per set."""
     require_motmetrics()
     settings = settings or CrowdSettings()
     for trajectories in sets:  # every set's replay checked before the first runs
         replay_view(trajectories, settings.replay)
     out: dict[str, Any] = {"settings": _settings_json(settings), "sets": {}}
     for trajectories in sets:
-        log = record_tracks(trajectories, settings, progress)
+        passes = [_pass(progress, k, trajectories.name) for k in range(len(EVALUATION_PASSES))]
+        log = record_tracks(trajectories, settings, passes[0])
+        people = score_people(trajectories, log, settings.match_distance, passes[1])
+        groups = score_groups(
+            trajectories, log, find_groups(log, settings.tracking.groups, passes[2]), settings, passes[3]
+        )
+        reference = find_coherent_groups(log, settings.coherent, passes[4])
         out["sets"][trajectories.name] = {
             "frames": len(log.times),
             "notes": list(trajectories.notes),
-            "people": score_people(trajectories, log, settings.match_distance),
-            "groups": score_groups(trajectories, log, find_groups(log, settings.tracking.groups), settings),
-            "coherent_motion": score_groups(trajectories, log, find_coherent_groups(log, settings.coherent), settings),
+            "people": people,
+            "groups": groups,
+            "coherent_motion": score_groups(trajectories, log, reference, settings, passes[5]),
         }
     return out
+
+
+EVALUATION_PASSES = (
+    "tracking",
+    "matching people",
+    "group tracker",
+    "scoring groups",
+    "reference groups",
+    "scoring the reference",
+)
+"""What ``evaluate_crowd`` does with each set, one pass over its frames each, as its progress names them."""
+
+
+def _pass(progress: Progress | None, index: int, name: str) -> Progress | None:
+    """``progress`` for pass ``index`` of ``EVALUATION_PASSES`` over set ``name``: counting on from the passes
+    before it, out of all of them."""
+    if progress is None:
+        return None
+    report = progress  # bound here for the closure's type
+    stages = len(EVALUATION_PASSES)
+
+    def step(done: int, total: int, what: str) -> None:
+        report(index * total + done, stages * total, f"{name}: {EVALUATION_PASSES[index]}")
+
+    return step
 
 
 def cross_validate(
@@ -316,7 +372,7 @@ def _with_tracker(settings: CrowdSettings, tracker: TrackerParams) -> CrowdSetti
     return dataclasses.replace(settings, tracking=dataclasses.replace(settings.tracking, tracker=tracker))
 
 
-def _accumulate(log: TrackLog, match_distance: float) -> Any:
+def _accumulate(log: TrackLog, match_distance: float, progress: Progress | None = None) -> Any:
     import motmetrics
 
     accumulator = motmetrics.MOTAccumulator(auto_id=True)
@@ -325,6 +381,8 @@ def _accumulate(log: TrackLog, match_distance: float) -> Any:
             log.truth_positions[k], log.track_positions(k), max_d2=match_distance**2
         )
         accumulator.update(log.truth_ids[k].tolist(), [p.id for p in log.tracks[k]], distances)
+        if progress is not None:
+            progress(k + 1, len(log.times), log.name)
     return accumulator
 
 

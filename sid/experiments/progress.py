@@ -30,7 +30,8 @@ class ProgressBar:
     """``progress(done, total, what)``. On a terminal: a bar (rich) with the count, the elapsed time and an estimate
     of the time left, drawn on one line and left in place when ``done`` reaches ``total``. Off a terminal (a log
     file, a pipe): no redraws, one plain line at the start, at each tenth of the work and at the end, e.g.
-    ``simulate: 120/600 (20 %), 14 s, about 56 s left, t = 12.0 s`` (tenths of a second below 10 s). A call with
+    ``simulate: 120/600 (20 %), 14 s, about 56 s left, t = 12.0 s`` (tenths of a second below 10 s; the time left
+    from the first tenth on). A call with
     less done than the last starts a new bar (a new stage of the work); the total may change (a run that ends early:
     ``progress(203, 203, ...)``)."""
 
@@ -98,7 +99,8 @@ class ProgressBar:
             return
         self._next_line = tenth + 1
         elapsed = time.monotonic() - self.start
-        left = f", about {_seconds(elapsed * (total - done) / done)} left" if 0 < done < total else ""
+        # The time left from a tenth of the work on: extrapolated from the first item (set-up included) it said hours.
+        left = f", about {_seconds(elapsed * (total - done) / done)} left" if tenth > 0 and done < total else ""
         line = f"{self.label}: {done}/{total} ({100 * done // total} %), {_seconds(elapsed)}{left}, {what}"
         print(line, file=self.stream, flush=True)
 

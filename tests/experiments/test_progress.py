@@ -27,6 +27,15 @@ def test_off_a_terminal_one_line_per_tenth_and_no_redraws() -> None:
     assert all(re.search(r"about \d+(\.\d)? s left", line) for line in lines[1:-1])
 
 
+def test_off_a_terminal_the_time_left_is_estimated_from_a_tenth_of_the_work_on() -> None:
+    """The first line, after one item of 87 000, said "about 9132 s left" for a run of 32 s."""
+    stream = io.StringIO()
+    bar = ProgressBar("work", stream)
+    for done in (1, 50, 100):
+        bar(done, 1000, "item")
+    assert [("left" in line) for line in stream.getvalue().splitlines()] == [False, True]
+
+
 def test_on_a_terminal_a_bar_with_the_count_and_the_time_left() -> None:
     stream = Terminal()
     bar = ProgressBar("work", stream)
