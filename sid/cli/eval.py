@@ -109,7 +109,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--gcff-settings",
         action="store_true",
         help="score the gcff method with each sequence's own settings_gc.mat (GCFF tuned per sequence, the "
-        "literature's reference) instead of the detector the other options choose",
+        "literature's reference; its stride and mdl in the positions' units, scaled as they are) instead of the "
+        "detector the other options choose",
     )
     ff.add_argument(
         "--facing-noise",
@@ -163,6 +164,7 @@ def run(args: argparse.Namespace) -> int:
             raise ValueError(f"--scale takes one value or one per DIR ({len(args.dirs)}), got {len(args.scale)}")
         scales = args.scale * len(args.dirs) if len(args.scale) == 1 else args.scale
         datasets: dict[str, list[LabelledFrame]] = {}
+        units: dict[str, float] = {}  # each dataset's scale to metres, for its settings_gc.mat too
         for folder, scale in zip(args.dirs, scales, strict=True):
             name = _dataset_name(folder, datasets)
             if scale == "auto":
@@ -174,6 +176,7 @@ def run(args: argparse.Namespace) -> int:
             if degrees and args.degrees is None:
                 reason = "as radians it reaches beyond two turns"
                 print(f"sid eval fformation: {name}: theta read as degrees ({reason})", file=sys.stderr)
+            units[name] = scale
             _warn_about_data(name, datasets[name], scale)
             if args.facing_missing:
                 datasets[name] = without_facings(datasets[name], args.facing_missing)
@@ -190,7 +193,9 @@ def run(args: argparse.Namespace) -> int:
             return 0
         per_sequence = None
         if args.gcff_settings:
-            per_sequence = {name: gcff_settings(folder) for name, folder in zip(datasets, args.dirs, strict=True)}
+            per_sequence = {
+                name: gcff_settings(folder, units[name]) for name, folder in zip(datasets, args.dirs, strict=True)
+            }
             params = dataclasses.replace(params, method="gcff")
         detected = detect_all(datasets, params, per_sequence)
         scores = score_all(datasets, detected, args.thresholds)

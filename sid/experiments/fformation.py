@@ -248,14 +248,15 @@ def sequence_folders(folder: str | Path) -> list[Path]:
     return sequences
 
 
-def gcff_settings(folder: str | Path) -> dict[str, GroupParams]:
+def gcff_settings(folder: str | Path, scale: float = 0.01) -> dict[str, GroupParams]:
     """Per sequence of a dataset folder (by its folder's name, as ``LabelledFrame.sequence`` holds it), the
     ``gcff`` method with that sequence's own ``settings_gc.mat``: GCFF tuned per sequence, the literature's
-    reference."""
+    reference. The settings are in the positions' units: ``scale`` turns them into metres, as it does the
+    positions (``load_settings_gc``)."""
     return {
         sequence.name: GroupParams(method="gcff", gcff_stride=settings.stride, gcff_mdl=settings.mdl)
         for sequence in sequence_folders(folder)
-        for settings in (load_settings_gc(sequence),)
+        for settings in (load_settings_gc(sequence, scale=scale),)
     }
 
 
@@ -553,10 +554,11 @@ def parse_threshold(text: str) -> float:
     return value
 
 
-def load_settings_gc(folder: str | Path, base: GCFFParams | None = None) -> GCFFParams:
+def load_settings_gc(folder: str | Path, base: GCFFParams | None = None, scale: float = 0.01) -> GCFFParams:
     """The GCFF settings in ``settings_gc.mat`` of a benchmark sequence folder (or that file itself): ``stride`` in
-    centimetres and ``mdl`` in square centimetres, as the F-formation datasets store them, returned in metres and
-    square metres (stride / 100, mdl / 1e4); the other fields from ``base`` (default ``GCFFParams()``).
+    the units of the sequence's positions and ``mdl`` in their square, returned in metres and square metres
+    (stride x ``scale``, mdl x ``scale``^2; 0.01, the default, for the public sets' centimetres); the other fields
+    from ``base`` (default ``GCFFParams()``).
 
     Raises ValueError naming the file when it is missing, unreadable, or lacks a finite scalar stride >= 0 or
     mdl > 0.
@@ -571,12 +573,15 @@ def load_settings_gc(folder: str | Path, base: GCFFParams | None = None) -> GCFF
         if array.size != 1 or not math.isfinite(float(array.ravel()[0])):
             raise ValueError(f"fformation: {path}: {name} must be one finite number, got {array.ravel()[:4]}")
         values[name] = float(array.ravel()[0])
+    check_number("fformation", "scale", scale, low=0, low_open=True)
+    unit = {0.01: "cm", 0.001: "mm", 1.0: "m"}.get(scale, f"x {scale:g} m")
     try:
-        return dataclasses.replace(base or GCFFParams(), stride=values["stride"] / 100.0, mdl=values["mdl"] / 1e4)
+        stride, mdl = values["stride"] * scale, values["mdl"] * scale * scale
+        return dataclasses.replace(base or GCFFParams(), stride=stride, mdl=mdl)
     except ValueError as exc:
         reason = str(exc).removeprefix("gcff: ")
         raise ValueError(
-            f"fformation: {path}: {reason} (from {values['stride']:g} cm, {values['mdl']:g} cm^2)"
+            f"fformation: {path}: {reason} (from {values['stride']:g} {unit}, {values['mdl']:g} {unit}^2)"
         ) from None
 
 

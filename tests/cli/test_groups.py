@@ -10,6 +10,7 @@ import sys
 
 import numpy as np
 import pytest
+import scipy.io
 
 from sid.cli import main
 from sid.experiments.fformation import DEFAULT_GRID
@@ -231,6 +232,21 @@ def test_eval_fformation_reads_the_unit_by_default(tmp_path, capsys):
     with pytest.raises(SystemExit):
         main(["eval", "fformation", str(tiny), "--scale", "-1"])
     assert "expected a positive number or auto" in capsys.readouterr().err
+
+
+def test_eval_fformation_reads_settings_gc_in_the_positions_units(tmp_path, capsys):
+    """A set in metres with its settings_gc.mat in metres (stride 0.45, mdl 3) scores as the same set in
+    centimetres (45, 30000): the settings were read as centimetres whatever the positions' unit, recall 0."""
+    truth = {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]}
+    scores = {}
+    for name, factor in (("Centimetres", 1.0), ("Metres", 0.01), ("Millimetres", 10.0)):
+        folder = write_sequence(tmp_path / name, [f * [1, factor, factor, 1] for f in tiny_frames()], truth)
+        scipy.io.savemat(folder / "settings_gc.mat", {"stride": 45 * factor, "mdl": 30000 * factor**2})
+        code, out, _ = run_sid(["eval", "fformation", str(folder), "--gcff-settings"], capsys)
+        assert code == 0
+        scores[name] = json.loads("\n".join(out))["scores"][name]
+    assert scores["Centimetres"]["2/3"]["recall"] > 0
+    assert scores["Metres"] == scores["Millimetres"] == scores["Centimetres"]
 
 
 def test_orientation_quality_is_read_and_checked(capsys, monkeypatch):
