@@ -222,7 +222,8 @@ def run(args: argparse.Namespace) -> int:
 
 def _warn_about_data(name: str, frames: list[LabelledFrame], scale: float) -> None:
     """On stderr: positions implausible as metres once scaled (with the --scale that fits), people left out for a
-    non-finite position, and ground-truth members missing from their frame's people."""
+    non-finite position, people without a facing (a theta that is not a finite number), and ground-truth members
+    missing from their frame's people."""
     if reason := unit_warning(frames, scale):
         print(f"sid eval fformation: warning: {name}: {reason} (set it with --scale)", file=sys.stderr)
     unplaced = sum(f.unplaced for f in frames)
@@ -230,6 +231,15 @@ def _warn_about_data(name: str, frames: list[LabelledFrame], scale: float) -> No
         print(
             f"sid eval fformation: warning: {name}: {plural(unplaced, 'person', 'people')} without a finite position "
             f"left out (in {plural(sum(f.unplaced > 0 for f in frames), 'frame')})",
+            file=sys.stderr,
+        )
+    unknown = [sum(p.theta is None for p in f.people) for f in frames]
+    if sum(unknown):
+        people = plural(sum(len(f.people) for f in frames), "person", "people")
+        print(
+            f"sid eval fformation: warning: {name}: {sum(unknown)} of {people} (in "
+            f"{plural(sum(n > 0 for n in unknown), 'frame')}) have a theta that is not a finite number: their "
+            "facing is taken as unknown",
             file=sys.stderr,
         )
     missing, total = missing_members(frames)

@@ -208,6 +208,21 @@ def test_eval_fformation_warns_of_people_left_out_without_a_position(tmp_path, c
     assert json.loads("\n".join(out))["scores"]["Tiny"]["2/3"]["f1"] == pytest.approx(0.8)  # as without them
 
 
+def test_eval_fformation_warns_of_people_without_a_facing(tmp_path, capsys):
+    """A NaN theta (no head pose) made the facing unknown and changed the scores without a word."""
+    frames = tiny_frames()
+    frames[0][1, 3] = frames[1][0, 3] = frames[1][2, 3] = np.nan
+    tiny = write_sequence(tmp_path / "Tiny", frames, {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]})
+    code, _, err = run_sid(["eval", "fformation", str(tiny)], capsys)
+    assert code == 0 and (
+        "warning: Tiny: 3 of 8 people (in 2 frames) have a theta that is not a finite number: their facing is taken "
+        "as unknown" in err
+    )
+    whole = write_sequence(tmp_path / "Whole", tiny_frames(), {1: [[1, 2]]})
+    code, _, err = run_sid(["eval", "fformation", str(whole)], capsys)
+    assert code == 0 and "theta" not in err
+
+
 def test_eval_fformation_scores_past_ground_truth_frames_without_features(tmp_path, capsys):
     slip = write_sequence(tmp_path / "Slip", tiny_frames(), {1: [[1, 2]], 9: [[4, 5]], 2: [[1, 2, 3]]})
     code, out, err = run_sid(["eval", "fformation", str(slip)], capsys)
