@@ -84,8 +84,8 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Run one command; its exit code. SIGINT and SIGTERM stop it cleanly (exit 130 / 143: every file it wrote is
-    whole), ``InputWarning``s print as one ``sid COMMAND: warning: ...`` line, and a standard output that cannot be
-    written ends it the same way in every command (``report_standard_output``)."""
+    whole), ``InputWarning``s print as one ``sid COMMAND [TASK]: warning: ...`` line, and a standard output that
+    cannot be written ends it the same way in every command (``report_standard_output``)."""
     argv = sys.argv[1:] if argv is None else argv
     known = argv[0] if argv and argv[0] in COMMANDS else None  # else: help, or an error listing every command
     with guarded_standard_output():  # --help writes there too
@@ -96,7 +96,7 @@ def main(argv: list[str] | None = None) -> int:
                 sys.stdout.flush()
         except StandardOutputError as exc:
             return report_standard_output(f"sid {known}" if known else "sid", exc)
-    command = f"sid {args.command}"
+    command = " ".join(["sid", args.command, *([args.task] if getattr(args, "task", None) else [])])  # sid eval crowd
     try:
         in_force = limits_from_environment()  # $SID_LIMITS, read here once; a malformed one is said before any work
     except ValueError as exc:

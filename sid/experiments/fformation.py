@@ -255,19 +255,38 @@ def gcff_settings(folder: str | Path, scale: float = 0.01) -> dict[str, GroupPar
     positions (``load_settings_gc``)."""
     return {
         sequence.name: GroupParams(method="gcff", gcff_stride=settings.stride, gcff_mdl=settings.mdl)
-        for sequence in sequence_folders(folder)
+        for sequence in _labelled(sequence_folders(folder))[0]
         for settings in (load_settings_gc(sequence, scale=scale),)
     }
 
 
 def load_dataset(folder: str | Path, scale: float = 1.0, degrees: bool = False) -> list[LabelledFrame]:
     """All ground-truth frames of a dataset folder: its own sequence, or those of its sub-folders, pooled
-    (``load_sequence``'s ``scale`` and ``degrees``). Raises ValueError when no frame has ground truth."""
+    (``load_sequence``'s ``scale`` and ``degrees``); sub-folders without ``groundtruth.mat`` beside others that
+    have one are left out with an ``InputWarning``. Raises ValueError when no frame has ground truth."""
     folder = Path(folder)
-    frames = [frame for sequence in sequence_folders(folder) for frame in load_sequence(sequence, scale, degrees)]
+    sequences, unlabelled = _labelled(sequence_folders(folder))
+    if unlabelled:
+        warnings.warn(
+            InputWarning(
+                f"fformation: {folder}: {plural(len(unlabelled), 'sequence')} without groundtruth.mat not scored: "
+                + ", ".join(s.name for s in unlabelled)
+            ),
+            stacklevel=1,  # this line: said once when the dataset is loaded again in another unit
+        )
+    frames = [frame for sequence in sequences for frame in load_sequence(sequence, scale, degrees)]
     if not frames:
         raise ValueError(f"fformation: {folder} has no frame with ground truth (GTtimestamp is empty)")
     return frames
+
+
+def _labelled(sequences: list[Path]) -> tuple[list[Path], list[Path]]:
+    """The sequence folders to score and those left out: all of them when none has ``groundtruth.mat`` (the
+    first's missing file is then the error), else those that have one, and the others."""
+    labelled = [s for s in sequences if (s / "groundtruth.mat").exists()]
+    if not labelled:
+        return sequences, []
+    return labelled, [s for s in sequences if s not in labelled]
 
 
 PLAUSIBLE_NEIGHBOUR_M = (0.1, 5.0)
@@ -587,19 +606,38 @@ def load_settings_gc(folder: str | Path, base: GCFFParams | None = None, scale: 
 
 def _load_mat(path: Path, keys: tuple[str, ...]) -> dict:
     if not path.exists():
-        raise ValueError(f"fformation: {path} is missing")
+        others = sorted(p.name for p in path.parent.glob("*") if p.suffix.lower() == ".mat" and p.is_file())
+        beside = f" (the folder holds {', '.join(others[:5])}{', ...' if len(others) > 5 else ''})" if others else ""
+        raise ValueError(f"fformation: {path} is missing{beside}")
     special = special_file(path)
     if special:
         raise ValueError(f"fformation: cannot read {path}: {special}")
     try:
         data = scipy.io.loadmat(str(path))
+    except NotImplementedError:  # scipy's answer to a v7.3 file, which is HDF5 inside
+        raise ValueError(
+            f"fformation: cannot read {path}: it is a MATLAB v7.3 (HDF5) file; save it again in MATLAB with "
+            "save(FILE, ..., '-v7')"
+        ) from None
     except Exception as exc:  # scipy raises ValueError, TypeError, MatReadError... for non-MAT input
         raise ValueError(f"fformation: cannot read {path} as a MATLAB file ({exc})") from None
     missing = [k for k in keys if k not in data]
+    # The variables as the fields of one struct (MATLAB's save(FILE, 'S') of a struct S holding them).
+    holders = [v for k, v in data.items() if not k.startswith("__") and set(missing) <= set(_fields(v))]
+    if missing and len(holders) == 1:
+        data = data | {k: holders[0][k].item() for k in missing}
+        missing = []
     if missing:
         present = sorted(k for k in data if not k.startswith("__"))
         raise ValueError(f"fformation: {path} lacks the variable(s) {missing} (it holds {present})")
     return data
+
+
+def _fields(value: object) -> tuple[str, ...]:
+    """The field names of a MATLAB struct of one element as scipy reads it; () for anything else."""
+    if isinstance(value, np.ndarray) and value.dtype.names and value.size == 1:
+        return value.dtype.names
+    return ()
 
 
 def _cells(value: np.ndarray, path: Path, name: str) -> list:

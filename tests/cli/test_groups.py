@@ -264,6 +264,22 @@ def test_eval_fformation_reads_settings_gc_in_the_positions_units(tmp_path, caps
     assert scores["Metres"] == scores["Millimetres"] == scores["Centimetres"]
 
 
+def test_eval_fformation_scores_the_annotated_sequences_of_a_release_naming_the_others(tmp_path, capsys):
+    """An unannotated sequence beside annotated ones was the end of the run; the loader's warnings said "sid eval:"."""
+    truth = {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]}
+    release = tmp_path / "Release"
+    for name in ("Seq1", "Test"):
+        write_sequence(release / name, tiny_frames(), truth if name == "Seq1" else {})
+        scipy.io.savemat(release / name / "settings_gc.mat", {"stride": 45, "mdl": 30000})
+    (release / "Test" / "groundtruth.mat").unlink()
+    for options in ([], ["--gcff-settings"]):
+        code, out, err = run_sid(["eval", "fformation", str(release), *options], capsys)
+        assert code == 0 and json.loads("\n".join(out))["scores"]["Release"]["2/3"]["frames"] == 3
+        assert (
+            err.count(f"sid eval fformation: warning: fformation: {release}: 1 sequence without groundtruth.mat") == 1
+        )
+
+
 def test_orientation_quality_is_read_and_checked(capsys, monkeypatch):
     # A pair 1.6 m apart, the second looking 120 degrees off: a clear facing is refused, a doubtful one joins.
     people = [{"id": 1, "x": 0.0, "y": 0.0, "theta": 0.0}, {"id": 2, "x": 1.6, "y": 0.0, "theta": math.radians(300)}]

@@ -174,6 +174,49 @@ def test_malformed_files_give_clear_errors(tmp_path, tiny):
         load_sequence(tiny, scale=0.0)
 
 
+def test_variables_saved_as_the_fields_of_one_struct_are_read(tmp_path, tiny):
+    """MATLAB's save(FILE, 'S') of a struct S holding features and timestamp: refused as lacking them."""
+    wrapped = tmp_path / "Wrapped"
+    wrapped.mkdir()
+    for name in ("features", "groundtruth"):
+        data = {k: v for k, v in scipy.io.loadmat(tiny / f"{name}.mat").items() if not k.startswith("__")}
+        scipy.io.savemat(wrapped / f"{name}.mat", {"S": data, "note": "exported"})
+    assert evaluate({"w": load_dataset(wrapped, 0.01)}) == evaluate({"w": load_dataset(tiny, 0.01)})
+    two = {"features": 1, "timestamp": 1}  # two structs that could hold them: which one is meant?
+    scipy.io.savemat(wrapped / "features.mat", {"A": two, "B": two})
+    with pytest.raises(
+        ValueError, match=r"lacks the variable\(s\) \['features', 'timestamp'\] \(it holds \['A', 'B'\]\)"
+    ):
+        load_sequence(wrapped)
+
+
+def test_a_matlab_v73_file_is_named_with_how_to_save_it_readably(tmp_path, tiny):
+    """scipy's answer was "Please use HDF reader for matlab v7.3 files, e.g. h5py", a library sid does not use."""
+    folder = tmp_path / "HDF5"
+    folder.mkdir()
+    header = b"MATLAB 7.3 MAT-file, Platform: GLNXA64, Created on: Mon Jan  1 00:00:00 2024 HDF5 schema 1.00 ."
+    (folder / "features.mat").write_bytes(header.ljust(124, b" ") + b"\x00\x02IM" + b"\x89HDF\r\n\x1a\n" + bytes(600))
+    (folder / "groundtruth.mat").write_bytes((tiny / "groundtruth.mat").read_bytes())
+    with pytest.raises(ValueError, match=r"it is a MATLAB v7.3 \(HDF5\) file; save it again in MATLAB with save\(FILE"):
+        load_sequence(folder)
+
+
+def test_sequences_without_ground_truth_beside_labelled_ones_are_left_out_with_a_warning(tmp_path, tiny):
+    """A release's unannotated test sequence stopped the whole dataset: "ZTest/groundtruth.mat is missing"."""
+    dataset = tmp_path / "Release"
+    write_sequence(dataset / "Seq1", tiny_frames(), {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]})
+    (dataset / "ZTest").mkdir()
+    (dataset / "ZTest" / "features.mat").write_bytes((tiny / "features.mat").read_bytes())
+    (dataset / "ZTest" / "GroundTruth.mat").write_bytes((tiny / "groundtruth.mat").read_bytes())
+    with pytest.warns(InputWarning, match="Release: 1 sequence without groundtruth.mat not scored: ZTest"):
+        frames = load_dataset(dataset, 0.01)
+    assert len(frames) == 3 and {f.sequence for f in frames} == {"Seq1"}
+    with pytest.raises(
+        ValueError, match=r"ZTest/groundtruth.mat is missing \(the folder holds GroundTruth.mat, features.mat\)"
+    ):
+        load_dataset(dataset / "ZTest")
+
+
 def _write_features(folder: Path, frames: list[np.ndarray], stamps: np.ndarray) -> None:
     scipy.io.savemat(folder / "features.mat", {"features": cells(frames), "timestamp": stamps[None, :]})
 
