@@ -159,7 +159,8 @@ def load_sequence(folder: str | Path, scale: float = 1.0, degrees: bool = False)
         people, unplaced = _people(frames_people[k], scale, degrees, where)
         shape = np.shape(frames_people[k])
         widest = max(widest, shape[1] if len(shape) == 2 and shape[0] else 4)
-        groups = [g for g in _groups(groups_cell, f"{truth_path} at timestamp {stamp:g}") if len(g) > 1]
+        where_truth = f"{truth_path} at timestamp {stamp:g}"
+        groups = [g for g in _groups(groups_cell, where_truth, {p.id for p in people}) if len(g) > 1]
         frames.append(LabelledFrame(folder.name, float(timestamps[k]), people, groups, unplaced))
     if unmatched and not frames:  # nothing matches: other clocks or units, not a slip
         raise ValueError(
@@ -642,7 +643,9 @@ def _fields(value: object) -> tuple[str, ...]:
 
 def _cells(value: np.ndarray, path: Path, name: str) -> list:
     if not isinstance(value, np.ndarray) or value.dtype != object:
-        raise ValueError(f"fformation: {path}: {name} must be a cell array, got {getattr(value, 'dtype', type(value))}")
+        names = getattr(getattr(value, "dtype", None), "names", None)
+        got = f"a struct array (fields {', '.join(names)})" if names else getattr(value, "dtype", type(value))
+        raise ValueError(f"fformation: {path}: {name} must be a cell array, got {got}")
     return list(value.ravel())
 
 
@@ -713,16 +716,17 @@ def _people(cell: np.ndarray, scale: float, degrees: bool, where: str) -> tuple[
     return people, unplaced
 
 
-def _groups(cell: object, where: str) -> list[frozenset[int]]:
+def _groups(cell: object, where: str, present: set[int]) -> list[frozenset[int]]:
     """Member-id sets from a GTgroups cell: a cell array of id arrays (possibly nested), an id vector, a matrix of
-    one group per row (equal sizes), or empty."""
+    one group per row (shorter groups padded with NaN, or with 0 when nobody ``present`` has id 0), or empty."""
     if isinstance(cell, np.ndarray) and cell.dtype == object:
-        return [g for item in cell.ravel() for g in _groups(item, where)]
+        return [g for item in cell.ravel() for g in _groups(item, where, present)]
     ids = _real(cell, f"{where}: a group must list real ids")
     if ids.size == 0:
         return []
+    if ids.ndim == 2 and min(ids.shape) > 1:  # MATLAB's [1 2; 3 4], two groups of two; [1 2 0; 3 4 5]: padded
+        padding = np.isnan(ids) | ((ids == 0) & (0 not in present))
+        return [g for row, pad in zip(ids, padding, strict=True) for g in _groups(row[~pad], where, present)]
     if not np.all(np.isfinite(ids)) or not np.array_equal(ids, np.round(ids)):
         raise ValueError(f"fformation: {where}: group member ids must be finite whole numbers, got {ids.ravel()[:10]}")
-    if ids.ndim == 2 and min(ids.shape) > 1:  # MATLAB's [1 2; 3 4]: two groups of two
-        return [frozenset(int(i) for i in row) for row in ids.tolist()]
     return [frozenset(int(i) for i in ids.ravel().tolist())]

@@ -293,6 +293,26 @@ def test_ground_truth_encodings_and_single_precision_timestamps(tmp_path):
         load_dataset(folder)
 
 
+def test_a_ground_truth_matrix_padded_with_zeros_or_nan_lists_the_shorter_groups(tmp_path):
+    """[1 2 0; 3 4 5] (MATLAB's padding of a matrix of groups) made 0 a member of the pair, which then never matched;
+    with NaN the file was refused. 0 is padding only where nobody of the frame has id 0."""
+    folder = tmp_path / "Padded"
+    folder.mkdir()
+    five = np.array([[k, 100.0 * k, 0.0, 0.0] for k in range(1, 6)])
+    _write_features(folder, [five, five - [1, 0, 0, 0]], np.array([1.0, 2.0]))  # ids 1-5, then 0-4
+    truth = cells([np.array([[1, 2, 0], [3, 4, 5]]), np.array([[0, 1, np.nan], [2, 3, 4]])])
+    scipy.io.savemat(folder / "groundtruth.mat", {"GTgroups": truth, "GTtimestamp": np.array([[1.0, 2.0]])})
+    frames = load_sequence(folder, 0.01)
+    assert [sorted(map(sorted, f.truth)) for f in frames] == [[[1, 2], [3, 4, 5]], [[0, 1], [2, 3, 4]]]
+    scipy.io.savemat(folder / "features.mat", {"features": np.zeros((5, 4, 2)), "timestamp": np.array([[1.0, 2.0]])})
+    with pytest.raises(ValueError, match="features must be a cell array, got float64"):
+        load_sequence(folder)
+    records = np.array([[(np.array([1.0]), np.array([0.0]))]], dtype=[("id", "O"), ("x", "O")])
+    scipy.io.savemat(folder / "features.mat", {"features": records, "timestamp": np.array([[1.0]])})
+    with pytest.raises(ValueError, match=r"features must be a cell array, got a struct array \(fields id, x\)"):
+        load_sequence(folder)
+
+
 def test_unit_warning_names_the_scale_that_fits(tiny):
     assert unit_warning(load_dataset(tiny, 0.01), 0.01) is None
     centimetres_as_metres = unit_warning(load_dataset(tiny, 1.0), 1.0)
