@@ -35,6 +35,7 @@ from sid.tracking.view import View
 __all__ = [
     "DEFAULT_INTERVAL",
     "REUSED_AFTER_S",
+    "WALKING_SPEED_MAX",
     "ReplayFrame",
     "ReplaySettings",
     "TrajectoryError",
@@ -115,6 +116,9 @@ class ReplayFrame:
 
 DEFAULT_INTERVAL = 0.4
 """Seconds between annotation steps where the annotations cannot tell (too few people walking): the public sets'."""
+WALKING_SPEED_MAX = 3.0
+"""m/s: a median annotated speed of people walking above this is not in m/s (1.2-1.5 m/s in the public sets; velocities
+in cm/s or km/h give 120-150 or 4.3-5.4): the time between annotation steps is not read from such velocities."""
 
 
 def load_trajectory_set(folder: str | Path, interval: float | None = None) -> TrajectorySet:
@@ -213,16 +217,23 @@ def _read_interval(
 ) -> tuple[float, str]:
     """Seconds between annotation steps, from the rows (sorted by frame, then id): the median of |move| / |velocity|
     over one-step moves of people annotated faster than 0.3 m/s, to two significant digits; and a note when it is
-    not ``DEFAULT_INTERVAL``, or when fewer than 5 such moves leave it at that."""
+    not ``DEFAULT_INTERVAL``, or when it is left at that: the velocities all 0, fewer than 5 such moves, or a median
+    speed of those people beyond ``WALKING_SPEED_MAX`` (velocities in another unit than m/s)."""
     order = np.lexsort((frames, ids))  # by person, then frame
     f, i, p, v = frames[order], ids[order], position[order], velocity[order]
     one_step = (i[1:] == i[:-1]) & (f[1:] - f[:-1] == step)
     speed = np.hypot(v[:-1, 0], v[:-1, 1])
     moving = one_step & (speed > 0.3)
+    taken = f"{DEFAULT_INTERVAL} s taken (--interval sets it)"
+    if not np.any(velocity):
+        return DEFAULT_INTERVAL, f"the velocities (v_x, v_y) are all 0: the time between annotation steps is {taken}"
     if moving.sum() < 5:
+        return DEFAULT_INTERVAL, f"too few people walking to read the time between annotation steps: {taken}"
+    walking = float(np.median(speed[moving]))
+    if walking > WALKING_SPEED_MAX:
         return DEFAULT_INTERVAL, (
-            f"too few people walking to read the time between annotation steps: {DEFAULT_INTERVAL} s taken "
-            "(--interval sets it)"
+            f"the people walking have a median annotated speed of {walking:.3g}, too fast for m/s (velocities in "
+            f"another unit?): the time between annotation steps is {taken}"
         )
     moved = np.hypot(*(p[1:] - p[:-1])[moving].T)
     interval = float(f"{np.median(moved / speed[moving]):.2g}")

@@ -59,6 +59,22 @@ def test_the_time_between_annotation_steps_is_read_from_positions_and_velocities
     assert load_trajectory_set(folder, interval=0.2).times.tolist() == pytest.approx([0.2 * k for k in range(8)])
 
 
+def test_velocities_that_cannot_give_the_time_between_steps_leave_it_at_0_4_s_saying_why(tmp_path: Path) -> None:
+    """Velocities in cm/s read as annotations every 0.004 s (MOTA -8.4 on the public sets, named only as that
+    interval); velocities all 0 were "too few people walking"."""
+    in_cm = [(*row[:5], row[5] * 100, row[6], row[7] * 100) for row in _walkers(frames=8)]
+    trajectories = load_trajectory_set(write_set(tmp_path / "cm", in_cm, "1 2\n"))
+    assert trajectories.times.tolist() == pytest.approx([0.4 * k for k in range(8)])
+    assert trajectories.notes == (
+        "the people walking have a median annotated speed of 100, too fast for m/s (velocities in another unit?): "
+        "the time between annotation steps is 0.4 s taken (--interval sets it)",
+    )
+    still = [(*row[:5], 0, 0, 0) for row in _walkers(frames=8)]
+    assert load_trajectory_set(write_set(tmp_path / "zero", still, "1 2\n")).notes == (
+        "the velocities (v_x, v_y) are all 0: the time between annotation steps is 0.4 s taken (--interval sets it)",
+    )
+
+
 def test_lines_sharing_a_person_are_one_group_with_a_note(tmp_path: Path) -> None:
     folder = write_set(tmp_path / "s", _walkers(), "1 2\n2 3\n")
     trajectories = load_trajectory_set(folder)
