@@ -130,7 +130,13 @@ def load_trajectory_set(folder: str | Path, interval: float | None = None) -> Tr
     obsmat, groups_file = folder / "obsmat.txt", folder / "groups.txt"
     for path in (obsmat, groups_file):
         if not path.exists():
-            raise TrajectoryError(f"{folder}: no {path.name} (a trajectory set holds obsmat.txt and groups.txt)")
+            inside = sorted(p.parent.name for p in folder.glob(f"*/{path.name}"))  # a folder of sets
+            hint = (
+                f"; its sub-folders {', '.join(inside[:5])}{', ...' if len(inside) > 5 else ''} do: give them"
+                if inside
+                else ""
+            )
+            raise TrajectoryError(f"{folder}: no {path.name} (a trajectory set holds obsmat.txt and groups.txt){hint}")
     rows = _read_obsmat(obsmat)
     # Sorted by frame, then pedestrian (then the rest); a row written twice is one annotation.
     rows, repeated = np.unique(rows, axis=0, return_counts=True)

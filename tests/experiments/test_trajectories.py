@@ -171,6 +171,15 @@ def test_a_missing_file_or_bytes_that_are_not_text_are_refused(tmp_path: Path) -
         load_trajectory_set(tmp_path)
 
 
+def test_a_folder_of_sets_given_as_a_set_names_the_sets_inside(tmp_path: Path) -> None:
+    for name in ("zara01", "eth"):
+        write_set(tmp_path / "release" / name, _walkers(), "1 2\n")
+    with pytest.raises(
+        TrajectoryError, match=r"release: no obsmat.txt \(.*\); its sub-folders eth, zara01 do: give them"
+    ):
+        load_trajectory_set(tmp_path / "release")
+
+
 def test_a_byte_order_mark_before_the_first_line_is_dropped(tmp_path: Path) -> None:
     # An editor's BOM was refused as "not numbers: '\\ufeff0 1 ...'".
     (tmp_path / "obsmat.txt").write_text("\ufeff0 1 0 0 0 0 0 0\n6 1 0.5 0 0 0 0 0\n", encoding="utf-8")
