@@ -237,13 +237,20 @@ def without_facings(frames: Sequence[LabelledFrame], share: float, seed: int = 0
 
 def sequence_folders(folder: str | Path) -> list[Path]:
     """The sequence folders of a dataset folder: itself when it holds ``features.mat``, else its sub-folders that
-    do, sorted. Raises ValueError when there is none."""
+    do, sorted. Raises ValueError when there is none, and for a folder of datasets (``features.mat`` two levels
+    down)."""
     folder = Path(folder)
     if not folder.is_dir():
         raise ValueError(f"fformation: {folder} is not a folder")
     if (folder / "features.mat").exists():
         return [folder]
     sequences = sorted(p.parent for p in folder.glob("*/features.mat"))
+    deeper = sorted({p.parent.parent.name for p in folder.glob("*/*/features.mat")})
+    if deeper:  # a folder of datasets: pooling its one-sequence datasets, and leaving the others out, is no score
+        datasets = sorted({s.name for s in sequences} | set(deeper))
+        raise ValueError(
+            f"fformation: {folder} holds datasets, not one ({', '.join(datasets)}): give each dataset's folder"
+        )
     if not sequences:
         raise ValueError(f"fformation: no features.mat in {folder} or its sub-folders")
     return sequences

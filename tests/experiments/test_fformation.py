@@ -293,6 +293,19 @@ def test_ground_truth_encodings_and_single_precision_timestamps(tmp_path):
         load_dataset(folder)
 
 
+def test_a_folder_of_datasets_is_refused_naming_them(tmp_path):
+    """The shared fformation folder itself scored Synth and CocktailParty pooled as one dataset's sequences and
+    left CoffeeBreak and GDet (sequences one level deeper) out, without a word."""
+    truth = {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]}
+    for sequence in ("Single", "Several/Seq1", "Several/Seq2"):
+        write_sequence(tmp_path / "all" / sequence, tiny_frames(), truth)
+    with pytest.raises(
+        ValueError, match=r"all holds datasets, not one \(Several, Single\): give each dataset's folder"
+    ):
+        load_dataset(tmp_path / "all")
+    assert len(load_dataset(tmp_path / "all" / "Several")) == 6
+
+
 def test_a_ground_truth_matrix_padded_with_zeros_or_nan_lists_the_shorter_groups(tmp_path):
     """[1 2 0; 3 4 5] (MATLAB's padding of a matrix of groups) made 0 a member of the pair, which then never matched;
     with NaN the file was refused. 0 is padding only where nobody of the frame has id 0."""
