@@ -1,13 +1,14 @@
 """F-formation group benchmarks: load the Verona datasets' ``.mat`` files and score a group detector on them.
 
-Format (``features.mat`` / ``groundtruth.mat``, MATLAB v5, one folder per sequence): ``features{t}`` is an N x 4 array
-``[id, x, y, theta]`` per frame with ``timestamp(t)`` (further columns are not read, with a warning); ``GTgroups{t}``
-lists the member ids of each group at ``GTtimestamp(t)``. x, y are ground-plane coordinates (centimetres in the public
-sets: use ``scale=0.01``), theta is the facing yaw in radians in the same frame (``degrees=True`` for files in degrees).
-A dataset is a folder holding ``features.mat`` (one sequence) or sub-folders that do (sequences pooled frame by frame).
-Ids are whole numbers, unique within a frame; timestamps are unique within a file; a ground-truth group is an id vector,
-a cell of them, or a matrix with one group per row. A ground-truth timestamp stored in single precision finds its
-double-precision frame.
+Format (``features.mat`` / ``groundtruth.mat``, MATLAB v5 to v7, one folder per sequence): ``features{t}`` is an N x 4
+array ``[id, x, y, theta]`` per frame with ``timestamp(t)`` (further columns are not read, with a warning);
+``GTgroups{t}`` lists the member ids of each group at ``GTtimestamp(t)``; the variables may be one struct's fields. x, y
+are ground-plane coordinates (centimetres in the public sets: use ``scale=0.01``), theta is the facing yaw in radians in
+the same frame (``degrees=True`` for files in degrees). A dataset is a folder holding ``features.mat`` (one sequence) or
+sub-folders that do (sequences pooled frame by frame; those without ``groundtruth.mat`` beside others that have one left
+out, with a warning). Ids are whole numbers, unique within a frame; timestamps are unique within a file; a ground-truth
+group is an id vector, a cell of them, or a matrix with one group per row (shorter ones padded with NaN, or 0 where
+nobody has id 0). A ground-truth timestamp stored in single precision finds its double-precision frame.
 
 Scoring (the protocol of this literature; its source: docs/parameters.md): only frames with ground truth are scored,
 groups of one are dropped on both sides; a truth group is found when some detected group G has
