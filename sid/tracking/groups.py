@@ -34,7 +34,7 @@ import numpy as np
 from sid.checks import check_number, check_numbers, check_whole
 from sid.perception.groups import GroupParams, detect_groups
 from sid.tracking.assignment import gated_assignment
-from sid.tracking.records import GroupKind, TrackedGroup, TrackedPerson
+from sid.tracking.records import TIME_TOLERANCE, GroupKind, TrackedGroup, TrackedPerson
 
 __all__ = ["GroupTracker", "GroupTrackerParams", "connected_components"]
 
@@ -151,7 +151,7 @@ class GroupTracker:
         found_now = {m for candidate in candidates for m in candidate.members}
         p = self.params
         kept: list[_GroupTrack] = []
-        slow = self._last_time is not None and timestamp - self._last_time >= p.confirm_time - 1e-9
+        slow = self._last_time is not None and timestamp - self._last_time >= p.confirm_time - TIME_TOLERANCE
         self._last_time = timestamp
         for track in self._tracks:
             candidate = matched.get(track.id)
@@ -162,7 +162,7 @@ class GroupTracker:
             if candidate is not None:
                 track.found, track.last_seen = candidate, timestamp
                 track.members |= dict.fromkeys(found, timestamp)
-            elif timestamp - track.last_seen > p.miss_timeout:
+            elif timestamp - track.last_seen > p.miss_timeout + TIME_TOLERANCE:
                 continue
             track.members = {
                 m: seen
@@ -170,7 +170,7 @@ class GroupTracker:
                 if m in found
                 or (
                     m not in found_now  # found in another group now: moved there
-                    and timestamp - seen <= p.miss_timeout
+                    and timestamp - seen <= p.miss_timeout + TIME_TOLERANCE
                     and self._stays(track, by_id.get(m))
                 )
             }
@@ -187,7 +187,7 @@ class GroupTracker:
         ids = np.array([people[k].id for k in order], dtype=np.int64)
         positions = np.array([[people[k].x, people[k].y] for k in order]).reshape(-1, 2)
         self._history.append(_Positions(timestamp, ids, positions))
-        while timestamp - self._history[0].timestamp > self.params.walk_window:
+        while timestamp - self._history[0].timestamp > self.params.walk_window + TIME_TOLERANCE:
             self._history.popleft()
 
     def _conversations(self, people: Sequence[TrackedPerson]) -> list[_Candidate]:
@@ -296,7 +296,7 @@ def _relative_speed(
     now = history[-1].timestamp if history else None
     filled = np.zeros(len(i), dtype=bool)
     for old in history:
-        if now is None or now - old.timestamp < params.walk_window / 2 or filled.all():
+        if now is None or now - old.timestamp < params.walk_window / 2 - TIME_TOLERANCE or filled.all():
             break
         if not len(old.ids):
             continue
@@ -327,7 +327,7 @@ def _stayed_close(
     own, a, b = ids[involved], pairs[: len(i)], pairs[len(i) :]
     last = -math.inf
     for old in itertools.islice(history, len(history) - 1):  # this frame's closeness is given
-        if old.timestamp < last + _CLOSENESS_STEP or not len(old.ids):
+        if old.timestamp < last + _CLOSENESS_STEP - TIME_TOLERANCE or not len(old.ids):
             continue
         last = old.timestamp
         rows = np.minimum(np.searchsorted(old.ids, own), len(old.ids) - 1)

@@ -16,10 +16,15 @@ import numpy as np
 from sid.perception.group import Group, group_json
 from sid.perception.people import Person
 
-__all__ = ["GroupKind", "MotionState", "TrackedGroup", "TrackedPerson", "Tracks"]
+__all__ = ["TIME_TOLERANCE", "GroupKind", "MotionState", "TrackedGroup", "TrackedPerson", "Tracks"]
 
 MotionState = Literal["standing", "walking"]
 GroupKind = Literal["conversation", "walking"]
+
+TIME_TOLERANCE = 1e-6
+"""Seconds within which the trackers take a time difference as equal to a window or timeout: frames a whole number
+of periods apart (15 frames at 15 Hz, 1 s) stay so whatever rounding the clock's offset brings (a ROS stamp of
+1.7e9 s is rounded to 2.4e-7 s)."""
 
 
 @dataclass(frozen=True)

@@ -27,7 +27,7 @@ from sid.errors import SidError
 from sid.perception.people import Person
 from sid.tracking.assignment import gated_assignment
 from sid.tracking.motion import MotionStates
-from sid.tracking.records import TrackedPerson
+from sid.tracking.records import TIME_TOLERANCE, TrackedPerson
 from sid.tracking.view import View, ViewCone
 
 __all__ = ["OCCLUDER_RADIUS", "PeopleTracker", "TrackerParams", "TrackingError"]
@@ -135,7 +135,7 @@ class PeopleTracker:
         self._time = float(timestamp)
         # Tracks undetected for longer than out_of_view_timeout expire below whatever their prediction says: dropped
         # first, so that the prediction never spans more than that (a gap of 1e308 s would overflow it).
-        self._keep(timestamp - self._last_hit <= p.out_of_view_timeout)
+        self._keep(timestamp - self._last_hit <= p.out_of_view_timeout + TIME_TOLERANCE)
         self._motion.predict(dt, q)
         self._in_view = np.ones(len(self._ids), dtype=bool) if view is None else view.contains(self._motion.position)
         self._unseen += np.where(self._in_view & ~_behind(view, self._motion.position, positions), dt, 0.0)
@@ -147,7 +147,7 @@ class PeopleTracker:
         self._last_hit[rows] = timestamp
         self._unseen[rows] = 0.0
         self._confirmed |= (self._hits >= p.confirm_hits) | (
-            (self._hits >= 2) & (timestamp - self._first_hit >= p.confirm_time - 1e-9)
+            (self._hits >= 2) & (timestamp - self._first_hit >= p.confirm_time - TIME_TOLERANCE)
         )
         self._detection[:] = -1
         self._detection[rows] = cols
@@ -168,7 +168,9 @@ class PeopleTracker:
         ``timeout``: a walker hidden behind a group for longer than it, then in view a moment before being detected
         again, keeps the track."""
         p = self.params
-        return (self._unseen > p.timeout) | (now - self._last_hit > p.out_of_view_timeout)
+        return (self._unseen > p.timeout + TIME_TOLERANCE) | (
+            now - self._last_hit > p.out_of_view_timeout + TIME_TOLERANCE
+        )
 
     def _assign(self, positions: np.ndarray, facing: np.ndarray, r: float) -> tuple[np.ndarray, np.ndarray]:
         """Rows of tracks and columns of detections matched by minimum total distance, each within its gate.

@@ -231,3 +231,27 @@ def test_young_tracks_moving_together_are_a_walking_group_before_the_tracker_cal
     assert groups[-1] and groups[-1][0].kind == "walking" and groups[-1][0].members == (1, 2)
     waiting = GroupTracker(GroupTrackerParams(moving_speed=1.0))  # only the tracker's walking state counts
     assert all(waiting.update(pair(k), k * DT) == [] for k in range(6))
+
+
+def _first_report_of_a_pair_far_apart_exactly_one_window_ago(offset: float, dt: float) -> int:
+    """The frame at which two walkers are first reported together: 1.6 m apart in their first frame (beyond
+    walk_distance), 1 m apart from then on, fed every ``dt`` seconds at the clock times ``offset + k dt`` from k = 7
+    on (as a replay at a camera's rate computes them)."""
+    tracker = GroupTracker(GroupTrackerParams(walk_window=2.0, walk_distance=1.5))
+    v = (1.2, 0.0)
+    for k in range(7, 7 + int(4.0 / dt)):
+        x, gap = 1.2 * k * dt, 1.6 if k == 7 else 1.0
+        people = [_person(1, x, 0.0, 0.0, v), _person(2, x, -gap, 0.0, v)]
+        if tracker.update(people, offset + k * dt):
+            return k
+    raise AssertionError("never reported")
+
+
+@pytest.mark.parametrize("dt", [1 / 15, 0.4])
+def test_groups_do_not_depend_on_the_clocks_offset(dt: float) -> None:
+    """The first frame is walk_window before a later one: whether it is still in the window (and which frames are
+    looked at 0.2 s apart) must not depend on how rounding treats the clock's times, e.g. ROS stamps in seconds since
+    1970."""
+    frames = {offset: _first_report_of_a_pair_far_apart_exactly_one_window_ago(offset, dt)
+              for offset in (0.0, 0.1, 17.3, 1234.567, 1.7e9 + 0.123, 1.7e9 + 0.9)}  # fmt: skip
+    assert len(set(frames.values())) == 1, frames

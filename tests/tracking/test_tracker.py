@@ -336,3 +336,21 @@ def test_a_walker_crossing_another_within_0_4_m_keeps_the_id(seed: int) -> None:
         frames.append((t, people, shown))
     ids = _walker_ids(frames)
     assert len(ids[0]) == 1 and len(ids[1]) == 1 and ids[0] != ids[1]
+
+
+@pytest.mark.parametrize("offset", [0.0, 0.1, 17.3, 1234.567, 1.7e9 + 0.123, 1.7e9 + 0.9])
+def test_a_track_missed_for_exactly_its_timeouts_lives_whatever_the_clocks_offset(offset: float) -> None:
+    """Undetected for exactly ``timeout`` in view, or ``out_of_view_timeout`` in all, a track still lives, and a
+    step later it is gone: the decision must not depend on how rounding treats the clock's times (e.g. ROS stamps in
+    seconds since 1970)."""
+    step = 0.4  # an annotation rate: 1.2 s and 4.0 s are whole numbers of steps
+    for params, view, steps in (
+        (TrackerParams(timeout=1.2), ViewCone(0.0, 0.0, 0.0, math.radians(90)), 3),
+        (TrackerParams(out_of_view_timeout=4.0), ViewCone(0.0, 0.0, math.pi, math.radians(90)), 10),
+    ):
+        tracker = PeopleTracker(params)
+        times = [offset + (k + 7) * step for k in range(5 + steps + 1)]
+        for t in times[:5]:
+            tracker.update([Person(0, 2.0, 0.0)], t)
+        alive = [bool(tracker.update([], t, view)) for t in times[5:]]
+        assert alive == [True] * steps + [False], (params, alive)
