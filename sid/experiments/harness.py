@@ -16,6 +16,7 @@ length over the same planner's "without" length for the same task and seed. Both
 
 from __future__ import annotations
 
+import math
 import statistics
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
@@ -27,7 +28,7 @@ from shapely.geometry import Point
 from costmap.layered import LayeredCostmap
 from costmap.layers.social import group_zone_polygon
 from planner.facade import PlanResult, plan, resolve_planner
-from planner.problem import DEFAULT_COST_WEIGHT, PlanningError, PlanningProblem
+from planner.problem import DEFAULT_COST_WEIGHT, NoPathError, PlanningError, PlanningProblem
 from sid.checks import repeated
 from sid.experiments.path_metrics import result_metrics
 from sid.perception.group import Group
@@ -44,6 +45,7 @@ __all__ = [
     "Run",
     "Task",
     "compare_with_without",
+    "people_at_ends",
     "prepare",
     "run_matrix",
     "summarise",
@@ -71,10 +73,21 @@ class Task:
         scenario when its task is impossible."""
         if mode not in self._references:
             try:
-                self._references[mode] = plan(self.problems[mode], "grid")
+                self._references[mode] = self.plan(mode, "grid")
             except PlanningError as exc:
                 raise type(exc)(f"{self.scenario.name}: {exc}") from exc
         return self._references[mode].cost
+
+    def plan(self, mode: str, planner: str, **budget: Any) -> PlanResult:
+        """``planner.facade.plan`` on the mode's problem (``budget``: its keyword arguments). A start or goal in
+        collision with a person raises the planner's NoPathError with the person named (``people_at_ends``)."""
+        try:
+            return plan(self.problems[mode], planner, **budget)
+        except NoPathError as exc:
+            people = people_at_ends(self.scenario)
+            if not people or "in collision" not in str(exc):
+                raise
+            raise NoPathError(f"{exc}; {'; '.join(people)}") from exc
 
 
 def prepare(scenario: Scenario, cost_weight: float = DEFAULT_COST_WEIGHT, labels: dict | None = None) -> Task:
@@ -100,6 +113,26 @@ def zone_warnings(task: Task) -> list[str]:
                 )
                 break
     return warnings
+
+
+def people_at_ends(scenario: Scenario) -> list[str]:
+    """A sentence for the robot's start and for its goal when it lies so near a person that the robot's disc
+    (``robot.radius``) may touch their body (``lidar.body_radius``, painted lethal on the costmap's cells, so within
+    a cell's diagonal of that): the person nearest it, and how far (m, world frame)."""
+    robot, body = scenario.robot, scenario.lidar.body_radius
+    reach = body + robot.radius + scenario.grid.resolution * math.sqrt(2.0)
+    sentences = []
+    for end, pose in (("start", robot.start), ("goal", robot.goal)):
+        near = [(math.hypot(p.x - pose[0], p.y - pose[1]), p) for p in scenario.people]
+        near = [(d, p) for d, p in near if d < reach]
+        if near:
+            distance, person = min(near, key=lambda item: item[0])
+            sentences.append(
+                f"the {end} is {distance:.2f} m from person {person.id} at ({person.x:.2f}, {person.y:.2f}): a person "
+                f"is an obstacle of radius {body:.2f} m (lidar.body_radius) and the robot a disc of radius "
+                f"{robot.radius:.2f} m (robot.radius)"
+            )
+    return sentences
 
 
 @dataclass(frozen=True)
@@ -176,7 +209,7 @@ def compare_with_without(
         reference_cost = task.reference_cost(mode) if reference else None  # an impossible task fails here, named
         if progress:
             progress(mode, None)
-        result = plan(task.problems[mode], name, time_limit=time_limit, seed=seed, max_iterations=max_iterations)
+        result = task.plan(mode, name, time_limit=time_limit, seed=seed, max_iterations=max_iterations)
         metrics = result_metrics(result, task.scenario.people, task.groups, measure_on)
         ratio = raw_ratio = detour = None  # also where the yardstick is 0 m long: a goal at the start
         if reference_cost is not None and reference_cost > 0 and result.success:

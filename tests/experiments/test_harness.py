@@ -7,9 +7,9 @@ import itertools
 
 import pytest
 
-from planner.problem import PlanningError
+from planner.problem import NoPathError, PlanningError
 from sid.experiments.demo import DEMO_SCENARIO, demo_scenario
-from sid.experiments.harness import compare_with_without, prepare, run_matrix, summarise, zone_warnings
+from sid.experiments.harness import compare_with_without, people_at_ends, prepare, run_matrix, summarise, zone_warnings
 from sid.scenario.loader import scenario_from_dict
 
 
@@ -152,3 +152,28 @@ def test_summary_does_not_depend_on_the_order_of_the_records():
     (row,) = expected
     assert row["intrusion_rate"] == 0.5 and row["crossing_rate"] == 0.5 and row["worst_min_person_distance_m"] == 0.4
     assert row["worst_cost_ratio"] == 1.3 and row["mean_intrusion_m"] == pytest.approx(0.225)
+
+
+def test_a_goal_on_a_person_is_refused_naming_the_person():
+    data = copy.deepcopy(DEMO_SCENARIO)
+    data["robot"]["goal"] = [7.5, 1.45, 0.0]  # 0.11 m from the lone person 4 at (7.6, 1.5)
+    task = prepare(scenario_from_dict(data))
+    for planner in ("grid", "bitstar"):
+        with pytest.raises(NoPathError) as caught:
+            compare_with_without(task, planner, 0.2, seed=1, modes=("with",))
+        assert str(caught.value) == (
+            "no path: goal (7.50, 1.45) is in collision: it lies inside an obstacle (cell cost 254, lethal); "
+            "the goal is 0.11 m from person 4 at (7.60, 1.50): a person is an obstacle of radius 0.20 m "
+            "(lidar.body_radius) and the robot a disc of radius 0.25 m (robot.radius)"
+        )
+    data["robot"]["goal"] = [8.05, 1.5, 0.0]  # 0.45 m away: the robot's disc just clear of the body
+    comparison = compare_with_without(prepare(scenario_from_dict(data)), "grid", 0.2, modes=("with",))
+    assert comparison.runs["with"].result.success
+
+
+def test_people_at_ends_names_the_nearest_person_to_each_end_in_reach():
+    data = copy.deepcopy(DEMO_SCENARIO)
+    data["robot"]["start"], data["robot"]["goal"] = [3.75, -0.3, 0.0], [9.0, 0.0, 0.0]
+    (sentence,) = people_at_ends(scenario_from_dict(data))
+    assert sentence.startswith("the start is 0.15 m from person 2 at (3.72, -0.45)")
+    assert people_at_ends(demo_scenario()) == []
