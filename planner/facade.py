@@ -20,7 +20,7 @@ from scipy import ndimage
 from costmap.grid import INSCRIBED, LETHAL, NO_INFORMATION
 from planner.grid_planner import grid_search
 from planner.ompl_planners import OMPL_PLANNERS, seed_ompl, solve_ompl
-from planner.problem import CostField, NoPathError, PlanningError, PlanningProblem
+from planner.problem import CostField, EndpointCollisionError, NoPathError, PlanningError, PlanningProblem
 from planner.smoothing import smooth
 from planner.validity import check_path
 
@@ -104,7 +104,7 @@ def _collision(cost: int, problem: PlanningProblem) -> str:
 
 def check_endpoints(field: CostField) -> None:
     """Raise NoPathError, its message starting "no path: " and naming the reason, when the start or goal lies in
-    collision or the two cannot be connected; PlanningError "... is outside the map"."""
+    collision (EndpointCollisionError) or the two cannot be connected; PlanningError "... is outside the map"."""
     problem, spec = field.problem, field.spec
     x0, y0 = spec.origin_x, spec.origin_y
     x1, y1 = x0 + spec.size_m[0], y0 + spec.size_m[1]
@@ -118,7 +118,8 @@ def check_endpoints(field: CostField) -> None:
         cell = spec.world_to_cell(np.array([x, y]))[0]
         if not field.free[cell[0], cell[1]]:
             cost = int(problem.costmap.costs[cell[0], cell[1]])
-            raise NoPathError(f"no path: {name} ({x:.2f}, {y:.2f}) is in collision: {_collision(cost, problem)}")
+            message = f"no path: {name} ({x:.2f}, {y:.2f}) is in collision: {_collision(cost, problem)}"
+            raise EndpointCollisionError(message, name)
         cells.append(cell)
     # 4-connected regions: a diagonal step between plannable cells needs the two cells beside it plannable too (no
     # corner cutting, as in the grid planner), so cells that touch only at a corner are not connected.

@@ -37,6 +37,7 @@ from sid.errors import SidError
 __all__ = [
     "CostField",
     "DEFAULT_COST_WEIGHT",
+    "EndpointCollisionError",
     "MAX_COST_WEIGHT",
     "PlanningError",
     "PlanningProblem",
@@ -66,6 +67,22 @@ class PlanningError(SidError, ValueError):
 class NoPathError(PlanningError):
     """A well-formed task without a solution: the start or goal in collision, or the two walled off from each other;
     the message starts with "no path: "."""
+
+
+class EndpointCollisionError(NoPathError):
+    """The NoPathError of a start or goal in collision; ``end`` says which ("start" or "goal"). Both are its
+    ``args``, so that it pickles (a sweep's worker process) and ``type(error)(message, *error.args[1:])`` renames
+    it."""
+
+    def __init__(self, message: str, end: str) -> None:
+        super().__init__(message, end)
+
+    @property
+    def end(self) -> str:
+        return str(self.args[1])
+
+    def __str__(self) -> str:
+        return str(self.args[0])
 
 
 @dataclass(frozen=True)

@@ -202,12 +202,7 @@ def find_groups(
     """Per frame of ``log``: the group tracker's confirmed groups (any kind), as member track ids; ``progress``
     after each frame."""
     tracker = GroupTracker(params)
-    found = []
-    for k, (t, people) in enumerate(zip(log.times, log.tracks, strict=True)):
-        found.append([frozenset(g.members) for g in tracker.update(people, t)])
-        if progress is not None:
-            progress(k + 1, len(log.times), log.name)
-    return found
+    return _per_frame(log, lambda people, t: [frozenset(g.members) for g in tracker.update(people, t)], progress)
 
 
 def find_coherent_groups(
@@ -215,10 +210,18 @@ def find_coherent_groups(
 ) -> list[list[frozenset[int]]]:
     """Per frame of ``log``: the coherent-motion reference's groups, as member track ids; ``progress`` after each
     frame."""
-    reference = CoherentMotion(params)
+    return _per_frame(log, CoherentMotion(params).update, progress)
+
+
+def _per_frame(
+    log: TrackLog,
+    update: Callable[[list[TrackedPerson], float], list[frozenset[int]]],
+    progress: Progress | None,
+) -> list[list[frozenset[int]]]:
+    """``update(tracks, timestamp)`` on every frame of ``log`` in order, its answers; ``progress`` after each."""
     found = []
     for k, (t, people) in enumerate(zip(log.times, log.tracks, strict=True)):
-        found.append(reference.update(people, t))
+        found.append(update(people, t))
         if progress is not None:
             progress(k + 1, len(log.times), log.name)
     return found

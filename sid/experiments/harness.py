@@ -28,7 +28,7 @@ from shapely.geometry import Point
 from costmap.layered import LayeredCostmap
 from costmap.layers.social import group_zone_polygon
 from planner.facade import PlanResult, plan, resolve_planner
-from planner.problem import DEFAULT_COST_WEIGHT, NoPathError, PlanningError, PlanningProblem
+from planner.problem import DEFAULT_COST_WEIGHT, EndpointCollisionError, PlanningError, PlanningProblem
 from sid.checks import repeated
 from sid.experiments.path_metrics import result_metrics
 from sid.perception.group import Group
@@ -75,19 +75,20 @@ class Task:
             try:
                 self._references[mode] = self.plan(mode, "grid")
             except PlanningError as exc:
-                raise type(exc)(f"{self.scenario.name}: {exc}") from exc
+                raise type(exc)(f"{self.scenario.name}: {exc}", *exc.args[1:]) from exc
         return self._references[mode].cost
 
     def plan(self, mode: str, planner: str, **budget: Any) -> PlanResult:
         """``planner.facade.plan`` on the mode's problem (``budget``: its keyword arguments). A start or goal in
-        collision with a person raises the planner's NoPathError with the person named (``people_at_ends``)."""
+        collision with a person raises the planner's EndpointCollisionError with the person named
+        (``people_at_ends``)."""
         try:
             return plan(self.problems[mode], planner, **budget)
-        except NoPathError as exc:
-            people = people_at_ends(self.scenario)
-            if not people or "in collision" not in str(exc):
+        except EndpointCollisionError as exc:
+            people = people_at_ends(self.scenario, (exc.end,))
+            if not people:
                 raise
-            raise NoPathError(f"{exc}; {'; '.join(people)}") from exc
+            raise EndpointCollisionError(f"{exc}; {people[0]}", exc.end) from exc
 
 
 def prepare(scenario: Scenario, cost_weight: float = DEFAULT_COST_WEIGHT, labels: dict | None = None) -> Task:
@@ -115,14 +116,15 @@ def zone_warnings(task: Task) -> list[str]:
     return warnings
 
 
-def people_at_ends(scenario: Scenario) -> list[str]:
-    """A sentence for the robot's start and for its goal when it lies so near a person that the robot's disc
-    (``robot.radius``) may touch their body (``lidar.body_radius``, painted lethal on the costmap's cells, so within
-    a cell's diagonal of that): the person nearest it, and how far (m, world frame)."""
+def people_at_ends(scenario: Scenario, ends: Sequence[str] = ("start", "goal")) -> list[str]:
+    """A sentence for each of the robot's ``ends`` ("start", "goal") that lies so near a person that the robot's
+    disc (``robot.radius``) may touch their body (``lidar.body_radius``, painted lethal on the costmap's cells, so
+    within a cell's diagonal of that): the person nearest it, and how far (m, world frame)."""
     robot, body = scenario.robot, scenario.lidar.body_radius
     reach = body + robot.radius + scenario.grid.resolution * math.sqrt(2.0)
     sentences = []
-    for end, pose in (("start", robot.start), ("goal", robot.goal)):
+    for end in ends:
+        pose = robot.start if end == "start" else robot.goal
         near = [(math.hypot(p.x - pose[0], p.y - pose[1]), p) for p in scenario.people]
         near = [(d, p) for d, p in near if d < reach]
         if near:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import pickle
 import re
 import subprocess
 import sys
@@ -19,7 +20,7 @@ from costmap.grid import INSCRIBED, LETHAL, NO_INFORMATION, Costmap2D, GridSpec
 from planner import ompl_planners
 from planner.facade import PLANNERS, plan, resolve_planner
 from planner.ompl_planners import OMPL_PLANNERS
-from planner.problem import CostField, PlanningError, PlanningProblem
+from planner.problem import CostField, EndpointCollisionError, PlanningError, PlanningProblem
 from planner.smoothing import _DIRECTIONS, dp_shortcut, refine, smooth
 from planner.validity import check_path, interpolate
 
@@ -379,6 +380,14 @@ def test_bitstar_settles_only_after_its_first_batch(monkeypatch):
 def test_impossible_endpoints_raise_clear_errors(start, goal, message, name):
     with pytest.raises(PlanningError, match=re.escape(message)):
         plan(PlanningProblem(walled_map(), start, goal, RADIUS), name, time_limit=0.2, seed=1)
+
+
+def test_an_end_in_collision_says_which_end_and_survives_pickling():
+    with pytest.raises(EndpointCollisionError) as caught:
+        plan(PlanningProblem(walled_map(), (1.0, 2.0), (6.6, 6.0), RADIUS), "grid")
+    copy = pickle.loads(pickle.dumps(caught.value))  # as a sweep's worker process hands it back
+    assert copy.end == caught.value.end == "goal" and str(copy) == str(caught.value)
+    assert str(copy).startswith("no path: goal (6.60, 6.00) is in collision")
 
 
 @pytest.mark.parametrize("name", ["grid", "rrtstar"])
