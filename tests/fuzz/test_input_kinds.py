@@ -324,10 +324,15 @@ def check_fformation(case: tuple[dict[str, Any], dict[str, Any]]) -> str:
         scipy.io.savemat(Path(folder) / "features.mat", features)
         scipy.io.savemat(Path(folder) / "groundtruth.mat", truth)
         try:
-            frames = load_dataset(folder)
+            with warnings.catch_warnings(record=True) as said:  # e.g. extra feature columns: said, one line each
+                warnings.simplefilter("always")
+                frames = load_dataset(folder)
         except ValueError as exc:
             assert str(exc).startswith("fformation: ") and "\n" not in str(exc)
             return "clear"
+    for warning in said:
+        assert issubclass(warning.category, InputWarning), warning
+        assert str(warning.message).startswith("fformation: ") and "\n" not in str(warning.message)
     for frame in frames:
         assert all(math.isfinite(p.x) and math.isfinite(p.y) for p in frame.people)
         assert all(p.theta is None or math.isfinite(p.theta) for p in frame.people)
