@@ -10,7 +10,8 @@ Protocol:
   reference (``sid.tracking.coherent``) runs on the same tracks.
 - people (py-motmetrics): ground truth = the people present (inside the robot's view when one is set);
   hypotheses = the confirmed tracks detected in the frame or inside the view. A track within ``match_distance`` may
-  match. MOTA, IDF1, identity switches (also per 100 true tracks).
+  match. MOTA, IDF1, identity switches (also per 100 true tracks). People and tracks never within
+  ``match_distance`` of each other are scored in separate motmetrics accumulators and merged (``MOT_PART_IDS``).
 - groups: each frame's tracks are identified with true people by minimum total distance within ``match_distance``
   (an unidentified member is a stranger). Truth = the annotated groups holding among the people present (two or
   more members there). G-MITRE (``sid.experiments.gmitre``): link counts over the people present, everyone not
@@ -31,12 +32,14 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+import scipy.sparse
+import scipy.sparse.csgraph
 
 from sid.checks import check_limit
 from sid.distribution import MissingDependencyError, install_hint
 from sid.experiments.fformation import format_threshold, frame_matches
 from sid.experiments.gmitre import LinkCounts, gmitre_counts
-from sid.experiments.synthetic_tracking import as_truth_ids, identify, mot_scores
+from sid.experiments.synthetic_tracking import as_truth_ids, identify, merged_mot_scores
 from sid.experiments.trajectories import ReplaySettings, TrajectoryError, TrajectorySet, replay, replay_length
 from sid.tracking.coherent import CoherentMotion, CoherentMotionParams
 from sid.tracking.groups import GroupTracker, GroupTrackerParams
@@ -49,6 +52,7 @@ __all__ = [
     "CrowdSettings",
     "DEFAULT_GRID",
     "EVALUATION_PASSES",
+    "MOT_PART_IDS",
     "Progress",
     "TrackLog",
     "cross_validate",
@@ -232,8 +236,7 @@ def score_people(
 ) -> dict[str, Any]:
     """MOTA, IDF1, identity switches (also per 100 true tracks) and the other motmetrics counts of ``log``;
     ``progress`` after each frame matched."""
-    accumulator = _accumulate(log, match_distance, progress)
-    people: dict[str, Any] = mot_scores([accumulator], [trajectories.name])[trajectories.name]
+    people = merged_mot_scores(_accumulate(log, match_distance, progress))
     people["true_tracks"] = trajectories.people
     people["id_switches_per_100_tracks"] = 100 * people["id_switches"] / max(trajectories.people, 1)
     return people
@@ -375,18 +378,74 @@ def _with_tracker(settings: CrowdSettings, tracker: TrackerParams) -> CrowdSetti
     return dataclasses.replace(settings, tracking=dataclasses.replace(settings.tracking, tracker=tracker))
 
 
-def _accumulate(log: TrackLog, match_distance: float, progress: Progress | None = None) -> Any:
+MOT_PART_IDS = 500
+"""The most ids (true people and tracks together) one motmetrics accumulator of ``score_people`` holds, unless
+people and tracks linked by a match candidate are more: motmetrics matches identities for IDF1 on a dense square of
+every id an accumulator holds, so one accumulator over a long, dense set takes memory that grows with the square of
+its ids (gigabytes at 5 000 people)."""
+
+
+def _accumulate(log: TrackLog, match_distance: float, progress: Progress | None = None) -> list[Any]:
+    """motmetrics accumulators over ``log`` in independent parts: true people and tracks linked, in any frame, by a
+    distance within ``match_distance`` (a match candidate) stay in one part, and parts are filled in the order
+    people appear up to ``MOT_PART_IDS`` ids. No match, switch or identity pairing crosses parts, so their merged
+    scores are those of one accumulator (``merged_mot_scores``). ``progress`` after each frame."""
     import motmetrics
 
-    accumulator = motmetrics.MOTAccumulator(auto_id=True)
+    max_d2 = match_distance**2
+    truth_node: dict[int, int] = {}
+    track_node: dict[int, int] = {}
+    edges: list[np.ndarray] = []
+    for k in range(len(log.times)):  # number people and tracks in order of appearance, collect the candidates
+        rows = np.array([truth_node.setdefault(int(i), len(truth_node) + len(track_node)) for i in log.truth_ids[k]])
+        cols = np.array([track_node.setdefault(p.id, len(truth_node) + len(track_node)) for p in log.tracks[k]])
+        pairs = np.argwhere(np.isfinite(_distances(log, k, max_d2)))
+        edges.append(np.stack([rows[pairs[:, 0]], cols[pairs[:, 1]]], axis=1).reshape(-1, 2))
+    part = _parts(len(truth_node) + len(track_node), np.concatenate(edges) if edges else np.empty((0, 2), int))
+    accumulators = [motmetrics.MOTAccumulator(auto_id=True) for _ in range(int(part.max(initial=-1)) + 1)]
     for k in range(len(log.times)):
-        distances = motmetrics.distances.norm2squared_matrix(
-            log.truth_positions[k], log.track_positions(k), max_d2=match_distance**2
-        )
-        accumulator.update(log.truth_ids[k].tolist(), [p.id for p in log.tracks[k]], distances)
+        truth_ids = log.truth_ids[k].tolist()
+        track_ids = [p.id for p in log.tracks[k]]
+        row_part = part[[truth_node[int(i)] for i in truth_ids]].reshape(-1)
+        col_part = part[[track_node[i] for i in track_ids]].reshape(-1)
+        distances = _distances(log, k, max_d2)
+        for index in np.unique(np.concatenate([row_part, col_part])).tolist():
+            rows, cols = row_part == index, col_part == index
+            accumulators[index].update(
+                [i for i, r in zip(truth_ids, rows.tolist(), strict=True) if r],
+                [i for i, c in zip(track_ids, cols.tolist(), strict=True) if c],
+                distances[np.ix_(rows, cols)],
+            )
         if progress is not None:
             progress(k + 1, len(log.times), log.name)
-    return accumulator
+    return accumulators
+
+
+def _distances(log: TrackLog, frame: int, max_d2: float) -> np.ndarray:
+    """(truth, tracks) squared distances (m^2) of ``frame``, NaN beyond ``max_d2``: motmetrics' match candidates."""
+    import motmetrics
+
+    return np.asarray(
+        motmetrics.distances.norm2squared_matrix(log.truth_positions[frame], log.track_positions(frame), max_d2=max_d2)
+    ).reshape(len(log.truth_ids[frame]), len(log.tracks[frame]))
+
+
+def _parts(nodes: int, edges: np.ndarray) -> np.ndarray:
+    """(nodes,) part index of each node: the connected components of ``edges`` ((E, 2) node pairs), taken in the
+    order of their first node and packed into parts of at most ``MOT_PART_IDS`` nodes (a larger component alone)."""
+    graph = scipy.sparse.coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(nodes, nodes))
+    _, component = scipy.sparse.csgraph.connected_components(graph, directed=False)
+    first = np.full(component.max(initial=-1) + 1, nodes)
+    np.minimum.at(first, component, np.arange(nodes))
+    sizes = np.bincount(component, minlength=len(first))
+    part_of_component = np.empty(len(first), dtype=np.int64)
+    part, filled = -1, MOT_PART_IDS
+    for c in np.argsort(first, kind="stable").tolist():
+        if filled + sizes[c] > MOT_PART_IDS:
+            part, filled = part + 1, 0
+        part_of_component[c] = part
+        filled += int(sizes[c])
+    return part_of_component[component]
 
 
 def _settings_json(settings: CrowdSettings) -> dict[str, Any]:

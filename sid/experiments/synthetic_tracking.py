@@ -56,6 +56,7 @@ from sid.tracking.session import TrackingParams
 from sid.tracking.view import ViewCone
 
 __all__ = [
+    "MOT_METRICS",
     "MissingDependencyError",
     "Progress",
     "TrackingEvalSettings",
@@ -63,6 +64,7 @@ __all__ = [
     "evaluate_tracking",
     "identify",
     "measure_flicker",
+    "merged_mot_scores",
     "mot_scores",
 ]
 
@@ -225,34 +227,57 @@ def _accumulate(logs: Sequence[_FrameLog], match_distance: float) -> Any:
     return accumulator
 
 
+MOT_METRICS = (
+    "mota",
+    "motp",
+    "idf1",
+    "num_switches",
+    "num_transfer",
+    "num_misses",
+    "num_false_positives",
+    "num_objects",
+)
+"""The py-motmetrics metrics every tracking score is made of (``_as_scores`` names them for sid's JSON)."""
+
+
 def mot_scores(accumulators: list[Any], names: list[str], overall: bool = False) -> dict[str, dict[str, Any]]:
+    """py-motmetrics' scores of each accumulator by name, and of all together as ``"OVERALL"`` when ``overall``."""
     import motmetrics
 
-    metrics = [
-        "mota",
-        "motp",
-        "idf1",
-        "num_switches",
-        "num_transfer",
-        "num_misses",
-        "num_false_positives",
-        "num_objects",
-    ]
     host = motmetrics.metrics.create()
-    table = host.compute_many(accumulators, metrics=metrics, names=names, generate_overall=overall)
-    out = {}
-    for name, row in table.iterrows():
-        out[str(name)] = {
-            "mota": float(row["mota"]),
-            "idf1": float(row["idf1"]),
-            "motp_m": float(np.sqrt(row["motp"])) if np.isfinite(row["motp"]) else None,  # of squared distances
-            "id_switches": int(row["num_switches"]),
-            "id_transfers": int(row["num_transfer"]),  # a track that moved on to another person
-            "misses": int(row["num_misses"]),
-            "false_positives": int(row["num_false_positives"]),
-            "objects": int(row["num_objects"]),
-        }
-    return out
+    table = host.compute_many(accumulators, metrics=list(MOT_METRICS), names=names, generate_overall=overall)
+    return {str(name): _as_scores(row) for name, row in table.iterrows()}
+
+
+def merged_mot_scores(parts: list[Any]) -> dict[str, Any]:
+    """py-motmetrics' scores of one sequence scored in independent parts (accumulators over disjoint true people
+    and tracks, no pair of them ever within the match distance), merged by motmetrics' overall rules: the same as
+    one accumulator over the whole. A part without a match adds no distance to MOTP (motmetrics' merge would carry
+    its undefined MOTP, 0 / 0, into the total)."""
+    import motmetrics
+
+    host = motmetrics.metrics.create()
+    partials = [
+        host.compute(part, metrics=list(MOT_METRICS), return_dataframe=False, return_cached=True) for part in parts
+    ]
+    for partial in partials:
+        if partial["num_detections"] == 0:
+            partial["motp"] = 0.0
+    return _as_scores(host.compute_overall(partials, metrics=list(MOT_METRICS), return_dataframe=False))
+
+
+def _as_scores(values: Any) -> dict[str, Any]:
+    """One motmetrics result (a table row or a dict of ``MOT_METRICS``) as sid's tracking scores."""
+    return {
+        "mota": float(values["mota"]),
+        "idf1": float(values["idf1"]),
+        "motp_m": float(np.sqrt(values["motp"])) if np.isfinite(values["motp"]) else None,  # of squared distances
+        "id_switches": int(values["num_switches"]),
+        "id_transfers": int(values["num_transfer"]),  # a track that moved on to another person
+        "misses": int(values["num_misses"]),
+        "false_positives": int(values["num_false_positives"]),
+        "objects": int(values["num_objects"]),
+    }
 
 
 def identify(positions: np.ndarray, truth_ids: list[int], truth_positions: np.ndarray, gate: float) -> list[int | None]:

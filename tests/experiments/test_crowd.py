@@ -3,13 +3,25 @@
 from __future__ import annotations
 
 import importlib.util
+import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from sid.checks import LimitError
-from sid.experiments.crowd import EVALUATION_PASSES, CrowdSettings, cross_validate, evaluate_crowd
-from sid.experiments.trajectories import ReplaySettings, TrajectoryError, load_trajectory_set
+from sid.experiments import crowd
+from sid.experiments.crowd import (
+    EVALUATION_PASSES,
+    CrowdSettings,
+    TrackLog,
+    cross_validate,
+    evaluate_crowd,
+    record_tracks,
+    score_people,
+)
+from sid.experiments.synthetic_tracking import mot_scores
+from sid.experiments.trajectories import ReplaySettings, TrajectoryError, TrajectorySet, load_trajectory_set
 from sid.tracking.view import ViewCone
 from tests.conftest import shared_path
 from tests.experiments.trajectory_files import pair_and_strangers, write_set
@@ -69,6 +81,66 @@ def test_cross_validation_reports_each_held_out_set(tmp_path: Path) -> None:
         assert fold["tracker"]["chosen"]["timeout"] in (1.0, 1.5) and 0.5 < fold["tracker"]["held_out_idf1"] <= 1
         assert fold["groups"]["chosen"]["walk_distance"] in (1.0, 2.0)
         assert 0.0 <= fold["coherent"]["held_out_f1"] <= 1.0
+
+
+def crossing_crowds(folder: Path, crowds: int = 5, walkers: int = 6) -> Path:
+    """``crowds`` scenes 30 m apart, in each ``walkers`` people crossing its centre from a 5 m circle at 1.2 m/s,
+    starting up to 4 s apart: close passes, so the noisy replay makes switches, misses and false tracks."""
+    rng = np.random.default_rng(3)
+    rows: list[tuple[float, ...]] = []
+    for c in range(crowds):
+        for w in range(walkers):
+            heading, start = rng.uniform(0, math.tau), int(rng.integers(0, 10))
+            for step in range(21):
+                x, y = 30.0 * c + (-5 + 0.48 * step) * math.cos(heading), (-5 + 0.48 * step) * math.sin(heading)
+                vx, vy = 1.2 * math.cos(heading), 1.2 * math.sin(heading)
+                rows.append((start + step, 10 * c + w + 1, x, 0, y, vx, 0, vy))
+    return write_set(folder, sorted(rows), "")
+
+
+def one_accumulator_scores(log: TrackLog, match_distance: float) -> dict[str, float]:
+    import motmetrics
+
+    accumulator = motmetrics.MOTAccumulator(auto_id=True)
+    for k in range(len(log.times)):
+        distances = motmetrics.distances.norm2squared_matrix(
+            log.truth_positions[k], log.track_positions(k), max_d2=match_distance**2
+        )
+        accumulator.update(log.truth_ids[k].tolist(), [p.id for p in log.tracks[k]], distances)
+    return mot_scores([accumulator], ["whole"])["whole"]
+
+
+def assert_scored_in_parts_as_one(scene: TrajectorySet, monkeypatch: pytest.MonkeyPatch, part_ids: int) -> int:
+    """The people's scores of ``scene`` in parts of at most ``part_ids`` ids equal one accumulator's; the parts."""
+    settings = CrowdSettings()
+    log = record_tracks(scene, settings)
+    monkeypatch.setattr(crowd, "MOT_PART_IDS", part_ids)
+    whole, parts = (
+        one_accumulator_scores(log, settings.match_distance),
+        score_people(scene, log, settings.match_distance),
+    )
+    for name, value in whole.items():
+        assert parts[name] == (pytest.approx(value, rel=1e-12) if name == "motp_m" else value), name
+    return len(crowd._accumulate(log, settings.match_distance))
+
+
+def test_people_are_scored_in_independent_parts_exactly_as_in_one_accumulator(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """motmetrics' identity matching is a dense square over every id of an accumulator: one accumulator over 5 300
+    people and their tracks took 4 GB; parts of people and tracks never within the match distance of each other
+    score the same."""
+    scene = load_trajectory_set(crossing_crowds(tmp_path / "crowds"))
+    whole = evaluate_crowd([scene])["sets"]["crowds"]["people"]
+    assert whole["id_switches"] + whole["misses"] + whole["false_positives"] > 0  # mistakes to keep apart
+    assert assert_scored_in_parts_as_one(scene, monkeypatch, part_ids=8) >= 5  # a crowd never shares a part
+    assert assert_scored_in_parts_as_one(scene, monkeypatch, part_ids=10**6) == 1
+
+
+@pytest.mark.parametrize("name", ["seq_eth", "seq_hotel", "zara01"])
+def test_the_shared_sets_score_the_same_in_parts(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    scene = load_trajectory_set(shared_path("data", "trajectories", name))
+    assert assert_scored_in_parts_as_one(scene, monkeypatch, part_ids=50) > 5
 
 
 def test_the_shared_sets_are_scored_with_both_group_trackers() -> None:
