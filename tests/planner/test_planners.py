@@ -20,7 +20,7 @@ from costmap.grid import INSCRIBED, LETHAL, NO_INFORMATION, Costmap2D, GridSpec
 from planner import ompl_planners
 from planner.facade import PLANNERS, plan, resolve_planner
 from planner.ompl_planners import OMPL_PLANNERS
-from planner.problem import CostField, EndpointCollisionError, PlanningError, PlanningProblem
+from planner.problem import CostField, EndpointCollisionError, PlanningError, PlanningProblem, WalledOffError
 from planner.smoothing import _DIRECTIONS, dp_shortcut, refine, smooth
 from planner.validity import check_path, interpolate
 
@@ -395,7 +395,7 @@ def test_disconnected_goal_fails_fast_with_reason(name):
     costmap = walled_map()
     x, _ = costmap.spec.cell_centres()
     costmap.costs[(x > 4.9) & (x < 5.1)] = LETHAL  # a wall across the whole map
-    with pytest.raises(PlanningError, match="separate free regions"):
+    with pytest.raises(WalledOffError, match="separate free regions"):
         plan(PlanningProblem(costmap, (1.0, 2.0), (9.0, 6.0), RADIUS), name, time_limit=5.0, seed=1)
 
 
