@@ -192,7 +192,12 @@ def plan(
     raw_cost = math.inf if raw is None else field.path_cost(raw)
     result = PlanResult(name, False, np.zeros((0, 2)), math.inf, 0.0, 0.0, solve_time, raw_cost, iterations, seed, "")
     if raw is None:
-        result.message = f"{name} found no path in {solve_time:.2f} s ({iterations} termination checks)"
+        samples = " (FMT*'s samples grow with it)" if name == "fmtstar" else ""
+        result.message = (
+            f"{name} found no path in {solve_time:.2f} s ({iterations} termination checks), although the start and "
+            f"the goal are connected on the costmap: a larger time budget{samples} may find one, the grid planner "
+            "does"
+        )
         result.planning_time_s = time.perf_counter() - t0
         return result
     result.raw_path = path = raw
