@@ -40,8 +40,9 @@ import numpy as np
 from costmap.grid import INSCRIBED, Costmap2D
 from costmap.scan import LaserScan
 from planner.facade import PlanResult, check_endpoints, plan, resolve_planner
-from planner.problem import DEFAULT_COST_WEIGHT, CostField, PlanningError, PlanningProblem
+from planner.problem import DEFAULT_COST_WEIGHT, CostField, PlanningError, PlanningProblem, WalledOffError
 from planner.validity import interpolate
+from sid.experiments.harness import people_walling_off
 from sid.experiments.simulate.follower import FollowerParams, follow, remaining
 from sid.experiments.simulate.perception import (
     SIM_CALIBRATION,
@@ -181,6 +182,7 @@ class _Planner:
         self.plans = self.replans = 0
         self.time_s = 0.0
         self.message = ""
+        self.walled_off = False  # the last plan failed on a start and goal in separate free regions
 
     def problem(self, costmap: Costmap2D, start: tuple[float, float]) -> PlanningProblem:
         robot = self.world.scenario.robot
@@ -189,11 +191,12 @@ class _Planner:
     def _plan(self, costmap: Costmap2D, xy: tuple[float, float]) -> PlanResult | None:
         problem = self.problem(costmap, xy)
         start = xy
+        self.walled_off = False
         try:
             result = plan(problem, self.options.planner, self.options.plan_time_s,
                           _ompl_seed(self.options.seed, self.plans))  # fmt: skip
         except PlanningError as exc:
-            self.message = str(exc)
+            self.message, self.walled_off = str(exc), isinstance(exc, WalledOffError)
             escape = _free_start(CostField(problem), xy) if str(exc).startswith("no path: start") else None
             if escape is None:
                 return None
@@ -202,7 +205,7 @@ class _Planner:
                 result = plan(self.problem(costmap, start), self.options.planner, self.options.plan_time_s,
                               _ompl_seed(self.options.seed, self.plans))  # fmt: skip
             except PlanningError as again:
-                self.message = str(again)
+                self.message, self.walled_off = str(again), isinstance(again, WalledOffError)
                 return None
         finally:
             self.plans += 1
@@ -287,6 +290,10 @@ def simulate(
             break
         if t >= settings.time_limit_s - 1e-9:
             why = f": {planner.message}" if planner.path is None and planner.message else ""
+            if why and planner.walled_off:  # who closes the way, where they truly stand (the robot saw them)
+                problem = planner.problem(sensing.costmap.master, (state.x, state.y))
+                wall = people_walling_off(replace(scenario, people=people), problem)
+                why += f"; {wall}" if wall else ""
             trace.reason = f"time limit ({settings.time_limit_s:g} s) reached{why}"
             break
         pose = RobotPose(state.x, state.y, state.yaw)
