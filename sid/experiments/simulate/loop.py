@@ -58,7 +58,7 @@ from sid.perception.groups import detect_groups
 from sid.perception.people import Person
 from sid.perception.pipeline import Pipeline, PoseFn, image_pose
 from sid.perception.robot_pose import RobotPose
-from sid.scenario.build import build_costmap
+from sid.scenario.build import build_costmap, map_walls
 from sid.scenario.lidar import simulate_scan
 from sid.stream import SocialStream
 from sid.synthetic.pose import TruthPose
@@ -133,12 +133,15 @@ def make_sensing(world: SimWorld, options: RunOptions, color: bool = False) -> S
     static layer holds the scenario's obstacles (none with ``unknown_map``); ``color``: render the camera's colour
     image (for pictures; a pose model always gets one), which changes no result of ``TruthPose``."""
     scenario = world.scenario
-    known = replace(scenario, people=[], obstacles=[] if options.unknown_map else scenario.obstacles)
+    known = replace(scenario, people=[])
+    if options.unknown_map:
+        known = replace(known, obstacles=[], static_map=None)
     if not options.social:
         return LidarSensing(build_costmap(known, social=False, groups=[]))
     if options.perception == "exact":
         costmap = build_costmap(known, social=True, groups=[])
-        return ExactSensing(costmap, scenario.obstacles, scenario.group_params, scenario.lidar.body_radius)
+        return ExactSensing(costmap, scenario.obstacles, scenario.group_params, scenario.lidar.body_radius,
+                            walls=map_walls(scenario))  # fmt: skip
     plugins = tuple("tracked_people" if name == "social" else name for name in scenario.layers.plugins)
     costmap = build_costmap(known, social=True, groups=[], params=replace(scenario.layers, plugins=plugins))
     if options.model is None:
@@ -267,7 +270,8 @@ def simulate(
             x, y, yaw = scenario.robot.start
             trace.trajectory.append((0.0, x, y, yaw))
             return trace
-    obstacles = obstacle_geometry(scenario.obstacles)
+    walls = map_walls(scenario)
+    obstacles = obstacle_geometry(scenario.obstacles, walls)
     lidar, goal = scenario.lidar, scenario.robot.goal
     state = RobotState(*scenario.robot.start)
     follower = FollowerParams(max_speed=limits.max_speed, max_turn_rate=limits.max_turn_rate)
@@ -298,7 +302,7 @@ def simulate(
             break
         pose = RobotPose(state.x, state.y, state.yaw)
         scan = simulate_scan(state.pose, scenario.obstacles, people, beams=lidar.beams,
-                             range_max=lidar.range_max, body_radius=lidar.body_radius)  # fmt: skip
+                             range_max=lidar.range_max, body_radius=lidar.body_radius, static=walls)  # fmt: skip
         seen = sensing(k, pose, people, scan)
         planner.update(t, sensing.costmap.master, (state.x, state.y), limits.radius)
         if planner.path is not None:
