@@ -249,8 +249,10 @@ LEGEND_ROW, MAX_GROUP_ENTRIES = 22, 6
 
 
 def _members(group: Group) -> str:
+    """The legend's name of a group: its members' ids, or, when they do not fit, how many (with "people", so that
+    "group of 6" is never read as the group of person 6)."""
     ids = ", ".join(str(m) for m in group.members)
-    return f"group of {ids}" if len(ids) <= 18 else f"group of {len(group.members)}"
+    return f"group of {ids}" if len(ids) <= 18 else f"group of {len(group.members)} people"
 
 
 def _legend_rows(

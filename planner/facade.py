@@ -20,7 +20,7 @@ from scipy import ndimage
 from costmap.grid import INSCRIBED, LETHAL, NO_INFORMATION
 from planner.grid_planner import grid_search
 from planner.ompl_planners import OMPL_PLANNERS, seed_ompl, solve_ompl
-from planner.problem import CostField, EndpointCollisionError, NoPathError, PlanningError, PlanningProblem
+from planner.problem import CostField, EndpointCollisionError, PlanningError, PlanningProblem, WalledOffError
 from planner.smoothing import smooth
 from planner.validity import check_path
 
@@ -33,6 +33,7 @@ __all__ = [
     "PlanResult",
     "UNAVAILABLE",
     "check_endpoints",
+    "free_regions",
     "plan",
     "resolve_planner",
 ]
@@ -102,9 +103,19 @@ def _collision(cost: int, problem: PlanningProblem) -> str:
     return f"an obstacle is within the robot radius {radius} (cell cost {cost})"
 
 
+def free_regions(field: CostField) -> np.ndarray:
+    """The connected regions of ``field.plannable``: an int array of the grid's shape, 0 on cells not plannable
+    and one label per region elsewhere. 4-connected: a diagonal step between plannable cells needs the two cells
+    beside it plannable too (no corner cutting, as in the grid planner), so cells that touch only at a corner are
+    not connected."""
+    labels, _ = ndimage.label(field.plannable)
+    return np.asarray(labels)
+
+
 def check_endpoints(field: CostField) -> None:
     """Raise NoPathError, its message starting "no path: " and naming the reason, when the start or goal lies in
-    collision (EndpointCollisionError) or the two cannot be connected; PlanningError "... is outside the map"."""
+    collision (EndpointCollisionError) or the two cannot be connected (WalledOffError); PlanningError "... is outside
+    the map"."""
     problem, spec = field.problem, field.spec
     x0, y0 = spec.origin_x, spec.origin_y
     x1, y1 = x0 + spec.size_m[0], y0 + spec.size_m[1]
@@ -121,12 +132,10 @@ def check_endpoints(field: CostField) -> None:
             message = f"no path: {name} ({x:.2f}, {y:.2f}) is in collision: {_collision(cost, problem)}"
             raise EndpointCollisionError(message, name)
         cells.append(cell)
-    # 4-connected regions: a diagonal step between plannable cells needs the two cells beside it plannable too (no
-    # corner cutting, as in the grid planner), so cells that touch only at a corner are not connected.
-    labels, _ = ndimage.label(field.plannable)
+    labels = free_regions(field)
     (sr, sc), (gr, gc) = cells
     if labels[sr, sc] != labels[gr, gc]:
-        raise NoPathError(
+        raise WalledOffError(
             "no path: the start and the goal lie in separate free regions of the costmap (walled off from each "
             f"other for a robot of radius {problem.robot_radius:.2f} m)"
         )
@@ -183,7 +192,12 @@ def plan(
     raw_cost = math.inf if raw is None else field.path_cost(raw)
     result = PlanResult(name, False, np.zeros((0, 2)), math.inf, 0.0, 0.0, solve_time, raw_cost, iterations, seed, "")
     if raw is None:
-        result.message = f"{name} found no path in {solve_time:.2f} s ({iterations} termination checks)"
+        samples = " (FMT*'s samples grow with it)" if name == "fmtstar" else ""
+        result.message = (
+            f"{name} found no path in {solve_time:.2f} s ({iterations} termination checks), although the start and "
+            f"the goal are connected on the costmap: a larger time budget{samples} may find one, the grid planner "
+            "does"
+        )
         result.planning_time_s = time.perf_counter() - t0
         return result
     result.raw_path = path = raw

@@ -85,6 +85,10 @@ class EndpointCollisionError(NoPathError):
         return str(self.args[0])
 
 
+class WalledOffError(NoPathError):
+    """The NoPathError of a start and goal in separate free regions of the costmap (``free_regions``)."""
+
+
 @dataclass(frozen=True)
 class PlanningProblem:
     """Plan a disc robot from ``start`` to ``goal`` (world x, y in metres) on ``costmap``."""

@@ -19,16 +19,25 @@ from __future__ import annotations
 import math
 import statistics
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import partial
 from typing import Any
 
+import numpy as np
+from scipy import ndimage
 from shapely.geometry import Point
 
 from costmap.layered import LayeredCostmap
 from costmap.layers.social import group_zone_polygon
-from planner.facade import PlanResult, plan, resolve_planner
-from planner.problem import DEFAULT_COST_WEIGHT, EndpointCollisionError, PlanningError, PlanningProblem
+from planner.facade import PlanResult, free_regions, plan, resolve_planner
+from planner.problem import (
+    DEFAULT_COST_WEIGHT,
+    CostField,
+    EndpointCollisionError,
+    PlanningError,
+    PlanningProblem,
+    WalledOffError,
+)
 from sid.checks import repeated
 from sid.experiments.path_metrics import result_metrics
 from sid.perception.group import Group
@@ -46,6 +55,7 @@ __all__ = [
     "Task",
     "compare_with_without",
     "people_at_ends",
+    "people_walling_off",
     "prepare",
     "run_matrix",
     "summarise",
@@ -81,7 +91,8 @@ class Task:
     def plan(self, mode: str, planner: str, **budget: Any) -> PlanResult:
         """``planner.facade.plan`` on the mode's problem (``budget``: its keyword arguments). A start or goal in
         collision with a person raises the planner's EndpointCollisionError with the person named
-        (``people_at_ends``)."""
+        (``people_at_ends``), and a start and goal walled off from each other partly by people its WalledOffError
+        with those people named (``people_walling_off``)."""
         try:
             return plan(self.problems[mode], planner, **budget)
         except EndpointCollisionError as exc:
@@ -89,6 +100,11 @@ class Task:
             if not people:
                 raise
             raise EndpointCollisionError(f"{exc}; {people[0]}", exc.end) from exc
+        except WalledOffError as exc:
+            wall = people_walling_off(self.scenario, self.problems[mode])
+            if wall is None:
+                raise
+            raise WalledOffError(f"{exc}; {wall}") from exc
 
 
 def prepare(scenario: Scenario, cost_weight: float = DEFAULT_COST_WEIGHT, labels: dict | None = None) -> Task:
@@ -135,6 +151,44 @@ def people_at_ends(scenario: Scenario, ends: Sequence[str] = ("start", "goal")) 
                 f"{robot.radius:.2f} m (robot.radius)"
             )
     return sentences
+
+
+def people_walling_off(scenario: Scenario, problem: PlanningProblem) -> str | None:
+    """A sentence naming the people who wall the robot's start off from its goal on ``problem``'s costmap, or None
+    when the two are connected or would stay walled off without the people too. The wall is made of the cells the
+    robot's centre can reach on the scenario's costmap without people (no social layer) but not on ``problem``'s,
+    taken as connected pieces; the people are those whose body's centre lies in a piece that borders both the
+    start's free region and the goal's (``free_regions``)."""
+    field = CostField(problem)
+    spec = field.spec
+    labels = free_regions(field)
+    ends = spec.world_to_cell(np.array([problem.start, problem.goal]))
+    start, goal = (int(labels[r, c]) for r, c in ends)
+    if start == goal or 0 in (start, goal):
+        return None
+    empty = replace(scenario, people=[], walks={}, conversations=())
+    bare = CostField(replace(problem, costmap=build_costmap(empty, social=False, groups=[]).master))
+    if int(free_regions(bare)[ends[0][0], ends[0][1]]) != int(free_regions(bare)[ends[1][0], ends[1][1]]):
+        return None
+    pieces, _ = ndimage.label(bare.plannable & ~field.plannable, structure=np.ones((3, 3), bool))
+    around = np.ones((3, 3), bool)
+    wall = []
+    for person in scenario.people:
+        row, col = spec.world_to_cell(np.array([person.x, person.y]))[0]
+        piece = int(pieces[row, col]) if spec.in_bounds(np.array([row, col]))[0] else 0
+        if piece == 0:
+            continue
+        border = ndimage.binary_dilation(pieces == piece, structure=around)
+        if {start, goal} <= set(np.unique(labels[border]).tolist()):
+            wall.append(person)
+    if not wall:
+        return None
+    names = ", ".join(f"{p.id} at ({p.x:.2f}, {p.y:.2f})" for p in wall)
+    return (
+        f"{'people' if len(wall) > 1 else 'person'} {names} {'close' if len(wall) > 1 else 'closes'} the way between "
+        f"them (without people it is open): a person is an obstacle of radius {scenario.lidar.body_radius:.2f} m "
+        f"(lidar.body_radius) and the robot a disc of radius {scenario.robot.radius:.2f} m (robot.radius)"
+    )
 
 
 @dataclass(frozen=True)

@@ -18,7 +18,7 @@ from sid.scenario.known_map import known_map
 from sid.scenario.lidar import simulate_scan
 from sid.scenario.loader import Scenario
 
-__all__ = ["build_costmap", "planning_problem"]
+__all__ = ["build_costmap", "map_walls", "planning_problem"]
 
 
 def build_costmap(
@@ -51,9 +51,7 @@ def build_costmap(
         static_map=known,
     )
     lidar = scenario.lidar
-    walls = None  # the static map's walls, which the simulated LiDAR sees whatever the costmap's layers
-    if static_map is not None:
-        walls = Costmap2D(scenario.grid, static_costs(static_map, scenario.grid, params.obstacle.track_unknown_space))
+    walls = map_walls(scenario)
     scan = simulate_scan(
         scenario.robot.start,
         scenario.obstacles,
@@ -67,6 +65,16 @@ def build_costmap(
         groups = detect_groups(scenario.people, scenario.group_params) if social else []
     layered.update(LayerInputs({PEOPLE: scenario.people, GROUPS: groups, SCAN: scan}))
     return layered
+
+
+def map_walls(scenario: Scenario) -> Costmap2D | None:
+    """The scenario's ``static_map`` file on its grid, read as the static layer reads it: the walls (its LETHAL cells)
+    that the simulated LiDAR hits whatever the costmap's layers; None without a file."""
+    if scenario.static_map is None:
+        return None
+    static_map = read_map(scenario.static_map)
+    track_unknown = scenario.layers.obstacle.track_unknown_space
+    return Costmap2D(scenario.grid, static_costs(static_map, scenario.grid, track_unknown))
 
 
 def planning_problem(

@@ -8,7 +8,8 @@ not only the faces the simulated scan from the start happens to hit. The LiDAR l
 Rasterisation (world frame, metres): a cell is occupied when the shape reaches into it, with cells as
 ``costmap.grid.GridSpec.world_to_cell`` assigns points (a point on a cell border belongs to the cell above / to the
 right, as a LiDAR hit there would): a box fills every cell from the one holding ``min`` to the one holding ``max``;
-a circle every cell whose square overlaps the disc; a wall every cell its polyline passes through.
+a circle every cell whose square overlaps the disc; a wall every cell its polyline passes through, a wall along the
+map's upper or right border the last row or column (the cells above / to the right of it lie outside the map).
 """
 
 from __future__ import annotations
@@ -25,9 +26,15 @@ __all__ = ["known_map", "obstacle_mask"]
 
 
 def _mark_points(mask: np.ndarray, spec: GridSpec, xy: np.ndarray) -> None:
-    cells = spec.world_to_cell(xy)
-    cells = cells[spec.in_bounds(cells)]
-    mask[cells[:, 0], cells[:, 1]] = True
+    """Mark the cells holding the points ``xy`` (N, 2); a point on the map's upper or right border (within a
+    millionth of a cell) is in the last row or column, so that a wall drawn along the map's edge is in the map."""
+    x0, y0, x1, y1 = spec.bounds
+    slack = spec.resolution * 1e-6
+    inside = (xy[:, 0] >= x0) & (xy[:, 0] <= x1 + slack) & (xy[:, 1] >= y0) & (xy[:, 1] <= y1 + slack)
+    cells = spec.world_to_cell(xy[inside])
+    rows = np.minimum(cells[:, 0], spec.height - 1)
+    cols = np.minimum(cells[:, 1], spec.width - 1)
+    mask[rows, cols] = True
 
 
 def obstacle_mask(obstacles: Sequence[Obstacle], spec: GridSpec) -> np.ndarray:

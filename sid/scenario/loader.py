@@ -516,12 +516,17 @@ TOP_LEVEL = {
     "lidar",
     "groups",
     "layers",
+    "simulation",
 }
+"""The fields of a scenario file. ``simulation`` is ``sid simulate``'s block (``sid.experiments.simulate.world``,
+which reads and checks it); a scenario ignores it once it is a mapping, so one scene file serves every command."""
 
 
 def scenario_from_dict(data: Any, base_dir: Path | None = None, default_name: str = "scenario") -> Scenario:
     """A Scenario from a parsed JSON/YAML mapping; ``static_map`` is relative to ``base_dir`` (default cwd)."""
     data = _mapping(data, "scenario", TOP_LEVEL, {"robot"})
+    if not isinstance(data.get("simulation", {}), dict):
+        raise _fail("simulation", "a mapping (sid simulate's settings, docs/simulate.md)", data["simulation"])
     name = data.get("name", default_name)
     if not isinstance(name, str) or not name:
         raise _fail("name", "a non-empty string", name)

@@ -54,6 +54,13 @@ def test_people_are_coloured_by_group_and_the_legend_names_each_group(legend) ->
     assert legend[-1][:3] == ["person in no group, facing", "group of 1, 2", "group of 4, 5"]
 
 
+def test_a_group_whose_ids_do_not_fit_the_legend_is_named_by_its_size_in_people(legend) -> None:
+    ring = [Person(7 + k, 3.0 + math.cos(k), math.sin(k), k + math.pi) for k in range(6)]  # ids 7..12
+    group = Group(tuple(p.id for p in ring), (3.0, 0.0), 1.0, np.array([[3.0, 0.0]]), 0.3)
+    render_costmap(Costmap2D.filled(SPEC), ring, [group], scale=2)
+    assert legend[-1][0] == "group of 6 people"  # not "group of 6", which reads as person 6's group
+
+
 def test_a_zone_of_one_point_is_drawn_as_a_point_and_the_hull_only_with_a_margin(legend) -> None:
     camera = CameraView(0.0, 0.0, 0.0, 1.5)
     top = render_costmap(Costmap2D.filled(SPEC), PAIR, [POINT_GROUP], scale=4, camera=camera)

@@ -7,9 +7,17 @@ import itertools
 
 import pytest
 
-from planner.problem import NoPathError, PlanningError
+from planner.problem import NoPathError, PlanningError, WalledOffError
 from sid.experiments.demo import DEMO_SCENARIO, demo_scenario
-from sid.experiments.harness import compare_with_without, people_at_ends, prepare, run_matrix, summarise, zone_warnings
+from sid.experiments.harness import (
+    compare_with_without,
+    people_at_ends,
+    people_walling_off,
+    prepare,
+    run_matrix,
+    summarise,
+    zone_warnings,
+)
 from sid.scenario.loader import scenario_from_dict
 
 
@@ -177,3 +185,43 @@ def test_people_at_ends_names_the_nearest_person_to_each_end_in_reach():
     (sentence,) = people_at_ends(scenario_from_dict(data))
     assert sentence.startswith("the start is 0.15 m from person 2 at (3.72, -0.45)")
     assert people_at_ends(demo_scenario()) == []
+
+
+def _corridor(people: list[dict], wall_across: bool = False) -> dict:
+    """A corridor 1.6 m wide, 12 m long, the robot's way along it; ``wall_across`` closes it at x = 9."""
+    obstacles = [{"type": "segment", "points": [[0, 0], [12, 0]]}, {"type": "segment", "points": [[0, 1.6], [12, 1.6]]}]
+    if wall_across:
+        obstacles.append({"type": "segment", "points": [[9, 0], [9, 1.6]]})
+    return {
+        "map": {"origin": [0, -0.4], "size": [12, 2.4]},
+        "obstacles": obstacles,
+        "people": people,
+        "robot": {"start": [0.6, 0.8, 0], "goal": [11.4, 0.8, 0]},
+    }
+
+
+PAIR_ACROSS = [{"id": 1, "x": 6.0, "y": 0.35, "theta": 1.5708}, {"id": 2, "x": 6.0, "y": 1.25, "theta": -1.5708}]
+
+
+@pytest.mark.parametrize("mode", ["with", "without"])
+def test_a_way_closed_by_people_names_them(mode):
+    """Two people talking across a 1.6 m corridor leave no gap for the robot's disc: the no-path message says who."""
+    task = prepare(scenario_from_dict(_corridor(PAIR_ACROSS + [{"id": 3, "x": 3.0, "y": 0.4, "theta": 0.0}])))
+    with pytest.raises(WalledOffError) as caught:
+        task.plan(mode, "grid")
+    assert str(caught.value) == (
+        "no path: the start and the goal lie in separate free regions of the costmap (walled off from each other "
+        "for a robot of radius 0.25 m); people 1 at (6.00, 0.35), 2 at (6.00, 1.25) close the way between them "
+        "(without people it is open): a person is an obstacle of radius 0.20 m (lidar.body_radius) and the robot a "
+        "disc of radius 0.25 m (robot.radius)"
+    )  # person 3 stands in the corridor too, on the start's side only: not named
+
+
+def test_people_walling_off_is_none_when_the_map_alone_closes_the_way_or_nothing_does():
+    walled = prepare(scenario_from_dict(_corridor(PAIR_ACROSS, wall_across=True)))
+    assert people_walling_off(walled.scenario, walled.problems["with"]) is None
+    with pytest.raises(WalledOffError, match=r"robot of radius 0.25 m\)$"):
+        walled.plan("with", "grid")
+    one = [{"id": 1, "x": 6.0, "y": 0.35, "theta": 1.5708}]  # one person leaves room to pass
+    task = prepare(scenario_from_dict(_corridor(one)))
+    assert people_walling_off(task.scenario, task.problems["with"]) is None

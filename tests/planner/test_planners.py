@@ -20,7 +20,7 @@ from costmap.grid import INSCRIBED, LETHAL, NO_INFORMATION, Costmap2D, GridSpec
 from planner import ompl_planners
 from planner.facade import PLANNERS, plan, resolve_planner
 from planner.ompl_planners import OMPL_PLANNERS
-from planner.problem import CostField, EndpointCollisionError, PlanningError, PlanningProblem
+from planner.problem import CostField, EndpointCollisionError, PlanningError, PlanningProblem, WalledOffError
 from planner.smoothing import _DIRECTIONS, dp_shortcut, refine, smooth
 from planner.validity import check_path, interpolate
 
@@ -395,14 +395,17 @@ def test_disconnected_goal_fails_fast_with_reason(name):
     costmap = walled_map()
     x, _ = costmap.spec.cell_centres()
     costmap.costs[(x > 4.9) & (x < 5.1)] = LETHAL  # a wall across the whole map
-    with pytest.raises(PlanningError, match="separate free regions"):
+    with pytest.raises(WalledOffError, match="separate free regions"):
         plan(PlanningProblem(costmap, (1.0, 2.0), (9.0, 6.0), RADIUS), name, time_limit=5.0, seed=1)
 
 
 def test_budget_exhausted_reports_failure_without_path(walls):
     result = plan(walls, "rrtstar", time_limit=5.0, seed=1, max_iterations=3)
     assert not result.success and len(result.path) == 0
-    assert "found no path" in result.message
+    assert result.message.startswith("rrtstar found no path in ") and result.message.endswith(
+        "although the start and the goal are connected on the costmap: a larger time budget may find one, the grid "
+        "planner does"
+    )  # impossible tasks are refused before planning (check_endpoints): what is left is the budget
 
 
 def test_planner_names_and_prm_exclusion():

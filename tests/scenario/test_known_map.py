@@ -141,3 +141,17 @@ def test_a_goal_inside_a_box_or_walled_in_is_refused(obstacles, message):
     with pytest.raises(PlanningError) as caught:
         plan(problem, "grid")
     assert message in str(caught.value)
+
+
+def test_a_wall_along_the_maps_border_is_in_its_outer_cells_on_every_side():
+    """A room drawn on the map's bounds: the walls on the upper and right borders would fall in the cells above and
+    to the right of the map, outside it; they are in the last row and column instead, as the other two are in the
+    first, and the robot keeps its radius from all four."""
+    room = [[0.0, 0.0], [10.0, 0.0], [10.0, 6.0], [0.0, 6.0], [0.0, 0.0]]
+    mask = obstacle_mask([SegmentObstacle(tuple(map(tuple, room)))], SPEC)
+    for edge in (mask[0], mask[-1], mask[:, 0], mask[:, -1]):
+        assert edge.all()
+    assert mask.sum() == 2 * (SPEC.width + SPEC.height) - 4  # the border cells only
+    master = build_costmap(scenario([{"type": "segment", "points": room}]), social=False).master.costs
+    assert (master[-1] == LETHAL).all() and (master[:, -1] == LETHAL).all()
+    assert (master[-5] >= 253).all() and (master[:, -5] >= 253).all()  # 0.25 m of the robot's radius inscribed

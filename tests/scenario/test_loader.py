@@ -161,3 +161,15 @@ def test_unreadable_static_map_is_named(tmp_path):
     path.write_text(json.dumps({**BASE, "static_map": "broken.yaml"}))
     with pytest.raises(ScenarioError, match="cannot read map image"):
         load_scenario(path)
+
+
+@pytest.mark.parametrize("scene", sorted((REPO_ROOT / "sid" / "experiments" / "simulate" / "scenes").glob("*.yaml")))
+def test_a_simulation_scene_is_a_scenario_file_too(scene):
+    """sid plan, costmap and compare read sid simulate's scenes: their ``simulation`` block is left to sid simulate."""
+    scenario = load_scenario(scene)
+    assert scenario.name == scene.stem and scenario.people
+
+
+def test_a_simulation_block_must_be_a_mapping():
+    with pytest.raises(ScenarioError, match=r"^simulation: expected a mapping \(sid simulate's settings"):
+        scenario_from_dict({**BASE, "simulation": [1]})

@@ -40,8 +40,9 @@ import numpy as np
 from costmap.grid import INSCRIBED, Costmap2D
 from costmap.scan import LaserScan
 from planner.facade import PlanResult, check_endpoints, plan, resolve_planner
-from planner.problem import DEFAULT_COST_WEIGHT, CostField, PlanningError, PlanningProblem
+from planner.problem import DEFAULT_COST_WEIGHT, CostField, PlanningError, PlanningProblem, WalledOffError
 from planner.validity import interpolate
+from sid.experiments.harness import people_walling_off
 from sid.experiments.simulate.follower import FollowerParams, follow, remaining
 from sid.experiments.simulate.perception import (
     SIM_CALIBRATION,
@@ -57,7 +58,7 @@ from sid.perception.groups import detect_groups
 from sid.perception.people import Person
 from sid.perception.pipeline import Pipeline, PoseFn, image_pose
 from sid.perception.robot_pose import RobotPose
-from sid.scenario.build import build_costmap
+from sid.scenario.build import build_costmap, map_walls
 from sid.scenario.lidar import simulate_scan
 from sid.stream import SocialStream
 from sid.synthetic.pose import TruthPose
@@ -132,12 +133,15 @@ def make_sensing(world: SimWorld, options: RunOptions, color: bool = False) -> S
     static layer holds the scenario's obstacles (none with ``unknown_map``); ``color``: render the camera's colour
     image (for pictures; a pose model always gets one), which changes no result of ``TruthPose``."""
     scenario = world.scenario
-    known = replace(scenario, people=[], obstacles=[] if options.unknown_map else scenario.obstacles)
+    known = replace(scenario, people=[])
+    if options.unknown_map:
+        known = replace(known, obstacles=[], static_map=None)
     if not options.social:
         return LidarSensing(build_costmap(known, social=False, groups=[]))
     if options.perception == "exact":
         costmap = build_costmap(known, social=True, groups=[])
-        return ExactSensing(costmap, scenario.obstacles, scenario.group_params, scenario.lidar.body_radius)
+        return ExactSensing(costmap, scenario.obstacles, scenario.group_params, scenario.lidar.body_radius,
+                            walls=map_walls(scenario))  # fmt: skip
     plugins = tuple("tracked_people" if name == "social" else name for name in scenario.layers.plugins)
     costmap = build_costmap(known, social=True, groups=[], params=replace(scenario.layers, plugins=plugins))
     if options.model is None:
@@ -181,6 +185,7 @@ class _Planner:
         self.plans = self.replans = 0
         self.time_s = 0.0
         self.message = ""
+        self.walled_off = False  # the last plan failed on a start and goal in separate free regions
 
     def problem(self, costmap: Costmap2D, start: tuple[float, float]) -> PlanningProblem:
         robot = self.world.scenario.robot
@@ -189,11 +194,12 @@ class _Planner:
     def _plan(self, costmap: Costmap2D, xy: tuple[float, float]) -> PlanResult | None:
         problem = self.problem(costmap, xy)
         start = xy
+        self.walled_off = False
         try:
             result = plan(problem, self.options.planner, self.options.plan_time_s,
                           _ompl_seed(self.options.seed, self.plans))  # fmt: skip
         except PlanningError as exc:
-            self.message = str(exc)
+            self.message, self.walled_off = str(exc), isinstance(exc, WalledOffError)
             escape = _free_start(CostField(problem), xy) if str(exc).startswith("no path: start") else None
             if escape is None:
                 return None
@@ -202,7 +208,7 @@ class _Planner:
                 result = plan(self.problem(costmap, start), self.options.planner, self.options.plan_time_s,
                               _ompl_seed(self.options.seed, self.plans))  # fmt: skip
             except PlanningError as again:
-                self.message = str(again)
+                self.message, self.walled_off = str(again), isinstance(again, WalledOffError)
                 return None
         finally:
             self.plans += 1
@@ -264,7 +270,8 @@ def simulate(
             x, y, yaw = scenario.robot.start
             trace.trajectory.append((0.0, x, y, yaw))
             return trace
-    obstacles = obstacle_geometry(scenario.obstacles)
+    walls = map_walls(scenario)
+    obstacles = obstacle_geometry(scenario.obstacles, walls)
     lidar, goal = scenario.lidar, scenario.robot.goal
     state = RobotState(*scenario.robot.start)
     follower = FollowerParams(max_speed=limits.max_speed, max_turn_rate=limits.max_turn_rate)
@@ -287,11 +294,15 @@ def simulate(
             break
         if t >= settings.time_limit_s - 1e-9:
             why = f": {planner.message}" if planner.path is None and planner.message else ""
+            if why and planner.walled_off:  # who closes the way, where they truly stand (the robot saw them)
+                problem = planner.problem(sensing.costmap.master, (state.x, state.y))
+                wall = people_walling_off(replace(scenario, people=people), problem)
+                why += f"; {wall}" if wall else ""
             trace.reason = f"time limit ({settings.time_limit_s:g} s) reached{why}"
             break
         pose = RobotPose(state.x, state.y, state.yaw)
         scan = simulate_scan(state.pose, scenario.obstacles, people, beams=lidar.beams,
-                             range_max=lidar.range_max, body_radius=lidar.body_radius)  # fmt: skip
+                             range_max=lidar.range_max, body_radius=lidar.body_radius, static=walls)  # fmt: skip
         seen = sensing(k, pose, people, scan)
         planner.update(t, sensing.costmap.master, (state.x, state.y), limits.radius)
         if planner.path is not None:

@@ -26,6 +26,7 @@ from typing import Protocol
 
 import numpy as np
 
+from costmap.grid import Costmap2D
 from costmap.layer import LayerInputs
 from costmap.layered import LayeredCostmap
 from costmap.layers.obstacle import SCAN
@@ -121,6 +122,7 @@ class ExactSensing:
     body_radius: float = 0.2
     fov: float = FIELD_OF_VIEW
     range_m: tuple[float, float] = (DepthNoise().min_range_m, DepthNoise().max_range_m)
+    walls: Costmap2D | None = None  # a static map file's walls (``sid.scenario.build.map_walls``): they hide people
 
     def __call__(self, step: int, pose: RobotPose, people: list[Person], scan: LaserScan) -> Seen:
         seen = []
@@ -140,7 +142,7 @@ class ExactSensing:
         bearing = math.atan2(ty - pose.y, tx - pose.x)
         # One beam: simulate_scan's beam 0 points at yaw - pi.
         scan = simulate_scan((pose.x, pose.y, bearing + math.pi), self.obstacles, others, beams=1,
-                             range_max=2 * distance + 1.0, body_radius=self.body_radius)  # fmt: skip
+                             range_max=2 * distance + 1.0, body_radius=self.body_radius, static=self.walls)  # fmt: skip
         target = math.hypot(tx - pose.x, ty - pose.y)
         return bool(not np.isfinite(scan.ranges[0]) or scan.ranges[0] > target - self.body_radius / 2)
 

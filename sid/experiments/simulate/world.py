@@ -23,9 +23,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from shapely.geometry import LineString, Point, Polygon
+from shapely.geometry import LineString, Point, Polygon, box
 from shapely.ops import unary_union
 
+from costmap.grid import LETHAL, Costmap2D
 from sid.checks import LimitError, check_limit
 from sid.documents import is_number, summary
 from sid.experiments.simulate.robot import DriveLimits
@@ -156,9 +157,18 @@ def load_world(path: str | Path) -> SimWorld:
 # --- ground-truth geometry -------------------------------------------------------------------------------------
 
 
-def obstacle_geometry(obstacles: list[Obstacle]) -> Any:
-    """The declared obstacles as one shapely geometry (walls as lines, boxes and circles as areas)."""
+def obstacle_geometry(obstacles: list[Obstacle], walls: Costmap2D | None = None) -> Any:
+    """The declared obstacles as one shapely geometry (walls as lines, boxes and circles as areas), with the LETHAL
+    cells of ``walls`` (a static map file's, ``sid.scenario.build.map_walls``) as squares, merged along each row."""
     shapes: list[Any] = []
+    if walls is not None:
+        spec, lethal = walls.spec, walls.costs == LETHAL
+        for row in np.flatnonzero(lethal.any(axis=1)):
+            edges = np.flatnonzero(np.diff(np.concatenate([[0], lethal[row].view(np.int8), [0]])))
+            y0 = spec.origin_y + row * spec.resolution
+            for c0, c1 in zip(edges[::2], edges[1::2], strict=True):
+                x0, x1 = spec.origin_x + c0 * spec.resolution, spec.origin_x + c1 * spec.resolution
+                shapes.append(box(x0, y0, x1, y0 + spec.resolution))
     for ob in obstacles:
         if isinstance(ob, BoxObstacle):
             (x0, y0), (x1, y1) = ob.min, ob.max

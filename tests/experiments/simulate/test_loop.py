@@ -2,11 +2,16 @@
 
 import copy
 
+import numpy as np
 import pytest
 
+from costmap.grid import LETHAL, GridSpec
+from costmap.mapfile import write_map
+from costmap.occupancy import OCC_OCCUPIED, OccupancyGrid
 from sid.experiments.simulate.loop import RunOptions, simulate
 from sid.experiments.simulate.metrics import run_metrics
-from sid.experiments.simulate.world import world_from_dict
+from sid.experiments.simulate.world import collision, obstacle_geometry, world_from_dict
+from sid.scenario.build import map_walls
 from tests.experiments.simulate.tiny import TINY, tiny_world
 
 EXACT = RunOptions(perception="exact")
@@ -44,7 +49,12 @@ def test_people_blocking_the_corridor_for_good_end_at_the_time_limit():
     trace = simulate(tiny_world(people=people, simulation={"time_limit_s": 2.0}), RunOptions(social=False))
     assert not trace.success and trace.collisions == 0
     assert trace.time_s == pytest.approx(2.0)
-    assert trace.reason.startswith("time limit (2 s) reached: no path")
+    assert trace.reason.startswith("time limit (2 s) reached: no path: the start and the goal lie in separate")
+    assert trace.reason.endswith(
+        "people 1 at (2.00, -1.35), 2 at (2.00, -0.45), 3 at (2.00, 0.45), 4 at (2.00, 1.35) close the way between "
+        "them (without people it is open): a person is an obstacle of radius 0.20 m (lidar.body_radius) and the robot "
+        "a disc of radius 0.25 m (robot.radius)"
+    )
 
 
 def test_the_unknown_map_is_discovered_by_the_lidar():
@@ -93,3 +103,35 @@ def test_an_onnx_pose_model_runs_in_the_loop(tmp_path):
     model = build_yolo_pose_model(tmp_path / "pose.onnx", yolo_candidate([128, 128, 60, 160], 0.9, keypoints)[:, None])
     trace = simulate(tiny_world(simulation={"time_limit_s": 0.3}), RunOptions(model=model))
     assert trace.reason == "time limit (0.3 s) reached" and len(trace.trajectory) == 4
+
+
+def _file_wall_world(tmp_path, **simulation):
+    """The tiny corridor, nobody in it, and a wall 0.2 m thick across it at x = 2 with a gap at the top, drawn only
+    in a static_map file."""
+    spec = GridSpec.from_size(0.05, (-0.5, -2.0), (5.0, 4.0))
+    xs, ys = spec.cell_centres()
+    data = np.zeros(spec.shape, dtype=np.int8)
+    data[(xs > 1.9) & (xs < 2.1) & (ys < 0.6)] = OCC_OCCUPIED
+    write_map(tmp_path / "wall.yaml", OccupancyGrid(spec, data))
+    data = copy.deepcopy(TINY) | {"people": [], "static_map": "wall.yaml"}
+    data["simulation"] |= simulation
+    return world_from_dict(data, base_dir=tmp_path)
+
+
+@pytest.mark.parametrize("unknown_map", [False, True])
+def test_a_static_map_files_walls_are_seen_by_the_lidar_and_unknown_with_unknown_map(tmp_path, unknown_map):
+    steps = []
+    trace = simulate(_file_wall_world(tmp_path), RunOptions(social=False, unknown_map=unknown_map), steps.append)
+    assert trace.success and trace.collisions == 0
+    first = steps[0]
+    ahead = first.scan.ranges[np.argmin(np.abs(first.scan.angles))]  # beam along +x from (0, 0)
+    assert ahead == pytest.approx(1.9, abs=0.06)  # the wall's near face, drawn only in the file
+    behind_face = first.costmap.costs[first.costmap.spec.world_to_cell(np.array([2.05, 0.0]))[0].tolist()]
+    assert (behind_face == LETHAL) is not unknown_map  # with unknown_map only the LiDAR's marks: the face
+
+
+def test_a_static_map_files_walls_are_obstacles_the_robot_collides_with(tmp_path):
+    world = _file_wall_world(tmp_path)
+    geometry = obstacle_geometry(world.scenario.obstacles, map_walls(world.scenario))
+    assert collision((2.0, -1.0), 0.25, geometry, [], 0.2) == "obstacle"
+    assert collision((2.0, 1.2), 0.25, geometry, [], 0.2) is None  # in the gap
