@@ -43,6 +43,7 @@ __all__ = [
     "PlanningProblem",
     "SAMPLES_PER_CALL",
     "NoPathError",
+    "WalledOffError",
 ]
 
 _LOOP_MAX = 20  # segment_cost sums this many samples or fewer in a Python loop, more with numpy (docs/parameters.md)
