@@ -49,6 +49,8 @@ def test_people_blocking_the_corridor_for_good_end_at_the_time_limit():
     trace = simulate(tiny_world(people=people, simulation={"time_limit_s": 2.0}), RunOptions(social=False))
     assert not trace.success and trace.collisions == 0
     assert trace.time_s == pytest.approx(2.0)
+    # every call failed, each after checking the costmap: their time counts (it was 0.0, as if nothing was planned)
+    assert trace.plans == 2 and trace.planning_time_s > 0.0
     assert trace.reason.startswith("time limit (2 s) reached: no path: the start and the goal lie in separate")
     assert trace.reason.endswith(
         "people 1 at (2.00, -1.35), 2 at (2.00, -0.45), 3 at (2.00, 0.45), 4 at (2.00, 1.35) close the way between "
