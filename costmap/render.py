@@ -206,10 +206,11 @@ class Extra:
     draw: Callable[[np.ndarray, GridSpec, int], None]
 
 
-def _person_swatch(colour: tuple[int, int, int]) -> Swatch:
+def _person_swatch(colour: tuple[int, int, int], arrow: bool = True) -> Swatch:
     def swatch(img: np.ndarray, u: int, v: int) -> None:
         cv2.circle(img, (u - 4, v), 6, colour, -1, cv2.LINE_AA)
-        cv2.arrowedLine(img, (u - 4, v), (u + 12, v), colour, 2, cv2.LINE_AA, tipLength=0.4)
+        if arrow:
+            cv2.arrowedLine(img, (u - 4, v), (u + 12, v), colour, 2, cv2.LINE_AA, tipLength=0.4)
 
     return swatch
 
@@ -261,9 +262,12 @@ def _legend_rows(
     """The legend, in order: people alone, one row per group in its colour, then each fixed entry drawn, then the
     callers' ``extras``."""
     grouped = {m for g in groups for m in g.members}
+    alone = [p for p in people if p.id not in grouped]
     rows: list[tuple[str, Swatch]] = []
-    if any(p.id not in grouped for p in people):
+    if any(p.theta is not None for p in alone):
         rows.append(("person in no group, facing", _person_swatch(PERSON)))
+    elif alone:  # drawn without an arrow: their facings are unknown ("unknown facing: id?")
+        rows.append(("person in no group", _person_swatch(PERSON, arrow=False)))
     for i, group in enumerate(groups[:MAX_GROUP_ENTRIES]):
         rows.append((_members(group), _group_swatch(GROUP_COLOURS[i % len(GROUP_COLOURS)])))
     if len(groups) > MAX_GROUP_ENTRIES:

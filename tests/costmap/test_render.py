@@ -54,6 +54,15 @@ def test_people_are_coloured_by_group_and_the_legend_names_each_group(legend) ->
     assert legend[-1][:3] == ["person in no group, facing", "group of 1, 2", "group of 4, 5"]
 
 
+def test_people_alone_of_unknown_facing_are_not_listed_as_facing(legend) -> None:
+    """The legend said "person in no group, facing" (a dot and an arrow) for people alone drawn without an arrow."""
+    unknown = [Person(3, 4.0, 2.0, None), Person(4, 4.0, -2.0, None)]
+    render_costmap(Costmap2D.filled(SPEC), [*PAIR, *unknown], [POINT_GROUP], scale=4)
+    assert legend[-1][:2] == ["person in no group", "group of 1, 2"] and "unknown facing: id?" in legend[-1]
+    render_costmap(Costmap2D.filled(SPEC), [*PAIR, *unknown, Person(5, 1.0, 2.0, 0.0)], [POINT_GROUP], scale=4)
+    assert legend[-1][:2] == ["person in no group, facing", "group of 1, 2"] and "unknown facing: id?" in legend[-1]
+
+
 def test_a_group_whose_ids_do_not_fit_the_legend_is_named_by_its_size_in_people(legend) -> None:
     ring = [Person(7 + k, 3.0 + math.cos(k), math.sin(k), k + math.pi) for k in range(6)]  # ids 7..12
     group = Group(tuple(p.id for p in ring), (3.0, 0.0), 1.0, np.array([[3.0, 0.0]]), 0.3)
