@@ -7,18 +7,19 @@ import copy
 import io
 import json
 import tempfile
+import warnings
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from costmap.mapfile import MapFileError, read_map
 from sid.checks import limits
 from sid.cli.groups import process
-from sid.documents import load_document
+from sid.documents import InputWarning, load_document
 from sid.experiments.fformation import load_dataset
 from sid.perception.camera import Calibration
 from sid.perception.groups import GroupParams
@@ -146,13 +147,20 @@ CALIBRATION = {"width": 640, "height": 480, "fx": 525.0, "fy": 525.0, "cx": 319.
         st.sampled_from([*CALIBRATION, "color", "depth", "depth_to_color", "depth_scale"]), VALUES, max_size=4
     )
 )
+@example({"depth_to_color": 0})  # a number sid does not read in a flat calibration: an InputWarning
 def test_any_calibration_reads_or_names_the_file(changes):
     with tempfile.TemporaryDirectory() as folder, bounded():
         path = _write(Path(folder), "calibration.json", json.dumps(CALIBRATION | changes).encode())
         try:
-            Calibration.from_json(path)
+            with warnings.catch_warnings(record=True) as said:  # unread numbers, distortion: said, one line each
+                warnings.simplefilter("always")
+                Calibration.from_json(path)
         except ValueError as exc:
             assert str(path) in str(exc)
+            return
+    for warning in said:
+        assert issubclass(warning.category, InputWarning), warning
+        assert str(warning.message).startswith(f"calibration {path}: ") and "\n" not in str(warning.message)
 
 
 LINES = st.lists(
