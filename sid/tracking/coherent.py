@@ -17,7 +17,7 @@ import numpy as np
 
 from sid.checks import check_number, check_whole
 from sid.tracking.groups import connected_components
-from sid.tracking.records import TrackedPerson
+from sid.tracking.records import TIME_TOLERANCE, TrackedPerson
 
 __all__ = ["CoherentMotion", "CoherentMotionParams"]
 
@@ -67,7 +67,7 @@ class CoherentMotion:
         near = _pair_distance(state[:, :2]) <= p.distance
         alike = _pair_distance(state[:, 2:]) <= p.velocity_difference
         self._frames.append(_Frame(timestamp, ids, near & alike))
-        while self._frames and timestamp - self._frames[0].timestamp > p.window:
+        while self._frames and timestamp - self._frames[0].timestamp > p.window + TIME_TOLERANCE:
             self._frames.popleft()
         together = np.zeros((len(ids), len(ids)), dtype=np.int64)
         coherent = np.zeros_like(together)

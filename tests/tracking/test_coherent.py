@@ -58,3 +58,24 @@ def test_reset_forgets_the_history() -> None:
 def test_bad_parameters_are_refused(field: str, value: float, problem: str) -> None:
     with pytest.raises(ValueError, match=f"coherent motion: {problem}"):
         CoherentMotionParams(**{field: value})
+
+
+def _first_report_after_a_frame_apart_exactly_one_window_ago(offset: float, dt: float) -> int:
+    """The frame at which two walkers are first a group: 3 m apart in their first frame, 0.6 m apart from then on,
+    fed every ``dt`` seconds at the clock times ``offset + k dt`` from k = 7 on (as a replay computes them); every
+    frame in the window must be coherent (share 1)."""
+    reference = CoherentMotion(CoherentMotionParams(window=2.0, share=1.0, min_frames=1))
+    for k in range(7, 7 + int(4.0 / dt)):
+        x, gap = 1.2 * k * dt, 3.0 if k == 7 else 0.6
+        if reference.update([_track(1, x, 0.0, 1.2, 0.0), _track(2, x, gap, 1.2, 0.0)], offset + k * dt):
+            return k
+    raise AssertionError("never a group")
+
+
+@pytest.mark.parametrize("dt", [1 / 15, 0.4])
+def test_groups_do_not_depend_on_the_clocks_offset(dt: float) -> None:
+    """Whether a frame exactly one window old still counts must not depend on how rounding treats the clock's times
+    (ROS stamps in seconds since 1970): the trackers' TIME_TOLERANCE, as in GroupTracker."""
+    frames = {offset: _first_report_after_a_frame_apart_exactly_one_window_ago(offset, dt)
+              for offset in (0.0, 0.1, 17.3, 1234.567, 1.7e9 + 0.123, 1.7e9 + 0.9)}  # fmt: skip
+    assert len(set(frames.values())) == 1, frames
