@@ -494,6 +494,17 @@ def _static_map(path: Path) -> OccupancyGrid:
     return static
 
 
+def _check_overlap(static: GridSpec, grid: GridSpec, path: Path) -> None:
+    """Refuse a static map that shares no area with the scenario's grid: every cell would be unknown and its walls
+    would vanish without a word (an origin in other coordinates, or the wrong file)."""
+    (sx0, sy0, sx1, sy1), (gx0, gy0, gx1, gy1) = static.bounds, grid.bounds
+    if sx0 >= gx1 or gx0 >= sx1 or sy0 >= gy1 or gy0 >= sy1:
+        raise ScenarioError(
+            f"static_map: {path}: the map (x {sx0:g}..{sx1:g}, y {sy0:g}..{sy1:g}) lies outside the scenario's map "
+            f"(x {gx0:g}..{gx1:g}, y {gy0:g}..{gy1:g}): no cell in common; check the two origins"
+        )
+
+
 def _warn_resampled(static: GridSpec, grid: GridSpec, path: Path) -> None:
     """Say that the static map is sampled onto the scenario's grid when their cells differ (nearest cell)."""
     if static.resolution != grid.resolution:
@@ -540,6 +551,7 @@ def scenario_from_dict(data: Any, base_dir: Path | None = None, default_name: st
         static_spec = _static_map(static_map).spec
     grid = _grid(data.get("map"), static_spec)
     if static_map is not None and static_spec is not None:
+        _check_overlap(static_spec, grid, static_map)
         _warn_resampled(static_spec, grid, static_map)
 
     obstacles_data = _list(data.get("obstacles", []), "obstacles")

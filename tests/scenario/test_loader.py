@@ -163,6 +163,18 @@ def test_unreadable_static_map_is_named(tmp_path):
         load_scenario(path)
 
 
+def test_a_static_map_with_no_cell_in_the_scenarios_map_is_refused(tmp_path):
+    """A map file 1 km away (an origin in other coordinates) would leave every cell unknown: its walls gone."""
+    spec = GridSpec(0.1, 1000.0, 1000.0, 30, 20)
+    write_map(tmp_path / "far.yaml", OccupancyGrid(spec, np.zeros(spec.shape, dtype=np.int8)))
+    with pytest.raises(ScenarioError, match=r"far.yaml: the map \(x 1000..1003, y 1000..1002\) lies outside the "):
+        scenario_from_dict({**BASE, "static_map": "far.yaml"}, tmp_path)
+    touching = GridSpec(0.1, -1.0, 4.0, 30, 20)  # shares the scenario map's upper edge only (y = 4)
+    write_map(tmp_path / "touching.yaml", OccupancyGrid(touching, np.zeros(touching.shape, dtype=np.int8)))
+    with pytest.raises(ScenarioError, match="no cell in common"):
+        scenario_from_dict({**BASE, "static_map": "touching.yaml"}, tmp_path)
+
+
 @pytest.mark.parametrize("scene", sorted((REPO_ROOT / "sid" / "experiments" / "simulate" / "scenes").glob("*.yaml")))
 def test_a_simulation_scene_is_a_scenario_file_too(scene):
     """sid plan, costmap and compare read sid simulate's scenes: their ``simulation`` block is left to sid simulate."""
