@@ -335,8 +335,12 @@ def _path(value: Any, name: str, grid: GridSpec, start: tuple[float, float]) -> 
     for i, raw in enumerate(value):
         point = _xy(raw, f"{name}[{i}]")
         _inside(grid, point, f"{name}[{i}]")
-        if point == (points[-1] if points else start):
+        if points and point == points[-1]:
             raise ScenarioError(f"{name}[{i}]: {list(point)} repeats the point before it")
+        if not points and point == start:
+            raise ScenarioError(
+                f"{name}[0]: {list(point)} repeats the point the path starts from: a path lists the waypoints after it"
+            )
         points.append(point)
     return tuple(points)
 
