@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 import numpy as np
+from shapely.geometry import box
 
 from costmap.grid import GridSpec
 from costmap.mapfile import MapFileError, read_map
@@ -26,8 +27,9 @@ from sid.documents import InputWarning, is_number, load_document, summary
 from sid.errors import SidError
 from sid.perception.groups import GroupParams
 from sid.perception.people import Person
+from sid.scenario.known_map import obstacle_mask
 from sid.scenario.motion import Trajectory
-from sid.scenario.obstacles import BoxObstacle, CircleObstacle, Obstacle, SegmentObstacle
+from sid.scenario.obstacles import BoxObstacle, CircleObstacle, Obstacle, SegmentObstacle, shape
 
 __all__ = [
     "BoxObstacle",
@@ -436,6 +438,24 @@ def _near_map(grid: GridSpec, obstacle: Obstacle, name: str) -> None:
             )
 
 
+def _warn_beyond_map(grid: GridSpec, obstacles: list[Obstacle], radius: float) -> None:
+    """Warn of each obstacle that holds no cell of the map (it lies outside) but comes nearer its edge than the
+    robot's ``radius`` (m): the costmap holds only the map's cells, so plans pass the edge as if it were not there,
+    and ``sid simulate``'s robot, whose world is every obstacle, can hit it."""
+    area = box(*grid.bounds)
+    for i, obstacle in enumerate(obstacles):
+        gap = area.distance(shape(obstacle))
+        if 0 < gap < radius and not obstacle_mask([obstacle], grid).any():
+            warnings.warn(
+                f"obstacles[{i}]: lies outside the map (x {grid.bounds[0]:g}..{grid.bounds[2]:g}, y "
+                f"{grid.bounds[1]:g}..{grid.bounds[3]:g}) but {gap:.3g} m from its edge, nearer than the robot's "
+                f"radius ({radius:g} m): the costmap holds only the map's cells, so plans pass it as if it were not "
+                "there (and sid simulate's robot can hit it); extend the map or move the obstacle inside",
+                InputWarning,
+                stacklevel=2,
+            )
+
+
 def _point_count(value: Any) -> int:
     """The points an obstacle's mapping gives, counted before it is read (``Limits.obstacle_points``): a wall's
     points, 4 per box, 1 for anything else (a circle, or a mapping refused when read)."""
@@ -588,6 +608,7 @@ def scenario_from_dict(data: Any, base_dir: Path | None = None, default_name: st
         **_motion(robot_data, "robot", grid, (start[0], start[1]), RobotSpec.speed),
     )
     _inside(grid, robot.goal, "robot.goal")
+    _warn_beyond_map(grid, obstacles, robot.radius)
 
     lidar_data = _mapping(data.get("lidar", {}), "lidar", {f.name for f in dataclasses.fields(LidarSpec)})
     defaults = LidarSpec()

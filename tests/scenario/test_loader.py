@@ -5,6 +5,7 @@ from __future__ import annotations
 import copy
 import json
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -14,6 +15,7 @@ from costmap.grid import GridSpec
 from costmap.layers.obstacle import ObstacleParams
 from costmap.mapfile import write_map
 from costmap.occupancy import OccupancyGrid
+from sid.documents import InputWarning
 from sid.perception.groups import GroupParams
 from sid.scenario.loader import ScenarioError, load_scenario, scenario_from_dict
 from sid.scenario.obstacles import BoxObstacle, CircleObstacle, SegmentObstacle
@@ -173,6 +175,20 @@ def test_a_static_map_with_no_cell_in_the_scenarios_map_is_refused(tmp_path):
     write_map(tmp_path / "touching.yaml", OccupancyGrid(touching, np.zeros(touching.shape, dtype=np.int8)))
     with pytest.raises(ScenarioError, match="no cell in common"):
         scenario_from_dict({**BASE, "static_map": "touching.yaml"}, tmp_path)
+
+
+def test_an_obstacle_outside_the_map_within_the_robots_radius_of_its_edge_is_warned_of():
+    """The map spans y -4..4: a wall 2 cm below it holds no cell, so plans pass the edge as if it were not there
+    and sid simulate's robot hit it."""
+    below = {"type": "segment", "points": [[0.0, -4.02], [5.0, -4.02]]}
+    with pytest.warns(InputWarning, match=r"^obstacles\[0\]: lies outside the map \(x -1..9, y -4..4\) but 0.02 m "):
+        scenario_from_dict({**BASE, "obstacles": [below]})
+    far = {"type": "box", "min": [0.0, -5.0], "max": [5.0, -4.3]}  # 0.3 m below: beyond the robot's 0.25 m
+    crossing = {"type": "segment", "points": [[0.0, -4.5], [0.0, -3.0]]}
+    on_edge = {"type": "circle", "center": [9.1, 0.0], "radius": 0.1}  # touches x = 9
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        scenario_from_dict({**BASE, "obstacles": [far, crossing, on_edge]})
 
 
 @pytest.mark.parametrize("scene", sorted((REPO_ROOT / "sid" / "experiments" / "simulate" / "scenes").glob("*.yaml")))
