@@ -176,17 +176,17 @@ def people_walling_off(scenario: Scenario, problem: PlanningProblem) -> str | No
         return None
     empty = replace(scenario, people=[], walks={}, conversations=())
     bare = CostField(replace(problem, costmap=build_costmap(empty, social=False, groups=[]).master))
-    if int(free_regions(bare)[ends[0][0], ends[0][1]]) != int(free_regions(bare)[ends[1][0], ends[1][1]]):
+    open_labels = free_regions(bare)
+    if int(open_labels[ends[0][0], ends[0][1]]) != int(open_labels[ends[1][0], ends[1][1]]):
         return None
     pieces, _ = ndimage.label(bare.plannable & ~field.plannable, structure=np.ones((3, 3), bool))
-    around, reach = np.ones((3, 3), bool), _reach(scenario)
+    boxes, reach = ndimage.find_objects(pieces), _reach(scenario)
     closing: dict[int, bool] = {}  # piece -> whether it borders both ends' regions
     wall = []
     for person in scenario.people:
         for piece in _pieces_within(pieces, spec, (person.x, person.y), reach):
             if piece not in closing:
-                border = ndimage.binary_dilation(pieces == piece, structure=around)
-                closing[piece] = {start, goal} <= set(np.unique(labels[border]).tolist())
+                closing[piece] = {start, goal} <= _bordering(pieces, piece, boxes[piece - 1], labels)
             if closing[piece]:
                 wall.append(person)
                 break
@@ -198,6 +198,14 @@ def people_walling_off(scenario: Scenario, problem: PlanningProblem) -> str | No
         f"them (without people it is open): a person is an obstacle of radius {scenario.lidar.body_radius:.2f} m "
         f"(lidar.body_radius) and the robot a disc of radius {scenario.robot.radius:.2f} m (robot.radius)"
     )
+
+
+def _bordering(pieces: np.ndarray, piece: int, box: tuple[slice, slice], labels: np.ndarray) -> set[int]:
+    """The ``labels`` (free regions) of the cells around piece ``piece`` of ``pieces`` (8-connected), looked at in
+    the piece's bounding ``box`` (``ndimage.find_objects``) grown by a cell."""
+    grown = tuple(slice(max(part.start - 1, 0), part.stop + 1) for part in box)
+    border = ndimage.binary_dilation(pieces[grown] == piece, structure=np.ones((3, 3), bool))
+    return set(np.unique(labels[grown][border]).tolist())
 
 
 def _pieces_within(pieces: np.ndarray, spec: GridSpec, xy: tuple[float, float], reach: float) -> list[int]:
