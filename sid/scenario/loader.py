@@ -402,9 +402,13 @@ def _yaw(value: float, name: str) -> float:
 
 
 def _inside(grid: GridSpec, xy: tuple[float, ...], name: str) -> None:
+    """Refuse a point outside the map's cells; one on its upper or right border is outside (the last cell ends
+    there), which the message says, since the bounds it quotes would seem to hold it."""
     if not grid.contains(np.array([xy[:2]]))[0]:
         x0, y0, x1, y1 = grid.bounds
-        raise ScenarioError(f"{name}: ({xy[0]}, {xy[1]}) is outside the map (x {x0:g}..{x1:g}, y {y0:g}..{y1:g})")
+        on_edge = (xy[0] == x1 and y0 <= xy[1] <= y1) or (xy[1] == y1 and x0 <= xy[0] <= x1)
+        note = ": the upper and right borders lie outside the map's last cells" if on_edge else ""
+        raise ScenarioError(f"{name}: ({xy[0]}, {xy[1]}) is outside the map (x {x0:g}..{x1:g}, y {y0:g}..{y1:g}){note}")
 
 
 # --- limits: sizes checked where they enter, before anything is allocated for them (sid.checks.Limits) ------

@@ -177,6 +177,14 @@ def test_a_static_map_with_no_cell_in_the_scenarios_map_is_refused(tmp_path):
         scenario_from_dict({**BASE, "static_map": "touching.yaml"}, tmp_path)
 
 
+@pytest.mark.parametrize("xy", [[9.0, 0.0], [2.0, 4.0], [9.0, 4.0]])
+def test_a_person_on_the_maps_upper_or_right_border_is_told_why_it_is_outside(xy):
+    with pytest.raises(ScenarioError, match=r"is outside the map \(x -1..9, y -4..4\): the upper and right borders"):
+        scenario_from_dict(with_change("people.0", {"id": 1, "x": xy[0], "y": xy[1], "theta": 0.0}))
+    with pytest.raises(ScenarioError, match=r"is outside the map \(x -1..9, y -4..4\)$"):
+        scenario_from_dict(with_change("people.0", {"id": 1, "x": 9.5, "y": 4.0, "theta": 0.0}))
+
+
 def test_an_obstacle_outside_the_map_within_the_robots_radius_of_its_edge_is_warned_of():
     """The map spans y -4..4: a wall 2 cm below it holds no cell, so plans pass the edge as if it were not there
     and sid simulate's robot hit it."""
