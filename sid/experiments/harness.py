@@ -27,6 +27,7 @@ import numpy as np
 from scipy import ndimage
 from shapely.geometry import Point
 
+from costmap.grid import GridSpec
 from costmap.layered import LayeredCostmap
 from costmap.layers.social import group_zone_polygon
 from planner.facade import PlanResult, free_regions, plan, resolve_planner
@@ -132,12 +133,18 @@ def zone_warnings(task: Task) -> list[str]:
     return warnings
 
 
+def _reach(scenario: Scenario) -> float:
+    """How far (m) from a person's centre the robot's centre is kept: their body (``lidar.body_radius``, painted
+    lethal on the costmap's cells, so within a cell's diagonal of that) and the robot's disc (``robot.radius``)."""
+    return scenario.lidar.body_radius + scenario.robot.radius + scenario.grid.resolution * math.sqrt(2.0)
+
+
 def people_at_ends(scenario: Scenario, ends: Sequence[str] = ("start", "goal")) -> list[str]:
     """A sentence for each of the robot's ``ends`` ("start", "goal") that lies so near a person that the robot's
     disc (``robot.radius``) may touch their body (``lidar.body_radius``, painted lethal on the costmap's cells, so
     within a cell's diagonal of that): the person nearest it, and how far (m, world frame)."""
     robot, body = scenario.robot, scenario.lidar.body_radius
-    reach = body + robot.radius + scenario.grid.resolution * math.sqrt(2.0)
+    reach = _reach(scenario)
     sentences = []
     for end in ends:
         pose = robot.start if end == "start" else robot.goal
@@ -157,8 +164,9 @@ def people_walling_off(scenario: Scenario, problem: PlanningProblem) -> str | No
     """A sentence naming the people who wall the robot's start off from its goal on ``problem``'s costmap, or None
     when the two are connected or would stay walled off without the people too. The wall is made of the cells the
     robot's centre can reach on the scenario's costmap without people (no social layer) but not on ``problem``'s,
-    taken as connected pieces; the people are those whose body's centre lies in a piece that borders both the
-    start's free region and the goal's (``free_regions``)."""
+    taken as connected pieces; the people are those who keep the robot off a piece that borders both the start's
+    free region and the goal's (``free_regions``): a cell of it lies within ``_reach`` of them (their centre may
+    lie where the robot cannot stand anyway, against a wall or inside an obstacle)."""
     field = CostField(problem)
     spec = field.spec
     labels = free_regions(field)
@@ -168,19 +176,20 @@ def people_walling_off(scenario: Scenario, problem: PlanningProblem) -> str | No
         return None
     empty = replace(scenario, people=[], walks={}, conversations=())
     bare = CostField(replace(problem, costmap=build_costmap(empty, social=False, groups=[]).master))
-    if int(free_regions(bare)[ends[0][0], ends[0][1]]) != int(free_regions(bare)[ends[1][0], ends[1][1]]):
+    open_labels = free_regions(bare)
+    if int(open_labels[ends[0][0], ends[0][1]]) != int(open_labels[ends[1][0], ends[1][1]]):
         return None
     pieces, _ = ndimage.label(bare.plannable & ~field.plannable, structure=np.ones((3, 3), bool))
-    around = np.ones((3, 3), bool)
+    boxes, reach = ndimage.find_objects(pieces), _reach(scenario)
+    closing: dict[int, bool] = {}  # piece -> whether it borders both ends' regions
     wall = []
     for person in scenario.people:
-        row, col = spec.world_to_cell(np.array([person.x, person.y]))[0]
-        piece = int(pieces[row, col]) if spec.in_bounds(np.array([row, col]))[0] else 0
-        if piece == 0:
-            continue
-        border = ndimage.binary_dilation(pieces == piece, structure=around)
-        if {start, goal} <= set(np.unique(labels[border]).tolist()):
-            wall.append(person)
+        for piece in _pieces_within(pieces, spec, (person.x, person.y), reach):
+            if piece not in closing:
+                closing[piece] = {start, goal} <= _bordering(pieces, piece, boxes[piece - 1], labels)
+            if closing[piece]:
+                wall.append(person)
+                break
     if not wall:
         return None
     names = ", ".join(f"{p.id} at ({p.x:.2f}, {p.y:.2f})" for p in wall)
@@ -189,6 +198,24 @@ def people_walling_off(scenario: Scenario, problem: PlanningProblem) -> str | No
         f"them (without people it is open): a person is an obstacle of radius {scenario.lidar.body_radius:.2f} m "
         f"(lidar.body_radius) and the robot a disc of radius {scenario.robot.radius:.2f} m (robot.radius)"
     )
+
+
+def _bordering(pieces: np.ndarray, piece: int, box: tuple[slice, slice], labels: np.ndarray) -> set[int]:
+    """The ``labels`` (free regions) of the cells around piece ``piece`` of ``pieces`` (8-connected), looked at in
+    the piece's bounding ``box`` (``ndimage.find_objects``) grown by a cell."""
+    grown = tuple(slice(max(part.start - 1, 0), part.stop + 1) for part in box)
+    border = ndimage.binary_dilation(pieces[grown] == piece, structure=np.ones((3, 3), bool))
+    return set(np.unique(labels[grown][border]).tolist())
+
+
+def _pieces_within(pieces: np.ndarray, spec: GridSpec, xy: tuple[float, float], reach: float) -> list[int]:
+    """The labels (> 0) of ``pieces`` (rows, cols) with a cell centre within ``reach`` (m) of world point ``xy``."""
+    (x, y), window = xy, spec.window((xy[0] - reach, xy[1] - reach), (xy[0] + reach, xy[1] + reach))
+    if window is None:
+        return []
+    xs, ys = spec.cell_axes(window)
+    near = pieces[window.slices][(xs - x) ** 2 + (ys - y) ** 2 <= reach**2]
+    return [int(label) for label in np.unique(near) if label > 0]
 
 
 @dataclass(frozen=True)

@@ -9,7 +9,8 @@ Rasterisation (world frame, metres): a cell is occupied when the shape reaches i
 ``costmap.grid.GridSpec.world_to_cell`` assigns points (a point on a cell border belongs to the cell above / to the
 right, as a LiDAR hit there would): a box fills every cell from the one holding ``min`` to the one holding ``max``;
 a circle every cell whose square overlaps the disc; a wall every cell its polyline passes through, a wall along the
-map's upper or right border the last row or column (the cells above / to the right of it lie outside the map).
+map's upper or right border the last row or column (the cells above / to the right of it lie outside the map), also
+when the map's size is not a whole number of cells and its border lies up to half a cell beyond the grid's.
 """
 
 from __future__ import annotations
@@ -26,10 +27,11 @@ __all__ = ["known_map", "obstacle_mask"]
 
 
 def _mark_points(mask: np.ndarray, spec: GridSpec, xy: np.ndarray) -> None:
-    """Mark the cells holding the points ``xy`` (N, 2); a point on the map's upper or right border (within a
-    millionth of a cell) is in the last row or column, so that a wall drawn along the map's edge is in the map."""
+    """Mark the cells holding the points ``xy`` (N, 2); a point on or up to half a cell beyond the grid's upper or
+    right border is in the last row or column, so that a wall drawn along the map's edge is in the map: the grid has
+    ``round(size / resolution)`` cells, so its border lies within half a cell of the declared one."""
     x0, y0, x1, y1 = spec.bounds
-    slack = spec.resolution * 1e-6
+    slack = spec.resolution / 2
     inside = (xy[:, 0] >= x0) & (xy[:, 0] <= x1 + slack) & (xy[:, 1] >= y0) & (xy[:, 1] <= y1 + slack)
     cells = spec.world_to_cell(xy[inside])
     rows = np.minimum(cells[:, 0], spec.height - 1)

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 import numpy as np
+from shapely.geometry import box
 
 from costmap.grid import GridSpec
 from costmap.mapfile import MapFileError, read_map
@@ -26,8 +27,9 @@ from sid.documents import InputWarning, is_number, load_document, summary
 from sid.errors import SidError
 from sid.perception.groups import GroupParams
 from sid.perception.people import Person
+from sid.scenario.known_map import obstacle_mask
 from sid.scenario.motion import Trajectory
-from sid.scenario.obstacles import BoxObstacle, CircleObstacle, Obstacle, SegmentObstacle
+from sid.scenario.obstacles import BoxObstacle, CircleObstacle, Obstacle, SegmentObstacle, shape
 
 __all__ = [
     "BoxObstacle",
@@ -335,8 +337,12 @@ def _path(value: Any, name: str, grid: GridSpec, start: tuple[float, float]) -> 
     for i, raw in enumerate(value):
         point = _xy(raw, f"{name}[{i}]")
         _inside(grid, point, f"{name}[{i}]")
-        if point == (points[-1] if points else start):
+        if points and point == points[-1]:
             raise ScenarioError(f"{name}[{i}]: {list(point)} repeats the point before it")
+        if not points and point == start:
+            raise ScenarioError(
+                f"{name}[0]: {list(point)} repeats the point the path starts from: a path lists the waypoints after it"
+            )
         points.append(point)
     return tuple(points)
 
@@ -396,9 +402,13 @@ def _yaw(value: float, name: str) -> float:
 
 
 def _inside(grid: GridSpec, xy: tuple[float, ...], name: str) -> None:
+    """Refuse a point outside the map's cells; one on its upper or right border is outside (the last cell ends
+    there), which the message says, since the bounds it quotes would seem to hold it."""
     if not grid.contains(np.array([xy[:2]]))[0]:
         x0, y0, x1, y1 = grid.bounds
-        raise ScenarioError(f"{name}: ({xy[0]}, {xy[1]}) is outside the map (x {x0:g}..{x1:g}, y {y0:g}..{y1:g})")
+        on_edge = (xy[0] == x1 and y0 <= xy[1] <= y1) or (xy[1] == y1 and x0 <= xy[0] <= x1)
+        note = ": the upper and right borders lie outside the map's last cells" if on_edge else ""
+        raise ScenarioError(f"{name}: ({xy[0]}, {xy[1]}) is outside the map (x {x0:g}..{x1:g}, y {y0:g}..{y1:g}){note}")
 
 
 # --- limits: sizes checked where they enter, before anything is allocated for them (sid.checks.Limits) ------
@@ -429,6 +439,24 @@ def _near_map(grid: GridSpec, obstacle: Obstacle, name: str) -> None:
             raise ScenarioError(
                 f"{field_name}: ({x:g}, {y:g}) lies farther from the map (x {x0:g}..{x1:g}, y {y0:g}..{y1:g}) than "
                 f"its diagonal ({reach:g} m); obstacle points must lie within that distance"
+            )
+
+
+def _warn_beyond_map(grid: GridSpec, obstacles: list[Obstacle], radius: float) -> None:
+    """Warn of each obstacle that holds no cell of the map (it lies outside) but comes nearer its edge than the
+    robot's ``radius`` (m): the costmap holds only the map's cells, so plans pass the edge as if it were not there,
+    and ``sid simulate``'s robot, whose world is every obstacle, can hit it."""
+    area = box(*grid.bounds)
+    for i, obstacle in enumerate(obstacles):
+        gap = area.distance(shape(obstacle))
+        if 0 < gap < radius and not obstacle_mask([obstacle], grid).any():
+            warnings.warn(
+                f"obstacles[{i}]: lies outside the map (x {grid.bounds[0]:g}..{grid.bounds[2]:g}, y "
+                f"{grid.bounds[1]:g}..{grid.bounds[3]:g}) but {gap:.3g} m from its edge, nearer than the robot's "
+                f"radius ({radius:g} m): the costmap holds only the map's cells, so plans pass it as if it were not "
+                "there (and sid simulate's robot can hit it); extend the map or move the obstacle inside",
+                InputWarning,
+                stacklevel=2,
             )
 
 
@@ -494,6 +522,17 @@ def _static_map(path: Path) -> OccupancyGrid:
     return static
 
 
+def _check_overlap(static: GridSpec, grid: GridSpec, path: Path) -> None:
+    """Refuse a static map that shares no area with the scenario's grid: every cell would be unknown and its walls
+    would vanish without a word (an origin in other coordinates, or the wrong file)."""
+    (sx0, sy0, sx1, sy1), (gx0, gy0, gx1, gy1) = static.bounds, grid.bounds
+    if sx0 >= gx1 or gx0 >= sx1 or sy0 >= gy1 or gy0 >= sy1:
+        raise ScenarioError(
+            f"static_map: {path}: the map (x {sx0:g}..{sx1:g}, y {sy0:g}..{sy1:g}) lies outside the scenario's map "
+            f"(x {gx0:g}..{gx1:g}, y {gy0:g}..{gy1:g}): no cell in common; check the two origins"
+        )
+
+
 def _warn_resampled(static: GridSpec, grid: GridSpec, path: Path) -> None:
     """Say that the static map is sampled onto the scenario's grid when their cells differ (nearest cell)."""
     if static.resolution != grid.resolution:
@@ -540,6 +579,7 @@ def scenario_from_dict(data: Any, base_dir: Path | None = None, default_name: st
         static_spec = _static_map(static_map).spec
     grid = _grid(data.get("map"), static_spec)
     if static_map is not None and static_spec is not None:
+        _check_overlap(static_spec, grid, static_map)
         _warn_resampled(static_spec, grid, static_map)
 
     obstacles_data = _list(data.get("obstacles", []), "obstacles")
@@ -572,6 +612,7 @@ def scenario_from_dict(data: Any, base_dir: Path | None = None, default_name: st
         **_motion(robot_data, "robot", grid, (start[0], start[1]), RobotSpec.speed),
     )
     _inside(grid, robot.goal, "robot.goal")
+    _warn_beyond_map(grid, obstacles, robot.radius)
 
     lidar_data = _mapping(data.get("lidar", {}), "lidar", {f.name for f in dataclasses.fields(LidarSpec)})
     defaults = LidarSpec()

@@ -5,8 +5,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from shapely.geometry import LineString, Point, Polygon
+from shapely.geometry.base import BaseGeometry
 
-__all__ = ["BoxObstacle", "CircleObstacle", "Obstacle", "SegmentObstacle", "outline"]
+__all__ = ["BoxObstacle", "CircleObstacle", "Obstacle", "SegmentObstacle", "outline", "shape"]
 
 
 @dataclass(frozen=True)
@@ -44,3 +46,13 @@ def outline(obstacle: Obstacle, sides: int = 48) -> tuple[np.ndarray, bool]:
         centre = np.asarray(obstacle.center, dtype=float)
         return centre + obstacle.radius * np.stack([np.cos(angles), np.sin(angles)], axis=1), True
     return np.asarray(obstacle.points, dtype=float), False
+
+
+def shape(obstacle: Obstacle) -> BaseGeometry:
+    """``obstacle`` as a shapely geometry: a wall as a line, a box and a circle (64 segments a quarter) as areas."""
+    if isinstance(obstacle, BoxObstacle):
+        (x0, y0), (x1, y1) = obstacle.min, obstacle.max
+        return Polygon([(x0, y0), (x1, y0), (x1, y1), (x0, y1)])
+    if isinstance(obstacle, CircleObstacle):
+        return Point(obstacle.center).buffer(obstacle.radius, 64)
+    return LineString(obstacle.points)

@@ -225,3 +225,17 @@ def test_people_walling_off_is_none_when_the_map_alone_closes_the_way_or_nothing
     one = [{"id": 1, "x": 6.0, "y": 0.35, "theta": 1.5708}]  # one person leaves room to pass
     task = prepare(scenario_from_dict(_corridor(one)))
     assert people_walling_off(task.scenario, task.problems["with"]) is None
+
+
+def test_people_against_the_walls_who_close_the_way_are_named():
+    """A person whose centre lies where the robot cannot stand anyway (0.3 m from a wall, inside a box) still
+    closes the way with their body: named, as the one inside the box is not."""
+    people = [{"id": 1, "x": 6.0, "y": 0.3, "theta": 1.5708}, {"id": 2, "x": 6.0, "y": 1.3, "theta": -1.5708}]
+    task = prepare(scenario_from_dict(_corridor(people)))
+    assert people_walling_off(task.scenario, task.problems["with"]).startswith(
+        "people 1 at (6.00, 0.30), 2 at (6.00, 1.30) close the way"
+    )
+    boxed = _corridor([people[1], {"id": 3, "x": 6.0, "y": 0.2, "theta": 0.0}])
+    boxed["obstacles"].append({"type": "box", "min": [5.5, 0.0], "max": [6.5, 0.5]})
+    task = prepare(scenario_from_dict(boxed))
+    assert people_walling_off(task.scenario, task.problems["with"]).startswith("person 2 at (6.00, 1.30) closes")

@@ -155,3 +155,15 @@ def test_a_wall_along_the_maps_border_is_in_its_outer_cells_on_every_side():
     master = build_costmap(scenario([{"type": "segment", "points": room}]), social=False).master.costs
     assert (master[-1] == LETHAL).all() and (master[:, -1] == LETHAL).all()
     assert (master[-5] >= 253).all() and (master[:, -5] >= 253).all()  # 0.25 m of the robot's radius inscribed
+
+
+@pytest.mark.parametrize(("resolution", "cells"), [(0.07, (86, 57)), (0.3, (20, 13))])
+def test_a_wall_on_the_declared_border_of_a_map_of_no_whole_number_of_cells_is_in_its_last_row(resolution, cells):
+    """A 6 x 4 m map of 0.07 m cells has 57 rows, 3.99 m: a wall along y = 4 lay outside the grid, lost, and the
+    simulated robot hit it; up to half a cell beyond the grid's edge it is in the last row (column)."""
+    spec = GridSpec.from_size(resolution, (0.0, 0.0), (6.0, 4.0))
+    assert (spec.width, spec.height) == cells
+    mask = obstacle_mask([SegmentObstacle(((0.0, 4.0), (6.0, 4.0))), SegmentObstacle(((6.0, 0.0), (6.0, 4.0)))], spec)
+    assert mask[-1].all() and mask[:, -1].all()
+    beyond = obstacle_mask([SegmentObstacle(((0.0, spec.bounds[3] + resolution * 0.6), (6.0, 5.0)))], spec)
+    assert not beyond[-1].any()  # more than half a cell beyond: outside the map, as before

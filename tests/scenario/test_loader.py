@@ -5,6 +5,7 @@ from __future__ import annotations
 import copy
 import json
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -14,6 +15,7 @@ from costmap.grid import GridSpec
 from costmap.layers.obstacle import ObstacleParams
 from costmap.mapfile import write_map
 from costmap.occupancy import OccupancyGrid
+from sid.documents import InputWarning
 from sid.perception.groups import GroupParams
 from sid.scenario.loader import ScenarioError, load_scenario, scenario_from_dict
 from sid.scenario.obstacles import BoxObstacle, CircleObstacle, SegmentObstacle
@@ -161,6 +163,40 @@ def test_unreadable_static_map_is_named(tmp_path):
     path.write_text(json.dumps({**BASE, "static_map": "broken.yaml"}))
     with pytest.raises(ScenarioError, match="cannot read map image"):
         load_scenario(path)
+
+
+def test_a_static_map_with_no_cell_in_the_scenarios_map_is_refused(tmp_path):
+    """A map file 1 km away (an origin in other coordinates) would leave every cell unknown: its walls gone."""
+    spec = GridSpec(0.1, 1000.0, 1000.0, 30, 20)
+    write_map(tmp_path / "far.yaml", OccupancyGrid(spec, np.zeros(spec.shape, dtype=np.int8)))
+    with pytest.raises(ScenarioError, match=r"far.yaml: the map \(x 1000..1003, y 1000..1002\) lies outside the "):
+        scenario_from_dict({**BASE, "static_map": "far.yaml"}, tmp_path)
+    touching = GridSpec(0.1, -1.0, 4.0, 30, 20)  # shares the scenario map's upper edge only (y = 4)
+    write_map(tmp_path / "touching.yaml", OccupancyGrid(touching, np.zeros(touching.shape, dtype=np.int8)))
+    with pytest.raises(ScenarioError, match="no cell in common"):
+        scenario_from_dict({**BASE, "static_map": "touching.yaml"}, tmp_path)
+
+
+@pytest.mark.parametrize("xy", [[9.0, 0.0], [2.0, 4.0], [9.0, 4.0]])
+def test_a_person_on_the_maps_upper_or_right_border_is_told_why_it_is_outside(xy):
+    with pytest.raises(ScenarioError, match=r"is outside the map \(x -1..9, y -4..4\): the upper and right borders"):
+        scenario_from_dict(with_change("people.0", {"id": 1, "x": xy[0], "y": xy[1], "theta": 0.0}))
+    with pytest.raises(ScenarioError, match=r"is outside the map \(x -1..9, y -4..4\)$"):
+        scenario_from_dict(with_change("people.0", {"id": 1, "x": 9.5, "y": 4.0, "theta": 0.0}))
+
+
+def test_an_obstacle_outside_the_map_within_the_robots_radius_of_its_edge_is_warned_of():
+    """The map spans y -4..4: a wall 2 cm below it holds no cell, so plans pass the edge as if it were not there
+    and sid simulate's robot hit it."""
+    below = {"type": "segment", "points": [[0.0, -4.02], [5.0, -4.02]]}
+    with pytest.warns(InputWarning, match=r"^obstacles\[0\]: lies outside the map \(x -1..9, y -4..4\) but 0.02 m "):
+        scenario_from_dict({**BASE, "obstacles": [below]})
+    far = {"type": "box", "min": [0.0, -5.0], "max": [5.0, -4.3]}  # 0.3 m below: beyond the robot's 0.25 m
+    crossing = {"type": "segment", "points": [[0.0, -4.5], [0.0, -3.0]]}
+    on_edge = {"type": "circle", "center": [9.1, 0.0], "radius": 0.1}  # touches x = 9
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        scenario_from_dict({**BASE, "obstacles": [far, crossing, on_edge]})
 
 
 @pytest.mark.parametrize("scene", sorted((REPO_ROOT / "sid" / "experiments" / "simulate" / "scenes").glob("*.yaml")))

@@ -63,7 +63,14 @@ def test_walks_robot_path_and_conversations_are_read(tmp_path: Path) -> None:
         ({"people__2__path": []}, r"people\[2\]\.path: expected a non-empty list"),
         ({"people__2__path": [[2.0, float("nan")]]}, r"people\[2\]\.path\[0\]\[1\]: expected a finite number"),
         ({"people__2__path": [[2.0, 30.0]]}, r"people\[2\]\.path\[0\]: \(2.0, 30.0\) is outside the map"),
-        ({"people__2__path": [[2.0, 3.0]]}, r"people\[2\]\.path\[0\]: \[2.0, 3.0\] repeats the point before it"),
+        (
+            {"people__2__path": [[2.0, 3.0]]},
+            r"people\[2\]\.path\[0\]: \[2.0, 3.0\] repeats the point the path starts from",
+        ),
+        (
+            {"people__2__path": [[2.0, 2.0], [2.0, 2.0]]},
+            r"people\[2\]\.path\[1\]: \[2.0, 2.0\] repeats the point before it",
+        ),
         ({"people__2__speed": 0}, r"people\[2\]\.speed: expected a positive number, got 0"),
         ({"people__2__speed": float("nan")}, r"people\[2\]\.speed: expected a finite number"),
         ({"people__2__start_time": -1}, r"people\[2\]\.start_time: expected a number >= 0"),

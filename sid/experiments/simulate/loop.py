@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -128,6 +128,19 @@ class RunTrace:
 
 
 Observer = Callable[[StepView], None]
+
+
+def _collision_reason(hit: str, t: float, k: int, state: RobotState, walkers: Iterable[int]) -> str:
+    """The run's reason for a collision with ``hit`` ("obstacle", "person N") at step ``k`` (time ``t``, s): at the
+    first step the robot starts overlapping it; scripted walkers do not avoid the robot, so one may walk into it
+    while it stands still (waiting for a path)."""
+    if k == 0:
+        note = " (where the robot starts: its disc overlaps it)"
+    elif state.v == 0.0 and hit in {f"person {pid}" for pid in walkers}:
+        note = " (the robot was standing still: the person walked into it)"
+    else:
+        note = ""
+    return f"collision with {hit} at t = {t:.1f} s{note}"
 
 
 def make_sensing(world: SimWorld, options: RunOptions, color: bool = False) -> Sensing:
@@ -288,9 +301,7 @@ def simulate(
         trace.time_s = t
         hit = collision((state.x, state.y), limits.radius, obstacles, people, lidar.body_radius)
         if hit is not None:
-            # Scripted walkers do not avoid the robot: say when one walked into it while it stood still.
-            still = " (the robot was standing still: the person walked into it)" if state.v == 0.0 else ""
-            trace.collisions, trace.reason = 1, f"collision with {hit} at t = {t:.1f} s{still}"
+            trace.collisions, trace.reason = 1, _collision_reason(hit, t, k, state, scenario.walks)
             break
         if math.hypot(goal[0] - state.x, goal[1] - state.y) <= settings.goal_tolerance_m:
             trace.success, trace.reason = True, f"goal reached at t = {t:.1f} s"

@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from shapely.geometry import LineString, Point, Polygon, box
+from shapely.geometry import Point, box
 from shapely.ops import unary_union
 
 from costmap.grid import LETHAL, Costmap2D
@@ -32,7 +32,7 @@ from sid.documents import is_number, summary
 from sid.experiments.simulate.robot import DriveLimits
 from sid.perception.people import Person
 from sid.scenario.loader import Scenario, ScenarioError, read_scenario_file, scenario_from_dict
-from sid.scenario.obstacles import BoxObstacle, CircleObstacle, Obstacle
+from sid.scenario.obstacles import Obstacle, shape
 
 __all__ = [
     "JITTER_THETA_RAD",
@@ -169,14 +169,7 @@ def obstacle_geometry(obstacles: list[Obstacle], walls: Costmap2D | None = None)
             for c0, c1 in zip(edges[::2], edges[1::2], strict=True):
                 x0, x1 = spec.origin_x + c0 * spec.resolution, spec.origin_x + c1 * spec.resolution
                 shapes.append(box(x0, y0, x1, y0 + spec.resolution))
-    for ob in obstacles:
-        if isinstance(ob, BoxObstacle):
-            (x0, y0), (x1, y1) = ob.min, ob.max
-            shapes.append(Polygon([(x0, y0), (x1, y0), (x1, y1), (x0, y1)]))
-        elif isinstance(ob, CircleObstacle):
-            shapes.append(Point(ob.center).buffer(ob.radius, 64))
-        else:
-            shapes.append(LineString(ob.points))
+    shapes.extend(shape(ob) for ob in obstacles)
     return unary_union(shapes) if shapes else None
 
 

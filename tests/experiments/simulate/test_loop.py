@@ -95,6 +95,20 @@ def test_a_walker_that_walks_into_a_waiting_robot_is_a_collision_that_says_so():
     )
 
 
+@pytest.mark.parametrize(
+    ("changes", "hit"),
+    [
+        ({"obstacles": [{"type": "box", "min": [-0.3, -0.3], "max": [0.3, 0.3]}]}, "obstacle"),
+        ({"people": [{"id": 7, "x": 0.2, "y": 0.0, "theta": 0.0}]}, "person 7"),
+    ],
+)
+def test_a_run_that_starts_in_collision_says_so_not_that_a_person_walked_in(changes, hit):
+    """Without the known map (or a person, whom the known map leaves out) nothing refuses such a start before the
+    run: its first step ends it, and the reason says where, not "the person walked into it"."""
+    trace = simulate(tiny_world(**changes), RunOptions(social=False, unknown_map=True))
+    assert trace.reason == f"collision with {hit} at t = 0.0 s (where the robot starts: its disc overlaps it)"
+
+
 def test_an_onnx_pose_model_runs_in_the_loop(tmp_path):
     pytest.importorskip("onnx")
     import numpy as np
