@@ -9,6 +9,7 @@ step).
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable
 from dataclasses import asdict
 from pathlib import Path
@@ -16,6 +17,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from sid.documents import InputWarning
 from sid.experiments.reproduce import write_json
 from sid.experiments.simulate.loop import Observer, RunOptions, StepView, simulate
 from sid.experiments.simulate.metrics import run_metrics
@@ -55,7 +57,8 @@ def write_run(
     still_s: float | None = None,
 ) -> dict:
     """Run once; with ``out_dir``, write ``run.json`` and ``run.mp4`` (and ``run.gif``; with ``still_s``, ``run.png``:
-    the picture of the first step at or after ``still_s`` seconds, or of the last step) there. Returns the record."""
+    the picture of the first step at or after ``still_s`` seconds, or of the last step, with an InputWarning when the
+    run ended before ``still_s``) there. Returns the record."""
     settings = world.settings
     total = int(math.ceil(settings.time_limit_s * settings.rate_hz))
     driven: list[tuple[float, float]] = []
@@ -93,4 +96,9 @@ def write_run(
         write_json(out_dir / "run.json", record)
         if still and not cv2.imwrite(str(out_dir / "run.png"), still[1]):
             raise OSError(f"could not write {out_dir / 'run.png'}")
+        if still and still_s is not None and still[0] < still_s - 0.5 / settings.rate_hz:
+            message = (
+                f"run.png: the run's last step is at t = {still[0]:.1f} s, before {still_s:g} s: it shows that step"
+            )
+            warnings.warn(InputWarning(message), stacklevel=2)
     return record

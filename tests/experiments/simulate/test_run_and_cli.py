@@ -90,3 +90,15 @@ def test_still_writes_the_picture_at_that_time_and_the_gif_is_full_size(scene, t
     assert 0 <= width - still.shape[1] <= 1 and 0 <= height - still.shape[0] <= 1
     with Image.open(out / "run.gif") as gif:
         assert gif.size == (still.shape[1], still.shape[0])  # text as legible as the video's
+
+
+def test_a_still_after_the_runs_end_shows_the_last_step_and_says_so(scene, tmp_path, capsys):
+    """--still 60 on a run that ends at 0.5 s drew the last step without a word."""
+    out = tmp_path / "out"
+    assert main(["simulate", scene, "--out", str(out), "--still", "60"]) == ExitCode.NO_PATH
+    assert cv2.imread(str(out / "run.png")) is not None
+    assert "sid simulate: warning: run.png: the run's last step is at t = 0.4 s, before 60 s: it shows that step" in (
+        capsys.readouterr().err
+    )
+    assert main(["simulate", scene, "--out", str(out), "--still", "0.2"]) == ExitCode.NO_PATH
+    assert "warning" not in capsys.readouterr().err
