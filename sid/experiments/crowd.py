@@ -408,7 +408,7 @@ def _accumulate(log: TrackLog, match_distance: float, progress: Progress | None 
         track_ids = [p.id for p in log.tracks[k]]
         row_part = part[[truth_node[int(i)] for i in truth_ids]].reshape(-1)
         col_part = part[[track_node[i] for i in track_ids]].reshape(-1)
-        distances = _distances(log, k, max_d2)
+        distances = _distances(log, k, max_d2)  # again, not kept from the first pass: (truth, tracks) per frame
         for index in np.unique(np.concatenate([row_part, col_part])).tolist():
             rows, cols = row_part == index, col_part == index
             accumulators[index].update(

@@ -10,6 +10,7 @@ from costmap.layers.obstacle import SCAN
 from costmap.layers.social import GROUPS, PEOPLE
 from costmap.layers.static import static_costs
 from costmap.mapfile import read_map
+from costmap.occupancy import OccupancyGrid
 from costmap.plugins import CostmapParams, layered_costmap
 from planner.problem import DEFAULT_COST_WEIGHT, PlanningProblem
 from sid.perception.group import Group
@@ -51,7 +52,7 @@ def build_costmap(
         static_map=known,
     )
     lidar = scenario.lidar
-    walls = map_walls(scenario)
+    walls = None if static_map is None else _walls(scenario, static_map)
     scan = simulate_scan(
         scenario.robot.start,
         scenario.obstacles,
@@ -70,9 +71,11 @@ def build_costmap(
 def map_walls(scenario: Scenario) -> Costmap2D | None:
     """The scenario's ``static_map`` file on its grid, read as the static layer reads it: the walls (its LETHAL cells)
     that the simulated LiDAR hits whatever the costmap's layers; None without a file."""
-    if scenario.static_map is None:
-        return None
-    static_map = read_map(scenario.static_map)
+    return None if scenario.static_map is None else _walls(scenario, read_map(scenario.static_map))
+
+
+def _walls(scenario: Scenario, static_map: OccupancyGrid) -> Costmap2D:
+    """``static_map`` (the scenario's file, read) on the scenario's grid as the static layer reads it."""
     track_unknown = scenario.layers.obstacle.track_unknown_space
     return Costmap2D(scenario.grid, static_costs(static_map, scenario.grid, track_unknown))
 

@@ -143,10 +143,11 @@ def _collision_reason(hit: str, t: float, k: int, state: RobotState, walkers: It
     return f"collision with {hit} at t = {t:.1f} s{note}"
 
 
-def make_sensing(world: SimWorld, options: RunOptions, color: bool = False) -> Sensing:
+def make_sensing(world: SimWorld, options: RunOptions, color: bool = False, walls: Costmap2D | None = None) -> Sensing:
     """The costmap and the sensing the options ask for (``sid.experiments.simulate.perception``). The costmap's
     static layer holds the scenario's obstacles (none with ``unknown_map``); ``color``: render the camera's colour
-    image (for pictures; a pose model always gets one), which changes no result of ``TruthPose``."""
+    image (for pictures; a pose model always gets one), which changes no result of ``TruthPose``; ``walls``: the
+    scenario's map file's walls (``map_walls``), which hide people from exact perception."""
     scenario = world.scenario
     known = replace(scenario, people=[])
     if options.unknown_map:
@@ -156,7 +157,7 @@ def make_sensing(world: SimWorld, options: RunOptions, color: bool = False) -> S
     if options.perception == "exact":
         costmap = build_costmap(known, social=True, groups=[])
         return ExactSensing(costmap, scenario.obstacles, scenario.group_params, scenario.lidar.body_radius,
-                            walls=map_walls(scenario))  # fmt: skip
+                            walls=walls)  # fmt: skip
     plugins = tuple("tracked_people" if name == "social" else name for name in scenario.layers.plugins)
     costmap = build_costmap(known, social=True, groups=[], params=replace(scenario.layers, plugins=plugins))
     if options.model is None:
@@ -275,7 +276,8 @@ def simulate(
     scenario, settings = world.scenario, world.settings
     limits = settings.limits
     dt = 1.0 / settings.rate_hz
-    sensing = make_sensing(world, options, color)
+    walls = map_walls(scenario)  # read once: the world's collisions and scans, exact perception's sight lines
+    sensing = make_sensing(world, options, color, walls)
     planner = _Planner(world, options)
     trace = RunTrace(False, "", 0, 0.0)
     if not options.unknown_map:
@@ -286,7 +288,6 @@ def simulate(
             x, y, yaw = scenario.robot.start
             trace.trajectory.append((0.0, x, y, yaw))
             return trace
-    walls = map_walls(scenario)
     obstacles = obstacle_geometry(scenario.obstacles, walls)
     lidar, goal = scenario.lidar, scenario.robot.goal
     state = RobotState(*scenario.robot.start)
