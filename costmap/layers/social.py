@@ -551,9 +551,23 @@ def repaint(
     for window in previous:
         costs[window.slices] = FREE_SPACE
     painted = paint_groups(costs, spec, hulls, params)
-    painted += paint_people(costs, spec, people, params, sigma_fronts)
-    painted += paint_bodies(costs, spec, people, body_radius)
+    spaces = paint_people(costs, spec, people, params, sigma_fronts)
+    bodies = paint_bodies(costs, spec, people, body_radius)
+    # a body inside its own personal space (the usual case) adds no cell: fewer windows for ``disjoint`` to merge
+    painted += spaces + [body for body, space in zip(bodies, spaces, strict=True) if not _inside(body, space)]
     return disjoint(painted)
+
+
+def _inside(window: Window | None, outer: Window | None) -> bool:
+    """Whether every cell of ``window`` lies in ``outer`` (None: no cell, inside anything)."""
+    if window is None:
+        return True
+    return (
+        outer is not None
+        and outer.row0 <= window.row0
+        and window.row1 <= outer.row1
+        and (outer.col0 <= window.col0 and window.col1 <= outer.col1)
+    )
 
 
 class SocialLayer(RepaintedLayer):

@@ -250,3 +250,23 @@ def test_the_distance_to_a_zone_is_shapelys(seed: int) -> None:
         xs, ys = REFERENCE_SPEC.cell_axes(window)
         centres = shapely.points(np.broadcast_to(xs, distance.shape), np.broadcast_to(ys, distance.shape))
         np.testing.assert_allclose(distance, shapely.distance(hull, centres), atol=2e-5)  # float32 in the layer
+
+
+@pytest.mark.parametrize(
+    "params", [SocialParams(), SocialParams(sigma_rear=0.05, sigma_side=0.05), SocialParams(amplitude=0.0)]
+)
+def test_the_windows_an_update_reports_hold_every_cell_it_painted_and_the_next_update_clears_them(params) -> None:
+    # Bodies within their personal space add no window of their own; bodies wider than it (a narrow space, none at
+    # amplitude 0) keep theirs, so the next update still clears them.
+    rng = np.random.default_rng(5)
+    layer = SocialLayer(SPEC, params, body_radius=0.3)
+    people = [Person(i, *map(float, rng.uniform((0, -3, -4), (8, 3, 4)))) for i in range(9)]
+    pair = Group((0, 1), (4.0, 0.0), 0.0, np.empty((0, 2)), 0.5)
+    windows = layer.update_windows(LayerInputs({PEOPLE: people, GROUPS: [pair]}), [])
+    covered = np.zeros(SPEC.shape, dtype=bool)
+    for window in windows:
+        assert not covered[window.slices].any(), "the windows share no cell"
+        covered[window.slices] = True
+    assert (layer.costs == LETHAL).any() and not (layer.costs[~covered] != FREE_SPACE).any()
+    layer.update_windows(LayerInputs({PEOPLE: []}), [])
+    assert not layer.costs.any()
