@@ -228,13 +228,6 @@ class GridSpec:
             return None
         return Window(row0, row1, col0, col1) if row0 < row1 and col0 < col1 else None
 
-    def window_around(self, xy: np.ndarray) -> Window | None:
-        """The cells of the bounding box of world points (N, 2), clipped to the grid; None when empty or outside."""
-        xy = np.asarray(xy, dtype=float).reshape(-1, 2)
-        if len(xy) == 0:
-            return None
-        return self.window(tuple(xy.min(axis=0)), tuple(xy.max(axis=0)))
-
     @property
     def whole(self) -> Window:
         """Every cell of the grid."""

@@ -110,8 +110,6 @@ def test_windows_union_grow_and_clip():
     assert Window(-5, 0, 0, 3).clipped(SPEC) is None
     assert SPEC.window((20.0, 0.0), (21.0, 1.0)) is None
     assert SPEC.window((np.nan, 0.0), (1.0, 1.0)) is None and SPEC.window((0.0, 0.0), (np.inf, 1.0)) is None
-    assert SPEC.window_around([[0.0, 0.0], [-0.96, 0.07]]) == Window(80, 82, 0, 21)
-    assert SPEC.window_around(np.zeros((0, 2))) is None
     costs = np.zeros(SPEC.shape)
     costs[Window(1, 3, 4, 7).slices] = 1
     assert costs.sum() == 6
