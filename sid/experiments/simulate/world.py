@@ -16,7 +16,6 @@ World frame = the map frame (REP-103), metres, radians, seconds.
 
 from __future__ import annotations
 
-import copy
 import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -106,9 +105,7 @@ def _fail(name: str, expected: str, value: Any) -> ScenarioError:
     return ScenarioError(f"{name}: expected {expected}, got {summary(value)}")
 
 
-def _settings(data: Any) -> SimSettings:
-    if not isinstance(data, dict):
-        raise _fail("simulation", "a mapping", data)
+def _settings(data: dict[str, Any]) -> SimSettings:
     unknown = sorted(set(data) - set(SIM_FIELDS))
     if unknown:
         raise ScenarioError(f"simulation.{unknown[0]}: unknown field; known fields: {', '.join(SIM_FIELDS)}")
@@ -135,11 +132,8 @@ def _settings(data: Any) -> SimSettings:
 
 def world_from_dict(data: Any, base_dir: Path | None = None, default_name: str = "scenario") -> SimWorld:
     """A SimWorld from a parsed simulation file (see the module docstring); errors name the field."""
-    if not isinstance(data, dict):
-        raise _fail("scenario", "a mapping", data)
-    data = copy.deepcopy(data)
-    settings = _settings(data.pop("simulation", {}))
-    scenario = scenario_from_dict(data, base_dir, default_name)
+    scenario = scenario_from_dict(data, base_dir, default_name)  # also checks that ``simulation`` is a mapping
+    settings = _settings(data.get("simulation", {}))
     for i, person in enumerate(scenario.people):
         if person.theta is None and person.id not in scenario.walks:
             raise ScenarioError(

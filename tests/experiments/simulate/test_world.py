@@ -31,6 +31,11 @@ def test_a_bad_simulation_block_is_named(simulation, message):
         tiny_world(simulation=simulation)
 
 
+def test_a_simulation_block_that_is_no_mapping_is_named_as_every_command_names_it():
+    with pytest.raises(ScenarioError, match=r"^simulation: expected a mapping \(sid simulate's settings, docs/simu"):
+        world_from_dict({**TINY, "simulation": [1.0]})
+
+
 def test_a_standing_person_without_a_facing_is_refused_by_name_whatever_the_run():
     # The world is ground truth: a person stands facing somewhere; "unknown facing" is what perception reports. The
     # camera cannot render a body without one, so the file is refused on loading, before any run of a sweep.
