@@ -108,17 +108,21 @@ def disjoint(windows: Iterable[Window | None], slack: int = SEPARATE_WINDOW_CELL
         if window is None:
             continue
         r0, r1, c0, c1 = window.row0, window.row1, window.col0, window.col1
-        merged = True
-        while merged:  # the merged box may reach others
-            merged = False
-            for i, (b0, b1, d0, d1) in enumerate(out):
-                u0, u1, v0, v1 = min(r0, b0), max(r1, b1), min(c0, d0), max(c1, d1)
-                overlap = r0 < b1 and b0 < r1 and c0 < d1 and d0 < c1
-                if overlap or (u1 - u0) * (v1 - v0) - (r1 - r0) * (c1 - c0) - (b1 - b0) * (d1 - d0) <= slack:
-                    del out[i]
-                    merged = (u0, u1, v0, v1) != (b0, b1, d0, d1)  # a box that grew may now reach others
-                    r0, r1, c0, c1 = u0, u1, v0, v1
+        i = 0
+        while i < len(out):  # conditional expressions, not min/max calls: this loop runs per window per frame
+            b0, b1, d0, d1 = out[i]
+            u0, u1 = (r0 if r0 < b0 else b0), (r1 if r1 > b1 else b1)
+            v0, v1 = (c0 if c0 < d0 else d0), (c1 if c1 > d1 else d1)
+            overlap = r0 < b1 and b0 < r1 and c0 < d1 and d0 < c1
+            if overlap or (u1 - u0) * (v1 - v0) - (r1 - r0) * (c1 - c0) - (b1 - b0) * (d1 - d0) <= slack:
+                del out[i]
+                grew = (u0, u1, v0, v1) != (b0, b1, d0, d1)
+                r0, r1, c0, c1 = u0, u1, v0, v1
+                if not grew:
                     break
+                i = 0  # the merged box grew: it may now reach windows already passed
+            else:
+                i += 1
         out.append((r0, r1, c0, c1))
     return [Window(*box) for box in out]
 
