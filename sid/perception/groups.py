@@ -230,9 +230,9 @@ class GroupParams:
 def detect_groups(people: Sequence[Person], params: GroupParams = GroupParams()) -> list[Group]:
     """Interacting groups among ``people`` (world frame) by ``params.method``.
 
-    Members are listed in input order, groups in order of their first member. Every method but ``gcff`` sees the
-    people sorted by id, so that the same people in another order give the same groups. Raises ValueError naming
-    the person for a non-finite position or yaw, and for duplicate ids. Fewer than two people give no group.
+    Members are listed in input order, groups in order of their first member. Every method sees the people sorted
+    by id, so that the same people in another order give the same groups. Raises ValueError naming the person for a
+    non-finite position or yaw, and for duplicate ids. Fewer than two people give no group.
     """
     people = list(people)
     ids, positions, facing = _validated(people)
@@ -241,7 +241,7 @@ def detect_groups(people: Sequence[Person], params: GroupParams = GroupParams())
     if params.method == "ospace":
         return _ospace_groups(people, ids, positions, facing, params)
     if params.method == "gcff":
-        return _gcff_groups(people, positions, facing, params)
+        return _gcff_groups(people, ids, positions, facing, params)
     if params.method == "paper" and not math.isinf(params.meeting_radius):
         params = params.as_paper
     return clustered_groups(ids, positions, facing, params)
@@ -288,20 +288,26 @@ def _ospace_groups(
 
 
 def _gcff_groups(
-    people: list[Person], positions: list[complex], facing: list[complex], params: GroupParams
+    people: list[Person], ids: list[int], positions: list[complex], facing: list[complex], params: GroupParams
 ) -> list[Group]:
     """The graph-cut method's groups, with the o-space method's zones; a group whose members' rays do not meet
-    gets the mean of its members' votes (position + stride x facing, known facings only) as its centre."""
+    gets the mean of its members' votes (position + stride x facing, known facings only) as its centre. The graph
+    cuts see the people sorted by id: their moves break exact ties by index."""
+    order = sorted(range(len(people)), key=ids.__getitem__)
     labels = gcff_labels(
-        np.array([(p.real, p.imag) for p in positions]),
-        np.array([math.nan if p.theta is None else p.theta for p in people]),
+        np.array([(positions[i].real, positions[i].imag) for i in order]),
+        np.array([math.nan if people[i].theta is None else people[i].theta for i in order]),
         params.gcff_params,
     ).tolist()
-    members = [[j for j, label in enumerate(labels) if label == g] for g in range(max(labels, default=-1) + 1)]
+    found: dict[int, list[int]] = {}
+    for k, label in zip(order, labels, strict=True):
+        if label >= 0:  # -1: alone
+            found.setdefault(label, []).append(k)
+    members = sorted(sorted(group) for group in found.values())  # input order, groups by their first member
     stride = params.gcff_stride
     votes = [[positions[j] + stride * facing[j] for j in group if facing[j] == facing[j]] for group in members]
     centres = [sum(v, 0j) / len(v) for v in votes]
-    return _zoned(members, centres, [p.id for p in people], positions, facing, params)
+    return _zoned(members, centres, ids, positions, facing, params)
 
 
 def _zoned(
