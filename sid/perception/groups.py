@@ -15,6 +15,7 @@ All coordinates are in the world frame (metres, REP-103, see ``sid.perception.pe
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from functools import cached_property
@@ -365,6 +366,9 @@ def facing_step(thetas: Sequence[float | None]) -> float:
 def _validated(people: list[Person]) -> tuple[list[int], list[complex], list[complex]]:
     """Ids, positions and unit facing vectors as complex numbers x + iy (NaN facing = unknown), validated."""
     ids = [p.id for p in people]
+    for i in ids:  # before sorting by id, which would fail inside Python on a str or None
+        if type(i) is not int and (isinstance(i, bool) or not isinstance(i, numbers.Integral)):
+            raise ValueError(f"groups: person id {i!r} is not a whole number")
     if len(set(ids)) != len(ids):
         duplicates = sorted({i for i in ids if ids.count(i) > 1})
         raise ValueError(f"groups: person ids must be unique, repeated: {duplicates}")

@@ -286,6 +286,9 @@ def test_empty_and_single_person_give_no_group():
         ([Person(1, "1", 0.0, 0.0), Person(2, 1.0, 0.0, 3.0)], "person 1 has a position that is not a pair of numbers"),
         ([Person(1, 0.0, 0.0, "0"), Person(2, 1.0, 0.0, 3.0)], "person 1 has a theta that is not a number"),
         ([Person(1, 0.0, 0.0, 0.0, math.nan), Person(2, 0.8, 0.0, 3.1, 1.0)], "person 1 has orientation_quality nan"),
+        ([Person("a", 0.0, 0.0, 0.0), Person(1, 1.0, 0.0, 3.1)], "person id 'a' is not a whole number"),
+        ([Person(1, 0.0, 0.0, 0.0), Person(None, 1.0, 0.0, 3.1)], "person id None is not a whole number"),
+        ([Person(1.5, 0.0, 0.0, 0.0), Person(1, 1.0, 0.0, 3.1)], "person id 1.5 is not a whole number"),
     ],
 )
 @pytest.mark.parametrize("method", ["ospace", "gcff", "rays", "paper"])
