@@ -21,11 +21,11 @@ from sid.checks import check_limit, check_yaw
 from sid.cli.common import fail, process_json_lines, refuse_unknown_fields, run_json_lines
 from sid.cli.grouping import add_json_lines_command, group_params_from
 from sid.documents import is_number, summary
-from sid.perception.group import Group
+from sid.perception.group import group_json
 from sid.perception.groups import GroupParams, detect_groups
 from sid.perception.people import Person
 
-__all__ = ["LINE_FIELDS", "PERSON_FIELDS", "add_parser", "group_to_json", "process", "run"]
+__all__ = ["LINE_FIELDS", "PERSON_FIELDS", "add_parser", "process", "run"]
 
 LINE_FIELDS = ("frame", "people")
 PERSON_FIELDS = ("id", "x", "y", "theta", "orientation_quality")
@@ -58,17 +58,7 @@ def process(lines: Iterable[str | bytes], out: TextIO, err: TextIO, params: Grou
 def _groups_line(data: Any, params: GroupParams) -> dict[str, Any]:
     """The output line of one parsed input line: its frame label and groups (ValueError for a malformed line)."""
     frame = _parse_frame(data)
-    return {"frame": frame["frame"], "groups": [group_to_json(g) for g in detect_groups(frame["people"], params)]}
-
-
-def group_to_json(group: Group) -> dict[str, Any]:
-    return {
-        "members": list(group.members),
-        "interest_point": list(group.interest_point),
-        "area": group.area,
-        "spread": group.spread,
-        "zone": group.zone.tolist(),
-    }
+    return {"frame": frame["frame"], "groups": [group_json(g) for g in detect_groups(frame["people"], params)]}
 
 
 def _parse_frame(data: Any) -> dict[str, Any]:

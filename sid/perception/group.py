@@ -7,6 +7,7 @@ Same frame as the members' ``Person`` records (``base_footprint`` or ``map``, me
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -29,8 +30,9 @@ class Group:
     spread: float
 
 
-def group_json(group: Group) -> dict:
-    """A group as plain JSON (the format of ``sid groups``)."""
+def group_json(group: Group) -> dict[str, Any]:
+    """A group as plain JSON (world frame, m, m^2; the zone's vertices to 0.1 mm): the format of ``sid groups``,
+    ``sid detect`` and the ROS node's group messages."""
     return {
         "members": [int(m) for m in group.members],
         "interest_point": [float(v) for v in group.interest_point],
