@@ -17,13 +17,13 @@ import argparse
 from collections.abc import Iterable
 from typing import Any, TextIO
 
-from sid.checks import check_limit, check_yaw
+from sid.checks import check_limit
 from sid.cli.common import fail, process_json_lines, refuse_unknown_fields, run_json_lines
 from sid.cli.grouping import add_json_lines_command, group_params_from
+from sid.cli.person_json import parse_person
 from sid.documents import is_number, summary
 from sid.perception.group import group_json
 from sid.perception.groups import GroupParams, detect_groups
-from sid.perception.people import Person
 
 __all__ = ["LINE_FIELDS", "PERSON_FIELDS", "add_parser", "process", "run"]
 
@@ -73,33 +73,4 @@ def _parse_frame(data: Any) -> dict[str, Any]:
     frame = data.get("frame")  # a label, echoed back: it must stay valid JSON (1e400 would come back as Infinity)
     if not (frame is None or isinstance(frame, str) or is_number(frame)):
         raise ValueError(f"'frame' must be a finite number or a string, got {summary(frame)}")
-    return {"frame": frame, "people": [_parse_person(p, k) for k, p in enumerate(data["people"])]}
-
-
-def _parse_person(data: Any, index: int) -> Person:
-    where = f"people[{index}]"
-    if not isinstance(data, dict):
-        raise ValueError(f"{where} must be an object with id, x, y, theta")
-    refuse_unknown_fields(data, PERSON_FIELDS, f"{where}: ")
-    for key in ("id", "x", "y"):
-        if key not in data:
-            raise ValueError(f"{where} is missing {key!r}")
-    person_id = data["id"]
-    if isinstance(person_id, bool) or not isinstance(person_id, int):
-        raise ValueError(f"{where}: id must be an integer, got {summary(person_id)}")
-    values = {}
-    for key in ("x", "y", "theta", "orientation_quality"):
-        value = data.get(key)
-        if key in ("theta", "orientation_quality") and value is None:
-            continue
-        if not is_number(value):
-            raise ValueError(f"{where} (id {person_id}): {key} must be a finite number, got {summary(value)}")
-        values[key] = float(value)
-    theta = values.get("theta")
-    if theta is not None:
-        check_yaw(f"{where} (id {person_id})", "theta", theta)
-    # A given facing is taken at full quality unless the line says otherwise (as in scenario files).
-    quality = values.get("orientation_quality", 0.0 if theta is None else 1.0)
-    if not 0.0 <= quality <= 1.0:
-        raise ValueError(f"{where} (id {person_id}): orientation_quality must lie in [0, 1], got {summary(quality)}")
-    return Person(person_id, values["x"], values["y"], theta, quality)
+    return {"frame": frame, "people": [parse_person(p, k, PERSON_FIELDS) for k, p in enumerate(data["people"])]}

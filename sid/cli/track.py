@@ -26,9 +26,10 @@ import argparse
 from collections.abc import Callable, Iterable
 from typing import Any, TextIO
 
-from sid.checks import check_limit, check_yaw, repeated
+from sid.checks import check_limit, repeated
 from sid.cli.common import fail, process_json_lines, refuse_unknown_fields, run_json_lines
 from sid.cli.grouping import add_json_lines_command, group_params_from
+from sid.cli.person_json import parse_person
 from sid.documents import is_number, summary
 from sid.perception.people import Person
 from sid.tracking import TrackingSession
@@ -112,7 +113,7 @@ def _parse_line(data: Any) -> tuple[int | float, list[Person]]:
     if not isinstance(data["people"], list):
         raise ValueError("'people' must be a list")
     check_limit("people", len(data["people"]), "people", "people")  # before any work on them (sid.checks.Limits)
-    people = [_parse_person(person, k) for k, person in enumerate(data["people"])]
+    people = [parse_person(person, k, PERSON_FIELDS, id_default=True) for k, person in enumerate(data["people"])]
     ids = [person.id for person in people]
     twice = repeated(ids)
     if twice is not None:
@@ -121,28 +122,3 @@ def _parse_line(data: Any) -> tuple[int | float, list[Person]]:
         why = f" ({defaults[0]} has no 'id': its index in the list is its id)" if defaults else ""
         raise ValueError(f"people[{first}] and people[{second}] have one id, {twice}{why}")
     return timestamp, people
-
-
-def _parse_person(data: Any, index: int) -> Person:
-    """A detection of the line's ``people`` list at ``index`` (id defaults to ``index``)."""
-    where = f"people[{index}]"
-    if not isinstance(data, dict):
-        raise ValueError(f"{where} must be an object with x, y and optionally theta and id")
-    refuse_unknown_fields(data, PERSON_FIELDS, f"{where}: ")
-    person_id = data.get("id", index)
-    if isinstance(person_id, bool) or not isinstance(person_id, int):
-        raise ValueError(f"{where}: id must be an integer, got {summary(person_id)}")
-    for key in ("x", "y"):
-        if key not in data:
-            raise ValueError(f"{where} is missing {key!r}")
-        if not is_number(data[key]):
-            raise ValueError(f"{where}: {key} must be a finite number of metres, got {summary(data[key])}")
-    theta = data.get("theta")
-    if theta is not None and not is_number(theta):
-        raise ValueError(
-            f"{where}: theta must be a finite number of radians, or null when unknown, got {summary(theta)}"
-        )
-    if theta is None:
-        return Person(person_id, float(data["x"]), float(data["y"]))
-    check_yaw(where, "theta", theta)
-    return Person(person_id, float(data["x"]), float(data["y"]), float(theta), 1.0)

@@ -63,7 +63,7 @@ def test_malformed_lines_are_reported_with_their_number_and_skipped(tmp_path, ca
     assert [json.loads(line)["frame"] for line in out] == [0, 9, "take 2"]
     assert "line 8: 'frame' must be a finite number or a string, got Infinity" in err
     assert "line 2: not valid JSON" in err
-    assert 'line 3: people[0] (id 1): x must be a finite number, got "far"' in err
+    assert 'line 3: people[0] (id 1): x must be a finite number of metres, got "far"' in err
     assert "line 4: groups: person ids must be unique" in err
     assert "line 5: not valid JSON (NaN is not a number)" in err
     assert "line 6: expected a JSON object" in err
@@ -291,7 +291,7 @@ def test_orientation_quality_is_read_and_checked(capsys, monkeypatch):
     monkeypatch.setattr(sys, "stdin", io.StringIO("\n".join(json.dumps(line) for line in lines) + "\n"))
     code, out, err = run_sid(["groups", "-"], capsys)
     assert code == 0 and [json.loads(line)["groups"] != [] for line in out] == [False, True]
-    assert "line 3: people[1] (id 2): orientation_quality must lie in [0, 1], got 1.5" in err
+    assert "line 3: people[1] (id 2): orientation_quality must be a number in [0, 1], got 1.5" in err
 
 
 def test_eval_fformation_cross_validates_over_a_grid(tmp_path, capsys):

@@ -108,16 +108,19 @@ BAD_LINES = [
     ('{"timestamp": 1e400, "people": []}', "'timestamp' must be a finite number of seconds, got Infinity"),
     ('{"timestamp": NaN, "people": []}', "not valid JSON (NaN is not a number)"),
     ('{"timestamp": 0.5, "people": {}}', "'people' must be a list"),
-    ('{"timestamp": 0.5, "people": [3]}', "people[0] must be an object with x, y and optionally theta and id"),
-    ('{"timestamp": 0.5, "people": [{"y": 0}]}', "people[0] is missing 'x'"),
-    ('{"timestamp": 0.5, "people": [{"x": 0, "y": null}]}', "people[0]: y must be a finite number of metres, got null"),
+    ('{"timestamp": 0.5, "people": [3]}', "people[0] must be an object with id, x, y, theta"),
+    ('{"timestamp": 0.5, "people": [{"y": 0}]}', "people[0] (id 0) is missing 'x'"),
+    (
+        '{"timestamp": 0.5, "people": [{"x": 0, "y": null}]}',
+        "people[0] (id 0): y must be a finite number of metres, got null",
+    ),
     (
         '{"timestamp": 0.5, "people": [{"x": 0, "y": 1' + "0" * 400 + "}]}",  # an int no float can hold
-        "people[0]: y must be a finite number of metres, got 1" + "0" * 76 + "...",  # its summary, 80 characters
+        "people[0] (id 0): y must be a finite number of metres, got 1" + "0" * 76 + "...",  # its summary, 80 characters
     ),
     (
         '{"timestamp": 0.5, "people": [{"x": 0, "y": 0, "theta": "north"}]}',
-        'people[0]: theta must be a finite number of radians, or null when unknown, got "north"',
+        'people[0] (id 0): theta must be a finite number of radians, or null when unknown, got "north"',
     ),
     (
         '{"timestamp": 0.5, "people": [{"x": 0, "y": 0, "thta": 1.0}]}',
@@ -159,7 +162,7 @@ def test_strict_stops_at_the_first_bad_line_keeping_earlier_output(tmp_path, cap
     code, out, err = run_sid(["track", "--strict", str(source)], capsys)
     assert code == 2 and [record["timestamp"] for record in out] == [line["timestamp"] for line in lines[:4]]
     assert len(out[-1]["people"]) == 5
-    assert err == ["sid track: line 5: people[0] is missing 'y'"]
+    assert err == ["sid track: line 5: people[0] (id 0) is missing 'y'"]
 
 
 def test_timestamps_out_of_order_are_refused_naming_both(tmp_path, capsys):
@@ -249,7 +252,9 @@ def test_a_facing_in_degrees_by_mistake_is_a_malformed_line(tmp_path, capsys):
     lines.append({"timestamp": 0.1, "people": [{"x": 1.0, "y": 0.0, "theta": -90}]})
     code, out, err = run_sid(["track", str(write_lines(tmp_path / "in.jsonl", lines))], capsys)
     assert code == 0 and [record["timestamp"] for record in out] == [0.0]
-    assert err[0] == "sid track: line 2: people[0]: theta -90 is beyond two turns (4 pi): radians expected, not degrees"
+    assert err[0] == (
+        "sid track: line 2: people[0] (id 0): theta -90 is beyond two turns (4 pi): radians expected, not degrees"
+    )
 
 
 def test_a_gap_that_ends_every_track_is_noted_so_timestamps_in_another_unit_are_not_silent(tmp_path, capsys):
