@@ -5,7 +5,8 @@ timestamp in seconds, each after the last good line's; theta null or absent = un
 integer id of the detection, default its index in the list, echoed back as the track's "detection"):
     {"timestamp": 0.0, "people": [{"id": 7, "x": 2.0, "y": 0.5, "theta": 3.1}, {"x": 2.0, "y": -0.5}]}
 Output, one line per good input line, flushed as it is written, the tracks as `sid detect` writes them
-(docs/tracking.md; a track is listed from its third detection, velocity in m/s, group members as track ids):
+(docs/tracking.md; a track is listed from its third detection, or its second 0.2 s or more after the first;
+velocity in m/s; group members as track ids):
     {"timestamp": 0.0, "people": [{"id": 1, "x": 2.0, "y": 0.5, "theta": 3.1, "velocity": [vx, vy],
                                    "state": "standing"|"walking", "visible": true, "detection": 7}],
      "groups": [{"id": 1, "kind": "conversation"|"walking", "members": [1, 2], "interest_point": [x, y],
