@@ -8,7 +8,8 @@ assigned to tracks by position alone, the least total distance to the prediction
 track's uncertainty (``sid.tracking.assignment``); matched tracks are corrected; a tentative track that is missed is
 deleted, and one detected ``confirm_hits`` times (or twice in a row ``confirm_time`` apart) is confirmed; every
 unmatched detection starts a tentative track. Facing is smoothed on the circle (an exponential average of unit
-vectors), and the state switches to walking above ``walk_speed`` and back to standing below ``stand_speed``.
+vectors, a new one weighted by the time since the track's last measured facing), and the state switches to
+walking above ``walk_speed`` and back to standing below ``stand_speed``.
 
 Only confirmed tracks are reported. Track ids count up from 1 and are never reused, also across ``reset``.
 """
@@ -104,6 +105,7 @@ class PeopleTracker:
         self._unseen = np.zeros(0)  # seconds undetected since the last hit while the camera could see the track
         self._first_hit = np.zeros(0)
         self._facing = np.zeros((0, 2))  # unit vectors, NaN while unknown
+        self._facing_time = np.zeros(0)  # timestamp (s) of the last measured facing, NaN while unknown
         self._detection = np.zeros(0, dtype=np.intp)  # index of this frame's matched detection, -1: none
         self._in_view = np.zeros(0, dtype=bool)  # the predicted position lies in the camera's view
 
@@ -142,7 +144,7 @@ class PeopleTracker:
         self._keep(~self._expired(timestamp))
         rows, cols = self._assign(positions, facing, r)
         self._motion.correct(rows, positions[cols], r)
-        self._smooth_facing(rows, facing[cols], dt)
+        self._smooth_facing(rows, facing[cols], timestamp)
         self._hits[rows] += 1
         self._last_hit[rows] = timestamp
         self._unseen[rows] = 0.0
@@ -195,18 +197,20 @@ class PeopleTracker:
             allowed[striding] &= ~turned
         return gated_assignment(distance, allowed)
 
-    def _smooth_facing(self, rows: np.ndarray, measured: np.ndarray, dt: float) -> None:
-        """Average measured facings (K, 2) unit vectors (NaN: none) into the tracks ``rows`` on the unit circle."""
+    def _smooth_facing(self, rows: np.ndarray, measured: np.ndarray, timestamp: float) -> None:
+        """Average facings (K, 2) unit vectors (NaN: none) measured at ``timestamp`` (s) into the tracks ``rows`` on
+        the unit circle, each weighted by the time since its track's last measured facing."""
         tau = self.params.facing_tau
-        weight = 1.0 - math.exp(-dt / tau) if tau > 0 else 1.0
         old = self._facing[rows]
-        mixed = (1 - weight) * old + weight * measured
+        weight = 1.0 - np.exp(-(timestamp - self._facing_time[rows]) / tau) if tau > 0 else np.ones(len(rows))
+        mixed = (1 - weight[:, None]) * old + weight[:, None] * measured
         mixed = np.where(np.isnan(old), measured, np.where(np.isnan(measured), old, mixed))
         norm = np.sqrt(mixed[:, 0] ** 2 + mixed[:, 1] ** 2)
         flat = ~(norm > 1e-9)  # exactly opposite facings average to nothing: take the new one
         mixed[flat] = measured[flat]
         norm[flat] = 1.0
         self._facing[rows] = mixed / norm[:, None]
+        self._facing_time[rows[~np.isnan(measured[:, 0])]] = timestamp
 
     def _start(self, cols: np.ndarray, positions: np.ndarray, facing: np.ndarray, timestamp: float) -> None:
         """Tentative tracks for the detections ``cols``."""
@@ -224,6 +228,7 @@ class PeopleTracker:
         self._detection = np.concatenate((self._detection, cols))
         self._in_view = np.concatenate((self._in_view, np.ones(k, dtype=bool)))  # just detected
         self._facing = np.concatenate((self._facing, facing[cols]))
+        self._facing_time = np.concatenate((self._facing_time, np.where(np.isnan(facing[cols, 0]), np.nan, timestamp)))
 
     def _keep(self, mask: np.ndarray) -> None:
         if mask.all():
@@ -237,6 +242,7 @@ class PeopleTracker:
         )
         self._unseen = self._unseen[mask]
         self._detection, self._facing, self._in_view = self._detection[mask], self._facing[mask], self._in_view[mask]
+        self._facing_time = self._facing_time[mask]
 
     def _report(self, ids: list[int]) -> list[TrackedPerson]:
         rows = np.flatnonzero(self._confirmed)

@@ -120,6 +120,18 @@ def test_unknown_facing_stays_unknown_until_measured() -> None:
     assert track.theta == pytest.approx(1.0)
 
 
+def test_a_facing_measured_long_ago_weighs_by_its_age_not_by_the_frame_interval() -> None:
+    tracker = PeopleTracker()
+    for k in range(5):  # facing 0
+        tracker.update([Person(0, 2.0, 0.0, 0.0)], k / FPS)
+    for k in range(5, 35):  # 2 s seen with no facing
+        tracker.update([Person(0, 2.0, 0.0, None)], k / FPS)
+    (track,) = tracker.update([Person(0, 2.0, 0.0, math.pi / 2)], 35 / FPS)
+    weight = 1 - math.exp(-(31 / FPS) / tracker.params.facing_tau)  # the last facing was measured at frame 4
+    assert track.theta == pytest.approx(math.atan2(weight, 1 - weight))
+    assert track.theta > math.radians(85)
+
+
 def test_frames_out_of_time_order_are_refused_and_change_nothing() -> None:
     tracker = PeopleTracker()
     t = _confirmed(tracker, 2.0, 0.0)
