@@ -93,8 +93,8 @@ class TrackingSession:
         if reset is not None:
             self.people.reset()
             self.groups.reset()
+        update = self._track(result.people, result.timestamp, view)  # a TrackingError here keeps the last frame
         self._last = (result.timestamp, result.frame_id, result.robot_pose)
-        update = self._track(result.people, result.timestamp, view)
         update.reset = reset
         return update
 
