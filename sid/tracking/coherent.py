@@ -18,6 +18,7 @@ import numpy as np
 from sid.checks import check_number, check_whole
 from sid.tracking.groups import connected_components
 from sid.tracking.records import TIME_TOLERANCE, TrackedPerson
+from sid.tracking.tracker import check_time_order
 
 __all__ = ["CoherentMotion", "CoherentMotionParams"]
 
@@ -59,7 +60,9 @@ class CoherentMotion:
         self._frames.clear()
 
     def update(self, people: Sequence[TrackedPerson], timestamp: float) -> list[frozenset[int]]:
-        """The groups (track ids, two or more) among ``people`` (this frame's tracks) at ``timestamp`` (s)."""
+        """The groups (track ids, two or more) among ``people`` (this frame's tracks) at ``timestamp`` (s);
+        TrackingError, changing nothing, when the timestamp is not after the last one."""
+        check_time_order("coherent motion: frame", timestamp, self._frames[-1].timestamp if self._frames else None)
         p = self.params
         order = sorted(range(len(people)), key=lambda k: people[k].id)
         ids = np.array([people[k].id for k in order], dtype=np.int64)

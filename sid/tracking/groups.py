@@ -35,6 +35,7 @@ from sid.checks import check_number, check_numbers, check_whole
 from sid.perception.groups import GroupParams, detect_groups
 from sid.tracking.assignment import gated_assignment
 from sid.tracking.records import TIME_TOLERANCE, GroupKind, TrackedGroup, TrackedPerson
+from sid.tracking.tracker import check_time_order
 
 __all__ = ["GroupTracker", "GroupTrackerParams", "connected_components"]
 
@@ -141,7 +142,9 @@ class GroupTracker:
         self._last_time = None
 
     def update(self, people: Sequence[TrackedPerson], timestamp: float) -> list[TrackedGroup]:
-        """The confirmed groups among ``people`` (this frame's tracks) at ``timestamp`` (s)."""
+        """The confirmed groups among ``people`` (this frame's tracks) at ``timestamp`` (s); TrackingError, changing
+        nothing, when the timestamp is not after the last one."""
+        check_time_order("group tracker: frame", timestamp, self._last_time)
         by_id = {p.id: p for p in people}
         if len(by_id) != len(people):
             raise ValueError("group tracker: a track id appears twice in one frame")

@@ -31,7 +31,7 @@ from sid.tracking.motion import MotionStates
 from sid.tracking.records import TIME_TOLERANCE, TrackedPerson
 from sid.tracking.view import View, ViewCone
 
-__all__ = ["OCCLUDER_RADIUS", "PeopleTracker", "TrackerParams", "TrackingError"]
+__all__ = ["OCCLUDER_RADIUS", "PeopleTracker", "TrackerParams", "TrackingError", "check_time_order"]
 
 OCCLUDER_RADIUS = 0.2
 """A person's half-width (m) seen from above, to tell who is behind whom in the camera's view (``ViewCone.behind``)."""
@@ -39,6 +39,16 @@ OCCLUDER_RADIUS = 0.2
 
 class TrackingError(SidError, ValueError):
     """Input a tracker cannot use: a frame out of time order, a non-finite position, an id given twice."""
+
+
+def check_time_order(what: str, timestamp: float, last: float | None) -> None:
+    """Raise TrackingError unless ``timestamp`` (s) is finite and after ``last`` (s; None: there was no frame before),
+    as every tracker requires; ``what`` names the input in the message."""
+    check_number(what, "timestamp", timestamp, unit="seconds", error=TrackingError)
+    if last is not None and timestamp <= last:
+        raise TrackingError(
+            f"{what} is out of time order: its timestamp {timestamp} s is not after the last one, {last} s"
+        )
 
 
 @dataclass(frozen=True)
@@ -126,11 +136,7 @@ class PeopleTracker:
         facing is not finite, or two people share an id.
         """
         positions, facing, ids = _measurements(people)
-        check_number("tracker", "timestamp", timestamp, unit="seconds", error=TrackingError)
-        if self._time is not None and timestamp <= self._time:
-            raise TrackingError(
-                f"tracker: frames out of time order, timestamp {timestamp} s is not after the last one, {self._time} s"
-            )
+        check_time_order("tracker: frame", timestamp, self._time)
         p = self.params
         r, q = p.measurement_sigma**2, p.acceleration_sigma**2
         dt = 0.0 if self._time is None else timestamp - self._time

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from sid.tracking import GroupTracker, GroupTrackerParams, TrackedPerson
+from sid.tracking import GroupTracker, GroupTrackerParams, TrackedPerson, TrackingError
 
 DT = 1 / 15
 
@@ -255,3 +255,18 @@ def test_groups_do_not_depend_on_the_clocks_offset(dt: float) -> None:
     frames = {offset: _first_report_of_a_pair_far_apart_exactly_one_window_ago(offset, dt)
               for offset in (0.0, 0.1, 17.3, 1234.567, 1.7e9 + 0.123, 1.7e9 + 0.9)}  # fmt: skip
     assert len(set(frames.values())) == 1, frames
+
+
+@pytest.mark.parametrize("back", [0.0, 2 * DT])
+def test_a_frame_not_after_the_last_is_refused_naming_both_timestamps_and_changes_nothing(back) -> None:
+    tracker = GroupTracker(GroupTrackerParams(miss_timeout=0.5))
+    for k in range(5):
+        groups = tracker.update(_circle(), 4 * DT + k * DT)
+    (group,) = groups
+    last = 8 * DT
+    with pytest.raises(TrackingError, match=rf"timestamp {4 * DT + back} s is not after the last one, {last} s"):
+        tracker.update([], 4 * DT + back)  # with a time gone backwards the group would never time out
+    blind = [_person(p.id, p.x, p.y, None) for p in _circle()]
+    alive = [tracker.update(blind, last + k * DT) for k in range(1, 10)]
+    assert [g.id for g in alive[6]] == [group.id]
+    assert not alive[8]  # gone after miss_timeout, counted from the last good frame
