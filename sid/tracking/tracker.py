@@ -147,7 +147,7 @@ class PeopleTracker:
         self._motion.predict(dt, q)
         self._in_view = np.ones(len(self._ids), dtype=bool) if view is None else view.contains(self._motion.position)
         self._unseen += np.where(self._in_view & ~_behind(view, self._motion.position, positions), dt, 0.0)
-        self._keep(~self._expired(timestamp))
+        self._keep(~self._expired())
         rows, cols = self._assign(positions, facing, r)
         self._motion.correct(rows, positions[cols], r)
         self._smooth_facing(rows, facing[cols], timestamp)
@@ -170,15 +170,11 @@ class PeopleTracker:
         self._walking = np.where(self._walking, speed > p.stand_speed, speed - speed_sigma > p.walk_speed)
         return self._report(ids)
 
-    def _expired(self, now: float) -> np.ndarray:
-        """(N,) bool: the tracks undetected for longer than ``timeout`` while the camera could see them, or for longer
-        than ``out_of_view_timeout`` in all. Time hidden (out of view, behind someone) does not count towards
-        ``timeout``: a walker hidden behind a group for longer than it, then in view a moment before being detected
-        again, keeps the track."""
-        p = self.params
-        return (self._unseen > p.timeout + TIME_TOLERANCE) | (
-            now - self._last_hit > p.out_of_view_timeout + TIME_TOLERANCE
-        )
+    def _expired(self) -> np.ndarray:
+        """(N,) bool: the tracks undetected for longer than ``timeout`` while the camera could see them. Time hidden
+        (out of view, behind someone) does not count towards it: a walker hidden behind a group for longer than it,
+        then in view a moment before being detected again, keeps the track."""
+        return self._unseen > self.params.timeout + TIME_TOLERANCE
 
     def _assign(self, positions: np.ndarray, facing: np.ndarray, r: float) -> tuple[np.ndarray, np.ndarray]:
         """Rows of tracks and columns of detections matched by minimum total distance, each within its gate.
