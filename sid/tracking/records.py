@@ -36,8 +36,8 @@ class TrackedPerson:
     (speed with hysteresis, ``TrackerParams``). visible: detected in this frame. in_view: the predicted position
     lies in the camera's field of view (True when the tracker was given no view). last_seen: timestamp (s) of the
     last detection. detection: the id of the person of this frame's input it was matched to (None when missed).
-    position_sigma, speed_sigma: standard deviations of the position (m) and velocity (m/s) estimates along each
-    axis (a new track's velocity is unknown: ``TrackerParams.initial_speed_sigma``).
+    speed_sigma: standard deviation of the velocity estimate along each axis (m/s; a new track's velocity is
+    unknown: ``TrackerParams.initial_speed_sigma``).
     """
 
     id: int
@@ -51,7 +51,6 @@ class TrackedPerson:
     in_view: bool
     last_seen: float
     detection: int | None
-    position_sigma: float
     speed_sigma: float
 
     @property

@@ -249,7 +249,7 @@ class PeopleTracker:
     def _report(self, ids: list[int]) -> list[TrackedPerson]:
         rows = np.flatnonzero(self._confirmed)
         in_view = self._in_view[rows].tolist()
-        sigma = np.sqrt(self._motion.covariance[rows][:, [0, 2]]).tolist()
+        speed_sigma = np.sqrt(self._motion.covariance[rows, 2]).tolist()
         facing = self._facing[rows]
         theta = [None if t != t else t for t in np.arctan2(facing[:, 1], facing[:, 0]).tolist()]  # NaN -> None
         detection = self._detection[rows].tolist()
@@ -266,8 +266,7 @@ class PeopleTracker:
                 seen,
                 last,
                 ids[d] if d >= 0 else None,
-                sd[0],
-                sd[1],
+                sd,
             )
             for track_id, (x, y), (vx, vy), th, walking, d, seen, last, sd in zip(
                 self._ids[rows].tolist(),
@@ -278,7 +277,7 @@ class PeopleTracker:
                 detection,
                 in_view,
                 self._last_hit[rows].tolist(),
-                sigma,
+                speed_sigma,
                 strict=True,
             )
         ]
