@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sid.checks import check_number, check_whole
-from sid.tracking.groups import connected_components
+from sid.tracking.groups import connected_components, pair_distance
 from sid.tracking.records import TIME_TOLERANCE, TrackedPerson
 from sid.tracking.tracker import check_time_order
 
@@ -67,8 +67,8 @@ class CoherentMotion:
         order = sorted(range(len(people)), key=lambda k: people[k].id)
         ids = np.array([people[k].id for k in order], dtype=np.int64)
         state = np.array([[people[k].x, people[k].y, people[k].vx, people[k].vy] for k in order]).reshape(-1, 4)
-        near = _pair_distance(state[:, :2]) <= p.distance
-        alike = _pair_distance(state[:, 2:]) <= p.velocity_difference
+        near = pair_distance(state[:, :2]) <= p.distance
+        alike = pair_distance(state[:, 2:]) <= p.velocity_difference
         self._frames.append(_Frame(timestamp, ids, near & alike))
         while self._frames and timestamp - self._frames[0].timestamp > p.window + TIME_TOLERANCE:
             self._frames.popleft()
@@ -89,8 +89,3 @@ class CoherentMotion:
         np.fill_diagonal(linked, False)
         groups = [frozenset(ids[rows].tolist()) for rows in connected_components(linked) if len(rows) >= 2]
         return sorted(groups, key=min)
-
-
-def _pair_distance(points: np.ndarray) -> np.ndarray:
-    d = points[:, None, :] - points[None, :, :]
-    return np.sqrt(d[..., 0] ** 2 + d[..., 1] ** 2)

@@ -37,7 +37,7 @@ from sid.tracking.assignment import gated_assignment
 from sid.tracking.records import TIME_TOLERANCE, GroupKind, TrackedGroup, TrackedPerson
 from sid.tracking.tracker import check_time_order
 
-__all__ = ["GroupTracker", "GroupTrackerParams", "connected_components"]
+__all__ = ["GroupTracker", "GroupTrackerParams", "connected_components", "pair_distance"]
 
 _NO_ZONE = np.zeros((0, 2))
 _CLOSENESS_STEP = 0.2
@@ -258,7 +258,7 @@ def _walking_groups(
         return []
     ids = np.array([p.id for p in walkers], dtype=np.int64)
     position = np.array([[p.x, p.y] for p in walkers])
-    i, j = np.nonzero(np.triu(_pair_distance(position) <= params.walk_distance, 1))
+    i, j = np.nonzero(np.triu(pair_distance(position) <= params.walk_distance, 1))
     velocity = np.array([[p.vx, p.vy] for p in walkers])
     alike = _relative_speed(ids, position, velocity, history, params, i, j) <= params.walk_velocity_difference
     i, j = i[alike], j[alike]
@@ -342,7 +342,8 @@ def _stayed_close(
     return close
 
 
-def _pair_distance(points: np.ndarray) -> np.ndarray:
+def pair_distance(points: np.ndarray) -> np.ndarray:
+    """(N, N) distances between the rows of (N, 2) ``points`` (positions, m; or velocities, m/s)."""
     d = points[:, None, :] - points[None, :, :]
     return np.sqrt(d[..., 0] ** 2 + d[..., 1] ** 2)
 
