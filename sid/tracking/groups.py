@@ -8,8 +8,9 @@ Per frame (``GroupTracker.update``), on the tracked people (``sid.tracking.track
   only once its speed is known, a second or more after it appeared) within ``walk_distance`` of each other whose
   velocities differ by at most ``walk_velocity_difference`` (side by side or in file), joined transitively
   (connected components).
-- each candidate is matched to a group track of its kind by member overlap (Jaccard index >= ``min_overlap``,
-  ``scipy.optimize.linear_sum_assignment`` on 1 - overlap); an unmatched candidate starts a tentative group.
+- each candidate is matched to a group track of its kind by member overlap (Jaccard index): as many pairs with an
+  overlap of ``min_overlap`` or more as can be matched, of the greatest total overlap among those matchings
+  (``sid.tracking.assignment.gated_assignment``); an unmatched candidate starts a tentative group.
 - a group is reported once it was found in ``confirm_hits`` of its last ``confirm_window`` frames; it survives
   frames in which it is not found for up to ``miss_timeout`` seconds, keeping its last geometry, but a member who
   leaves (track deleted, starts walking for a conversation or stops for a walking group, or goes farther than
