@@ -116,6 +116,7 @@ class PeopleTracker:
         self._first_hit = np.zeros(0)
         self._facing = np.zeros((0, 2))  # unit vectors, NaN while unknown
         self._facing_time = np.zeros(0)  # timestamp (s) of the last measured facing, NaN while unknown
+        self._quality = np.zeros(0)  # the facing's orientation quality in [0, 1], averaged as it; NaN while unknown
         self._detection = np.zeros(0, dtype=np.intp)  # index of this frame's matched detection, -1: none
         self._in_view = np.zeros(0, dtype=bool)  # the predicted position lies in the camera's view
 
@@ -135,7 +136,7 @@ class PeopleTracker:
         Raises TrackingError, changing nothing, when the timestamp is not after the last one, a position or a
         facing is not finite, or two people share an id.
         """
-        positions, facing, ids = _measurements(people)
+        positions, facing, quality, ids = _measurements(people)
         check_time_order("tracker: frame", timestamp, self._time)
         p = self.params
         r, q = p.measurement_sigma**2, p.acceleration_sigma**2
@@ -150,7 +151,7 @@ class PeopleTracker:
         self._keep(~self._expired())
         rows, cols = self._assign(positions, facing, r)
         self._motion.correct(rows, positions[cols], r)
-        self._smooth_facing(rows, facing[cols], timestamp)
+        self._smooth_facing(rows, facing[cols], quality[cols], timestamp)
         self._hits[rows] += 1
         self._last_hit[rows] = timestamp
         self._unseen[rows] = 0.0
@@ -163,7 +164,7 @@ class PeopleTracker:
         if len(cols) < len(ids):
             unmatched = np.ones(len(ids), dtype=bool)
             unmatched[cols] = False
-            self._start(np.flatnonzero(unmatched), positions, facing, timestamp)
+            self._start(np.flatnonzero(unmatched), positions, facing, quality, timestamp)
         velocity, speed_sigma = self._motion.velocity, np.sqrt(self._motion.covariance[:, 2])
         speed = np.sqrt(velocity[:, 0] ** 2 + velocity[:, 1] ** 2)
         # a young track's velocity is mostly noise: it must exceed walk_speed by its own standard deviation
@@ -199,22 +200,30 @@ class PeopleTracker:
             allowed[striding] &= ~turned
         return gated_assignment(distance, allowed)
 
-    def _smooth_facing(self, rows: np.ndarray, measured: np.ndarray, timestamp: float) -> None:
+    def _smooth_facing(self, rows: np.ndarray, measured: np.ndarray, quality: np.ndarray, timestamp: float) -> None:
         """Average facings (K, 2) unit vectors (NaN: none) measured at ``timestamp`` (s) into the tracks ``rows`` on
-        the unit circle, each weighted by the time since its track's last measured facing."""
+        the unit circle, each weighted by the time since its track's last measured facing; their orientation
+        qualities (K,) (NaN: none) likewise."""
         tau = self.params.facing_tau
-        old = self._facing[rows]
+        old, old_quality = self._facing[rows], self._quality[rows]
         weight = 1.0 - np.exp(-(timestamp - self._facing_time[rows]) / tau) if tau > 0 else np.ones(len(rows))
         mixed = (1 - weight[:, None]) * old + weight[:, None] * measured
         mixed = np.where(np.isnan(old), measured, np.where(np.isnan(measured), old, mixed))
+        mixed_quality = (1 - weight) * old_quality + weight * quality
+        mixed_quality = np.where(
+            np.isnan(old_quality), quality, np.where(np.isnan(quality), old_quality, mixed_quality)
+        )
         norm = np.sqrt(mixed[:, 0] ** 2 + mixed[:, 1] ** 2)
         flat = ~(norm > 1e-9)  # exactly opposite facings average to nothing: take the new one
-        mixed[flat] = measured[flat]
+        mixed[flat], mixed_quality[flat] = measured[flat], quality[flat]
         norm[flat] = 1.0
         self._facing[rows] = mixed / norm[:, None]
+        self._quality[rows] = mixed_quality
         self._facing_time[rows[~np.isnan(measured[:, 0])]] = timestamp
 
-    def _start(self, cols: np.ndarray, positions: np.ndarray, facing: np.ndarray, timestamp: float) -> None:
+    def _start(
+        self, cols: np.ndarray, positions: np.ndarray, facing: np.ndarray, quality: np.ndarray, timestamp: float
+    ) -> None:
         """Tentative tracks for the detections ``cols``."""
         k = len(cols)
         p = self.params
@@ -230,6 +239,7 @@ class PeopleTracker:
         self._detection = np.concatenate((self._detection, cols))
         self._in_view = np.concatenate((self._in_view, np.ones(k, dtype=bool)))  # just detected
         self._facing = np.concatenate((self._facing, facing[cols]))
+        self._quality = np.concatenate((self._quality, quality[cols]))
         self._facing_time = np.concatenate((self._facing_time, np.where(np.isnan(facing[cols, 0]), np.nan, timestamp)))
 
     def _keep(self, mask: np.ndarray) -> None:
@@ -244,7 +254,7 @@ class PeopleTracker:
         )
         self._unseen = self._unseen[mask]
         self._detection, self._facing, self._in_view = self._detection[mask], self._facing[mask], self._in_view[mask]
-        self._facing_time = self._facing_time[mask]
+        self._facing_time, self._quality = self._facing_time[mask], self._quality[mask]
 
     def _report(self, ids: list[int]) -> list[TrackedPerson]:
         rows = np.flatnonzero(self._confirmed)
@@ -252,6 +262,7 @@ class PeopleTracker:
         speed_sigma = np.sqrt(self._motion.covariance[rows, 2]).tolist()
         facing = self._facing[rows]
         theta = [None if t != t else t for t in np.arctan2(facing[:, 1], facing[:, 0]).tolist()]  # NaN -> None
+        quality = np.nan_to_num(self._quality[rows], nan=0.0).tolist()  # no facing: quality 0
         detection = self._detection[rows].tolist()
         return [
             TrackedPerson(
@@ -267,8 +278,9 @@ class PeopleTracker:
                 last,
                 ids[d] if d >= 0 else None,
                 sd,
+                q,
             )
-            for track_id, (x, y), (vx, vy), th, walking, d, seen, last, sd in zip(
+            for track_id, (x, y), (vx, vy), th, walking, d, seen, last, sd, q in zip(
                 self._ids[rows].tolist(),
                 self._motion.position[rows].tolist(),
                 self._motion.velocity[rows].tolist(),
@@ -278,6 +290,7 @@ class PeopleTracker:
                 in_view,
                 self._last_hit[rows].tolist(),
                 speed_sigma,
+                quality,
                 strict=True,
             )
         ]
@@ -293,20 +306,22 @@ def _behind(view: View | None, positions: np.ndarray, detections: np.ndarray) ->
     return view.behind(positions, detections, OCCLUDER_RADIUS)
 
 
-def _measurements(people: Sequence[Person]) -> tuple[np.ndarray, np.ndarray, list[int]]:
-    """Positions (N, 2) m, facings (N, 2) unit vectors (NaN: unknown) and ids of ``people``; TrackingError on bad
-    values."""
+def _measurements(people: Sequence[Person]) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[int]]:
+    """Positions (N, 2) m, facings (N, 2) unit vectors and their orientation qualities (N,) in [0, 1] (both NaN:
+    unknown) and ids of ``people``; TrackingError on bad values."""
     for person in people:  # before numpy, which would read "1.5" as a number
         if isinstance(person.id, bool) or not isinstance(person.id, numbers.Integral):
             raise TrackingError(f"tracker: person id {person.id!r} is not a whole number")
-        for name in ("x", "y") if person.theta is None else ("x", "y", "theta"):
+        for name in ("x", "y") if person.theta is None else ("x", "y", "theta", "orientation_quality"):
             if not is_real(getattr(person, name)):
                 raise TrackingError(f"tracker: person {person.id}: {name} is not a number: {getattr(person, name)!r}")
     ids = [int(p.id) for p in people]
     positions = np.array([(p.x, p.y) for p in people], dtype=float).reshape(-1, 2)
     theta = np.array([np.nan if p.theta is None else p.theta for p in people], dtype=float)
+    quality = np.array([np.nan if p.theta is None else p.orientation_quality for p in people], dtype=float)
     known = [p.theta is not None for p in people]
-    if not (np.isfinite(positions).all() and np.isfinite(theta[known]).all()) or (
+    good_quality = (quality[known] >= 0) & (quality[known] <= 1)  # NaN: False
+    if not (np.isfinite(positions).all() and np.isfinite(theta[known]).all() and good_quality.all()) or (
         len(positions) and np.abs(positions).max() > MAX_COORDINATE
     ):
         for person in people:  # name the first bad one
@@ -316,7 +331,8 @@ def _measurements(people: Sequence[Person]) -> tuple[np.ndarray, np.ndarray, lis
             )
             if person.theta is not None:
                 check_numbers(owner, person, ("theta",), error=TrackingError)
+                check_numbers(owner, person, ("orientation_quality",), low=0, high=1, error=TrackingError)
     if len(set(ids)) != len(ids):
         twice = sorted({i for i in ids if ids.count(i) > 1})
         raise TrackingError(f"tracker: person id {twice[0]} appears twice in one frame")
-    return positions, np.column_stack((np.cos(theta), np.sin(theta))), ids
+    return positions, np.column_stack((np.cos(theta), np.sin(theta))), quality, ids

@@ -12,7 +12,7 @@ DT = 0.4
 
 def _track(track_id: int, x: float, y: float, vx: float, vy: float) -> TrackedPerson:
     state = "walking" if abs(vx) + abs(vy) > 0.5 else "standing"
-    return TrackedPerson(track_id, x, y, vx, vy, None, state, True, True, 0.0, None, 0.1)
+    return TrackedPerson(track_id, x, y, vx, vy, None, state, True, True, 0.0, None, 0.1, 0.0)
 
 
 def _frames(reference: CoherentMotion, count: int, start: int = 0) -> list[list[frozenset[int]]]:

@@ -17,7 +17,9 @@ def _person(
     track_id: int, x: float, y: float, theta: float | None, v: tuple[float, float] = (0.0, 0.0)
 ) -> TrackedPerson:
     state = "walking" if math.hypot(*v) > 0.5 else "standing"
-    return TrackedPerson(track_id, x, y, v[0], v[1], theta, state, True, True, 0.0, None, 0.1)
+    return TrackedPerson(
+        track_id, x, y, v[0], v[1], theta, state, True, True, 0.0, None, 0.1, 0.0 if theta is None else 1.0
+    )
 
 
 def _circle(ids: tuple[int, ...] = (1, 2, 3), centre: tuple[float, float] = (3.0, 0.0), r: float = 0.7):
@@ -145,7 +147,10 @@ def test_noisy_tracks_keep_one_group() -> None:
 def test_tracks_whose_velocity_is_not_yet_known_join_no_conversation() -> None:
     tracker = GroupTracker(GroupTrackerParams(max_speed_sigma=0.4))
     young = [
-        TrackedPerson(p.id, p.x, p.y, 0.0, 0.0, p.theta, "standing", True, True, 0.0, None, 0.9) for p in _circle()
+        TrackedPerson(
+            p.id, p.x, p.y, 0.0, 0.0, p.theta, "standing", True, True, 0.0, None, 0.9, 0.0 if p.theta is None else 1.0
+        )
+        for p in _circle()
     ]
     for k in range(10):
         assert tracker.update(young, k * DT) == []
