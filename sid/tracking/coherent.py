@@ -16,8 +16,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from sid.checks import check_number, check_whole
-from sid.tracking.groups import connected_components
+from sid.tracking.groups import connected_components, pair_distance
 from sid.tracking.records import TIME_TOLERANCE, TrackedPerson
+from sid.tracking.tracker import check_time_order
 
 __all__ = ["CoherentMotion", "CoherentMotionParams"]
 
@@ -59,13 +60,15 @@ class CoherentMotion:
         self._frames.clear()
 
     def update(self, people: Sequence[TrackedPerson], timestamp: float) -> list[frozenset[int]]:
-        """The groups (track ids, two or more) among ``people`` (this frame's tracks) at ``timestamp`` (s)."""
+        """The groups (track ids, two or more) among ``people`` (this frame's tracks) at ``timestamp`` (s);
+        TrackingError, changing nothing, when the timestamp is not after the last one."""
+        check_time_order("coherent motion: frame", timestamp, self._frames[-1].timestamp if self._frames else None)
         p = self.params
         order = sorted(range(len(people)), key=lambda k: people[k].id)
         ids = np.array([people[k].id for k in order], dtype=np.int64)
         state = np.array([[people[k].x, people[k].y, people[k].vx, people[k].vy] for k in order]).reshape(-1, 4)
-        near = _pair_distance(state[:, :2]) <= p.distance
-        alike = _pair_distance(state[:, 2:]) <= p.velocity_difference
+        near = pair_distance(state[:, :2]) <= p.distance
+        alike = pair_distance(state[:, 2:]) <= p.velocity_difference
         self._frames.append(_Frame(timestamp, ids, near & alike))
         while self._frames and timestamp - self._frames[0].timestamp > p.window + TIME_TOLERANCE:
             self._frames.popleft()
@@ -86,8 +89,3 @@ class CoherentMotion:
         np.fill_diagonal(linked, False)
         groups = [frozenset(ids[rows].tolist()) for rows in connected_components(linked) if len(rows) >= 2]
         return sorted(groups, key=min)
-
-
-def _pair_distance(points: np.ndarray) -> np.ndarray:
-    d = points[:, None, :] - points[None, :, :]
-    return np.sqrt(d[..., 0] ** 2 + d[..., 1] ** 2)

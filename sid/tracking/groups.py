@@ -8,8 +8,9 @@ Per frame (``GroupTracker.update``), on the tracked people (``sid.tracking.track
   only once its speed is known, a second or more after it appeared) within ``walk_distance`` of each other whose
   velocities differ by at most ``walk_velocity_difference`` (side by side or in file), joined transitively
   (connected components).
-- each candidate is matched to a group track of its kind by member overlap (Jaccard index >= ``min_overlap``,
-  ``scipy.optimize.linear_sum_assignment`` on 1 - overlap); an unmatched candidate starts a tentative group.
+- each candidate is matched to a group track of its kind by member overlap (Jaccard index): as many pairs with an
+  overlap of ``min_overlap`` or more as can be matched, of the greatest total overlap among those matchings
+  (``sid.tracking.assignment.gated_assignment``); an unmatched candidate starts a tentative group.
 - a group is reported once it was found in ``confirm_hits`` of its last ``confirm_window`` frames; it survives
   frames in which it is not found for up to ``miss_timeout`` seconds, keeping its last geometry, but a member who
   leaves (track deleted, starts walking for a conversation or stops for a walking group, or goes farther than
@@ -35,8 +36,9 @@ from sid.checks import check_number, check_numbers, check_whole
 from sid.perception.groups import GroupParams, detect_groups
 from sid.tracking.assignment import gated_assignment
 from sid.tracking.records import TIME_TOLERANCE, GroupKind, TrackedGroup, TrackedPerson
+from sid.tracking.tracker import check_time_order
 
-__all__ = ["GroupTracker", "GroupTrackerParams", "connected_components"]
+__all__ = ["GroupTracker", "GroupTrackerParams", "connected_components", "pair_distance"]
 
 _NO_ZONE = np.zeros((0, 2))
 _CLOSENESS_STEP = 0.2
@@ -141,7 +143,9 @@ class GroupTracker:
         self._last_time = None
 
     def update(self, people: Sequence[TrackedPerson], timestamp: float) -> list[TrackedGroup]:
-        """The confirmed groups among ``people`` (this frame's tracks) at ``timestamp`` (s)."""
+        """The confirmed groups among ``people`` (this frame's tracks) at ``timestamp`` (s); TrackingError, changing
+        nothing, when the timestamp is not after the last one."""
+        check_time_order("group tracker: frame", timestamp, self._last_time)
         by_id = {p.id: p for p in people}
         if len(by_id) != len(people):
             raise ValueError("group tracker: a track id appears twice in one frame")
@@ -255,7 +259,7 @@ def _walking_groups(
         return []
     ids = np.array([p.id for p in walkers], dtype=np.int64)
     position = np.array([[p.x, p.y] for p in walkers])
-    i, j = np.nonzero(np.triu(_pair_distance(position) <= params.walk_distance, 1))
+    i, j = np.nonzero(np.triu(pair_distance(position) <= params.walk_distance, 1))
     velocity = np.array([[p.vx, p.vy] for p in walkers])
     alike = _relative_speed(ids, position, velocity, history, params, i, j) <= params.walk_velocity_difference
     i, j = i[alike], j[alike]
@@ -339,7 +343,8 @@ def _stayed_close(
     return close
 
 
-def _pair_distance(points: np.ndarray) -> np.ndarray:
+def pair_distance(points: np.ndarray) -> np.ndarray:
+    """(N, N) distances between the rows of (N, 2) ``points`` (positions, m; or velocities, m/s)."""
     d = points[:, None, :] - points[None, :, :]
     return np.sqrt(d[..., 0] ** 2 + d[..., 1] ** 2)
 

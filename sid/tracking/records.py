@@ -36,8 +36,9 @@ class TrackedPerson:
     (speed with hysteresis, ``TrackerParams``). visible: detected in this frame. in_view: the predicted position
     lies in the camera's field of view (True when the tracker was given no view). last_seen: timestamp (s) of the
     last detection. detection: the id of the person of this frame's input it was matched to (None when missed).
-    position_sigma, speed_sigma: standard deviations of the position (m) and velocity (m/s) estimates along each
-    axis (a new track's velocity is unknown: ``TrackerParams.initial_speed_sigma``).
+    speed_sigma: standard deviation of the velocity estimate along each axis (m/s; a new track's velocity is
+    unknown: ``TrackerParams.initial_speed_sigma``). orientation_quality: the measured facings' orientation quality
+    in [0, 1] (``Person.orientation_quality``), averaged as theta is; 0 while theta is None.
     """
 
     id: int
@@ -51,8 +52,8 @@ class TrackedPerson:
     in_view: bool
     last_seen: float
     detection: int | None
-    position_sigma: float
     speed_sigma: float
+    orientation_quality: float
 
     @property
     def speed(self) -> float:
@@ -64,8 +65,8 @@ class TrackedPerson:
         return self.state == "walking"
 
     def as_person(self) -> Person:
-        """The track as a per-frame ``Person`` (id = track id; orientation quality 1 when the facing is known)."""
-        return Person(self.id, self.x, self.y, self.theta, 0.0 if self.theta is None else 1.0)
+        """The track as a per-frame ``Person`` (id = track id), its facing with its averaged orientation quality."""
+        return Person(self.id, self.x, self.y, self.theta, self.orientation_quality)
 
     def to_json(self) -> dict[str, Any]:
         """The track as plain JSON (``sid detect``): id, x, y, theta, velocity [vx, vy], state, visible."""

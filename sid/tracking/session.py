@@ -15,14 +15,14 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from sid.checks import check_number, check_numbers
+from sid.checks import check_numbers
 from sid.perception.groups import GroupParams
 from sid.perception.people import Person
 from sid.perception.pipeline import FrameResult
 from sid.perception.robot_pose import RobotPose
 from sid.tracking.groups import GroupTracker, GroupTrackerParams
 from sid.tracking.records import TrackedGroup, TrackedPerson
-from sid.tracking.tracker import PeopleTracker, TrackerParams, TrackingError
+from sid.tracking.tracker import PeopleTracker, TrackerParams, TrackingError, check_time_order
 from sid.tracking.view import View
 
 __all__ = ["SessionUpdate", "TrackingParams", "TrackingSession"]
@@ -75,11 +75,7 @@ class TrackingSession:
     def check(self, timestamp: float, pose: RobotPose | None, what: str = "frame") -> None:
         """Raise TrackingError unless ``timestamp`` (s) is finite and after the last one, and ``pose`` (None allowed)
         a finite RobotPose; ``what`` names the input in the message."""
-        check_number(what, "timestamp", timestamp, unit="seconds", error=TrackingError)
-        if self._last is not None and timestamp <= self._last[0]:
-            raise TrackingError(
-                f"{what} is out of time order: its timestamp {timestamp} s is not after the last one, {self._last[0]} s"
-            )
+        check_time_order(what, timestamp, None if self._last is None else self._last[0])
         if pose is not None:
             if not isinstance(pose, RobotPose):
                 raise TrackingError(f"{what}: robot_pose must be a RobotPose, got {type(pose).__name__}")
@@ -93,8 +89,8 @@ class TrackingSession:
         if reset is not None:
             self.people.reset()
             self.groups.reset()
+        update = self._track(result.people, result.timestamp, view)  # a TrackingError here keeps the last frame
         self._last = (result.timestamp, result.frame_id, result.robot_pose)
-        update = self._track(result.people, result.timestamp, view)
         update.reset = reset
         return update
 

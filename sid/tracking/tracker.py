@@ -8,7 +8,8 @@ assigned to tracks by position alone, the least total distance to the prediction
 track's uncertainty (``sid.tracking.assignment``); matched tracks are corrected; a tentative track that is missed is
 deleted, and one detected ``confirm_hits`` times (or twice in a row ``confirm_time`` apart) is confirmed; every
 unmatched detection starts a tentative track. Facing is smoothed on the circle (an exponential average of unit
-vectors), and the state switches to walking above ``walk_speed`` and back to standing below ``stand_speed``.
+vectors, a new one weighted by the time since the track's last measured facing), and the state switches to
+walking above ``walk_speed`` and back to standing below ``stand_speed``.
 
 Only confirmed tracks are reported. Track ids count up from 1 and are never reused, also across ``reset``.
 """
@@ -30,7 +31,7 @@ from sid.tracking.motion import MotionStates
 from sid.tracking.records import TIME_TOLERANCE, TrackedPerson
 from sid.tracking.view import View, ViewCone
 
-__all__ = ["OCCLUDER_RADIUS", "PeopleTracker", "TrackerParams", "TrackingError"]
+__all__ = ["OCCLUDER_RADIUS", "PeopleTracker", "TrackerParams", "TrackingError", "check_time_order"]
 
 OCCLUDER_RADIUS = 0.2
 """A person's half-width (m) seen from above, to tell who is behind whom in the camera's view (``ViewCone.behind``)."""
@@ -38,6 +39,16 @@ OCCLUDER_RADIUS = 0.2
 
 class TrackingError(SidError, ValueError):
     """Input a tracker cannot use: a frame out of time order, a non-finite position, an id given twice."""
+
+
+def check_time_order(what: str, timestamp: float, last: float | None) -> None:
+    """Raise TrackingError unless ``timestamp`` (s) is finite and after ``last`` (s; None: there was no frame before),
+    as every tracker requires; ``what`` names the input in the message."""
+    check_number(what, "timestamp", timestamp, unit="seconds", error=TrackingError)
+    if last is not None and timestamp <= last:
+        raise TrackingError(
+            f"{what} is out of time order: its timestamp {timestamp} s is not after the last one, {last} s"
+        )
 
 
 @dataclass(frozen=True)
@@ -104,6 +115,8 @@ class PeopleTracker:
         self._unseen = np.zeros(0)  # seconds undetected since the last hit while the camera could see the track
         self._first_hit = np.zeros(0)
         self._facing = np.zeros((0, 2))  # unit vectors, NaN while unknown
+        self._facing_time = np.zeros(0)  # timestamp (s) of the last measured facing, NaN while unknown
+        self._quality = np.zeros(0)  # the facing's orientation quality in [0, 1], averaged as it; NaN while unknown
         self._detection = np.zeros(0, dtype=np.intp)  # index of this frame's matched detection, -1: none
         self._in_view = np.zeros(0, dtype=bool)  # the predicted position lies in the camera's view
 
@@ -123,12 +136,8 @@ class PeopleTracker:
         Raises TrackingError, changing nothing, when the timestamp is not after the last one, a position or a
         facing is not finite, or two people share an id.
         """
-        positions, facing, ids = _measurements(people)
-        check_number("tracker", "timestamp", timestamp, unit="seconds", error=TrackingError)
-        if self._time is not None and timestamp <= self._time:
-            raise TrackingError(
-                f"tracker: frames out of time order, timestamp {timestamp} s is not after the last one, {self._time} s"
-            )
+        positions, facing, quality, ids = _measurements(people)
+        check_time_order("tracker: frame", timestamp, self._time)
         p = self.params
         r, q = p.measurement_sigma**2, p.acceleration_sigma**2
         dt = 0.0 if self._time is None else timestamp - self._time
@@ -139,10 +148,10 @@ class PeopleTracker:
         self._motion.predict(dt, q)
         self._in_view = np.ones(len(self._ids), dtype=bool) if view is None else view.contains(self._motion.position)
         self._unseen += np.where(self._in_view & ~_behind(view, self._motion.position, positions), dt, 0.0)
-        self._keep(~self._expired(timestamp))
+        self._keep(~self._expired())
         rows, cols = self._assign(positions, facing, r)
         self._motion.correct(rows, positions[cols], r)
-        self._smooth_facing(rows, facing[cols], dt)
+        self._smooth_facing(rows, facing[cols], quality[cols], timestamp)
         self._hits[rows] += 1
         self._last_hit[rows] = timestamp
         self._unseen[rows] = 0.0
@@ -155,22 +164,18 @@ class PeopleTracker:
         if len(cols) < len(ids):
             unmatched = np.ones(len(ids), dtype=bool)
             unmatched[cols] = False
-            self._start(np.flatnonzero(unmatched), positions, facing, timestamp)
+            self._start(np.flatnonzero(unmatched), positions, facing, quality, timestamp)
         velocity, speed_sigma = self._motion.velocity, np.sqrt(self._motion.covariance[:, 2])
         speed = np.sqrt(velocity[:, 0] ** 2 + velocity[:, 1] ** 2)
         # a young track's velocity is mostly noise: it must exceed walk_speed by its own standard deviation
         self._walking = np.where(self._walking, speed > p.stand_speed, speed - speed_sigma > p.walk_speed)
         return self._report(ids)
 
-    def _expired(self, now: float) -> np.ndarray:
-        """(N,) bool: the tracks undetected for longer than ``timeout`` while the camera could see them, or for longer
-        than ``out_of_view_timeout`` in all. Time hidden (out of view, behind someone) does not count towards
-        ``timeout``: a walker hidden behind a group for longer than it, then in view a moment before being detected
-        again, keeps the track."""
-        p = self.params
-        return (self._unseen > p.timeout + TIME_TOLERANCE) | (
-            now - self._last_hit > p.out_of_view_timeout + TIME_TOLERANCE
-        )
+    def _expired(self) -> np.ndarray:
+        """(N,) bool: the tracks undetected for longer than ``timeout`` while the camera could see them. Time hidden
+        (out of view, behind someone) does not count towards it: a walker hidden behind a group for longer than it,
+        then in view a moment before being detected again, keeps the track."""
+        return self._unseen > self.params.timeout + TIME_TOLERANCE
 
     def _assign(self, positions: np.ndarray, facing: np.ndarray, r: float) -> tuple[np.ndarray, np.ndarray]:
         """Rows of tracks and columns of detections matched by minimum total distance, each within its gate.
@@ -195,20 +200,30 @@ class PeopleTracker:
             allowed[striding] &= ~turned
         return gated_assignment(distance, allowed)
 
-    def _smooth_facing(self, rows: np.ndarray, measured: np.ndarray, dt: float) -> None:
-        """Average measured facings (K, 2) unit vectors (NaN: none) into the tracks ``rows`` on the unit circle."""
+    def _smooth_facing(self, rows: np.ndarray, measured: np.ndarray, quality: np.ndarray, timestamp: float) -> None:
+        """Average facings (K, 2) unit vectors (NaN: none) measured at ``timestamp`` (s) into the tracks ``rows`` on
+        the unit circle, each weighted by the time since its track's last measured facing; their orientation
+        qualities (K,) (NaN: none) likewise."""
         tau = self.params.facing_tau
-        weight = 1.0 - math.exp(-dt / tau) if tau > 0 else 1.0
-        old = self._facing[rows]
-        mixed = (1 - weight) * old + weight * measured
+        old, old_quality = self._facing[rows], self._quality[rows]
+        weight = 1.0 - np.exp(-(timestamp - self._facing_time[rows]) / tau) if tau > 0 else np.ones(len(rows))
+        mixed = (1 - weight[:, None]) * old + weight[:, None] * measured
         mixed = np.where(np.isnan(old), measured, np.where(np.isnan(measured), old, mixed))
+        mixed_quality = (1 - weight) * old_quality + weight * quality
+        mixed_quality = np.where(
+            np.isnan(old_quality), quality, np.where(np.isnan(quality), old_quality, mixed_quality)
+        )
         norm = np.sqrt(mixed[:, 0] ** 2 + mixed[:, 1] ** 2)
         flat = ~(norm > 1e-9)  # exactly opposite facings average to nothing: take the new one
-        mixed[flat] = measured[flat]
+        mixed[flat], mixed_quality[flat] = measured[flat], quality[flat]
         norm[flat] = 1.0
         self._facing[rows] = mixed / norm[:, None]
+        self._quality[rows] = mixed_quality
+        self._facing_time[rows[~np.isnan(measured[:, 0])]] = timestamp
 
-    def _start(self, cols: np.ndarray, positions: np.ndarray, facing: np.ndarray, timestamp: float) -> None:
+    def _start(
+        self, cols: np.ndarray, positions: np.ndarray, facing: np.ndarray, quality: np.ndarray, timestamp: float
+    ) -> None:
         """Tentative tracks for the detections ``cols``."""
         k = len(cols)
         p = self.params
@@ -224,6 +239,8 @@ class PeopleTracker:
         self._detection = np.concatenate((self._detection, cols))
         self._in_view = np.concatenate((self._in_view, np.ones(k, dtype=bool)))  # just detected
         self._facing = np.concatenate((self._facing, facing[cols]))
+        self._quality = np.concatenate((self._quality, quality[cols]))
+        self._facing_time = np.concatenate((self._facing_time, np.where(np.isnan(facing[cols, 0]), np.nan, timestamp)))
 
     def _keep(self, mask: np.ndarray) -> None:
         if mask.all():
@@ -237,13 +254,15 @@ class PeopleTracker:
         )
         self._unseen = self._unseen[mask]
         self._detection, self._facing, self._in_view = self._detection[mask], self._facing[mask], self._in_view[mask]
+        self._facing_time, self._quality = self._facing_time[mask], self._quality[mask]
 
     def _report(self, ids: list[int]) -> list[TrackedPerson]:
         rows = np.flatnonzero(self._confirmed)
         in_view = self._in_view[rows].tolist()
-        sigma = np.sqrt(self._motion.covariance[rows][:, [0, 2]]).tolist()
+        speed_sigma = np.sqrt(self._motion.covariance[rows, 2]).tolist()
         facing = self._facing[rows]
         theta = [None if t != t else t for t in np.arctan2(facing[:, 1], facing[:, 0]).tolist()]  # NaN -> None
+        quality = np.nan_to_num(self._quality[rows], nan=0.0).tolist()  # no facing: quality 0
         detection = self._detection[rows].tolist()
         return [
             TrackedPerson(
@@ -258,10 +277,10 @@ class PeopleTracker:
                 seen,
                 last,
                 ids[d] if d >= 0 else None,
-                sd[0],
-                sd[1],
+                sd,
+                q,
             )
-            for track_id, (x, y), (vx, vy), th, walking, d, seen, last, sd in zip(
+            for track_id, (x, y), (vx, vy), th, walking, d, seen, last, sd, q in zip(
                 self._ids[rows].tolist(),
                 self._motion.position[rows].tolist(),
                 self._motion.velocity[rows].tolist(),
@@ -270,7 +289,8 @@ class PeopleTracker:
                 detection,
                 in_view,
                 self._last_hit[rows].tolist(),
-                sigma,
+                speed_sigma,
+                quality,
                 strict=True,
             )
         ]
@@ -286,20 +306,22 @@ def _behind(view: View | None, positions: np.ndarray, detections: np.ndarray) ->
     return view.behind(positions, detections, OCCLUDER_RADIUS)
 
 
-def _measurements(people: Sequence[Person]) -> tuple[np.ndarray, np.ndarray, list[int]]:
-    """Positions (N, 2) m, facings (N, 2) unit vectors (NaN: unknown) and ids of ``people``; TrackingError on bad
-    values."""
+def _measurements(people: Sequence[Person]) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[int]]:
+    """Positions (N, 2) m, facings (N, 2) unit vectors and their orientation qualities (N,) in [0, 1] (both NaN:
+    unknown) and ids of ``people``; TrackingError on bad values."""
     for person in people:  # before numpy, which would read "1.5" as a number
         if isinstance(person.id, bool) or not isinstance(person.id, numbers.Integral):
             raise TrackingError(f"tracker: person id {person.id!r} is not a whole number")
-        for name in ("x", "y") if person.theta is None else ("x", "y", "theta"):
+        for name in ("x", "y") if person.theta is None else ("x", "y", "theta", "orientation_quality"):
             if not is_real(getattr(person, name)):
                 raise TrackingError(f"tracker: person {person.id}: {name} is not a number: {getattr(person, name)!r}")
     ids = [int(p.id) for p in people]
     positions = np.array([(p.x, p.y) for p in people], dtype=float).reshape(-1, 2)
     theta = np.array([np.nan if p.theta is None else p.theta for p in people], dtype=float)
+    quality = np.array([np.nan if p.theta is None else p.orientation_quality for p in people], dtype=float)
     known = [p.theta is not None for p in people]
-    if not (np.isfinite(positions).all() and np.isfinite(theta[known]).all()) or (
+    good_quality = (quality[known] >= 0) & (quality[known] <= 1)  # NaN: False
+    if not (np.isfinite(positions).all() and np.isfinite(theta[known]).all() and good_quality.all()) or (
         len(positions) and np.abs(positions).max() > MAX_COORDINATE
     ):
         for person in people:  # name the first bad one
@@ -309,7 +331,8 @@ def _measurements(people: Sequence[Person]) -> tuple[np.ndarray, np.ndarray, lis
             )
             if person.theta is not None:
                 check_numbers(owner, person, ("theta",), error=TrackingError)
+                check_numbers(owner, person, ("orientation_quality",), low=0, high=1, error=TrackingError)
     if len(set(ids)) != len(ids):
         twice = sorted({i for i in ids if ids.count(i) > 1})
         raise TrackingError(f"tracker: person id {twice[0]} appears twice in one frame")
-    return positions, np.column_stack((np.cos(theta), np.sin(theta))), ids
+    return positions, np.column_stack((np.cos(theta), np.sin(theta))), quality, ids

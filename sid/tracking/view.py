@@ -110,8 +110,9 @@ def camera_fov(calibration: Calibration, mount: CameraMount) -> tuple[float, flo
     color = calibration.color
     edges = np.array([[-0.5 - color.cx, 0.0, color.fx], [color.width - 0.5 - color.cx, 0.0, color.fx]])
     world = edges @ mount.rotation.T
-    left, right = np.arctan2(world[:, 1], world[:, 0])
-    return float(left + right) / 2, float(left - right)
+    left, right = np.arctan2(world[:, 1], world[:, 0]).tolist()
+    fov = (left - right) % math.tau  # counter-clockwise from the right edge to the left, across +-pi too
+    return math.remainder(right + fov / 2, math.tau), fov
 
 
 def camera_view_cone(

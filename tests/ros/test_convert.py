@@ -18,7 +18,7 @@ SPEC = GridSpec.from_size(0.1, (-1.0, 2.0), (3.0, 2.0))  # 30 x 20 cells, lower-
 
 
 def person(pid: int, x: float, y: float, theta: float | None, state: MotionState = "standing") -> TrackedPerson:
-    return TrackedPerson(pid, x, y, 0.0, 0.0, theta, state, True, True, 0.0, pid, 0.1, 0.1)
+    return TrackedPerson(pid, x, y, 0.0, 0.0, theta, state, True, True, 0.0, pid, 0.1, 0.0 if theta is None else 1.0)
 
 
 def test_grid_fields_are_the_occupancy_grid_message_layout() -> None:

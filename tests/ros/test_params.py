@@ -70,7 +70,7 @@ def test_a_parameters_file_names_two_tracked_people_layers_with_their_own_lookah
     assert layers.layer_params("inflation") == InflationParams(inflation_radius=0.3)
     layered = layered_costmap(params.grid, layers)
     assert [layer.name for layer in layered.layers] == ["tracked_people", "walkers", "inflation"]
-    walker = TrackedPerson(1, 0.0, 0.0, 1.3, 0.0, None, "walking", True, True, 0.0, None, 0.05, 0.1)
+    walker = TrackedPerson(1, 0.0, 0.0, 1.3, 0.0, None, "walking", True, True, 0.0, None, 0.1, 0.0)
     layered.update(LayerInputs({PEOPLE: [walker.as_person()], TRACKS: Tracks([walker])}))
     for name, lookahead in (("tracked_people", 0.5), ("walkers", 1.5)):  # each layer stretches by its own lookahead
         layer = layered.layer(name)

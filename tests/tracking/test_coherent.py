@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from sid.tracking import TrackedPerson
+from sid.tracking import TrackedPerson, TrackingError
 from sid.tracking.coherent import CoherentMotion, CoherentMotionParams
 
 DT = 0.4
@@ -12,7 +12,7 @@ DT = 0.4
 
 def _track(track_id: int, x: float, y: float, vx: float, vy: float) -> TrackedPerson:
     state = "walking" if abs(vx) + abs(vy) > 0.5 else "standing"
-    return TrackedPerson(track_id, x, y, vx, vy, None, state, True, True, 0.0, None, 0.1, 0.1)
+    return TrackedPerson(track_id, x, y, vx, vy, None, state, True, True, 0.0, None, 0.1, 0.0)
 
 
 def _frames(reference: CoherentMotion, count: int, start: int = 0) -> list[list[frozenset[int]]]:
@@ -79,3 +79,12 @@ def test_groups_do_not_depend_on_the_clocks_offset(dt: float) -> None:
     frames = {offset: _first_report_after_a_frame_apart_exactly_one_window_ago(offset, dt)
               for offset in (0.0, 0.1, 17.3, 1234.567, 1.7e9 + 0.123, 1.7e9 + 0.9)}  # fmt: skip
     assert len(set(frames.values())) == 1, frames
+
+
+def test_a_frame_not_after_the_last_is_refused_and_counts_nothing() -> None:
+    reference = CoherentMotion(CoherentMotionParams(min_frames=3))
+    assert _frames(reference, 2) == [[], []]
+    for repeated in (DT, 0.0):  # a repeated frame would count twice towards min_frames
+        with pytest.raises(TrackingError, match=f"timestamp {repeated} s is not after the last one, {DT} s"):
+            _frames(reference, 1, start=round(repeated / DT))
+    assert _frames(reference, 1, start=2) == [[frozenset({1, 2})]]  # the third frame, as without the refusals

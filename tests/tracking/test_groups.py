@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from sid.tracking import GroupTracker, GroupTrackerParams, TrackedPerson
+from sid.tracking import GroupTracker, GroupTrackerParams, TrackedPerson, TrackingError
 
 DT = 1 / 15
 
@@ -17,7 +17,9 @@ def _person(
     track_id: int, x: float, y: float, theta: float | None, v: tuple[float, float] = (0.0, 0.0)
 ) -> TrackedPerson:
     state = "walking" if math.hypot(*v) > 0.5 else "standing"
-    return TrackedPerson(track_id, x, y, v[0], v[1], theta, state, True, True, 0.0, None, 0.05, 0.1)
+    return TrackedPerson(
+        track_id, x, y, v[0], v[1], theta, state, True, True, 0.0, None, 0.1, 0.0 if theta is None else 1.0
+    )
 
 
 def _circle(ids: tuple[int, ...] = (1, 2, 3), centre: tuple[float, float] = (3.0, 0.0), r: float = 0.7):
@@ -145,7 +147,9 @@ def test_noisy_tracks_keep_one_group() -> None:
 def test_tracks_whose_velocity_is_not_yet_known_join_no_conversation() -> None:
     tracker = GroupTracker(GroupTrackerParams(max_speed_sigma=0.4))
     young = [
-        TrackedPerson(p.id, p.x, p.y, 0.0, 0.0, p.theta, "standing", True, True, 0.0, None, 0.05, 0.9)
+        TrackedPerson(
+            p.id, p.x, p.y, 0.0, 0.0, p.theta, "standing", True, True, 0.0, None, 0.9, 0.0 if p.theta is None else 1.0
+        )
         for p in _circle()
     ]
     for k in range(10):
@@ -255,3 +259,18 @@ def test_groups_do_not_depend_on_the_clocks_offset(dt: float) -> None:
     frames = {offset: _first_report_of_a_pair_far_apart_exactly_one_window_ago(offset, dt)
               for offset in (0.0, 0.1, 17.3, 1234.567, 1.7e9 + 0.123, 1.7e9 + 0.9)}  # fmt: skip
     assert len(set(frames.values())) == 1, frames
+
+
+@pytest.mark.parametrize("back", [0.0, 2 * DT])
+def test_a_frame_not_after_the_last_is_refused_naming_both_timestamps_and_changes_nothing(back) -> None:
+    tracker = GroupTracker(GroupTrackerParams(miss_timeout=0.5))
+    for k in range(5):
+        groups = tracker.update(_circle(), 4 * DT + k * DT)
+    (group,) = groups
+    last = 8 * DT
+    with pytest.raises(TrackingError, match=rf"timestamp {4 * DT + back} s is not after the last one, {last} s"):
+        tracker.update([], 4 * DT + back)  # with a time gone backwards the group would never time out
+    blind = [_person(p.id, p.x, p.y, None) for p in _circle()]
+    alive = [tracker.update(blind, last + k * DT) for k in range(1, 10)]
+    assert [g.id for g in alive[6]] == [group.id]
+    assert not alive[8]  # gone after miss_timeout, counted from the last good frame

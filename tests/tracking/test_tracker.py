@@ -120,6 +120,34 @@ def test_unknown_facing_stays_unknown_until_measured() -> None:
     assert track.theta == pytest.approx(1.0)
 
 
+def test_a_facing_measured_long_ago_weighs_by_its_age_not_by_the_frame_interval() -> None:
+    tracker = PeopleTracker()
+    for k in range(5):  # facing 0
+        tracker.update([Person(0, 2.0, 0.0, 0.0)], k / FPS)
+    for k in range(5, 35):  # 2 s seen with no facing
+        tracker.update([Person(0, 2.0, 0.0, None)], k / FPS)
+    (track,) = tracker.update([Person(0, 2.0, 0.0, math.pi / 2)], 35 / FPS)
+    weight = 1 - math.exp(-(31 / FPS) / tracker.params.facing_tau)  # the last facing was measured at frame 4
+    assert track.theta == pytest.approx(math.atan2(weight, 1 - weight))
+    assert track.theta > math.radians(85)
+
+
+def test_the_orientation_quality_is_averaged_with_the_facing_and_reaches_the_group_detector() -> None:
+    tracker = PeopleTracker()
+    for k in range(3):
+        (track,) = tracker.update([Person(0, 2.0, 0.0, None)], k / FPS) or [None]
+    assert track is not None and track.orientation_quality == 0.0  # no facing, no quality
+    for k in range(3, 20):  # a doubtful facing
+        (track,) = tracker.update([Person(0, 2.0, 0.0, 0.0, 0.2)], k / FPS)
+    assert track.orientation_quality == pytest.approx(0.2)
+    (track,) = tracker.update([Person(0, 2.0, 0.0, None)], 20 / FPS)  # no facing measured: the quality stays
+    assert track.orientation_quality == pytest.approx(0.2)
+    (track,) = tracker.update([Person(0, 2.0, 0.0, 0.0, 1.0)], 21 / FPS)
+    weight = 1 - math.exp(-(2 / FPS) / tracker.params.facing_tau)
+    assert track.orientation_quality == pytest.approx(0.2 + 0.8 * weight)
+    assert track.as_person().orientation_quality == track.orientation_quality  # what detect_groups weighs
+
+
 def test_frames_out_of_time_order_are_refused_and_change_nothing() -> None:
     tracker = PeopleTracker()
     t = _confirmed(tracker, 2.0, 0.0)
@@ -139,6 +167,8 @@ def test_frames_out_of_time_order_are_refused_and_change_nothing() -> None:
         ([Person(1, 1.0, 0.0), Person(1, 3.0, 0.0)], "person id 1 appears twice"),
         ([Person(0, "1.5", 0.0)], "person 0: x is not a number: '1.5'"),
         ([Person(0, 1.0, 0.0, "0")], "person 0: theta is not a number"),
+        ([Person(0, 1.0, 0.0, 0.0, math.nan)], r"person 0: orientation_quality must be a finite number in \[0, 1\]"),
+        ([Person(0, 1.0, 0.0, 0.0, 1.5)], r"person 0: orientation_quality must be a finite number in \[0, 1\]"),
         ([Person("a", 1.0, 0.0)], "person id 'a' is not a whole number"),
         ([Person(2, 1.0, -1e200)], r"person 2: y must be a finite number of metres in \[-1e\+08, 1e\+08\]"),
     ],

@@ -21,7 +21,9 @@ SPEC = GridSpec.from_size(0.05, (-1.0, -4.0), (10.0, 8.0))
 
 def _track(track_id: int, x: float, y: float, theta: float | None, v: tuple[float, float] = (0.0, 0.0)):
     state = "walking" if math.hypot(*v) > 0.5 else "standing"
-    return TrackedPerson(track_id, x, y, v[0], v[1], theta, state, True, True, 0.0, None, 0.05, 0.1)
+    return TrackedPerson(
+        track_id, x, y, v[0], v[1], theta, state, True, True, 0.0, None, 0.1, 0.0 if theta is None else 1.0
+    )
 
 
 def _cost(layer: TrackedPeopleLayer | SocialLayer, x: float, y: float) -> int:
