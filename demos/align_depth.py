@@ -6,6 +6,8 @@ splat); then the depth of 17 keypoints per person is looked up on the aligned im
 raw depth frame. Run: python demos/align_depth.py
 """
 
+from collections.abc import Callable
+
 import numpy as np
 from scipy.spatial.transform import Rotation
 
@@ -17,7 +19,7 @@ from sid.perception.camera import Calibration, Extrinsics, Intrinsics, deproject
 DEPTH = Intrinsics(848, 480, 426.0, 426.0, 423.5, 239.8)
 COLOR = Intrinsics(1280, 720, 910.0, 910.0, 641.2, 358.9)
 ROTATION = Rotation.from_euler("xyz", [0.3, -0.2, 0.1], degrees=True).as_matrix()
-CALIB = Calibration(COLOR, DEPTH, Extrinsics(ROTATION, [0.015, 0.0, 0.0]))
+CALIB = Calibration(COLOR, DEPTH, Extrinsics(ROTATION, np.array([0.015, 0.0, 0.0])))
 
 
 # Two people as boxes in the depth image: (u0, v0, u1, v1) depth pixels (inclusive) and their distance in metres.
@@ -50,7 +52,7 @@ def keypoints_of(box: tuple[float, float, float, float], seed: int) -> np.ndarra
     return np.column_stack([u, rng.uniform(v0, v1, 17)])
 
 
-def median_ms(function) -> float:
+def median_ms(function: Callable[[], object]) -> float:
     """Median milliseconds of 50 calls after one untimed call (``sid bench``'s timing harness)."""
     return measure(function, RunSettings(warmup=1, min_runs=50, max_runs=50, budget_s=1.0)).median_ms
 

@@ -32,7 +32,11 @@ def main(model_path: Path = MODEL, image_path: Path = IMAGE) -> int:
             "MODEL.onnx IMAGE.png (where to get a model: docs/models.md)"
         )
         return 1
-    color = cv2.cvtColor(cv2.imread(str(image_path)), cv2.COLOR_BGR2RGB)
+    image = cv2.imread(str(image_path))
+    if image is None:
+        print(f"cannot read {image_path} as an image (PNG, JPEG, ...)")
+        return 1
+    color = cv2.cvtColor(image, cv2.COLOR_BGR2RGB)
 
     estimator = load_pose_estimator(model_path)  # contract read from the model's own signature
     people = estimator(color)

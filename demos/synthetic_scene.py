@@ -16,6 +16,7 @@ from sid.perception.keypoints import KP
 from sid.sources.synthetic import SyntheticSource
 from sid.synthetic.layouts import LAYOUTS
 from sid.synthetic.pose import TruthPose
+from sid.synthetic.scene import Scene
 
 TORSO = [KP["left_shoulder"], KP["right_shoulder"], KP["left_hip"], KP["right_hip"]]
 
@@ -23,21 +24,24 @@ source = SyntheticSource("S3", frames=8, seed=0)
 frames = list(source)
 camera = source.camera
 calib = frames[0].calibration
+depth_camera = camera.depth_intrinsics  # the frames' depth camera (calib.depth)
+scene = source.scene
+assert isinstance(scene, Scene), "S3 is one scene, not a moving sequence"
 print(f"S3: {LAYOUTS['S3'].description}; {len(frames)} frames")
-print(f"colour {calib.color.width}x{calib.color.height} fx={calib.color.fx:.0f} px, depth {calib.depth.width}x"
-      f"{calib.depth.height} fx={calib.depth.fx:.0f} px, camera {source.scene.mount.height} m high")  # fmt: skip
+print(f"colour {calib.color.width}x{calib.color.height} fx={calib.color.fx:.0f} px, depth {depth_camera.width}x"
+      f"{depth_camera.height} fx={depth_camera.fx:.0f} px, camera {scene.mount.height} m high")  # fmt: skip
 
 # Per person: the truth, and the depth readings at the torso centre across frames.
-to_depth = camera.world_to_depth(source.scene.mount)
+to_depth = camera.world_to_depth(scene.mount)
 print("\n id     x      y   theta  visible  self-occl.  torso z (exact)  mean reading  RMS error (model)")
 for person in frames[0].truth.people:
     torso = to_depth.apply(person.keypoints_world[TORSO].mean(axis=0)[None])
     u, v = np.rint(project(torso, camera.depth_intrinsics)[0]).astype(int)
-    exact = float(camera.exact_depth(source.scene).depth[v, u])  # the body's surface in front of the spine
+    exact = float(camera.exact_depth(scene).depth[v, u])  # the body's surface in front of the spine
     readings = np.array([frame.depth[v, u] for frame in frames], dtype=float)
     readings = readings[readings > 0]
     rms_mm = np.sqrt(np.mean((readings - exact) ** 2)) * 1000
-    model_mm = camera.noise.rms(exact, calib.depth.fx) * 1000
+    model_mm = camera.noise.rms(exact, depth_camera.fx) * 1000
     print(f"{person.id:3d} {person.x:5.2f} {person.y:6.2f} {np.degrees(person.theta):6.0f}   "
           f"{person.visible.sum():3d}/17     {person.self_occluded.sum():3d}         {exact:.3f} m        "
           f"{readings.mean():.3f} m    {rms_mm:4.1f} mm ({model_mm:.1f})")  # fmt: skip
