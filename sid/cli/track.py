@@ -1,14 +1,16 @@
 """``sid track FILE|-``: track people and groups over JSON-lines detections, one time step per line.
 
 Input, one time step per line, in one fixed ground frame (REP-103: metres, radians counter-clockwise from +x;
-timestamp in seconds, each after the last good line's; theta null or absent = unknown facing; id: the detector's
-integer id of the detection, default its index in the list, echoed back as the track's "detection"):
+timestamp in seconds, each after the last good line's; theta null or absent = unknown facing; orientation_quality,
+optional, in [0, 1], default 1 with a facing; id: the detector's integer id of the detection, default its index in
+the list, echoed back as the track's "detection"):
     {"timestamp": 0.0, "people": [{"id": 7, "x": 2.0, "y": 0.5, "theta": 3.1}, {"x": 2.0, "y": -0.5}]}
 Output, one line per good input line, flushed as it is written, the tracks as `sid detect` writes them
 (docs/tracking.md; a track is listed from its third detection, or its second 0.2 s or more after the first;
 velocity in m/s; group members as track ids):
-    {"timestamp": 0.0, "people": [{"id": 1, "x": 2.0, "y": 0.5, "theta": 3.1, "velocity": [vx, vy],
-                                   "state": "standing"|"walking", "visible": true, "detection": 7}],
+    {"timestamp": 0.0, "people": [{"id": 1, "x": 2.0, "y": 0.5, "theta": 3.1, "orientation_quality": 1.0,
+                                   "velocity": [vx, vy], "state": "standing"|"walking", "visible": true,
+                                   "detection": 7}],
      "groups": [{"id": 1, "kind": "conversation"|"walking", "members": [1, 2], "interest_point": [x, y],
                  "area": a, "spread": d, "zone": [[x, y], ...], "velocity": [vx, vy]}],
      "timing_ms": {"track": ms, "track_groups": ms}}
@@ -38,7 +40,7 @@ from sid.tracking import TrackingSession
 __all__ = ["LINE_FIELDS", "PERSON_FIELDS", "add_parser", "process", "run"]
 
 LINE_FIELDS = ("timestamp", "people")
-PERSON_FIELDS = ("id", "x", "y", "theta")
+PERSON_FIELDS = ("id", "x", "y", "theta", "orientation_quality")
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:

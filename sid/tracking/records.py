@@ -69,12 +69,14 @@ class TrackedPerson:
         return Person(self.id, self.x, self.y, self.theta, self.orientation_quality)
 
     def to_json(self) -> dict[str, Any]:
-        """The track as plain JSON (``sid detect``): id, x, y, theta, velocity [vx, vy], state, visible."""
+        """The track as plain JSON (``sid detect``): id, x, y, theta, orientation_quality, velocity [vx, vy], state,
+        visible."""
         return {
             "id": self.id,
             "x": round(self.x, 4),
             "y": round(self.y, 4),
             "theta": None if self.theta is None else round(self.theta, 4),
+            "orientation_quality": round(self.orientation_quality, 3),
             "velocity": [round(self.vx, 3), round(self.vy, 3)],
             "state": self.state,
             "visible": self.visible,

@@ -19,7 +19,7 @@ def test_detect_reports_tracks_with_stable_ids_velocities_and_groups(capsys) -> 
     ids = [sorted(p["id"] for p in r["people"]) for r in records[2:]]
     assert all(i == ids[0] for i in ids) and len(ids[0]) == 2
     person = records[-1]["people"][0]
-    assert set(person) == {"id", "x", "y", "theta", "velocity", "state", "visible"}
+    assert set(person) == {"id", "x", "y", "theta", "orientation_quality", "velocity", "state", "visible"}
     assert person["state"] == "standing" and len(person["velocity"]) == 2 and person["visible"]
     (group,) = records[-1]["groups"]
     assert group["kind"] == "conversation" and group["members"] == ids[0]

@@ -71,7 +71,17 @@ def test_a_walking_pair_and_a_standing_conversation_are_tracked_with_stable_ids(
         assert set(record["timing_ms"]) == {"track", "track_groups"}
         assert len(record["people"]) == 5
         for person in record["people"]:
-            assert set(person) == {"id", "x", "y", "theta", "velocity", "state", "visible", "detection"}
+            assert set(person) == {
+                "id",
+                "x",
+                "y",
+                "theta",
+                "orientation_quality",
+                "velocity",
+                "state",
+                "visible",
+                "detection",
+            }
             assert person["visible"] and person["detection"] in behind
             # the same track id stays with the same person on every line
             assert person_of_track.setdefault(person["id"], behind[person["detection"]]) == behind[person["detection"]]
@@ -108,7 +118,7 @@ BAD_LINES = [
     ('{"timestamp": 1e400, "people": []}', "'timestamp' must be a finite number of seconds, got Infinity"),
     ('{"timestamp": NaN, "people": []}', "not valid JSON (NaN is not a number)"),
     ('{"timestamp": 0.5, "people": {}}', "'people' must be a list"),
-    ('{"timestamp": 0.5, "people": [3]}', "people[0] must be an object with id, x, y, theta"),
+    ('{"timestamp": 0.5, "people": [3]}', "people[0] must be an object with id, x, y, theta, orientation_quality"),
     ('{"timestamp": 0.5, "people": [{"y": 0}]}', "people[0] (id 0) is missing 'x'"),
     (
         '{"timestamp": 0.5, "people": [{"x": 0, "y": null}]}',
@@ -124,7 +134,7 @@ BAD_LINES = [
     ),
     (
         '{"timestamp": 0.5, "people": [{"x": 0, "y": 0, "thta": 1.0}]}',
-        "people[0]: unknown field 'thta' (the fields are id, x, y, theta)",
+        "people[0]: unknown field 'thta' (the fields are id, x, y, theta, orientation_quality)",
     ),
     ('{"timestamp": 0.5, "frame": 3, "people": []}', "unknown field 'frame' (the fields are timestamp, people)"),
     ('{"timestamp": 0.5, "people": [{"x": 0, "x": 1, "y": 0}]}', "not valid JSON (duplicate key 'x')"),
