@@ -160,7 +160,8 @@ class CostField:
         graded = np.where(unknown, MAX_NON_OBSTACLE, np.minimum(costs, MAX_NON_OBSTACLE)).astype(float)
         self.weight = np.where(self.free, problem.cost_weight * graded / MAX_NON_OBSTACLE, 0.0)
         # Scalar lookups use grids padded by one row and column (copies of the last ones), so a point on the map's
-        # upper edge needs no clamping; int() truncates, which is floor for the non-negative offsets inside the map.
+        # upper edge needs no clamping. Every lookup finds a point's cell as ``GridSpec.world_to_cell`` does,
+        # floor((x - origin) / resolution), so that a point on a cell border lands in the same cell everywhere.
         self._stride = self._w + 1
         self._weight_padded = np.pad(self.weight, ((0, 1), (0, 1)), mode="edge")
         self._plannable_flat: list[bool] = np.pad(self.plannable, ((0, 1), (0, 1)), mode="edge").ravel().tolist()
@@ -169,27 +170,27 @@ class CostField:
     # ---- scalar lookups (OMPL callbacks) -------------------------------------------------------------------------
     def is_plannable(self, x: float, y: float) -> bool:
         """Whether a robot centre at world (x, y), inside the map, may be used by a planner."""
-        return self._plannable_flat[
-            int((y - self._oy) * self._inv_res) * self._stride + int((x - self._ox) * self._inv_res)
-        ]
+        res = self.resolution
+        return self._plannable_flat[math.floor((y - self._oy) / res) * self._stride + math.floor((x - self._ox) / res)]
 
     def segment_cost(self, x0: float, y0: float, x1: float, y1: float) -> float:
         """J of the straight segment (x0, y0) -> (x1, y1) (metres of weighted length), both ends inside the map."""
         dx, dy = x1 - x0, y1 - y0
         length = math.hypot(dx, dy)
         n = max(1, math.ceil(length * self._inv_res))
-        # Midpoints in cell units; inside the map they floor to a cell of the padded grids (module docstring).
-        inv = self._inv_res
-        cx, cy = (x0 + 0.5 * dx / n - self._ox) * inv, (y0 + 0.5 * dy / n - self._oy) * inv
-        sx, sy = dx / n * inv, dy / n * inv
+        # Midpoint i at t = (i + 0.5) / n, to a cell of the padded grids as ``GridSpec.world_to_cell`` does.
+        res, ox, oy = self.resolution, self._ox, self._oy
         if n > _LOOP_MAX:  # numpy's fixed overhead pays off on long segments
-            k = np.arange(n)
-            total = float(self._weight_padded[(cy + k * sy).astype(np.intp), (cx + k * sx).astype(np.intp)].sum())
+            ts = (np.arange(n) + 0.5) / n
+            rows = np.floor((y0 + ts * dy - oy) / res).astype(np.intp)
+            cols = np.floor((x0 + ts * dx - ox) / res).astype(np.intp)
+            total = float(self._weight_padded[rows, cols].sum())
         else:
-            weight, stride = self._weight_flat, self._stride
+            weight, stride, floor = self._weight_flat, self._stride, math.floor
             total = 0.0
             for i in range(n):
-                total += weight[int(cy + i * sy) * stride + int(cx + i * sx)]
+                t = (i + 0.5) / n
+                total += weight[floor((y0 + t * dy - oy) / res) * stride + floor((x0 + t * dx - ox) / res)]
         return length * (1.0 + total / n)
 
     # ---- vectorised lookups (planners' post-processing, validation, metrics) -------------------------------------
@@ -230,9 +231,9 @@ class CostField:
         already. ``segments_xy`` uses q only through d, so the values are the same.
 
         Sample k of a segment of n pieces (k = 0 .. 2n: even k piece ends, odd k the midpoints the cost uses) sits in
-        row k of (K, M) arrays (samples past a segment's end repeat its end), in cell units (offsets times
-        1 / resolution, floored, as ``segment_cost``); each segment's cost sums its midpoints in order of k, and
-        numpy's inner loops run over segments, not over two coordinates.
+        row k of (K, M) arrays (samples past a segment's end repeat its end), at t = k / (2n) along it, in the cell
+        ``GridSpec.world_to_cell`` gives (as ``segment_cost``); each segment's cost sums its midpoints in order of k,
+        and numpy's inner loops run over segments, not over two coordinates.
         """
         inv = self._inv_res
         pieces = np.ceil(length * inv - 1e-9)
@@ -248,10 +249,11 @@ class CostField:
         width = int(longest) + 2  # one spare sample: each segment's slice of samples ends inside its row
         if width * len(last) > SAMPLES_PER_CALL and len(last) > 1:
             return self._segments_in_chunks(p, d, length, last)
-        k = np.minimum(np.arange(width, dtype=float)[:, None], last)  # (K, M)
-        start = (p - self._origin) * inv
-        xy = k * (d * (inv / last))[:, None, :]  # (2, K, M) cells
-        xy += start[:, None, :]
+        t = np.minimum(np.arange(width, dtype=float)[:, None], last) / last  # (K, M), 0 .. 1 along each segment
+        xy = t * d[:, None, :]  # (2, K, M): world points, then cells as GridSpec.world_to_cell finds them
+        xy += p[:, None, :]
+        xy -= self._origin[:, :, None]
+        xy /= self.resolution
         size = self._size
         # The samples run monotonically from one end (row 0) to the other (row K - 1): both inside, all inside.
         ends = xy[:, :: width - 1]
