@@ -19,13 +19,15 @@ Cost. Planners minimise J = integral over the path of (1 + w * c(s) / 252) ds, w
 under the robot centre (0..252) and w = ``cost_weight``: w = 0 is the shortest path; with w = 4 a metre through a
 cell of cost 252 counts as five metres, so the path accepts up to four metres of detour to avoid it. This is Smac
 Planner's travel-cost model (``cost_penalty``) with a larger default so that graded social zones bend the path.
-The integral uses the midpoint rule on ``ceil(L / resolution)`` equal pieces of each straight segment.
+The integral uses the midpoint rule on ``ceil(L / resolution)`` equal pieces of each straight segment (a length of
+k cells up to rounding is k pieces; ``CostField._pieces``).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TypeVar
 
 import numpy as np
 from scipy import ndimage
@@ -47,6 +49,7 @@ __all__ = [
 ]
 
 _LOOP_MAX = 20  # segment_cost sums this many samples or fewer in a Python loop, more with numpy (docs/parameters.md)
+_Length = TypeVar("_Length", float, np.ndarray)  # one segment's length, or an array of them
 SAMPLES_PER_CALL = 2**20
 """``CostField.segments`` prices at most about this many samples at once (a few arrays of 8 MB): a batch of long and
 short segments (all pairs of a long path) is cut into chunks of similar length."""
@@ -167,6 +170,13 @@ class CostField:
         self._plannable_flat: list[bool] = np.pad(self.plannable, ((0, 1), (0, 1)), mode="edge").ravel().tolist()
         self._weight_flat: list[float] = self._weight_padded.ravel().tolist()
 
+    def _pieces(self, length: _Length) -> _Length:
+        """The number of equal pieces (a float, at least 1) the midpoint rule cuts segments of ``length`` (metres)
+        into: the length in cells rounded up, where a length of k cells give or take rounding (0.8 - 0.1 m at 0.1 m
+        is 7.000000000000001 cells) is k pieces. The one rule of ``segment_cost`` and ``segments_along``, so that the
+        cost OMPL minimises is the cost reported and smoothed."""
+        return np.maximum(np.ceil(length * self._inv_res - 1e-9), 1.0)
+
     # ---- scalar lookups (OMPL callbacks) -------------------------------------------------------------------------
     def is_plannable(self, x: float, y: float) -> bool:
         """Whether a robot centre at world (x, y), inside the map, may be used by a planner."""
@@ -177,7 +187,7 @@ class CostField:
         """J of the straight segment (x0, y0) -> (x1, y1) (metres of weighted length), both ends inside the map."""
         dx, dy = x1 - x0, y1 - y0
         length = math.hypot(dx, dy)
-        n = max(1, math.ceil(length * self._inv_res))
+        n = int(self._pieces(length))
         # Midpoint i at t = (i + 0.5) / n, to a cell of the padded grids as ``GridSpec.world_to_cell`` does.
         res, ox, oy = self.resolution, self._ox, self._oy
         if n > _LOOP_MAX:  # numpy's fixed overhead pays off on long segments
@@ -235,9 +245,7 @@ class CostField:
         ``GridSpec.world_to_cell`` gives (as ``segment_cost``); each segment's cost sums its midpoints in order of k,
         and numpy's inner loops run over segments, not over two coordinates.
         """
-        inv = self._inv_res
-        pieces = np.ceil(length * inv - 1e-9)
-        np.maximum(pieces, 1.0, out=pieces)
+        pieces = self._pieces(length)
         last = 2.0 * pieces  # each segment's end sample
         longest = float(last.max())  # NaN or infinite when any length is
         if not math.isfinite(longest):  # NaN or infinite ends: J is the length (NaN or inf), not plannable

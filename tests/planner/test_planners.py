@@ -107,7 +107,7 @@ def plain_segment_cost(field: CostField, spec: GridSpec, x0: float, y0: float, x
     """J of a segment by its definition: length x (1 + the mean weight of the cells under n midpoints, n = the
     length in cells rounded up), each midpoint's cell found on its own (floor, clamped at the map's upper edge)."""
     length = math.hypot(x1 - x0, y1 - y0)
-    n = max(1, math.ceil(length / spec.resolution))
+    n = max(1, math.ceil(length / spec.resolution - 1e-9))
     total = 0.0
     for i in range(n):
         t = (i + 0.5) / n
@@ -538,3 +538,18 @@ def test_every_lookup_finds_a_points_cell_as_world_to_cell(origin: float) -> Non
             expected = plain_segment_cost(field, spec, *start, *end)
             assert field.segment_cost(*start, *end) == expected
             assert field.segments(np.array([start]), np.array([end]))[0][0] == pytest.approx(expected, rel=1e-12)
+
+
+def test_both_cost_lookups_cut_a_segment_into_the_same_pieces() -> None:
+    # 0.8 - 0.1 is 7.000000000000001 cells of 0.1 m: seven pieces for both lookups, not eight for one of them. Across
+    # one column of cost 200, eight midpoints in other cells would make OMPL minimise another J than the one reported.
+    costs = np.zeros((20, 20), np.uint8)
+    costs[:, 5] = 200
+    field = CostField(PlanningProblem(Costmap2D(GridSpec(0.1, 0, 0, 20, 20), costs), (0.15, 1.05), (0.85, 1.05), 0.1))
+    tenths = np.arange(1, 19) / 10
+    for a, b in itertools.permutations(tenths, 2):
+        expected = abs(b - a) * (
+            1 + field.weight[10].take(np.arange(round(min(a, b) * 10), round(max(a, b) * 10))).mean()
+        )
+        assert field.segment_cost(a, 1.05, b, 1.05) == pytest.approx(expected, rel=1e-12)
+        assert field.segments(np.array([[a, 1.05]]), np.array([[b, 1.05]]))[0][0] == pytest.approx(expected, rel=1e-12)
