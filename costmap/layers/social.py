@@ -114,13 +114,20 @@ def _people_by_id(people: Sequence[Person] | Mapping[int, Person]) -> Mapping[in
 
 
 def zone_hull(group: Group, people: Sequence[Person] | Mapping[int, Person]) -> BaseGeometry:
-    """Convex hull (Polygon, LineString or Point) of the group's o-space vertices and its members' positions."""
+    """Convex hull (Polygon, LineString or Point) of the group's o-space vertices and its members' positions (world
+    frame, metres). ValueError naming the group for a zone not of shape (K, 2), for no member and no zone vertex (no
+    zone to draw), for a member missing from ``people`` and for a value that is not finite."""
     by_id = _people_by_id(people)
     missing = [m for m in group.members if m not in by_id]
     if missing:
         raise ValueError(f"group {group.members}: members {missing} are not among the people given")
+    zone = np.asarray(group.zone, dtype=float)
+    if zone.ndim != 2 or zone.shape[1] != 2:
+        raise ValueError(f"group {group.members}: zone must be (K, 2) vertices (x, y), got shape {zone.shape}")
+    if not group.members and not len(zone):
+        raise ValueError(f"group {group.members}: no member and no zone vertex, so no zone to draw")
     members = np.array([(by_id[m].x, by_id[m].y) for m in group.members], dtype=float).reshape(-1, 2)
-    points = np.vstack([members, np.asarray(group.zone, dtype=float).reshape(-1, 2)])
+    points = np.vstack([members, zone])
     if not np.isfinite(points).all():
         raise ValueError(f"group {group.members}: non-finite member position or zone vertex")
     return cast(MultiPoint, shapely.multipoints(points)).convex_hull  # from the array: no point object per vertex
