@@ -71,6 +71,14 @@ class CostmapParams:
         for name, instance in self.instances.items():
             if not isinstance(instance, LayerInstance):
                 raise ValueError(f"instances: {name} must be a LayerInstance, got {type(instance).__name__}")
+            section = SECTIONS.get(instance.plugin)
+            wanted = None if section is None else type(getattr(self, section))
+            if instance.params is not None and not isinstance(instance.params, wanted or type(None)):
+                expected = "None (it takes no parameters)" if wanted is None else f"{wanted.__name__} or None"
+                raise ValueError(
+                    f"instances: {name}'s params must be {expected} for the {instance.plugin} plugin, got "
+                    f"{type(instance.params).__name__}"
+                )
         self.shared("lidar", "track_unknown_space")
         self.shared("social", "people_clear_margin")
 

@@ -165,3 +165,22 @@ def test_unknown_space_and_the_peoples_clearing_come_from_the_listed_layer_insta
     disagreeing = {**data["layers"], "plugins": ["near", "lidar", "crowd"]}
     with pytest.raises(ScenarioError, match=r"layers\.plugins: the lidar layers disagree on track_unknown_space"):
         scenario_from_dict({**data, "layers": disagreeing})
+
+
+@pytest.mark.parametrize(
+    ("instance", "message"),
+    [
+        (
+            LayerInstance("lidar", {"obstacle_max_range": 5.0}),
+            r"near's params must be ObstacleParams or None for the lidar plugin, got dict",
+        ),
+        (
+            LayerInstance("inflation", NEAR),
+            r"near's params must be InflationParams or None for the inflation plugin, got Obs",
+        ),
+        (LayerInstance("static", NEAR), r"near's params must be None \(it takes no parameters\) for the static plugin"),
+    ],
+)
+def test_an_instance_with_parameters_of_another_plugin_is_named(instance: LayerInstance, message: str) -> None:
+    with pytest.raises(ValueError, match=rf"instances: {message}"):
+        CostmapParams(plugins=("near", "social"), instances={"near": instance})
