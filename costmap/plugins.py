@@ -73,7 +73,8 @@ class CostmapParams:
                 raise ValueError(f"instances: {name} must be a LayerInstance, got {type(instance).__name__}")
             section = SECTIONS.get(instance.plugin)
             wanted = None if section is None else type(getattr(self, section))
-            if instance.params is not None and not isinstance(instance.params, wanted or type(None)):
+            known = instance.plugin in PLUGINS  # another plugin (``layered_costmap``'s ``plugins``) takes any params
+            if known and instance.params is not None and not isinstance(instance.params, wanted or type(None)):
                 expected = "None (it takes no parameters)" if wanted is None else f"{wanted.__name__} or None"
                 raise ValueError(
                     f"instances: {name}'s params must be {expected} for the {instance.plugin} plugin, got "

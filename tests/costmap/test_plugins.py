@@ -184,3 +184,8 @@ def test_unknown_space_and_the_peoples_clearing_come_from_the_listed_layer_insta
 def test_an_instance_with_parameters_of_another_plugin_is_named(instance: LayerInstance, message: str) -> None:
     with pytest.raises(ValueError, match=rf"instances: {message}"):
         CostmapParams(plugins=("near", "social"), instances={"near": instance})
+
+
+def test_an_instance_of_a_plugin_of_the_callers_own_takes_any_params() -> None:
+    custom = CostmapParams(plugins=("sonar_1", "lidar"), instances={"sonar_1": LayerInstance("sonar", {"range": 3.0})})
+    assert custom.layer_params("sonar_1") == {"range": 3.0}
