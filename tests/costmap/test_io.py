@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import cv2
 import numpy as np
 import pytest
 import yaml
+from rosbags.rosbag2 import StoragePlugin, Writer
+from rosbags.typesys import Stores, get_typestore
 
 from costmap.export import export_costmap
 from costmap.grid import Costmap2D, GridSpec
@@ -16,7 +20,7 @@ from costmap.mapfile import MapFileError, read_map, write_map
 from costmap.npz import load_npz, save_npz
 from costmap.occupancy import OccupancyGrid, cost_to_occupancy, costmap_to_occupancy, occupancy_to_cost
 from costmap.render import GROUP_COLOURS, OBSTACLE, default_scale, render_costmap, world_to_image
-from costmap.rosbag import read_occupancy_grids, write_occupancy_mcap
+from costmap.rosbag import MSGTYPE, _message, read_occupancy_grids, write_occupancy_mcap
 from sid.cli import main
 from sid.perception.group import Group
 from sid.perception.people import Person
@@ -207,6 +211,25 @@ def test_mcap_round_trip_is_exact(tmp_path, distro):
         np.testing.assert_array_equal(msg.data, grid.data)
     with pytest.raises(ValueError, match="already exists"):
         write_occupancy_mcap(path, grids)
+
+
+def test_an_occupancy_grid_message_of_the_wrong_size_names_the_bag_and_the_topic(tmp_path):
+    # A real rosbag2 folder (MCAP storage) written with rosbags: one good message, then one whose data is a cell short
+    # and one of width 0.
+    typestore = get_typestore(Stores.ROS2_HUMBLE)
+    good = _message(typestore, costmap_to_occupancy(every_cost_grid()), 0)
+    short = dataclasses.replace(good, data=good.data[:-1])
+    empty = dataclasses.replace(good, info=dataclasses.replace(good.info, width=0), data=good.data[:0])
+    for name, bad, message in (
+        ("short", short, rf"/costmap, message 2: data holds {good.data.size - 1} cells, not width x height = "),
+        ("empty", empty, r"/costmap, message 2: map.size must give at least one cell, got 0x"),
+    ):
+        with Writer(tmp_path / name, version=8, storage_plugin=StoragePlugin.MCAP) as writer:
+            connection = writer.add_connection("/costmap", MSGTYPE, typestore=typestore)
+            for stamp, msg in enumerate((good, bad)):
+                writer.write(connection, stamp, typestore.serialize_cdr(msg, MSGTYPE))
+        with pytest.raises(ValueError, match=rf"{name}: {message}"):
+            read_occupancy_grids(tmp_path / name)
 
 
 # --- pictures and the command -------------------------------------------------------------------------------
