@@ -194,6 +194,19 @@ def test_npz_errors_name_the_file(tmp_path):
     np.savez(tmp_path / "other.npz", a=np.zeros(3))
     with pytest.raises(ValueError, match="missing 'costmap'"):
         load_npz(tmp_path / "other.npz")
+    grid = dict(layer_names=np.array(["social"]), resolution=np.float64(0.05), origin=np.zeros(2))
+    known, unknown = np.zeros((3, 4), np.uint8), np.zeros((3, 4))
+    for name, arrays, message in (
+        ("float_layer", dict(costmap=known, layer_social=unknown), "social' must be uint8 .*, got float64 \\(3, 4\\)"),
+        ("no_layer", dict(costmap=known), "must be uint8 of shape \\(3, 4\\), got missing"),
+        ("float_master", dict(costmap=unknown, layer_social=known), "costs must be uint8"),
+    ):
+        np.savez(tmp_path / f"{name}.npz", **grid, **arrays)
+        with pytest.raises(ValueError, match=f"{name}.npz: .*{message}"):
+            load_npz(tmp_path / f"{name}.npz")
+    np.savez(tmp_path / "flat.npz", **{**grid, "resolution": np.float64(0.0)}, costmap=known)
+    with pytest.raises(ValueError, match="flat.npz: map: resolution must be a positive number"):
+        load_npz(tmp_path / "flat.npz")
 
 
 @pytest.mark.parametrize("distro", ["humble", "jazzy"])
