@@ -14,7 +14,7 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import ArrayLike
 
-from sid.checks import check_limit, check_number, check_numbers
+from sid.checks import check_limit, check_number, check_numbers, check_whole
 
 __all__ = [
     "Costmap2D",
@@ -152,8 +152,8 @@ class GridSpec:
     def __post_init__(self) -> None:
         check_number("map", "resolution", self.resolution, low=0, low_open=True, unit="metres")
         check_numbers("map", self, ("origin_x", "origin_y"), low=-MAX_ORIGIN, high=MAX_ORIGIN, unit="metres")
-        if self.width <= 0 or self.height <= 0:
-            raise ValueError(f"map.size must give at least one cell, got {self.width}x{self.height} cells")
+        for name in ("width", "height"):  # whole cells, stored as Python ints (a bool or 10.5 is no size)
+            object.__setattr__(self, name, check_whole("map", name, getattr(self, name), low=1))
         _check_cells(self.width, self.height)
 
     @classmethod

@@ -235,7 +235,7 @@ def test_an_occupancy_grid_message_of_the_wrong_size_names_the_bag_and_the_topic
     empty = dataclasses.replace(good, info=dataclasses.replace(good.info, width=0), data=good.data[:0])
     for name, bad, message in (
         ("short", short, rf"/costmap, message 2: data holds {good.data.size - 1} cells, not width x height = "),
-        ("empty", empty, r"/costmap, message 2: map.size must give at least one cell, got 0x"),
+        ("empty", empty, r"/costmap, message 2: map: width must be a whole number >= 1, got 0"),
     ):
         with Writer(tmp_path / name, version=8, storage_plugin=StoragePlugin.MCAP) as writer:
             connection = writer.add_connection("/costmap", MSGTYPE, typestore=typestore)
