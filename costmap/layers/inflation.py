@@ -15,6 +15,7 @@ cell gets exactly Nav2's value.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Literal
@@ -27,7 +28,14 @@ from costmap.grid import FREE_SPACE, INSCRIBED, LETHAL, MAX_NON_OBSTACLE, GridSp
 from costmap.layer import Layer, LayerInputs
 from sid.checks import check_number
 
-__all__ = ["DistanceMethod", "InflationLayer", "InflationParams", "distance_to_lethal_cells", "inflation_cost"]
+__all__ = [
+    "DistanceMethod",
+    "InflationLayer",
+    "InflationParams",
+    "check_reach",
+    "distance_to_lethal_cells",
+    "inflation_cost",
+]
 
 DistanceMethod = Literal["opencv", "scipy"]
 
@@ -47,6 +55,17 @@ class InflationParams:
     def __post_init__(self) -> None:
         check_number("inflation", "inflation_radius", self.inflation_radius, low=0, unit="metres")
         check_number("inflation", "cost_scaling_factor", self.cost_scaling_factor, low=0)
+
+
+def check_reach(spec: GridSpec, inflation_radius: float, field: str) -> None:
+    """ValueError, naming ``field``, for an inflation radius (m) beyond the map's diagonal: costs cannot spread farther
+    than the map, and the cost table grows with the square of the radius in cells."""
+    diagonal = math.hypot(*spec.size_m)
+    if inflation_radius > diagonal:
+        raise ValueError(
+            f"{field}: {inflation_radius:g} m is more than the map's diagonal ({diagonal:g} m), the farthest any cost "
+            "can spread; use at most that"
+        )
 
 
 def inflation_cost(distance_m: np.ndarray, inscribed_radius: float, cost_scaling_factor: float) -> np.ndarray:
@@ -82,6 +101,7 @@ class InflationLayer(Layer):
 
     def __init__(self, spec: GridSpec, params: InflationParams, inscribed_radius: float) -> None:
         check_number("inflation layer", "robot.radius (inscribed radius)", inscribed_radius, low=0, unit="metres")
+        check_reach(spec, params.inflation_radius, "inflation layer: inflation_radius")
         self.combination = "max_nonzero" if params.inflate_unknown else "max_keep_unknown"
         super().__init__(spec)
         self.params = params

@@ -7,6 +7,7 @@ import pytest
 
 from costmap.grid import FREE_SPACE, INSCRIBED, LETHAL, NO_INFORMATION, GridSpec, Window
 from costmap.layers.inflation import InflationLayer, InflationParams, distance_to_lethal_cells
+from costmap.plugins import CostmapParams, LayerInstance, layered_costmap
 
 SPEC = GridSpec.from_size(0.05, (-1.0, -4.0), (10.0, 8.0))
 
@@ -48,6 +49,18 @@ def test_inflation_reach_rounds_up_like_nav2_cell_distance():
     assert layer.cell_radius == 11  # ceil(0.53 / 0.05): the reach is 0.55 m, beyond the 0.53 m asked for
     assert master[20, 31] == nav2_cost(0.55, 0.25, 10.0) > 0
     assert master[20, 32] == 0
+
+
+def test_an_inflation_radius_beyond_the_maps_diagonal_is_named_on_every_path():
+    spec = GridSpec(0.05, 0.0, 0.0, 60, 80)  # 3 x 4 m: a diagonal of 5 m
+    assert InflationLayer(spec, InflationParams(inflation_radius=5.0), 0.25).cell_radius == 100
+    with pytest.raises(ValueError, match=r"inflation layer: inflation_radius: 5.01 m is more than the map's diagonal"):
+        InflationLayer(spec, InflationParams(inflation_radius=5.01), 0.25)  # the table of (R cells)^2 never made
+    params = CostmapParams(
+        plugins=("lidar", "wide"), instances={"wide": LayerInstance("inflation", InflationParams(50))}
+    )
+    with pytest.raises(ValueError, match=r"inflation_radius: 50 m is more than the map's diagonal \(5 m\)"):
+        layered_costmap(spec, params)
 
 
 def test_opencv_and_scipy_distances_agree():
