@@ -553,3 +553,15 @@ def test_both_cost_lookups_cut_a_segment_into_the_same_pieces() -> None:
         )
         assert field.segment_cost(a, 1.05, b, 1.05) == pytest.approx(expected, rel=1e-12)
         assert field.segments(np.array([[a, 1.05]]), np.array([[b, 1.05]]))[0][0] == pytest.approx(expected, rel=1e-12)
+
+
+def test_an_empty_path_fails_the_check_and_says_why(walls) -> None:
+    field = CostField(walls)
+    check = check_path(field, np.zeros((0, 2)))
+    assert not check.valid and check.samples == 0 and check.describe() == "no samples: the path is empty"
+    single = check_path(field, np.array([[1.0, 2.0]]))  # one free point: one free sample
+    assert single.valid and single.describe() == "all 1 samples free"
+    blocked = check_path(field, np.array([[1.0, 2.0], [4.0, 2.0]]))
+    assert not blocked.valid and re.fullmatch(
+        r"\d+ of \d+ samples in collision, first at \(\d\.\d{3}, 2\.000\) m", blocked.describe()
+    )
