@@ -5,8 +5,9 @@ plane; the costmap follows Nav2's values (``costmap.grid``).
 
 Validity. A robot centre is *free* in a cell when the cell is known (or ``allow_unknown``), its cost is below
 INSCRIBED (253) and no LETHAL cell centre lies within ``robot_radius`` of the cell centre. The last test is an
-exact Euclidean distance transform of the lethal cells (scipy), i.e. the disc footprint checked against every
-lethal cell at once; it agrees with Nav2's inscribed value when the inflation layer was built with this robot's
+exact Euclidean distance transform of the lethal cells (the inflation layer's,
+``costmap.layers.inflation.squared_distance_to_lethal_cells``), i.e. the disc footprint checked against every lethal
+cell at once; it agrees with Nav2's inscribed value when the inflation layer was built with this robot's
 radius, and it still protects the robot when the costmap was inflated for a smaller one.
 
 Planners see a slightly stricter mask, *plannable*: free cells whose eight neighbours are free too. A straight
@@ -33,6 +34,7 @@ import numpy as np
 from scipy import ndimage
 
 from costmap.grid import INSCRIBED, LETHAL, MAX_NON_OBSTACLE, NO_INFORMATION, Costmap2D
+from costmap.layers.inflation import squared_distance_to_lethal_cells
 from sid.checks import check_number
 from sid.errors import SidError
 
@@ -144,8 +146,11 @@ class CostField:
 
         lethal = costs == LETHAL
         if lethal.any():
-            # Distance (m) from every cell centre to the nearest lethal cell centre.
-            clearance = ndimage.distance_transform_edt(~lethal) * spec.resolution
+            # Distance (m) from every cell centre to the nearest lethal cell centre, from the exact squared distance
+            # in cells; capped beyond the robot's radius (or the map's diagonal), whose cells do not touch.
+            reach = min(problem.robot_radius / spec.resolution, math.hypot(*spec.shape))
+            cap = math.floor(reach**2) + 2.0
+            clearance = np.sqrt(squared_distance_to_lethal_cells(lethal, cap), dtype=float) * spec.resolution
             touches_lethal = clearance <= problem.robot_radius
         else:
             touches_lethal = np.zeros(spec.shape, dtype=bool)

@@ -565,3 +565,14 @@ def test_an_empty_path_fails_the_check_and_says_why(walls) -> None:
     assert not blocked.valid and re.fullmatch(
         r"\d+ of \d+ samples in collision, first at \(\d\.\d{3}, 2\.000\) m", blocked.describe()
     )
+
+
+@pytest.mark.parametrize("radius", [0.0, 0.05, math.hypot(0.05, 0.05), 0.1, 0.25, 0.3, 1e300])
+def test_the_clearance_test_is_the_exact_euclidean_distance_of_cell_centres(radius: float) -> None:
+    # The inflation layer's distance transform (OpenCV) against scipy's exact one, at radii on cell distances.
+    spec = GridSpec(0.05, -1.0, 2.0, 90, 70)
+    lethal = np.random.default_rng(4).random(spec.shape) < 0.004
+    costs = np.where(lethal, LETHAL, 0).astype(np.uint8)
+    field = CostField(PlanningProblem(Costmap2D(spec, costs), (0.0, 3.0), (1.0, 4.0), radius))
+    clearance = ndimage.distance_transform_edt(~lethal) * spec.resolution
+    np.testing.assert_array_equal(field.free, clearance > radius)

@@ -4,9 +4,15 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy import ndimage
 
 from costmap.grid import FREE_SPACE, INSCRIBED, LETHAL, NO_INFORMATION, GridSpec, Window
-from costmap.layers.inflation import InflationLayer, InflationParams, distance_to_lethal_cells
+from costmap.layers.inflation import (
+    SQUARED_DISTANCE_EXACT,
+    InflationLayer,
+    InflationParams,
+    squared_distance_to_lethal_cells,
+)
 from costmap.plugins import CostmapParams, LayerInstance, layered_costmap
 
 SPEC = GridSpec.from_size(0.05, (-1.0, -4.0), (10.0, 8.0))
@@ -63,14 +69,15 @@ def test_an_inflation_radius_beyond_the_maps_diagonal_is_named_on_every_path():
         layered_costmap(spec, params)
 
 
-def test_opencv_and_scipy_distances_agree():
+@pytest.mark.parametrize(("shape", "density"), [((120, 90), 0.01), ((300, 400), 0.001), ((1400, 1400), 0.0)])
+def test_squared_distances_are_scipys_exact_ones(shape, density):
     rng = np.random.default_rng(0)
-    lethal = rng.random((120, 90)) < 0.01
-    a = distance_to_lethal_cells(lethal, "opencv")
-    b = distance_to_lethal_cells(lethal, "scipy")
-    np.testing.assert_allclose(a, b, atol=1e-4)
-    with pytest.raises(ValueError, match="distance method"):
-        distance_to_lethal_cells(lethal, "manhattan")
+    lethal = rng.random(shape) < density
+    lethal[0, 0] = True  # on the largest grid: squared distances up to 2 x 1399^2, near SQUARED_DISTANCE_EXACT
+    exact = np.rint(ndimage.distance_transform_edt(~lethal) ** 2)
+    assert exact.max() < SQUARED_DISTANCE_EXACT
+    np.testing.assert_array_equal(squared_distance_to_lethal_cells(lethal, np.inf), exact)
+    np.testing.assert_array_equal(squared_distance_to_lethal_cells(lethal, 50.0), np.minimum(exact, 50.0))
 
 
 def test_inflation_keeps_the_larger_cost_and_nav2_unknown_rule():
