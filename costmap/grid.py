@@ -136,7 +136,8 @@ def nonzero_cells(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 MAX_ORIGIN = 1e7
 """The farthest (m, along x or y) a map's origin may lie from the world's: 10 000 km holds any UTM coordinate, and
-float64 still resolves nanometres there (at 1e300 m a person 4 m inside a map lands on its corner)."""
+float64 still resolves nanometres there; far beyond, a person's offset into the map is lost to rounding
+(docs/parameters.md, "Input limits")."""
 
 
 @dataclass(frozen=True)

@@ -58,11 +58,11 @@ short segments (all pairs of a long path) is cut into chunks of similar length."
 
 DEFAULT_COST_WEIGHT = 4.0
 """w in J = integral of (1 + w c / 252) ds; see the module docstring. 4: on the demo scenario the smallest weight
-tried that keeps the whole path beyond Hall's personal distance (1.2 m) of every member, for a few per cent of
-length; smaller weights cut through the conversation or graze it (docs/parameters.md)."""
+tried that keeps the whole path beyond Hall's personal distance (1.2 m) of every member, at little extra length;
+smaller weights cut through the conversation or graze it (docs/parameters.md)."""
 MAX_COST_WEIGHT = 1000.0
 """The largest w accepted: a metre through the costliest free cell then costs 1001 m, past any detour a map offers;
-a larger w only overflows the cost sums (1e308 did)."""
+a larger w only brings the cost sums nearer overflow (docs/parameters.md, "Planner")."""
 
 
 class PlanningError(SidError, ValueError):
