@@ -50,7 +50,7 @@ __all__ = [
     "WalledOffError",
 ]
 
-_LOOP_MAX = 20  # segment_cost sums this many samples or fewer in a Python loop, more with numpy (docs/parameters.md)
+_LOOP_MAX = 40  # segment_cost sums this many samples or fewer in a Python loop, more with numpy (docs/parameters.md)
 _Length = TypeVar("_Length", float, np.ndarray)  # one segment's length, or an array of them
 SAMPLES_PER_CALL = 2**20
 """``CostField.segments`` prices at most about this many samples at once (a few arrays of 8 MB): a batch of long and
@@ -180,7 +180,10 @@ class CostField:
         into: the length in cells rounded up, where a length of k cells give or take rounding (0.8 - 0.1 m at 0.1 m
         is 7.000000000000001 cells) is k pieces. The one rule of ``segment_cost`` and ``segments_along``, so that the
         cost OMPL minimises is the cost reported and smoothed."""
-        return np.maximum(np.ceil(length * self._inv_res - 1e-9), 1.0)
+        # ceil(x) as -((-x) // 1), which Python floats and numpy arrays both compute, and fast on a float (OMPL's
+        # cost callback); the rounded-up count is a whole number >= 0, so adding (count < 1) makes it at least 1.
+        pieces = -((1e-9 - length * self._inv_res) // 1.0)
+        return pieces + (pieces < 1.0)
 
     # ---- scalar lookups (OMPL callbacks) -------------------------------------------------------------------------
     def is_plannable(self, x: float, y: float) -> bool:
@@ -196,9 +199,10 @@ class CostField:
         # Midpoint i at t = (i + 0.5) / n, to a cell of the padded grids as ``GridSpec.world_to_cell`` does.
         res, ox, oy = self.resolution, self._ox, self._oy
         if n > _LOOP_MAX:  # numpy's fixed overhead pays off on long segments
-            ts = (np.arange(n) + 0.5) / n
-            rows = np.floor((y0 + ts * dy - oy) / res).astype(np.intp)
-            cols = np.floor((x0 + ts * dx - ox) / res).astype(np.intp)
+            ts = np.arange(0.5, n) / n  # (i + 0.5) / n
+            # Offsets >= 0 inside the map: truncation is the floor.
+            rows = ((y0 + ts * dy - oy) / res).astype(np.intp)
+            cols = ((x0 + ts * dx - ox) / res).astype(np.intp)
             total = float(self._weight_padded[rows, cols].sum())
         else:
             weight, stride, floor = self._weight_flat, self._stride, math.floor
@@ -250,16 +254,15 @@ class CostField:
         ``GridSpec.world_to_cell`` gives (as ``segment_cost``); each segment's cost sums its midpoints in order of k,
         and numpy's inner loops run over segments, not over two coordinates.
         """
-        pieces = self._pieces(length)
-        last = 2.0 * pieces  # each segment's end sample
-        longest = float(last.max())  # NaN or infinite when any length is
-        if not math.isfinite(longest):  # NaN or infinite ends: J is the length (NaN or inf), not plannable
+        if not math.isfinite(float(length.max())):  # NaN or infinite ends: J is the length (NaN or inf), not plannable
             finite = np.isfinite(length)
             cost, ok = length.copy(), np.zeros(len(length), dtype=bool)
             if finite.any():
                 cost[finite], ok[finite] = self.segments_along(p[:, finite], d[:, finite], length[finite])
             return cost, ok
-        width = int(longest) + 2  # one spare sample: each segment's slice of samples ends inside its row
+        pieces = self._pieces(length)
+        last = 2.0 * pieces  # each segment's end sample
+        width = int(last.max()) + 2  # one spare sample: each segment's slice of samples ends inside its row
         if width * len(last) > SAMPLES_PER_CALL and len(last) > 1:
             return self._segments_in_chunks(p, d, length, last)
         t = np.minimum(np.arange(width, dtype=float)[:, None], last) / last  # (K, M), 0 .. 1 along each segment
