@@ -1,8 +1,8 @@
 """How a layer's grid is written into the combined (master) grid: Nav2's combination methods and two of ours, in place.
 
 - max: keep the larger value; an unknown (255) layer cell is ignored, an unknown master cell is overwritten.
-- max_nonzero: max, and a free (0) layer cell is ignored too: it carries no opinion, so unknown space stays unknown
-  (the social layer).
+- max_nonzero: max, and a free (0) layer cell is ignored as an unknown one is: it carries no opinion, so unknown
+  space stays unknown (the social layer).
 - max_keep_unknown: max, but an unknown master cell stays unknown unless the layer value is >= 253 (Nav2's inflation
   rule).
 - overwrite: copy the layer value unless it is unknown.
@@ -54,21 +54,23 @@ def _opencv_max(master: np.ndarray, layer: np.ndarray) -> bool:
     return True
 
 
-def update_with_max(master: np.ndarray, layer: np.ndarray, no_opinion: int = NO_INFORMATION) -> None:
-    """Nav2's max; layer cells equal to ``no_opinion`` (unknown by default) leave the master untouched."""
-    # With no unknown master cell and no layer cell without an opinion but free ones (a free cell never raises the
-    # max), it is the plain max: the usual case, without masks.
-    plain = no_opinion == FREE_SPACE or (no_opinion == NO_INFORMATION and not _holds_unknown(layer))
-    if plain and not _holds_unknown(master) and _opencv_max(master, layer):
+def update_with_max(master: np.ndarray, layer: np.ndarray, ignore_free: bool = False) -> None:
+    """Nav2's max: unknown layer cells leave the master untouched, and free ones too with ``ignore_free``."""
+    # With no unknown master or layer cell it is the plain max (a free layer cell never raises it): the usual case,
+    # without masks.
+    if not _holds_unknown(layer) and not _holds_unknown(master) and _opencv_max(master, layer):
         return
     master_unknown = master == NO_INFORMATION
     larger = np.maximum(master, layer)
     np.copyto(larger, layer, where=master_unknown)
-    np.copyto(master, larger, where=layer != no_opinion)
+    opinion = layer != NO_INFORMATION
+    if ignore_free:
+        opinion &= layer != FREE_SPACE
+    np.copyto(master, larger, where=opinion)
 
 
 def update_with_max_nonzero(master: np.ndarray, layer: np.ndarray) -> None:
-    update_with_max(master, layer, no_opinion=FREE_SPACE)
+    update_with_max(master, layer, ignore_free=True)
 
 
 def update_with_max_keep_unknown(master: np.ndarray, layer: np.ndarray) -> None:

@@ -14,7 +14,7 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import ArrayLike
 
-from sid.checks import check_limit, check_number, check_numbers
+from sid.checks import check_limit, check_number, check_numbers, check_whole
 
 __all__ = [
     "Costmap2D",
@@ -136,7 +136,8 @@ def nonzero_cells(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 MAX_ORIGIN = 1e7
 """The farthest (m, along x or y) a map's origin may lie from the world's: 10 000 km holds any UTM coordinate, and
-float64 still resolves nanometres there (at 1e300 m a person 4 m inside a map lands on its corner)."""
+float64 still resolves nanometres there; far beyond, a person's offset into the map is lost to rounding
+(docs/parameters.md, "Input limits")."""
 
 
 @dataclass(frozen=True)
@@ -152,8 +153,8 @@ class GridSpec:
     def __post_init__(self) -> None:
         check_number("map", "resolution", self.resolution, low=0, low_open=True, unit="metres")
         check_numbers("map", self, ("origin_x", "origin_y"), low=-MAX_ORIGIN, high=MAX_ORIGIN, unit="metres")
-        if self.width <= 0 or self.height <= 0:
-            raise ValueError(f"map.size must give at least one cell, got {self.width}x{self.height} cells")
+        for name in ("width", "height"):  # whole cells, stored as Python ints (a bool or 10.5 is no size)
+            object.__setattr__(self, name, check_whole("map", name, getattr(self, name), low=1))
         _check_cells(self.width, self.height)
 
     @classmethod

@@ -45,7 +45,8 @@ def save_npz(path: str | Path, layered: LayeredCostmap) -> Path:
 
 
 def load_npz(path: str | Path) -> SavedCostmap:
-    """Read an archive written by ``save_npz``; a missing key or a wrong shape names the file and the key."""
+    """Read an archive written by ``save_npz``; a missing key, a wrong shape or dtype (grids are uint8) or a bad
+    geometry names the file and the key."""
     path = Path(path)
     try:
         archive = np.load(path, allow_pickle=False)
@@ -60,12 +61,17 @@ def load_npz(path: str | Path) -> SavedCostmap:
         if costs.ndim != 2 or origin.shape != (2,):
             raise ValueError(f"{path}: 'costmap' must be 2-D and 'origin' [x, y]")
         rows, cols = costs.shape
-        spec = GridSpec(float(archive["resolution"]), float(origin[0]), float(origin[1]), cols, rows)
-        master = Costmap2D(spec, costs)
+        try:
+            spec = GridSpec(float(archive["resolution"]), float(origin[0]), float(origin[1]), cols, rows)
+            master = Costmap2D(spec, costs)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"{path}: {exc}") from exc
         layers = {}
         for name in archive["layer_names"].tolist():
             key = f"layer_{name}"
-            if key not in archive or archive[key].shape != spec.shape:
-                raise ValueError(f"{path}: layer '{name}' is missing or not of shape {spec.shape}")
-            layers[name] = archive[key]
+            grid = archive.get(key)
+            if grid is None or grid.shape != spec.shape or grid.dtype != np.uint8:
+                found = "missing" if grid is None else f"{grid.dtype} {grid.shape}"
+                raise ValueError(f"{path}: layer '{name}' must be uint8 of shape {spec.shape}, got {found}")
+            layers[name] = grid
     return SavedCostmap(master, layers)

@@ -5,7 +5,9 @@ As in Nav2, a costmap lists layer instances by name; each has a plugin (the kind
 and its own parameters. A name that is itself a plugin (``lidar``, ``social``, ...) is an instance of that plugin
 with the costmap's parameters for it (``CostmapParams.obstacle`` for ``lidar``, ...); any other name is declared in
 ``CostmapParams.instances`` (a scenario file's ``layers.NAME: {plugin: lidar, ...}``), so that two LiDAR layers
-with different ranges can sit in one costmap.
+with different ranges can sit in one costmap. Two settings of the whole costmap come from the listed instances
+(``CostmapParams.shared``), which must agree on them: the LiDAR layers' ``track_unknown_space`` (the master's default
+value and the static layer's unknown cells) and the social layers' ``people_clear_margin``.
 
 Adding a kind of layer is one class (a ``costmap.layer.Layer``), one line in ``PLUGINS`` and, when it has
 parameters, one in ``SECTIONS``.
@@ -69,6 +71,31 @@ class CostmapParams:
         for name, instance in self.instances.items():
             if not isinstance(instance, LayerInstance):
                 raise ValueError(f"instances: {name} must be a LayerInstance, got {type(instance).__name__}")
+            section = SECTIONS.get(instance.plugin)
+            wanted = None if section is None else type(getattr(self, section))
+            known = instance.plugin in PLUGINS  # another plugin (``layered_costmap``'s ``plugins``) takes any params
+            if known and instance.params is not None and not isinstance(instance.params, wanted or type(None)):
+                expected = "None (it takes no parameters)" if wanted is None else f"{wanted.__name__} or None"
+                raise ValueError(
+                    f"instances: {name}'s params must be {expected} for the {instance.plugin} plugin, got "
+                    f"{type(instance.params).__name__}"
+                )
+        self.shared("lidar", "track_unknown_space")
+        self.shared("social", "people_clear_margin")
+
+    def shared(self, plugin: str, name: str) -> Any:
+        """The parameter ``name`` that the listed instances of ``plugin`` hold, for a setting of the whole costmap
+        taken from a layer's (the master's and the static layer's unknown space from the LiDAR layers'
+        ``track_unknown_space``, the people's clearing radius from the social layers'); the plugin's section's value
+        when none is listed. ValueError naming the instances when they disagree (checked when the record is made)."""
+        values = {layer: getattr(self.layer_params(layer), name) for layer in self.named(plugin)}
+        if len(set(values.values())) > 1:
+            given = ", ".join(f"{layer} {value}" for layer, value in values.items())
+            raise ValueError(
+                f"plugins: the {plugin} layers disagree on {name} ({given}); it sets the whole costmap, so give them "
+                "the same value"
+            )
+        return next(iter(values.values()), getattr(getattr(self, SECTIONS[plugin]), name))
 
     def plugin(self, name: str) -> str:
         """The plugin of the layer instance ``name``: its declared one, else the name itself."""
@@ -111,14 +138,18 @@ class LayerContext:
         is one of ``PEOPLE_LAYERS`` draws the people."""
         if PEOPLE_LAYERS.isdisjoint(self.params.plugin(name) for name in self.params.plugins):
             return 0.0
-        return self.body_radius + self.params.social.people_clear_margin
+        return self.body_radius + self.params.shared("social", "people_clear_margin")
 
 
 Factory = Callable[[LayerContext], Layer | None]  # None: nothing to add (the static layer without a map)
 
 
 def _static(c: LayerContext) -> StaticLayer | None:
-    return None if c.static_map is None else StaticLayer(c.spec, c.static_map, c.params.obstacle.track_unknown_space)
+    return (
+        None
+        if c.static_map is None
+        else StaticLayer(c.spec, c.static_map, c.params.shared("lidar", "track_unknown_space"))
+    )
 
 
 PLUGINS: dict[str, Factory] = {
@@ -166,4 +197,4 @@ def layered_costmap(
         if layer is not None:
             layer.name = name
             layers.append(layer)
-    return LayeredCostmap(spec, layers, params.obstacle.default_value)
+    return LayeredCostmap(spec, layers, params.shared("lidar", "default_value"))

@@ -247,6 +247,13 @@ LEGEND: dict[str, Swatch] = {  # the fixed entries, name -> swatch
     "camera, field of view": _legend_camera,
 }
 LEGEND_ROW, MAX_GROUP_ENTRIES = 22, 6
+# The panel right of the map (px): its gap from the map, the top and right padding, the swatches' width, a legend
+# label's offset from the panel's left, the graded colour scale's height and the space below it (or the first row's
+# baseline without a scale), and the space between the special values and the legend.
+PANEL_GAP, PANEL_PAD, SWATCH_WIDTH, LABEL_X = 22, 10, 22, 34
+SCALE_HEIGHT, SCALE_GAP, NO_SCALE = 200, 24, 14
+SPECIALS_GAP = 8
+SPECIALS = ((INSCRIBED, "253 inscribed"), (LETHAL, "254 lethal"), (NO_INFORMATION, "255 unknown"))
 
 
 def _members(group: Group) -> str:
@@ -276,41 +283,48 @@ def _legend_rows(
     return rows + [(extra.label, extra.swatch) for extra in extras]
 
 
+def _panel_contents(costs: np.ndarray) -> tuple[bool, list[tuple[int, str]]]:
+    """What the panel shows of ``costs``: whether any cost is graded (the colour scale), and the special values
+    present with their labels."""
+    graded = bool(np.any((costs > 0) & (costs <= MAX_NON_OBSTACLE)))
+    return graded, [(value, label) for value, label in SPECIALS if np.any(costs == value)]
+
+
 def _panel_size(costs: np.ndarray, rows: Sequence[tuple[str, Swatch]]) -> tuple[int, int]:
     """Width and height (px) of ``_panel`` for these costs and legend rows."""
-    height = 10 + (224 if np.any((costs > 0) & (costs <= MAX_NON_OBSTACLE)) else 14)
-    height += LEGEND_ROW * sum(bool(np.any(costs == value)) for value in (INSCRIBED, LETHAL, NO_INFORMATION)) + 8
+    graded, specials = _panel_contents(costs)
+    height = PANEL_PAD + (SCALE_HEIGHT + SCALE_GAP if graded else NO_SCALE)
+    height += LEGEND_ROW * len(specials) + SPECIALS_GAP + LEGEND_ROW * len(rows)
     widths = [cv2.getTextSize(name, FONT, 0.4, 1)[0][0] for name, _ in rows]
-    return max(PANEL_WIDTH, 22 + 34 + max(widths, default=0) + 10), height + LEGEND_ROW * len(rows)
+    return max(PANEL_WIDTH, PANEL_GAP + LABEL_X + max(widths, default=0) + PANEL_PAD), height
 
 
 def _panel(img: np.ndarray, spec: GridSpec, scale: int, costs: np.ndarray, rows: Sequence[tuple[str, Swatch]]) -> None:
     """Right of the map: the colour scale if any cost is graded, the special values present, then the legend."""
-    left, y = MARGIN_LEFT + spec.width * scale + 22, MARGIN_TOP + 10
-    width = 22
-    if np.any((costs > 0) & (costs <= MAX_NON_OBSTACLE)):
-        height = 200
-        values = np.linspace(MAX_NON_OBSTACLE, 0, height).round().astype(np.uint8)
-        img[y : y + height, left : left + width] = COST_COLOURS[values][:, None, :]
-        cv2.rectangle(img, (left, y), (left + width, y + height), TEXT, 1)
+    left, y = MARGIN_LEFT + spec.width * scale + PANEL_GAP, MARGIN_TOP + PANEL_PAD
+    width = SWATCH_WIDTH
+    graded, specials = _panel_contents(costs)
+    if graded:
+        values = np.linspace(MAX_NON_OBSTACLE, 0, SCALE_HEIGHT).round().astype(np.uint8)
+        img[y : y + SCALE_HEIGHT, left : left + width] = COST_COLOURS[values][:, None, :]
+        cv2.rectangle(img, (left, y), (left + width, y + SCALE_HEIGHT), TEXT, 1)
         _text(img, "cost", (left, y - 6), 0.45)
         for value in (0, 50, 100, 150, 200, 252):
-            v = y + int(round((MAX_NON_OBSTACLE - value) / MAX_NON_OBSTACLE * (height - 1)))
+            v = y + int(round((MAX_NON_OBSTACLE - value) / MAX_NON_OBSTACLE * (SCALE_HEIGHT - 1)))
             cv2.line(img, (left + width, v), (left + width + 4, v), TEXT, 1)
             _text(img, str(value), (left + width + 7, v + 4), 0.4)
-        y += height + 24
+        y += SCALE_HEIGHT + SCALE_GAP
     else:
-        y += 14
-    for value, label in ((INSCRIBED, "253 inscribed"), (LETHAL, "254 lethal"), (NO_INFORMATION, "255 unknown")):
-        if np.any(costs == value):
-            cv2.rectangle(img, (left, y - 11), (left + width, y + 3), tuple(int(c) for c in COST_COLOURS[value]), -1)
-            cv2.rectangle(img, (left, y - 11), (left + width, y + 3), TEXT, 1)
-            _text(img, label, (left + width + 7, y), 0.4)
-            y += LEGEND_ROW
-    y += 8
+        y += NO_SCALE
+    for value, label in specials:
+        cv2.rectangle(img, (left, y - 11), (left + width, y + 3), tuple(int(c) for c in COST_COLOURS[value]), -1)
+        cv2.rectangle(img, (left, y - 11), (left + width, y + 3), TEXT, 1)
+        _text(img, label, (left + width + 7, y), 0.4)
+        y += LEGEND_ROW
+    y += SPECIALS_GAP
     for name, swatch in rows:
-        swatch(img, left + 11, y - 4)
-        _text(img, name, (left + 34, y), 0.4)
+        swatch(img, left + SWATCH_WIDTH // 2, y - 4)  # centred over the swatches above
+        _text(img, name, (left + LABEL_X, y), 0.4)
         y += LEGEND_ROW
 
 

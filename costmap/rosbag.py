@@ -110,15 +110,27 @@ def read_occupancy_grids(path: str | Path) -> dict[str, list[OccupancyGrid]]:
             msg = typestore.deserialize_cdr(raw, MSGTYPE)
             if not isinstance(msg, OccupancyGridMsg):  # the Humble store builds this class for MSGTYPE
                 raise TypeError(f"{path}: {MSGTYPE} deserialized as {type(msg).__name__}")
-            q = msg.info.origin.orientation
-            yaw = float(2 * np.arctan2(q.z, q.w))
-            spec = GridSpec(
-                _float32_decimal(msg.info.resolution),
-                msg.info.origin.position.x,
-                msg.info.origin.position.y,
-                msg.info.width,
-                msg.info.height,
-            )
-            data = np.asarray(msg.data, dtype=np.int8).reshape(spec.shape)
-            out.setdefault(connection.topic, []).append(OccupancyGrid(spec, data, yaw, msg.header.frame_id))
+            grids = out.setdefault(connection.topic, [])
+            where = f"{path}: {connection.topic}, message {len(grids) + 1}"
+            try:
+                grids.append(_grid(msg))
+            except ValueError as exc:
+                raise ValueError(f"{where}: {exc}") from exc
     return out
+
+
+def _grid(msg: OccupancyGridMsg) -> OccupancyGrid:
+    """The grid of one message; ValueError for a bad geometry or data not of width x height cells."""
+    q = msg.info.origin.orientation
+    yaw = float(2 * np.arctan2(q.z, q.w))
+    info = msg.info
+    spec = GridSpec(
+        _float32_decimal(info.resolution), info.origin.position.x, info.origin.position.y, info.width, info.height
+    )
+    if len(msg.data) != spec.width * spec.height:
+        raise ValueError(
+            f"data holds {len(msg.data)} cells, not width x height = {spec.width} x {spec.height} = "
+            f"{spec.width * spec.height}"
+        )
+    data = np.asarray(msg.data, dtype=np.int8).reshape(spec.shape)
+    return OccupancyGrid(spec, data, yaw, msg.header.frame_id)

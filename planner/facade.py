@@ -46,8 +46,8 @@ DEFAULT_SETTLE_S = 0.04
 Chosen over the navigation study's tasks (docs/benchmarks.md, "Planning: when BIT* stops")."""
 DEFAULT_SOFT_LIMIT_S = 0.10
 """``plan``'s default ``soft_limit``: an anytime planner that has a path stops after this long (s) even if its cost
-still falls, so that a plan (with the lookups, smoothing and the final check) returns within 0.15 s without costing
-more than the seeds' own spread (docs/benchmarks.md, "Planning: when BIT* stops")."""
+still falls, so that a plan (with the lookups, smoothing and the final check) keeps to the time the navigation study
+allows it without costing more than the seeds' own spread (docs/benchmarks.md, "Planning: when BIT* stops")."""
 MAX_SEED = 2**32 - 1
 """The largest seed ``plan`` takes: OMPL's seed is a ``std::uint_fast32_t``, 32 bits wide on some platforms."""
 UNAVAILABLE: dict[str, str] = {

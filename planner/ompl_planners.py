@@ -43,8 +43,9 @@ __all__ = [
 
 FMT_SAMPLES_PER_SECOND = 250
 """Samples of FMT* per second of time budget. FMT* is not anytime: it plans on a fixed sample set and returns nothing
-if stopped early, so its sample count follows the time budget, at about half the rate it reaches on the demo scenario
-(a margin for a slower or loaded machine; docs/parameters.md), or equals ``max_iterations`` when that is given."""
+if stopped early, so its sample count follows the time budget, at a rate below the one it reaches on the demo
+scenario (a margin for a slower or loaded machine; the rates in docs/parameters.md), or equals ``max_iterations``
+when that is given."""
 
 
 SETTLING_PLANNERS = ("bitstar",)

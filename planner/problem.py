@@ -5,8 +5,9 @@ plane; the costmap follows Nav2's values (``costmap.grid``).
 
 Validity. A robot centre is *free* in a cell when the cell is known (or ``allow_unknown``), its cost is below
 INSCRIBED (253) and no LETHAL cell centre lies within ``robot_radius`` of the cell centre. The last test is an
-exact Euclidean distance transform of the lethal cells (scipy), i.e. the disc footprint checked against every
-lethal cell at once; it agrees with Nav2's inscribed value when the inflation layer was built with this robot's
+exact Euclidean distance transform of the lethal cells (the inflation layer's,
+``costmap.layers.inflation.squared_distance_to_lethal_cells``), i.e. the disc footprint checked against every lethal
+cell at once; it agrees with Nav2's inscribed value when the inflation layer was built with this robot's
 radius, and it still protects the robot when the costmap was inflated for a smaller one.
 
 Planners see a slightly stricter mask, *plannable*: free cells whose eight neighbours are free too. A straight
@@ -19,18 +20,21 @@ Cost. Planners minimise J = integral over the path of (1 + w * c(s) / 252) ds, w
 under the robot centre (0..252) and w = ``cost_weight``: w = 0 is the shortest path; with w = 4 a metre through a
 cell of cost 252 counts as five metres, so the path accepts up to four metres of detour to avoid it. This is Smac
 Planner's travel-cost model (``cost_penalty``) with a larger default so that graded social zones bend the path.
-The integral uses the midpoint rule on ``ceil(L / resolution)`` equal pieces of each straight segment.
+The integral uses the midpoint rule on ``ceil(L / resolution)`` equal pieces of each straight segment (a length of
+k cells up to rounding is k pieces; ``CostField._pieces``).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TypeVar
 
 import numpy as np
 from scipy import ndimage
 
 from costmap.grid import INSCRIBED, LETHAL, MAX_NON_OBSTACLE, NO_INFORMATION, Costmap2D
+from costmap.layers.inflation import squared_distance_to_lethal_cells
 from sid.checks import check_number
 from sid.errors import SidError
 
@@ -46,18 +50,19 @@ __all__ = [
     "WalledOffError",
 ]
 
-_LOOP_MAX = 20  # segment_cost sums this many samples or fewer in a Python loop, more with numpy (docs/parameters.md)
+_LOOP_MAX = 40  # segment_cost sums this many samples or fewer in a Python loop, more with numpy (docs/parameters.md)
+_Length = TypeVar("_Length", float, np.ndarray)  # one segment's length, or an array of them
 SAMPLES_PER_CALL = 2**20
 """``CostField.segments`` prices at most about this many samples at once (a few arrays of 8 MB): a batch of long and
 short segments (all pairs of a long path) is cut into chunks of similar length."""
 
 DEFAULT_COST_WEIGHT = 4.0
 """w in J = integral of (1 + w c / 252) ds; see the module docstring. 4: on the demo scenario the smallest weight
-tried that keeps the whole path beyond Hall's personal distance (1.2 m) of every member, for a few per cent of
-length; smaller weights cut through the conversation or graze it (docs/parameters.md)."""
+tried that keeps the whole path beyond Hall's personal distance (1.2 m) of every member, at little extra length;
+smaller weights cut through the conversation or graze it (docs/parameters.md)."""
 MAX_COST_WEIGHT = 1000.0
 """The largest w accepted: a metre through the costliest free cell then costs 1001 m, past any detour a map offers;
-a larger w only overflows the cost sums (1e308 did)."""
+a larger w only brings the cost sums nearer overflow (docs/parameters.md, "Planner")."""
 
 
 class PlanningError(SidError, ValueError):
@@ -141,8 +146,11 @@ class CostField:
 
         lethal = costs == LETHAL
         if lethal.any():
-            # Distance (m) from every cell centre to the nearest lethal cell centre.
-            clearance = ndimage.distance_transform_edt(~lethal) * spec.resolution
+            # Distance (m) from every cell centre to the nearest lethal cell centre, from the exact squared distance
+            # in cells; capped beyond the robot's radius (or the map's diagonal), whose cells do not touch.
+            reach = min(problem.robot_radius / spec.resolution, math.hypot(*spec.shape))
+            cap = math.floor(reach**2) + 2.0
+            clearance = np.sqrt(squared_distance_to_lethal_cells(lethal, cap), dtype=float) * spec.resolution
             touches_lethal = clearance <= problem.robot_radius
         else:
             touches_lethal = np.zeros(spec.shape, dtype=bool)
@@ -160,36 +168,48 @@ class CostField:
         graded = np.where(unknown, MAX_NON_OBSTACLE, np.minimum(costs, MAX_NON_OBSTACLE)).astype(float)
         self.weight = np.where(self.free, problem.cost_weight * graded / MAX_NON_OBSTACLE, 0.0)
         # Scalar lookups use grids padded by one row and column (copies of the last ones), so a point on the map's
-        # upper edge needs no clamping; int() truncates, which is floor for the non-negative offsets inside the map.
+        # upper edge needs no clamping. Every lookup finds a point's cell as ``GridSpec.world_to_cell`` does,
+        # floor((x - origin) / resolution), so that a point on a cell border lands in the same cell everywhere.
         self._stride = self._w + 1
         self._weight_padded = np.pad(self.weight, ((0, 1), (0, 1)), mode="edge")
         self._plannable_flat: list[bool] = np.pad(self.plannable, ((0, 1), (0, 1)), mode="edge").ravel().tolist()
         self._weight_flat: list[float] = self._weight_padded.ravel().tolist()
 
+    def _pieces(self, length: _Length) -> _Length:
+        """The number of equal pieces (a float, at least 1) the midpoint rule cuts segments of ``length`` (metres)
+        into: the length in cells rounded up, where a length of k cells give or take rounding (0.8 - 0.1 m at 0.1 m
+        is 7.000000000000001 cells) is k pieces. The one rule of ``segment_cost`` and ``segments_along``, so that the
+        cost OMPL minimises is the cost reported and smoothed."""
+        # ceil(x) as -((-x) // 1), which Python floats and numpy arrays both compute, and fast on a float (OMPL's
+        # cost callback); the rounded-up count is a whole number >= 0, so adding (count < 1) makes it at least 1.
+        pieces = -((1e-9 - length * self._inv_res) // 1.0)
+        return pieces + (pieces < 1.0)
+
     # ---- scalar lookups (OMPL callbacks) -------------------------------------------------------------------------
     def is_plannable(self, x: float, y: float) -> bool:
         """Whether a robot centre at world (x, y), inside the map, may be used by a planner."""
-        return self._plannable_flat[
-            int((y - self._oy) * self._inv_res) * self._stride + int((x - self._ox) * self._inv_res)
-        ]
+        res = self.resolution
+        return self._plannable_flat[math.floor((y - self._oy) / res) * self._stride + math.floor((x - self._ox) / res)]
 
     def segment_cost(self, x0: float, y0: float, x1: float, y1: float) -> float:
         """J of the straight segment (x0, y0) -> (x1, y1) (metres of weighted length), both ends inside the map."""
         dx, dy = x1 - x0, y1 - y0
         length = math.hypot(dx, dy)
-        n = max(1, math.ceil(length * self._inv_res))
-        # Midpoints in cell units; inside the map they floor to a cell of the padded grids (module docstring).
-        inv = self._inv_res
-        cx, cy = (x0 + 0.5 * dx / n - self._ox) * inv, (y0 + 0.5 * dy / n - self._oy) * inv
-        sx, sy = dx / n * inv, dy / n * inv
+        n = int(self._pieces(length))
+        # Midpoint i at t = (i + 0.5) / n, to a cell of the padded grids as ``GridSpec.world_to_cell`` does.
+        res, ox, oy = self.resolution, self._ox, self._oy
         if n > _LOOP_MAX:  # numpy's fixed overhead pays off on long segments
-            k = np.arange(n)
-            total = float(self._weight_padded[(cy + k * sy).astype(np.intp), (cx + k * sx).astype(np.intp)].sum())
+            ts = np.arange(0.5, n) / n  # (i + 0.5) / n
+            # Offsets >= 0 inside the map: truncation is the floor.
+            rows = ((y0 + ts * dy - oy) / res).astype(np.intp)
+            cols = ((x0 + ts * dx - ox) / res).astype(np.intp)
+            total = float(self._weight_padded[rows, cols].sum())
         else:
-            weight, stride = self._weight_flat, self._stride
+            weight, stride, floor = self._weight_flat, self._stride, math.floor
             total = 0.0
             for i in range(n):
-                total += weight[int(cy + i * sy) * stride + int(cx + i * sx)]
+                t = (i + 0.5) / n
+                total += weight[floor((y0 + t * dy - oy) / res) * stride + floor((x0 + t * dx - ox) / res)]
         return length * (1.0 + total / n)
 
     # ---- vectorised lookups (planners' post-processing, validation, metrics) -------------------------------------
@@ -230,28 +250,26 @@ class CostField:
         already. ``segments_xy`` uses q only through d, so the values are the same.
 
         Sample k of a segment of n pieces (k = 0 .. 2n: even k piece ends, odd k the midpoints the cost uses) sits in
-        row k of (K, M) arrays (samples past a segment's end repeat its end), in cell units (offsets times
-        1 / resolution, floored, as ``segment_cost``); each segment's cost sums its midpoints in order of k, and
-        numpy's inner loops run over segments, not over two coordinates.
+        row k of (K, M) arrays (samples past a segment's end repeat its end), at t = k / (2n) along it, in the cell
+        ``GridSpec.world_to_cell`` gives (as ``segment_cost``); each segment's cost sums its midpoints in order of k,
+        and numpy's inner loops run over segments, not over two coordinates.
         """
-        inv = self._inv_res
-        pieces = np.ceil(length * inv - 1e-9)
-        np.maximum(pieces, 1.0, out=pieces)
-        last = 2.0 * pieces  # each segment's end sample
-        longest = float(last.max())  # NaN or infinite when any length is
-        if not math.isfinite(longest):  # NaN or infinite ends: J is the length (NaN or inf), not plannable
+        if not math.isfinite(float(length.max())):  # NaN or infinite ends: J is the length (NaN or inf), not plannable
             finite = np.isfinite(length)
             cost, ok = length.copy(), np.zeros(len(length), dtype=bool)
             if finite.any():
                 cost[finite], ok[finite] = self.segments_along(p[:, finite], d[:, finite], length[finite])
             return cost, ok
-        width = int(longest) + 2  # one spare sample: each segment's slice of samples ends inside its row
+        pieces = self._pieces(length)
+        last = 2.0 * pieces  # each segment's end sample
+        width = int(last.max()) + 2  # one spare sample: each segment's slice of samples ends inside its row
         if width * len(last) > SAMPLES_PER_CALL and len(last) > 1:
             return self._segments_in_chunks(p, d, length, last)
-        k = np.minimum(np.arange(width, dtype=float)[:, None], last)  # (K, M)
-        start = (p - self._origin) * inv
-        xy = k * (d * (inv / last))[:, None, :]  # (2, K, M) cells
-        xy += start[:, None, :]
+        t = np.minimum(np.arange(width, dtype=float)[:, None], last) / last  # (K, M), 0 .. 1 along each segment
+        xy = t * d[:, None, :]  # (2, K, M): world points, then cells as GridSpec.world_to_cell finds them
+        xy += p[:, None, :]
+        xy -= self._origin[:, :, None]
+        xy /= self.resolution
         size = self._size
         # The samples run monotonically from one end (row 0) to the other (row K - 1): both inside, all inside.
         ends = xy[:, :: width - 1]

@@ -129,10 +129,10 @@ def _descend(
     ``active`` (vertices that may move). Whether any moved.
 
     A segment costs at least its length, so a move whose two new segments are together at least as long as the
-    cost to beat cannot win, nor be the best of the moves that do: only the others are priced (on the navigation
-    study's paths about a quarter of the moves), by ``CostField.segments_along`` from the starts, offsets and lengths
-    computed here. Arrays are coordinate-major, vertices last: numpy's inner loops then run over vertices rather than
-    over two coordinates."""
+    cost to beat cannot win, nor be the best of the moves that do: only the others are priced (a minority of the
+    moves: docs/benchmarks.md, "Planning: the smoother"), by ``CostField.segments_along`` from the starts, offsets
+    and lengths computed here. Arrays are coordinate-major, vertices last: numpy's inner loops then run over vertices
+    rather than over two coordinates."""
     k = len(idx)
     before, vertex, after = xy.take(idx + _NEIGHBOURS, axis=1).transpose(1, 0, 2)  # each (2, k): x/y, vertex
     # Per candidate segment: start x/y, offset x/y to its end, length; (5, in/out segment, move, vertex).

@@ -50,8 +50,11 @@ class PathCheck:
     bad_points: np.ndarray  # (K, 2) world points of samples that are not free
 
     def describe(self) -> str:
+        """The result in words: every sample free, no sample (an empty path: invalid), or the first in collision."""
         if self.valid:
             return f"all {self.samples} samples free"
+        if not self.samples:
+            return "no samples: the path is empty"
         x, y = self.bad_points[0]
         return f"{len(self.bad_points)} of {self.samples} samples in collision, first at ({x:.3f}, {y:.3f}) m"
 

@@ -7,29 +7,34 @@ Only cells within ``ceil(inflation_radius / resolution)`` cells of a lethal cell
 ``cellDistance`` rounds up, so the reach can exceed ``inflation_radius`` by up to one cell).
 
 Distances come from an exact Euclidean distance transform (OpenCV's Felzenszwalb-Huttenlocher
-``DIST_MASK_PRECISE``, as newer Nav2 does, and faster than ``scipy.ndimage.distance_transform_edt``, which gives
-the same values and is kept as an alternative; timings in docs/parameters.md). Both return d in cells; squaring and
-rounding recovers the exact integer squared distance, which indexes a cost table built with Nav2's formula, so every
-cell gets exactly Nav2's value.
+``DIST_MASK_PRECISE``, as newer Nav2 does, and faster than ``scipy.ndimage.distance_transform_edt``; timings in
+docs/parameters.md). It gives d in cells as the float32 nearest the exact distance (the tests hold it to scipy's);
+squaring and rounding recovers the exact integer squared distance (``squared_distance_to_lethal_cells``), which
+indexes a cost table built with Nav2's formula, so every cell gets exactly Nav2's value. The planner's clearance
+test (``planner.problem``) reads the same squared distances.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Literal
 
 import cv2
 import numpy as np
-from scipy import ndimage
 
 from costmap.grid import FREE_SPACE, INSCRIBED, LETHAL, MAX_NON_OBSTACLE, GridSpec, Window, nonzero_cells
 from costmap.layer import Layer, LayerInputs
 from sid.checks import check_number
 
-__all__ = ["DistanceMethod", "InflationLayer", "InflationParams", "distance_to_lethal_cells", "inflation_cost"]
-
-DistanceMethod = Literal["opencv", "scipy"]
+__all__ = [
+    "InflationLayer",
+    "InflationParams",
+    "SQUARED_DISTANCE_EXACT",
+    "check_reach",
+    "inflation_cost",
+    "squared_distance_to_lethal_cells",
+]
 
 
 @dataclass(frozen=True)
@@ -49,6 +54,17 @@ class InflationParams:
         check_number("inflation", "cost_scaling_factor", self.cost_scaling_factor, low=0)
 
 
+def check_reach(spec: GridSpec, inflation_radius: float, field: str) -> None:
+    """ValueError, naming ``field``, for an inflation radius (m) beyond the map's diagonal: costs cannot spread farther
+    than the map, and the cost table grows with the square of the radius in cells."""
+    diagonal = math.hypot(*spec.size_m)
+    if inflation_radius > diagonal:
+        raise ValueError(
+            f"{field}: {inflation_radius:g} m is more than the map's diagonal ({diagonal:g} m), the farthest any cost "
+            "can spread; use at most that"
+        )
+
+
 def inflation_cost(distance_m: np.ndarray, inscribed_radius: float, cost_scaling_factor: float) -> np.ndarray:
     """Nav2's inflation cost (uint8) for distances (metres) to the nearest lethal cell; no radius cut-off here."""
     d = np.asarray(distance_m, dtype=float)
@@ -58,16 +74,18 @@ def inflation_cost(distance_m: np.ndarray, inscribed_radius: float, cost_scaling
     return np.where(d == 0, LETHAL, cost).astype(np.uint8)
 
 
-def distance_to_lethal_cells(lethal: np.ndarray, method: DistanceMethod = "opencv") -> np.ndarray:
-    """Euclidean distance (cells, float32) from every cell centre to the nearest ``lethal`` cell centre.
+SQUARED_DISTANCE_EXACT = 2**22
+"""``squared_distance_to_lethal_cells`` is the exact integer below this (cells^2, distances under 2048 cells): a
+float32 distance squared and rounded resolves whole numbers that far; beyond, within float32's precision."""
 
-    Undefined (large) when ``lethal`` has no True cell; callers check that first.
-    """
-    if method == "opencv":
-        return cv2.distanceTransform((~lethal).view(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
-    if method == "scipy":
-        return ndimage.distance_transform_edt(~lethal).astype(np.float32)
-    raise ValueError(f"unknown distance method {method!r}; use 'opencv' or 'scipy'")
+
+def squared_distance_to_lethal_cells(lethal: np.ndarray, cap: float) -> np.ndarray:
+    """Squared Euclidean distance (cells^2, whole numbers in float32) from every cell centre of a (rows, cols) grid to
+    the nearest ``lethal`` cell centre, at most ``cap`` (farther cells read ``cap`` rounded): exact below
+    ``SQUARED_DISTANCE_EXACT``. Undefined (large) when ``lethal`` has no True cell; callers check that first."""
+    distance = cv2.distanceTransform((~lethal).view(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+    np.minimum(distance, np.float32(np.sqrt(cap)), out=distance)  # clip first: the squares stay small
+    return np.rint(np.square(distance, out=distance), out=distance)
 
 
 class InflationLayer(Layer):
@@ -82,6 +100,7 @@ class InflationLayer(Layer):
 
     def __init__(self, spec: GridSpec, params: InflationParams, inscribed_radius: float) -> None:
         check_number("inflation layer", "robot.radius (inscribed radius)", inscribed_radius, low=0, unit="metres")
+        check_reach(spec, params.inflation_radius, "inflation layer: inflation_radius")
         self.combination = "max_nonzero" if params.inflate_unknown else "max_keep_unknown"
         super().__init__(spec)
         self.params = params
@@ -153,10 +172,7 @@ class InflationLayer(Layer):
         """Nav2's cost for every cell of ``lethal`` (bool) within reach of a True cell, 0 beyond."""
         if self.cell_radius == 0 or not lethal.any():
             return np.where(lethal, LETHAL, FREE_SPACE).astype(np.uint8)
-        distance = distance_to_lethal_cells(lethal)
-        far = len(self._cost_by_d2) - 1  # index of the "beyond reach" entry
-        np.minimum(distance, np.float32(np.sqrt(far)), out=distance)  # clip first: the squares stay small
-        d2 = np.rint(np.square(distance, out=distance))
+        d2 = squared_distance_to_lethal_cells(lethal, len(self._cost_by_d2) - 1)  # cap: the "beyond reach" entry
         if self._lut is not None:  # the usual case (reach <= 15 cells): OpenCV's lookup is faster (docs/parameters.md)
             return cv2.LUT(d2.astype(np.uint8), self._lut)
         return self._cost_by_d2[d2.astype(np.int32)]

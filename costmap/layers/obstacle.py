@@ -49,8 +49,9 @@ class ObstacleParams:
 
     track_unknown_space (default False, Nav2's costmap default): cells no beam has crossed start FREE. With True
     (as Nav2's global costmap is usually configured) they stay NO_INFORMATION (255); after a single scan that
-    leaves unknown wedges behind every obstacle and, beyond ~5.7 m at 720 beams and 5 cm cells, unknown stripes
-    between diverging beams, so the map would depend on beam aliasing rather than on the scene.
+    leaves unknown wedges behind every obstacle and, beyond the range where neighbouring beams lie more than a cell
+    apart (resolution / angle increment; docs/scenario.md), unknown stripes between diverging beams, so the map would
+    depend on beam aliasing rather than on the scene.
     """
 
     obstacle_max_range: float = 10.0

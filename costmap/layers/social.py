@@ -13,9 +13,9 @@ All geometry is in the world frame (metres, radians). Costs follow Nav2 (uint8):
   ``group_cost``; outside it the cost falls off as a Gaussian of the distance to the zone (``group_sigma``).
 
 Zones never exceed 252 and the layer never writes 253 or 255. Numbers (defaults) are our choice, documented in
-docs/scenario.md: personal costs reach ~65 at Hall's personal distance (1.2 m) ahead and fade within ~1.5 m; the
-group zone costs 240, high enough that a cost-aware planner prefers any reasonable detour, yet below the
-inscribed value so a robot that starts inside a zone may still leave it.
+docs/scenario.md (the personal costs they give at Hall's personal distance and how far they reach: docs/parameters.md,
+"Personal space at the defaults"); the group zone costs 240, high enough that a cost-aware planner prefers any
+reasonable detour, yet below the inscribed value so a robot that starts inside a zone may still leave it.
 """
 
 from __future__ import annotations
@@ -114,13 +114,20 @@ def _people_by_id(people: Sequence[Person] | Mapping[int, Person]) -> Mapping[in
 
 
 def zone_hull(group: Group, people: Sequence[Person] | Mapping[int, Person]) -> BaseGeometry:
-    """Convex hull (Polygon, LineString or Point) of the group's o-space vertices and its members' positions."""
+    """Convex hull (Polygon, LineString or Point) of the group's o-space vertices and its members' positions (world
+    frame, metres). ValueError naming the group for a zone not of shape (K, 2), for no member and no zone vertex (no
+    zone to draw), for a member missing from ``people`` and for a value that is not finite."""
     by_id = _people_by_id(people)
     missing = [m for m in group.members if m not in by_id]
     if missing:
         raise ValueError(f"group {group.members}: members {missing} are not among the people given")
+    zone = np.asarray(group.zone, dtype=float)
+    if zone.ndim != 2 or zone.shape[1] != 2:
+        raise ValueError(f"group {group.members}: zone must be (K, 2) vertices (x, y), got shape {zone.shape}")
+    if not group.members and not len(zone):
+        raise ValueError(f"group {group.members}: no member and no zone vertex, so no zone to draw")
     members = np.array([(by_id[m].x, by_id[m].y) for m in group.members], dtype=float).reshape(-1, 2)
-    points = np.vstack([members, np.asarray(group.zone, dtype=float).reshape(-1, 2)])
+    points = np.vstack([members, zone])
     if not np.isfinite(points).all():
         raise ValueError(f"group {group.members}: non-finite member position or zone vertex")
     return cast(MultiPoint, shapely.multipoints(points)).convex_hull  # from the array: no point object per vertex
@@ -266,7 +273,8 @@ def paint_person(
     half's Gaussian, W, and of the narrower half's, N, are evaluated together (``_polynomials``'s products, float32)
     with P = W + lam u' (u' the distance into the wider half), lam large enough that P <= N on the narrower half; then
     min(W, max(N, P)) is W on the wider half and N on the other, in two passes and without a mask. Within 1 cost
-    unit of the float64 formula, which it matches at all but a few cells in a million (a test checks both).
+    unit of the float64 formula and equal to it at nearly every cell (tests check both; the share of cells that
+    differ: docs/parameters.md, "float32 painting").
     ``paint_people`` with one person: the same arithmetic, cell for cell."""
     return paint_people(costs, spec, [person], params, None if sigma_front is None else [sigma_front])[0]
 
@@ -285,7 +293,8 @@ def paint_people(
     common (rows, cols) block from the corner of their own window, in two batched matrix products, then one pass
     each of max, min, exp and the uint8 cast for all of them, and one ``cv2.max`` per person over its own window
     (the block's cells beyond it are dropped). Per cell the same float32 arithmetic as one person alone; ~10 numpy
-    calls per batch instead of per person (a person's window, ~5k cells, costs about as much as the calls)."""
+    calls per batch instead of per person: on a person's window their fixed cost is a good part of the work
+    (docs/parameters.md, "Personal space at the defaults")."""
     if sigma_fronts is not None and len(sigma_fronts) != len(people):
         raise ValueError(f"social: {len(sigma_fronts)} sigma_fronts for {len(people)} people")
     windows: list[Window | None] = []

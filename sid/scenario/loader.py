@@ -19,6 +19,7 @@ import numpy as np
 from shapely.geometry import box
 
 from costmap.grid import GridSpec
+from costmap.layers.inflation import check_reach
 from costmap.mapfile import MapFileError, read_map
 from costmap.occupancy import OccupancyGrid
 from costmap.plugins import PEOPLE_LAYERS, PLUGINS, SECTIONS, CostmapParams, LayerInstance
@@ -494,17 +495,13 @@ def _check_scan(grid: GridSpec, lidar: LidarSpec, layers: CostmapParams, edges: 
 
 
 def _check_inflation(grid: GridSpec, layers: CostmapParams, where: str) -> None:
-    """An inflation radius within the map's diagonal: costs cannot spread farther than the map, and Nav2's cost
-    table grows with the square of the radius in cells."""
-    reach = math.hypot(*grid.size_m)
+    """Each inflation radius within the map's diagonal (``costmap.layers.inflation.check_reach``), checked here so
+    that the error names the file's field."""
     for name in layers.named("inflation"):
-        radius = layers.layer_params(name).inflation_radius
-        if radius > reach:
-            section = "inflation" if name == "inflation" else name
-            raise ScenarioError(
-                f"{where}.{section}.inflation_radius: {radius:g} m is more than the map's diagonal ({reach:g} m), "
-                "the farthest any cost can spread; use at most that"
-            )
+        try:
+            check_reach(grid, layers.layer_params(name).inflation_radius, f"{where}.{name}.inflation_radius")
+        except ValueError as exc:
+            raise ScenarioError(str(exc)) from exc
 
 
 def _static_map(path: Path) -> OccupancyGrid:

@@ -37,6 +37,9 @@ def test_max_can_skip_a_layer_value_that_carries_no_opinion():
     master = np.array([255, 255, 10, 10], dtype=np.uint8)
     combine(master, np.array([0, 40, 0, 40], dtype=np.uint8), "max_nonzero")
     assert master.tolist() == [255, 40, 10, 40]  # a zero social cell does not turn unknown into free
+    known = np.array([0, 10, 253, 254], dtype=np.uint8)
+    combine(known, np.full(4, NO_INFORMATION, dtype=np.uint8), "max_nonzero")  # the plain-max path
+    assert known.tolist() == [0, 10, 253, 254]  # nor does an unknown layer cell turn a known master cell unknown
 
 
 @pytest.mark.parametrize("method", ["max", "max_nonzero", "max_keep_unknown"])
@@ -50,8 +53,8 @@ def test_max_combinations_equal_nav2_rules_written_out_on_every_pair_of_values(m
     if method == "max_keep_unknown":
         expected = np.where(unknown & (layer >= INSCRIBED), layer, larger)
     else:
-        no_opinion = NO_INFORMATION if method == "max" else FREE_SPACE
-        expected = np.where(layer == no_opinion, master, np.where(unknown, layer, larger))
+        no_opinion = (layer == NO_INFORMATION) | ((layer == FREE_SPACE) & (method == "max_nonzero"))
+        expected = np.where(no_opinion, master, np.where(unknown, layer, larger))
     windows = [(slice(None), slice(None)), (slice(0, 255), slice(0, 255)), (slice(3, 90), slice(7, 255))]
     for rows, cols in [*windows, (slice(0, 0), slice(None)), (slice(None, None, 3), slice(None, None, -2))]:
         out = master.copy()

@@ -42,6 +42,22 @@ def test_bad_resolution_is_named(resolution):
         GridSpec.from_size(resolution, (0, 0), (1, 1))
 
 
+@pytest.mark.parametrize(
+    ("width", "height", "message"),
+    [
+        (10.5, 10, r"map: width must be a whole number >= 1, got 10.5"),
+        (True, True, r"map: width must be a whole number >= 1, got True"),
+        (10, 0, r"map: height must be a whole number >= 1, got 0"),
+        (10, "10", r"map: height must be a whole number >= 1, got '10'"),
+    ],
+)
+def test_a_size_that_is_not_a_whole_number_of_cells_is_named(width, height, message):
+    with pytest.raises(ValueError, match=message):
+        GridSpec(0.1, 0, 0, width, height)
+    spec = GridSpec(0.1, 0, 0, np.int64(10), 10.0)  # whole numbers of other types: stored as Python ints
+    assert type(spec.width) is int and type(spec.height) is int and spec.shape == (10, 10)
+
+
 def test_cost_at_reads_unknown_outside():
     costmap = Costmap2D.filled(SPEC)
     costmap.costs[80, 100] = LETHAL

@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import cv2
 import numpy as np
 import pytest
 import yaml
+from rosbags.rosbag2 import StoragePlugin, Writer
+from rosbags.typesys import Stores, get_typestore
 
 from costmap.export import export_costmap
 from costmap.grid import Costmap2D, GridSpec
@@ -16,7 +20,7 @@ from costmap.mapfile import MapFileError, read_map, write_map
 from costmap.npz import load_npz, save_npz
 from costmap.occupancy import OccupancyGrid, cost_to_occupancy, costmap_to_occupancy, occupancy_to_cost
 from costmap.render import GROUP_COLOURS, OBSTACLE, default_scale, render_costmap, world_to_image
-from costmap.rosbag import read_occupancy_grids, write_occupancy_mcap
+from costmap.rosbag import MSGTYPE, _message, read_occupancy_grids, write_occupancy_mcap
 from sid.cli import main
 from sid.perception.group import Group
 from sid.perception.people import Person
@@ -190,6 +194,19 @@ def test_npz_errors_name_the_file(tmp_path):
     np.savez(tmp_path / "other.npz", a=np.zeros(3))
     with pytest.raises(ValueError, match="missing 'costmap'"):
         load_npz(tmp_path / "other.npz")
+    grid = dict(layer_names=np.array(["social"]), resolution=np.float64(0.05), origin=np.zeros(2))
+    known, unknown = np.zeros((3, 4), np.uint8), np.zeros((3, 4))
+    for name, arrays, message in (
+        ("float_layer", dict(costmap=known, layer_social=unknown), "social' must be uint8 .*, got float64 \\(3, 4\\)"),
+        ("no_layer", dict(costmap=known), "must be uint8 of shape \\(3, 4\\), got missing"),
+        ("float_master", dict(costmap=unknown, layer_social=known), "costs must be uint8"),
+    ):
+        np.savez(tmp_path / f"{name}.npz", **grid, **arrays)
+        with pytest.raises(ValueError, match=f"{name}.npz: .*{message}"):
+            load_npz(tmp_path / f"{name}.npz")
+    np.savez(tmp_path / "flat.npz", **{**grid, "resolution": np.float64(0.0)}, costmap=known)
+    with pytest.raises(ValueError, match="flat.npz: map: resolution must be a positive number"):
+        load_npz(tmp_path / "flat.npz")
 
 
 @pytest.mark.parametrize("distro", ["humble", "jazzy"])
@@ -207,6 +224,25 @@ def test_mcap_round_trip_is_exact(tmp_path, distro):
         np.testing.assert_array_equal(msg.data, grid.data)
     with pytest.raises(ValueError, match="already exists"):
         write_occupancy_mcap(path, grids)
+
+
+def test_an_occupancy_grid_message_of_the_wrong_size_names_the_bag_and_the_topic(tmp_path):
+    # A real rosbag2 folder (MCAP storage) written with rosbags: one good message, then one whose data is a cell short
+    # and one of width 0.
+    typestore = get_typestore(Stores.ROS2_HUMBLE)
+    good = _message(typestore, costmap_to_occupancy(every_cost_grid()), 0)
+    short = dataclasses.replace(good, data=good.data[:-1])
+    empty = dataclasses.replace(good, info=dataclasses.replace(good.info, width=0), data=good.data[:0])
+    for name, bad, message in (
+        ("short", short, rf"/costmap, message 2: data holds {good.data.size - 1} cells, not width x height = "),
+        ("empty", empty, r"/costmap, message 2: map: width must be a whole number >= 1, got 0"),
+    ):
+        with Writer(tmp_path / name, version=8, storage_plugin=StoragePlugin.MCAP) as writer:
+            connection = writer.add_connection("/costmap", MSGTYPE, typestore=typestore)
+            for stamp, msg in enumerate((good, bad)):
+                writer.write(connection, stamp, typestore.serialize_cdr(msg, MSGTYPE))
+        with pytest.raises(ValueError, match=rf"{name}: {message}"):
+            read_occupancy_grids(tmp_path / name)
 
 
 # --- pictures and the command -------------------------------------------------------------------------------

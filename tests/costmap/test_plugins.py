@@ -6,11 +6,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from costmap.grid import FREE_SPACE, LETHAL, GridSpec
+from costmap.grid import FREE_SPACE, LETHAL, NO_INFORMATION, GridSpec
 from costmap.layer import LayerInputs
 from costmap.layered import LayeredCostmap
 from costmap.layers.inflation import InflationLayer, InflationParams
 from costmap.layers.obstacle import SCAN, ObstacleLayer, ObstacleParams
+from costmap.mapfile import write_map
+from costmap.occupancy import OccupancyGrid
 from costmap.plugins import PLUGINS, CostmapParams, LayerInstance, layered_costmap
 from costmap.scan import LaserScan
 from sid.scenario.build import build_costmap
@@ -141,3 +143,49 @@ def test_a_scenario_names_its_layers_in_order(tmp_path):
     ):
         with pytest.raises(ScenarioError, match=message):
             scenario_from_dict({**data, "layers": {"plugins": plugins}}, base_dir=tmp_path)
+
+
+def test_unknown_space_and_the_peoples_clearing_come_from_the_listed_layer_instances(tmp_path) -> None:
+    data = _scenario(
+        {
+            "plugins": ["static", "near", "crowd", "inflation"],
+            "near": {"plugin": "lidar", "track_unknown_space": True},
+            "crowd": {"plugin": "social", "people_clear_margin": 0.5},
+        }
+    )
+    write_map(tmp_path / "map.yaml", OccupancyGrid(SPEC, np.full(SPEC.shape, -1, np.int8)))  # all unknown
+    layered = build_costmap(scenario_from_dict({**data, "static_map": "map.yaml"}, base_dir=tmp_path))
+    assert layered.default_value == NO_INFORMATION  # the listed LiDAR layer tracks unknown space, not the section
+    assert (layered.grids["static"] == NO_INFORMATION).all()
+    assert (layered.master.costs == NO_INFORMATION).any()
+    assert layered.layer("near").people_clear_radius == pytest.approx(0.2 + 0.5)  # the listed social layer's margin
+    near = LayerInstance("lidar", ObstacleParams(track_unknown_space=True))
+    with pytest.raises(ValueError, match=r"plugins: the lidar layers disagree on track_unknown_space \(near True, li"):
+        CostmapParams(plugins=("near", "lidar"), instances={"near": near})
+    disagreeing = {**data["layers"], "plugins": ["near", "lidar", "crowd"]}
+    with pytest.raises(ScenarioError, match=r"layers\.plugins: the lidar layers disagree on track_unknown_space"):
+        scenario_from_dict({**data, "layers": disagreeing})
+
+
+@pytest.mark.parametrize(
+    ("instance", "message"),
+    [
+        (
+            LayerInstance("lidar", {"obstacle_max_range": 5.0}),
+            r"near's params must be ObstacleParams or None for the lidar plugin, got dict",
+        ),
+        (
+            LayerInstance("inflation", NEAR),
+            r"near's params must be InflationParams or None for the inflation plugin, got Obs",
+        ),
+        (LayerInstance("static", NEAR), r"near's params must be None \(it takes no parameters\) for the static plugin"),
+    ],
+)
+def test_an_instance_with_parameters_of_another_plugin_is_named(instance: LayerInstance, message: str) -> None:
+    with pytest.raises(ValueError, match=rf"instances: {message}"):
+        CostmapParams(plugins=("near", "social"), instances={"near": instance})
+
+
+def test_an_instance_of_a_plugin_of_the_callers_own_takes_any_params() -> None:
+    custom = CostmapParams(plugins=("sonar_1", "lidar"), instances={"sonar_1": LayerInstance("sonar", {"range": 3.0})})
+    assert custom.layer_params("sonar_1") == {"range": 3.0}

@@ -133,3 +133,26 @@ def test_axis_ticks_are_readable_on_every_map_and_never_negative_zero(origin, si
     xs, ys = render.axis_ticks(spec, render.default_scale(spec))
     assert xs == pytest.approx(list(x_ticks)) and ys == pytest.approx(list(y_ticks))
     assert all(math.copysign(1.0, t) > 0 for t in (*xs, *ys) if t == 0)  # 0, not -0
+
+
+@pytest.mark.parametrize("values", [[0], [0, 100], [0, 253, 254, 255], [0, 100, 253, 254, 255], [255]])
+@pytest.mark.parametrize("entries", [0, 1, 9])
+def test_the_panel_size_is_where_the_panel_draws(values: list[int], entries: int) -> None:
+    # _panel_size and _panel lay out the same rows: nothing the panel draws lies beyond its size, and with a legend
+    # its last row reaches the last row band.
+    spec = GridSpec(0.1, 0.0, 0.0, 10, 10)
+    costs = np.resize(np.array(values, np.uint8), spec.shape)
+    swatches = list(render.LEGEND.values()) * 2
+    rows = [(f"entry {i} " + "x" * 3 * i, swatches[i]) for i in range(entries)]
+    width, height = render._panel_size(costs, rows)
+    left = render.MARGIN_LEFT + spec.width
+    img = np.full((render.MARGIN_TOP + height + 40, left + width + 40, 3), 255, np.uint8)
+    render._panel(img, spec, 1, costs, rows)
+    drawn_rows, drawn_cols = np.nonzero(np.any(img != 255, axis=2))
+    if values == [0] and not entries:
+        assert not len(drawn_rows)  # nothing to show
+        return
+    bottom = drawn_rows.max() - render.MARGIN_TOP
+    assert bottom < height and drawn_cols.max() - left < width
+    if entries:  # the last legend row ends the panel
+        assert bottom > height - render.LEGEND_ROW

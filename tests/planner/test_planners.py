@@ -107,7 +107,7 @@ def plain_segment_cost(field: CostField, spec: GridSpec, x0: float, y0: float, x
     """J of a segment by its definition: length x (1 + the mean weight of the cells under n midpoints, n = the
     length in cells rounded up), each midpoint's cell found on its own (floor, clamped at the map's upper edge)."""
     length = math.hypot(x1 - x0, y1 - y0)
-    n = max(1, math.ceil(length / spec.resolution))
+    n = max(1, math.ceil(length / spec.resolution - 1e-9))
     total = 0.0
     for i in range(n):
         t = (i + 0.5) / n
@@ -218,8 +218,8 @@ def test_refine_and_a_short_reach_shortcut_never_raise_cost_and_keep_vertices(wa
 
 def plain_segments(field: CostField, p: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``CostField.segments`` written plainly, segment by segment: the midpoints of ceil(L / resolution) pieces for
-    the cost (even samples weigh 0), midpoints and piece ends for plannability, outside samples clamped to the
-    border and not plannable;
+    the cost (even samples weigh 0), midpoints and piece ends for plannability, each in the cell ``world_to_cell``
+    gives, outside samples clamped to the border and not plannable;
     ends that are not finite give J = the length and not plannable."""
     inv = 1.0 / field.resolution
     costs, oks = [], []
@@ -233,9 +233,8 @@ def plain_segments(field: CostField, p: np.ndarray, q: np.ndarray) -> tuple[np.n
         n = max(1.0, float(np.ceil(length * inv - 1e-9)))
         weights, ok = [], True
         for k in range(int(2 * n) + 1):
-            x = (x0 - field.spec.origin_x) * inv + k * (dx * (inv / (2 * n)))
-            y = (y0 - field.spec.origin_y) * inv + k * (dy * (inv / (2 * n)))
-            col, row = int(np.floor(x)), int(np.floor(y))
+            t = k / (2 * n)
+            (row, col) = field.spec.world_to_cell(np.array([x0 + t * dx, y0 + t * dy]))[0].tolist()
             inside = 0 <= row < field.spec.height and 0 <= col < field.spec.width
             row, col = min(max(row, 0), field.spec.height - 1), min(max(col, 0), field.spec.width - 1)
             ok &= inside and bool(field.plannable[row, col])
@@ -501,3 +500,79 @@ def test_ompl_log_level_is_set_only_while_planning(walls, capfd):
         assert capfd.readouterr().out == ""  # OMPL's INFO lines would land on stdout
     finally:
         ou.setLogLevel(before)
+
+
+def column_wall(origin: float = 0.0) -> Costmap2D:
+    """20 x 20 cells at 0.1 m from (origin, origin), lethal column 5."""
+    costs = np.zeros((20, 20), np.uint8)
+    costs[:, 5] = LETHAL
+    return Costmap2D(GridSpec(0.1, origin, origin, 20, 20), costs)
+
+
+@pytest.mark.parametrize("name", PLANNERS)
+def test_a_start_on_a_cell_border_is_plannable_for_every_planner(name: str) -> None:
+    # x = 0.3 is the border of columns 2 and 3; (0.3 - 0) * (1 / 0.1) truncates to 3, next to the inscribed column 4,
+    # where world_to_cell (and so check_endpoints and the forced start cell) says column 2.
+    result = plan(PlanningProblem(column_wall(), (0.3, 1.0), (0.25, 0.25), 0.1), name, time_limit=0.3, seed=1)
+    assert result.success, result.message
+    assert np.allclose(result.path[0], (0.3, 1.0)) and np.allclose(result.path[-1], (0.25, 0.25))
+
+
+@pytest.mark.parametrize("origin", [0.0, -1.05])
+def test_every_lookup_finds_a_points_cell_as_world_to_cell(origin: float) -> None:
+    spec = GridSpec(0.1, origin, origin, 20, 20)
+    costs = (np.arange(400).reshape(20, 20) % 200).astype(np.uint8)  # a cost per cell
+    costs[::4, ::4] = LETHAL  # plannable: rows and columns 2 (mod 4) only
+    field = CostField(PlanningProblem(Costmap2D(spec, costs), (origin + 0.25, origin + 0.25), (origin + 1, origin), 0))
+    borders = origin + np.arange(1, 20) / 10  # on cell borders: 0.3 / 0.1 floors to 2, 0.3 * (1 / 0.1) to 3
+    xy = np.stack(np.meshgrid(borders, borders), -1).reshape(-1, 2)
+    rows, cols = spec.world_to_cell(xy).T
+    assert [field.is_plannable(x, y) for x, y in xy] == field.plannable[rows, cols].tolist()
+    # A zero-length segment is its own one sample: its plannability reads the point's cell.
+    assert field.segments(xy, xy)[1].tolist() == field.plannable[rows, cols].tolist()
+    # Segments whose midpoints lie on the borders, priced as the definition prices them (world_to_cell's floor).
+    inside = (borders > origin + 0.1) & (borders < origin + 1.9)
+    for x, y in itertools.product(borders[inside], borders[inside]):
+        for end in ((x + 0.05, y + 0.05), (x + 0.15, y - 0.05)):
+            start = (2 * x - end[0], 2 * y - end[1])
+            expected = plain_segment_cost(field, spec, *start, *end)
+            assert field.segment_cost(*start, *end) == expected
+            assert field.segments(np.array([start]), np.array([end]))[0][0] == pytest.approx(expected, rel=1e-12)
+
+
+def test_both_cost_lookups_cut_a_segment_into_the_same_pieces() -> None:
+    # 0.8 - 0.1 is 7.000000000000001 cells of 0.1 m: seven pieces for both lookups, not eight for one of them. Across
+    # one column of cost 200, eight midpoints in other cells would make OMPL minimise another J than the one reported.
+    costs = np.zeros((20, 20), np.uint8)
+    costs[:, 5] = 200
+    field = CostField(PlanningProblem(Costmap2D(GridSpec(0.1, 0, 0, 20, 20), costs), (0.15, 1.05), (0.85, 1.05), 0.1))
+    tenths = np.arange(1, 19) / 10
+    for a, b in itertools.permutations(tenths, 2):
+        expected = abs(b - a) * (
+            1 + field.weight[10].take(np.arange(round(min(a, b) * 10), round(max(a, b) * 10))).mean()
+        )
+        assert field.segment_cost(a, 1.05, b, 1.05) == pytest.approx(expected, rel=1e-12)
+        assert field.segments(np.array([[a, 1.05]]), np.array([[b, 1.05]]))[0][0] == pytest.approx(expected, rel=1e-12)
+
+
+def test_an_empty_path_fails_the_check_and_says_why(walls) -> None:
+    field = CostField(walls)
+    check = check_path(field, np.zeros((0, 2)))
+    assert not check.valid and check.samples == 0 and check.describe() == "no samples: the path is empty"
+    single = check_path(field, np.array([[1.0, 2.0]]))  # one free point: one free sample
+    assert single.valid and single.describe() == "all 1 samples free"
+    blocked = check_path(field, np.array([[1.0, 2.0], [4.0, 2.0]]))
+    assert not blocked.valid and re.fullmatch(
+        r"\d+ of \d+ samples in collision, first at \(\d\.\d{3}, 2\.000\) m", blocked.describe()
+    )
+
+
+@pytest.mark.parametrize("radius", [0.0, 0.05, math.hypot(0.05, 0.05), 0.1, 0.25, 0.3, 1e300])
+def test_the_clearance_test_is_the_exact_euclidean_distance_of_cell_centres(radius: float) -> None:
+    # The inflation layer's distance transform (OpenCV) against scipy's exact one, at radii on cell distances.
+    spec = GridSpec(0.05, -1.0, 2.0, 90, 70)
+    lethal = np.random.default_rng(4).random(spec.shape) < 0.004
+    costs = np.where(lethal, LETHAL, 0).astype(np.uint8)
+    field = CostField(PlanningProblem(Costmap2D(spec, costs), (0.0, 3.0), (1.0, 4.0), radius))
+    clearance = ndimage.distance_transform_edt(~lethal) * spec.resolution
+    np.testing.assert_array_equal(field.free, clearance > radius)

@@ -4,9 +4,16 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy import ndimage
 
 from costmap.grid import FREE_SPACE, INSCRIBED, LETHAL, NO_INFORMATION, GridSpec, Window
-from costmap.layers.inflation import InflationLayer, InflationParams, distance_to_lethal_cells
+from costmap.layers.inflation import (
+    SQUARED_DISTANCE_EXACT,
+    InflationLayer,
+    InflationParams,
+    squared_distance_to_lethal_cells,
+)
+from costmap.plugins import CostmapParams, LayerInstance, layered_costmap
 
 SPEC = GridSpec.from_size(0.05, (-1.0, -4.0), (10.0, 8.0))
 
@@ -50,14 +57,27 @@ def test_inflation_reach_rounds_up_like_nav2_cell_distance():
     assert master[20, 32] == 0
 
 
-def test_opencv_and_scipy_distances_agree():
+def test_an_inflation_radius_beyond_the_maps_diagonal_is_named_on_every_path():
+    spec = GridSpec(0.05, 0.0, 0.0, 60, 80)  # 3 x 4 m: a diagonal of 5 m
+    assert InflationLayer(spec, InflationParams(inflation_radius=5.0), 0.25).cell_radius == 100
+    with pytest.raises(ValueError, match=r"inflation layer: inflation_radius: 5.01 m is more than the map's diagonal"):
+        InflationLayer(spec, InflationParams(inflation_radius=5.01), 0.25)  # the table of (R cells)^2 never made
+    params = CostmapParams(
+        plugins=("lidar", "wide"), instances={"wide": LayerInstance("inflation", InflationParams(50))}
+    )
+    with pytest.raises(ValueError, match=r"inflation_radius: 50 m is more than the map's diagonal \(5 m\)"):
+        layered_costmap(spec, params)
+
+
+@pytest.mark.parametrize(("shape", "density"), [((120, 90), 0.01), ((300, 400), 0.001), ((1400, 1400), 0.0)])
+def test_squared_distances_are_scipys_exact_ones(shape, density):
     rng = np.random.default_rng(0)
-    lethal = rng.random((120, 90)) < 0.01
-    a = distance_to_lethal_cells(lethal, "opencv")
-    b = distance_to_lethal_cells(lethal, "scipy")
-    np.testing.assert_allclose(a, b, atol=1e-4)
-    with pytest.raises(ValueError, match="distance method"):
-        distance_to_lethal_cells(lethal, "manhattan")
+    lethal = rng.random(shape) < density
+    lethal[0, 0] = True  # on the largest grid: squared distances up to 2 x 1399^2, near SQUARED_DISTANCE_EXACT
+    exact = np.rint(ndimage.distance_transform_edt(~lethal) ** 2)
+    assert exact.max() < SQUARED_DISTANCE_EXACT
+    np.testing.assert_array_equal(squared_distance_to_lethal_cells(lethal, np.inf), exact)
+    np.testing.assert_array_equal(squared_distance_to_lethal_cells(lethal, 50.0), np.minimum(exact, 50.0))
 
 
 def test_inflation_keeps_the_larger_cost_and_nav2_unknown_rule():

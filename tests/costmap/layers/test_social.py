@@ -56,6 +56,28 @@ def test_group_zone_of_a_pair_is_a_proper_polygon_and_missing_members_are_named(
         group_zone_polygon(pair, people[:1])
 
 
+@pytest.mark.parametrize(
+    ("members", "zone", "message"),
+    [
+        ((), np.zeros((0, 2)), r"group \(\): no member and no zone vertex, so no zone to draw"),
+        (
+            (1,),
+            np.array([1.0, 1.0, 2.0, 2.0]),
+            r"group \(1,\): zone must be \(K, 2\) vertices \(x, y\), got shape \(4,\)",
+        ),
+        ((1,), np.zeros((2, 3)), r"zone must be \(K, 2\) vertices \(x, y\), got shape \(2, 3\)"),
+    ],
+)
+def test_a_group_without_a_zone_to_draw_is_named_before_the_layer_changes(members, zone, message) -> None:
+    people = [Person(1, 1.0, 1.0, 0.0)]
+    layer = SocialLayer(SPEC)
+    layer.update(LayerInputs({PEOPLE: people}), SPEC.whole)
+    before = layer.costs.copy()
+    with pytest.raises(ValueError, match=message):
+        layer.update(LayerInputs({PEOPLE: people, GROUPS: (Group(members, (1.0, 1.0), 0.0, zone, 0.0),)}), SPEC.whole)
+    np.testing.assert_array_equal(layer.costs, before)
+
+
 def test_every_cell_inside_the_group_zone_costs_at_least_group_cost():
     people, group = triad()
     params = SocialParams()
