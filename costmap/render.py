@@ -252,8 +252,8 @@ LEGEND_ROW, MAX_GROUP_ENTRIES = 22, 6
 # baseline without a scale), and the space between the special values and the legend.
 PANEL_GAP, PANEL_PAD, SWATCH_WIDTH, LABEL_X = 22, 10, 22, 34
 SCALE_HEIGHT, SCALE_GAP, NO_SCALE = 200, 24, 14
-SPECIALS_GAP = 8
-SPECIALS = ((INSCRIBED, "253 inscribed"), (LETHAL, "254 lethal"), (NO_INFORMATION, "255 unknown"))
+_SPECIALS_GAP = 8
+_SPECIALS = ((INSCRIBED, "253 inscribed"), (LETHAL, "254 lethal"), (NO_INFORMATION, "255 unknown"))
 
 
 def _members(group: Group) -> str:
@@ -287,14 +287,14 @@ def _panel_contents(costs: np.ndarray) -> tuple[bool, list[tuple[int, str]]]:
     """What the panel shows of ``costs``: whether any cost is graded (the colour scale), and the special values
     present with their labels."""
     graded = bool(np.any((costs > 0) & (costs <= MAX_NON_OBSTACLE)))
-    return graded, [(value, label) for value, label in SPECIALS if np.any(costs == value)]
+    return graded, [(value, label) for value, label in _SPECIALS if np.any(costs == value)]
 
 
 def _panel_size(costs: np.ndarray, rows: Sequence[tuple[str, Swatch]]) -> tuple[int, int]:
     """Width and height (px) of ``_panel`` for these costs and legend rows."""
     graded, specials = _panel_contents(costs)
     height = PANEL_PAD + (SCALE_HEIGHT + SCALE_GAP if graded else NO_SCALE)
-    height += LEGEND_ROW * len(specials) + SPECIALS_GAP + LEGEND_ROW * len(rows)
+    height += LEGEND_ROW * len(specials) + _SPECIALS_GAP + LEGEND_ROW * len(rows)
     widths = [cv2.getTextSize(name, FONT, 0.4, 1)[0][0] for name, _ in rows]
     return max(PANEL_WIDTH, PANEL_GAP + LABEL_X + max(widths, default=0) + PANEL_PAD), height
 
@@ -321,7 +321,7 @@ def _panel(img: np.ndarray, spec: GridSpec, scale: int, costs: np.ndarray, rows:
         cv2.rectangle(img, (left, y - 11), (left + width, y + 3), TEXT, 1)
         _text(img, label, (left + width + 7, y), 0.4)
         y += LEGEND_ROW
-    y += SPECIALS_GAP
+    y += _SPECIALS_GAP
     for name, swatch in rows:
         swatch(img, left + SWATCH_WIDTH // 2, y - 4)  # centred over the swatches above
         _text(img, name, (left + LABEL_X, y), 0.4)
