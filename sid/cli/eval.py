@@ -114,7 +114,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     ff.add_argument(
         "--facing-noise",
-        type=float,
+        type=positive_number("number of degrees", zero=True),
         default=0.0,
         metavar="DEG",
         help="add seeded Gaussian noise of this standard deviation (degrees) to every facing first (default 0)",

@@ -198,6 +198,16 @@ def test_eval_fformation_counts_how_each_true_group_came_out(tmp_path, capsys):
     assert code == 2 and "--errors counts one detector's groups" in err
 
 
+@pytest.mark.parametrize("value", ["-5", "nan", "1e400"])
+def test_eval_fformation_names_a_bad_facing_noise_as_typed(tmp_path, capsys, value):
+    # It was checked after turning degrees into radians: "-5" came back as "-0.0872... radians".
+    tiny = write_sequence(tmp_path / "tiny", tiny_frames(), {1: [[1, 2]]})
+    with pytest.raises(SystemExit) as stop:
+        main(["eval", "fformation", str(tiny), "--facing-noise", value])
+    assert stop.value.code == 2
+    assert f"--facing-noise: expected a finite number of degrees >= 0, got '{value}'" in capsys.readouterr().err
+
+
 def test_eval_fformation_warns_of_people_left_out_without_a_position(tmp_path, capsys):
     frames = tiny_frames()
     frames[0] = np.vstack([frames[0], [7, np.nan, 0.0, 0.0], [8, 0.0, np.inf, 0.0]])
