@@ -326,7 +326,7 @@ def test_eval_fformation_cross_validates_over_a_grid(tmp_path, capsys):
 
 @pytest.mark.parametrize(
     ("option", "value", "bad", "message"),
-    [("--facing-noise", "20", "-5", "facing noise"), ("--facing-missing", "0.5", "2", "share of facings missing")],
+    [("--facing-noise", "20", None, ""), ("--facing-missing", "0.5", "2", "share of facings missing")],
 )
 def test_eval_fformation_changes_the_facings_seeded(tmp_path, capsys, option, value, bad, message):
     """--facing-noise adds seeded noise to every facing, --facing-missing makes a seeded share of them unknown."""
@@ -334,8 +334,9 @@ def test_eval_fformation_changes_the_facings_seeded(tmp_path, capsys, option, va
     args = ["eval", "fformation", str(tiny), "--scale", "0.01", option]
     first, second = run_sid([*args, value], capsys), run_sid([*args, value], capsys)
     assert first[0] == 0 and first[1] == second[1]
-    code, _, err = run_sid([*args, bad], capsys)
-    assert code == 2 and message in err
+    if bad is not None:  # a bad noise is argparse's to refuse (test_eval_fformation_names_a_bad_facing_noise_as_typed)
+        code, _, err = run_sid([*args, bad], capsys)
+        assert code == 2 and message in err
 
 
 def test_eval_fformation_reports_malformed_data(tmp_path, capsys):
