@@ -231,14 +231,13 @@ def _per_frame(
     return found
 
 
-def score_people(
-    trajectories: TrajectorySet, log: TrackLog, match_distance: float, progress: Progress | None = None
-) -> dict[str, Any]:
-    """MOTA, IDF1, identity switches (also per 100 true tracks) and the other motmetrics counts of ``log``;
-    ``progress`` after each frame matched."""
+def score_people(log: TrackLog, match_distance: float, progress: Progress | None = None) -> dict[str, Any]:
+    """MOTA, IDF1, identity switches (also per 100 true tracks: the distinct annotated people scored, those ever
+    inside the view) and the other motmetrics counts of ``log``; ``progress`` after each frame matched."""
     people = merged_mot_scores(_accumulate(log, match_distance, progress))
-    people["true_tracks"] = trajectories.people
-    people["id_switches_per_100_tracks"] = 100 * people["id_switches"] / max(trajectories.people, 1)
+    true_tracks = len(np.unique(np.concatenate(log.truth_ids)))
+    people["true_tracks"] = true_tracks
+    people["id_switches_per_100_tracks"] = 100 * people["id_switches"] / max(true_tracks, 1)
     return people
 
 
@@ -255,7 +254,7 @@ def evaluate_crowd(
     for trajectories in sets:
         passes = [_pass(progress, k, trajectories.name) for k in range(len(EVALUATION_PASSES))]
         log = record_tracks(trajectories, settings, passes[0])
-        people = score_people(trajectories, log, settings.match_distance, passes[1])
+        people = score_people(log, settings.match_distance, passes[1])
         groups = score_groups(
             trajectories, log, find_groups(log, settings.tracking.groups, passes[2]), settings, passes[3]
         )
@@ -321,8 +320,8 @@ def cross_validate(
     for row, tracker in enumerate(trackers):
         trial = _with_tracker(settings, tracker)
         logs.append([record_tracks(s, trial) for s in sets])
-        for col, (trajectories, log) in enumerate(zip(sets, logs[row], strict=True)):
-            idf1[row, col] = score_people(trajectories, log, settings.match_distance)["idf1"]
+        for col, log in enumerate(logs[row]):
+            idf1[row, col] = score_people(log, settings.match_distance)["idf1"]
             if progress is not None:
                 progress(row * len(sets) + col + 1, total, f"tracker {row + 1}/{len(trackers)}")
     group_f1: dict[tuple[str, int], np.ndarray] = {}  # (which, tracker row) -> (points, sets)
