@@ -29,9 +29,9 @@ from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 from sid.checks import check_number, check_whole, repeated
+from sid.experiments.synthetic_tracking import identify
 from sid.perception.group import Group
 from sid.perception.groups import GroupParams
 from sid.perception.lifting import LiftParams
@@ -208,15 +208,14 @@ def wrap_degrees(radians: float) -> float:
 
 
 def match_people(people: Sequence[Person], truth: FrameTruth, radius: float) -> dict[int, int]:
-    """Detected person id -> true person id: Hungarian assignment on ground-plane distance, pairs within
-    ``radius`` (m) only."""
+    """Detected person id -> true person id: ``identify``'s assignment (minimum total ground-plane distance over
+    the pairs within ``radius``, m)."""
     if not people or not truth.people:
         return {}
     detected = np.array([(p.x, p.y) for p in people], dtype=float)
     true = np.array([(p.x, p.y) for p in truth.people], dtype=float)
-    distance = np.hypot(*(detected[:, None, :] - true[None, :, :]).transpose(2, 0, 1))
-    rows, cols = linear_sum_assignment(distance)
-    return {people[r].id: truth.people[c].id for r, c in zip(rows, cols, strict=True) if distance[r, c] <= radius}
+    identity = identify(detected, [p.id for p in truth.people], true, radius)
+    return {p.id: i for p, i in zip(people, identity, strict=True) if i is not None}
 
 
 def best_group(groups: Sequence[Group], matches: dict[int, int], members: Sequence[int]) -> tuple[Group | None, int]:
