@@ -25,7 +25,6 @@ Protocol:
 from __future__ import annotations
 
 import dataclasses
-import importlib.util
 import itertools
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -36,10 +35,9 @@ import scipy.sparse
 import scipy.sparse.csgraph
 
 from sid.checks import check_limit
-from sid.distribution import MissingDependencyError, install_hint
 from sid.experiments.fformation import format_threshold, frame_matches
 from sid.experiments.gmitre import LinkCounts, gmitre_counts
-from sid.experiments.synthetic_tracking import as_truth_ids, identify, merged_mot_scores
+from sid.experiments.synthetic_tracking import as_truth_ids, identify, merged_mot_scores, require_motmetrics
 from sid.experiments.trajectories import ReplaySettings, TrajectoryError, TrajectorySet, replay, replay_length
 from sid.tracking.coherent import CoherentMotion, CoherentMotionParams
 from sid.tracking.groups import GroupTracker, GroupTrackerParams
@@ -61,7 +59,6 @@ __all__ = [
     "find_groups",
     "record_tracks",
     "replay_view",
-    "require_motmetrics",
     "score_groups",
     "score_people",
 ]
@@ -457,10 +454,3 @@ def _settings_json(settings: CrowdSettings) -> dict[str, Any]:
         "match_distance": settings.match_distance,
         "thresholds": list(settings.thresholds),
     }
-
-
-def require_motmetrics() -> None:
-    if importlib.util.find_spec("motmetrics") is None:
-        raise MissingDependencyError(
-            f"the crowd evaluation needs py-motmetrics: {install_hint('eval')} (or pip install motmetrics)"
-        )
