@@ -67,6 +67,7 @@ __all__ = [
     "load_settings_gc",
     "median_neighbour_distance",
     "missing_members",
+    "most_shared",
     "parse_threshold",
     "score",
     "score_all",
@@ -453,6 +454,14 @@ def detect_all(
     }
 
 
+def most_shared(groups: Sequence[frozenset[int]], true: frozenset[int]) -> int | None:
+    """Index in ``groups`` of the group sharing the most members with ``true``, the one with fewest others (members
+    not in ``true``) on ties, the first of equals; None when ``groups`` is empty."""
+    if not groups:
+        return None
+    return max(range(len(groups)), key=lambda k: (len(groups[k] & true), -len(groups[k] - true)))
+
+
 GROUP_ERRORS = ("exact", "one_too_many", "more_too_many", "lacking", "mixed", "missed")
 """How a true group can come out (``group_errors``), best first."""
 
@@ -470,7 +479,8 @@ def group_errors(frames: Sequence[LabelledFrame], detections: Sequence[Sequence[
         groups = [frozenset(g) for g in found if len(frozenset(g)) > 1]
         truth = [t for t in frame.truth if len(t) > 1]
         for true in truth:
-            best = max(groups, key=lambda g: (len(g & true), -len(g - true)), default=frozenset())
+            k = most_shared(groups, true)
+            best = groups[k] if k is not None else frozenset()
             shared, others = len(best & true), len(best - true)
             if shared < 2:
                 counts["missed"] += 1

@@ -31,6 +31,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from sid.checks import check_number, check_whole, repeated
+from sid.experiments.fformation import most_shared
 from sid.experiments.synthetic_tracking import identify
 from sid.perception.group import Group
 from sid.perception.groups import GroupParams
@@ -219,17 +220,11 @@ def match_people(people: Sequence[Person], truth: FrameTruth, radius: float) -> 
 
 
 def best_group(groups: Sequence[Group], matches: dict[int, int], members: Sequence[int]) -> tuple[Group | None, int]:
-    """The detected group holding the most of the true ``members`` (under ``matches``), fewest strangers on ties;
-    and how many true members it holds."""
-    wanted = set(members)
-    best, best_key = None, (0, 0)
-    for group in groups:
-        mapped = [matches.get(m) for m in group.members]
-        hits = sum(m in wanted for m in mapped)
-        key = (hits, -(len(mapped) - hits))
-        if best is None or key > best_key:
-            best, best_key = group, key
-    return best, best_key[0]
+    """The detected group holding the most of the true ``members`` (under ``matches``; unmatched members count as
+    strangers), fewest strangers on ties (``fformation.most_shared``); and how many true members it holds."""
+    mapped = [frozenset(matches.get(m, -1 - n) for n, m in enumerate(g.members)) for g in groups]
+    k = most_shared(mapped, frozenset(members))
+    return (None, 0) if k is None else (groups[k], len(mapped[k] & frozenset(members)))
 
 
 Progress = Callable[[int, int, str], None]

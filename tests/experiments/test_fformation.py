@@ -26,6 +26,7 @@ from sid.experiments.fformation import (
     load_sequence,
     median_neighbour_distance,
     missing_members,
+    most_shared,
     parse_threshold,
     score,
     unit_warning,
@@ -542,3 +543,10 @@ def test_features_with_more_than_four_columns_are_read_from_the_first_four_with_
     assert [[(p.id, p.x, p.y, p.theta) for p in f.people] for f in frames] == [
         [(p.id, p.x, p.y, p.theta) for p in f.people] for f in plain
     ]
+
+
+def test_the_detected_group_sharing_most_members_fewest_strangers_on_ties_is_chosen():
+    true = frozenset({1, 2, 3})
+    assert most_shared([frozenset({1, 2, 9}), frozenset({1, 2}), frozenset({3})], true) == 1
+    assert most_shared([frozenset({1, 5}), frozenset({2, 6})], frozenset({1, 2})) == 0  # the first of equals
+    assert most_shared([frozenset({7, 8})], true) == 0 and most_shared([], true) is None
