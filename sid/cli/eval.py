@@ -82,7 +82,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         type=_threshold,
         default=list(DEFAULT_THRESHOLDS),
         metavar="T",
-        help="tolerances in (0, 1], e.g. --T 2/3 1 after the DIRs (default: 2/3 1)",
+        help="tolerances in (1/2, 1], e.g. --T 2/3 1 after the DIRs (default: 2/3 1)",
     )
     ff.add_argument("--table", action="store_true", help="print a readable table instead of JSON")
     ff.add_argument(

@@ -25,7 +25,6 @@ Protocol:
 from __future__ import annotations
 
 import dataclasses
-import importlib.util
 import itertools
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -36,10 +35,9 @@ import scipy.sparse
 import scipy.sparse.csgraph
 
 from sid.checks import check_limit
-from sid.distribution import MissingDependencyError, install_hint
 from sid.experiments.fformation import format_threshold, frame_matches
 from sid.experiments.gmitre import LinkCounts, gmitre_counts
-from sid.experiments.synthetic_tracking import as_truth_ids, identify, merged_mot_scores
+from sid.experiments.synthetic_tracking import as_truth_ids, identify, merged_mot_scores, require_motmetrics
 from sid.experiments.trajectories import ReplaySettings, TrajectoryError, TrajectorySet, replay, replay_length
 from sid.tracking.coherent import CoherentMotion, CoherentMotionParams
 from sid.tracking.groups import GroupTracker, GroupTrackerParams
@@ -61,7 +59,6 @@ __all__ = [
     "find_groups",
     "record_tracks",
     "replay_view",
-    "require_motmetrics",
     "score_groups",
     "score_people",
 ]
@@ -231,14 +228,13 @@ def _per_frame(
     return found
 
 
-def score_people(
-    trajectories: TrajectorySet, log: TrackLog, match_distance: float, progress: Progress | None = None
-) -> dict[str, Any]:
-    """MOTA, IDF1, identity switches (also per 100 true tracks) and the other motmetrics counts of ``log``;
-    ``progress`` after each frame matched."""
+def score_people(log: TrackLog, match_distance: float, progress: Progress | None = None) -> dict[str, Any]:
+    """MOTA, IDF1, identity switches (also per 100 true tracks: the distinct annotated people scored, those ever
+    inside the view) and the other motmetrics counts of ``log``; ``progress`` after each frame matched."""
     people = merged_mot_scores(_accumulate(log, match_distance, progress))
-    people["true_tracks"] = trajectories.people
-    people["id_switches_per_100_tracks"] = 100 * people["id_switches"] / max(trajectories.people, 1)
+    true_tracks = len(np.unique(np.concatenate(log.truth_ids)))
+    people["true_tracks"] = true_tracks
+    people["id_switches_per_100_tracks"] = 100 * people["id_switches"] / max(true_tracks, 1)
     return people
 
 
@@ -255,7 +251,7 @@ def evaluate_crowd(
     for trajectories in sets:
         passes = [_pass(progress, k, trajectories.name) for k in range(len(EVALUATION_PASSES))]
         log = record_tracks(trajectories, settings, passes[0])
-        people = score_people(trajectories, log, settings.match_distance, passes[1])
+        people = score_people(log, settings.match_distance, passes[1])
         groups = score_groups(
             trajectories, log, find_groups(log, settings.tracking.groups, passes[2]), settings, passes[3]
         )
@@ -321,8 +317,8 @@ def cross_validate(
     for row, tracker in enumerate(trackers):
         trial = _with_tracker(settings, tracker)
         logs.append([record_tracks(s, trial) for s in sets])
-        for col, (trajectories, log) in enumerate(zip(sets, logs[row], strict=True)):
-            idf1[row, col] = score_people(trajectories, log, settings.match_distance)["idf1"]
+        for col, log in enumerate(logs[row]):
+            idf1[row, col] = score_people(log, settings.match_distance)["idf1"]
             if progress is not None:
                 progress(row * len(sets) + col + 1, total, f"tracker {row + 1}/{len(trackers)}")
     group_f1: dict[tuple[str, int], np.ndarray] = {}  # (which, tracker row) -> (points, sets)
@@ -458,10 +454,3 @@ def _settings_json(settings: CrowdSettings) -> dict[str, Any]:
         "match_distance": settings.match_distance,
         "thresholds": list(settings.thresholds),
     }
-
-
-def require_motmetrics() -> None:
-    if importlib.util.find_spec("motmetrics") is None:
-        raise MissingDependencyError(
-            f"the crowd evaluation needs py-motmetrics: {install_hint('eval')} (or pip install motmetrics)"
-        )

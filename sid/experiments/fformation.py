@@ -67,6 +67,7 @@ __all__ = [
     "load_settings_gc",
     "median_neighbour_distance",
     "missing_members",
+    "most_shared",
     "parse_threshold",
     "score",
     "score_all",
@@ -392,8 +393,15 @@ def median_neighbour_distance(frames: Sequence[LabelledFrame]) -> float | None:
 def frame_matches(
     detected: Sequence[Iterable[int]], truth: Sequence[Iterable[int]], threshold: float
 ) -> tuple[int, int, int]:
-    """(true groups found, groups detected, true groups) of one frame under the tolerance ``threshold`` (T); groups
-    of one are ignored."""
+    """(true groups found, groups detected, true groups) of one frame under the tolerance ``threshold`` (T, above
+    1/2); groups of one are ignored.
+
+    A true group is found when some detected group G has |G & truth| / max(|G|, |truth|) >= T. Above 1/2 a detected
+    group holds most of at most one (disjoint) true group, so no detection counts twice and precision stays <= 1.
+
+    Raises ValueError when T is not in (1/2, 1].
+    """
+    _check_threshold(threshold)
     found_sets = [frozenset(g) for g in detected if len(frozenset(g)) > 1]
     true_sets = [frozenset(g) for g in truth if len(frozenset(g)) > 1]
     true_positives = sum(any(len(g & t) / max(len(g), len(t)) >= threshold for g in found_sets) for t in true_sets)
@@ -403,7 +411,8 @@ def frame_matches(
 def frame_precision_recall(
     detected: Sequence[Iterable[int]], truth: Sequence[Iterable[int]], threshold: float
 ) -> tuple[float, float]:
-    """Precision and recall of one frame under the tolerance ``threshold`` (T); groups of one are ignored."""
+    """Precision and recall of one frame under the tolerance ``threshold`` (T in (1/2, 1]); groups of one are
+    ignored."""
     true_positives, found, true = frame_matches(detected, truth, threshold)
     if not found and not true:
         return 1.0, 1.0
@@ -445,6 +454,14 @@ def detect_all(
     }
 
 
+def most_shared(groups: Sequence[frozenset[int]], true: frozenset[int]) -> int | None:
+    """Index in ``groups`` of the group sharing the most members with ``true``, the one with fewest others (members
+    not in ``true``) on ties, the first of equals; None when ``groups`` is empty."""
+    if not groups:
+        return None
+    return max(range(len(groups)), key=lambda k: (len(groups[k] & true), -len(groups[k] - true)))
+
+
 GROUP_ERRORS = ("exact", "one_too_many", "more_too_many", "lacking", "mixed", "missed")
 """How a true group can come out (``group_errors``), best first."""
 
@@ -462,7 +479,8 @@ def group_errors(frames: Sequence[LabelledFrame], detections: Sequence[Sequence[
         groups = [frozenset(g) for g in found if len(frozenset(g)) > 1]
         truth = [t for t in frame.truth if len(t) > 1]
         for true in truth:
-            best = max(groups, key=lambda g: (len(g & true), -len(g - true)), default=frozenset())
+            k = most_shared(groups, true)
+            best = groups[k] if k is not None else frozenset()
             shared, others = len(best & true), len(best - true)
             if shared < 2:
                 counts["missed"] += 1
@@ -561,14 +579,21 @@ def cross_validate(
 
 def format_threshold(threshold: float) -> str:
     """'2/3' for 2/3, '1' for 1, else the decimal."""
-    for num, den in ((2, 3), (1, 1), (1, 2), (3, 4), (1, 3)):
+    for num, den in ((2, 3), (1, 1), (3, 4)):
         if math.isclose(threshold, num / den):
             return f"{num}/{den}" if den != 1 else str(num)
     return f"{threshold:g}"
 
 
+def _check_threshold(threshold: float) -> None:
+    """Raise ValueError unless the tolerance ``threshold`` lies in (1/2, 1], where the protocol is defined (at 1/2
+    or below one detected group could find two true groups)."""
+    if not 0.5 < threshold <= 1:
+        raise ValueError(f"threshold {threshold:g} must lie in (1/2, 1], e.g. 2/3 or 1")
+
+
 def parse_threshold(text: str) -> float:
-    """'2/3', '0.75' or '1' -> a tolerance T in (0, 1]."""
+    """'2/3', '0.75' or '1' -> a tolerance T in (1/2, 1]."""
     try:
         if "/" in text:
             num, den = text.split("/", 1)
@@ -577,8 +602,7 @@ def parse_threshold(text: str) -> float:
             value = float(text)
     except (ValueError, ZeroDivisionError):
         raise ValueError(f"threshold {text!r} is not a number or fraction such as 2/3") from None
-    if not 0 < value <= 1:
-        raise ValueError(f"threshold {text!r} must lie in (0, 1]")
+    _check_threshold(value)
     return value
 
 

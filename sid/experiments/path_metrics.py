@@ -35,10 +35,12 @@ __all__ = [
     "FIXED_KEYS",
     "HALL_BANDS",
     "PERSONAL_DISTANCE_M",
+    "SAMPLE_SPACING_M",
     "crosses_group",
     "group_zones",
     "heading_change",
     "min_distance_to_points",
+    "nearest_distances",
     "path_length",
     "path_metrics",
     "result_metrics",
@@ -46,6 +48,8 @@ __all__ = [
 
 HALL_BANDS: dict[str, tuple[float, float]] = {"intimate": (0.0, 0.45), "personal": (0.45, 1.2), "social": (1.2, 3.6)}
 PERSONAL_DISTANCE_M = 1.2
+SAMPLE_SPACING_M = 0.02
+"""Largest gap (m) between the path samples that the band fractions and ``personal_space_fraction`` count."""
 
 
 def path_length(path: np.ndarray) -> float:
@@ -63,6 +67,15 @@ def heading_change(path: np.ndarray) -> float:
     heading = np.arctan2(d[:, 1], d[:, 0])
     turn = (np.diff(heading) + np.pi) % (2 * np.pi) - np.pi
     return float(np.abs(turn).sum())
+
+
+def nearest_distances(samples: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """(N,) distance (m) from each of ``samples`` (N, 2) to the nearest of ``points`` (M, 2); inf when M = 0."""
+    samples = np.asarray(samples, dtype=float).reshape(-1, 2)
+    points = np.asarray(points, dtype=float).reshape(-1, 2)
+    if len(points) == 0:
+        return np.full(len(samples), math.inf)
+    return np.hypot(*(samples[:, None, :] - points[None]).transpose(2, 0, 1)).min(axis=1)
 
 
 def min_distance_to_points(path: np.ndarray, points: np.ndarray) -> float:
@@ -104,7 +117,7 @@ def path_metrics(
     people: Sequence[Person],
     groups: Sequence[Group],
     costmap: Costmap2D | None = None,
-    spacing: float = 0.02,
+    spacing: float = SAMPLE_SPACING_M,
 ) -> dict:
     """Geometry and social metrics of a successful path (N >= 1, world frame).
 
@@ -125,7 +138,7 @@ def path_metrics(
         "waypoints": len(path),
     }
     if len(positions):
-        nearest = np.hypot(*(samples[:, None, :] - positions[None]).transpose(2, 0, 1)).min(axis=1)
+        nearest = nearest_distances(samples, positions)
         metrics["min_person_distance_m"] = min_distance_to_points(path, positions)
         metrics["band_fractions"] = {
             name: float(((nearest >= lo) & (nearest < hi)).mean()) for name, (lo, hi) in HALL_BANDS.items()

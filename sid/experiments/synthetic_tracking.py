@@ -66,6 +66,7 @@ __all__ = [
     "measure_flicker",
     "merged_mot_scores",
     "mot_scores",
+    "require_motmetrics",
 ]
 
 Progress = Callable[[int, int, str], None]
@@ -123,13 +124,19 @@ class _FrameLog:
     track_groups: list[tuple[int, ...]]
 
 
-def evaluate_tracking(settings: TrackingEvalSettings | None = None, progress: Progress | None = None) -> dict:
-    """Every score of the module docstring: ``{"sequences": {name: {...}}, "overall": {...}, "flicker": {...},
-    "settings": {...}}``."""
-    if importlib.util.find_spec("motmetrics") is None:  # fail before any rendering
+def require_motmetrics() -> None:
+    """Raise MissingDependencyError, with the command that installs it, when py-motmetrics (the people-tracking
+    scores of ``sid eval tracking`` and ``sid eval crowd``) is not installed."""
+    if importlib.util.find_spec("motmetrics") is None:
         raise MissingDependencyError(
             f"the tracking evaluation needs py-motmetrics: {install_hint('eval')} (or pip install motmetrics)"
         )
+
+
+def evaluate_tracking(settings: TrackingEvalSettings | None = None, progress: Progress | None = None) -> dict:
+    """Every score of the module docstring: ``{"sequences": {name: {...}}, "overall": {...}, "flicker": {...},
+    "settings": {...}}``."""
+    require_motmetrics()  # fail before any rendering
     settings = settings or TrackingEvalSettings()
     per_sequence: dict[str, Any] = {}
     accumulators, logs_by_name = [], {}

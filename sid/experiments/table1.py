@@ -29,9 +29,10 @@ from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 from sid.checks import check_number, check_whole, repeated
+from sid.experiments.fformation import most_shared
+from sid.experiments.synthetic_tracking import identify
 from sid.perception.group import Group
 from sid.perception.groups import GroupParams
 from sid.perception.lifting import LiftParams
@@ -208,29 +209,22 @@ def wrap_degrees(radians: float) -> float:
 
 
 def match_people(people: Sequence[Person], truth: FrameTruth, radius: float) -> dict[int, int]:
-    """Detected person id -> true person id: Hungarian assignment on ground-plane distance, pairs within
-    ``radius`` (m) only."""
+    """Detected person id -> true person id: ``identify``'s assignment (minimum total ground-plane distance over
+    the pairs within ``radius``, m)."""
     if not people or not truth.people:
         return {}
     detected = np.array([(p.x, p.y) for p in people], dtype=float)
     true = np.array([(p.x, p.y) for p in truth.people], dtype=float)
-    distance = np.hypot(*(detected[:, None, :] - true[None, :, :]).transpose(2, 0, 1))
-    rows, cols = linear_sum_assignment(distance)
-    return {people[r].id: truth.people[c].id for r, c in zip(rows, cols, strict=True) if distance[r, c] <= radius}
+    identity = identify(detected, [p.id for p in truth.people], true, radius)
+    return {p.id: i for p, i in zip(people, identity, strict=True) if i is not None}
 
 
 def best_group(groups: Sequence[Group], matches: dict[int, int], members: Sequence[int]) -> tuple[Group | None, int]:
-    """The detected group holding the most of the true ``members`` (under ``matches``), fewest strangers on ties;
-    and how many true members it holds."""
-    wanted = set(members)
-    best, best_key = None, (0, 0)
-    for group in groups:
-        mapped = [matches.get(m) for m in group.members]
-        hits = sum(m in wanted for m in mapped)
-        key = (hits, -(len(mapped) - hits))
-        if best is None or key > best_key:
-            best, best_key = group, key
-    return best, best_key[0]
+    """The detected group holding the most of the true ``members`` (under ``matches``; unmatched members count as
+    strangers), fewest strangers on ties (``fformation.most_shared``); and how many true members it holds."""
+    mapped = [frozenset(matches.get(m, -1 - n) for n, m in enumerate(g.members)) for g in groups]
+    k = most_shared(mapped, frozenset(members))
+    return (None, 0) if k is None else (groups[k], len(mapped[k] & frozenset(members)))
 
 
 Progress = Callable[[int, int, str], None]

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 import warnings
 from collections.abc import Callable
 from collections.abc import Set as AbstractSet
@@ -196,8 +197,9 @@ def _params(value: Any, name: str, cls: type) -> Any:
             kwargs[key] = _number(raw, key_name)
     try:
         return cls(**kwargs)
-    except ValueError as exc:
-        raise ScenarioError(f"{name}: {exc}") from exc
+    except ValueError as exc:  # "groups: method must be ...": the dataclass's own name gives way to the block's path
+        reason = re.sub(r"^\w+: ", "", str(exc), count=1)
+        raise ScenarioError(f"{name}: {reason}") from exc
 
 
 def _plugins(value: Any, where: str, declared: dict[str, str]) -> tuple[str, ...]:

@@ -41,6 +41,19 @@ def test_a_clean_scene_is_tracked_and_grouped_without_mistakes(tmp_path: Path) -
     assert result["coherent_motion"]["groups_T2/3"]["precision"] == 1.0
 
 
+def test_switches_per_100_tracks_count_only_the_people_scored_inside_the_view(tmp_path: Path) -> None:
+    scene = load_trajectory_set(pair_and_strangers(tmp_path / "scene"))
+    # 6 m around (9.5, 0.3): the pair and stranger 3 (y = 4) pass through it, stranger 4 (y = 7) never comes nearer
+    # than 6.7 m, so only three people are ever scored.
+    view = ViewCone(9.5, 0.3, 0.0, 2 * math.pi, 6.0)
+    settings = CrowdSettings(replay=ReplaySettings(noise=0.05, miss_rate=0.0, view=view))
+    log = record_tracks(scene, settings)
+    assert {int(i) for ids in log.truth_ids for i in ids} == {1, 2, 3}
+    people = evaluate_crowd([scene], settings)["sets"]["scene"]["people"]
+    assert people["true_tracks"] == 3
+    assert people["id_switches_per_100_tracks"] == pytest.approx(100 * people["id_switches"] / 3)
+
+
 def test_progress_counts_every_pass_over_the_frames_not_only_the_tracking(tmp_path: Path) -> None:
     """The count reached 100 % after the tracking, the first of six passes: with 65 people at 15 Hz the other five
     took 35 s per set without a line."""
@@ -117,7 +130,7 @@ def assert_scored_in_parts_as_one(scene: TrajectorySet, monkeypatch: pytest.Monk
     monkeypatch.setattr(crowd, "MOT_PART_IDS", part_ids)
     whole, parts = (
         one_accumulator_scores(log, settings.match_distance),
-        score_people(scene, log, settings.match_distance),
+        score_people(log, settings.match_distance),
     )
     for name, value in whole.items():
         assert parts[name] == (pytest.approx(value, rel=1e-12) if name == "motp_m" else value), name

@@ -26,6 +26,7 @@ from sid.experiments.fformation import (
     load_sequence,
     median_neighbour_distance,
     missing_members,
+    most_shared,
     parse_threshold,
     score,
     unit_warning,
@@ -143,9 +144,18 @@ def test_score_averages_over_frames_then_takes_f1(tiny):
 def test_thresholds_parse_and_format():
     assert parse_threshold("2/3") == pytest.approx(2 / 3) and parse_threshold("1") == 1.0
     assert format_threshold(2 / 3) == "2/3" and format_threshold(1.0) == "1" and format_threshold(0.9) == "0.9"
-    for bad in ("0", "1.5", "x", "1/0"):
+    assert parse_threshold("0.51") == pytest.approx(0.51)
+    for bad in ("0", "1/2", "1/3", "1.5", "x", "1/0"):
         with pytest.raises(ValueError, match="threshold"):
             parse_threshold(bad)
+
+
+def test_a_tolerance_of_one_half_or_below_is_refused_rather_than_counting_a_detection_twice():
+    # At T = 1/2 the one detected group [1, 2, 3, 4] would find both true pairs: two hits from one detection.
+    for threshold in (0.5, 1 / 3):
+        with pytest.raises(ValueError, match=r"threshold .* must lie in \(1/2, 1\]"):
+            frame_precision_recall([[1, 2, 3, 4]], [[1, 2], [3, 4]], threshold)
+    assert frame_precision_recall([[1, 2, 3, 4]], [[1, 2], [3, 4]], 2 / 3) == (0.0, 0.0)
 
 
 def test_malformed_files_give_clear_errors(tmp_path, tiny):
@@ -533,3 +543,10 @@ def test_features_with_more_than_four_columns_are_read_from_the_first_four_with_
     assert [[(p.id, p.x, p.y, p.theta) for p in f.people] for f in frames] == [
         [(p.id, p.x, p.y, p.theta) for p in f.people] for f in plain
     ]
+
+
+def test_the_detected_group_sharing_most_members_fewest_strangers_on_ties_is_chosen():
+    true = frozenset({1, 2, 3})
+    assert most_shared([frozenset({1, 2, 9}), frozenset({1, 2}), frozenset({3})], true) == 1
+    assert most_shared([frozenset({1, 5}), frozenset({2, 6})], frozenset({1, 2})) == 0  # the first of equals
+    assert most_shared([frozenset({7, 8})], true) == 0 and most_shared([], true) is None

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 
 import cv2
 import numpy as np
@@ -112,6 +113,15 @@ def test_people_are_matched_by_position_not_by_id():
     assert matches == {10 + p.id: p.id for p in truth.people}
     assert match_people(_people_from_truth(truth, offset=(0.6, 0.0)), truth, radius=0.5) == {}
     assert match_people([], truth, radius=0.5) == {}
+
+
+def test_people_are_matched_within_the_radius_even_when_an_unrestricted_assignment_would_pair_them_farther():
+    truth = _truth("S3")
+    near, far = truth.people[:2]
+    truth = replace(truth, people=[replace(near, x=0.45, y=0.0), replace(far, x=-2.0, y=0.0)])
+    # Unrestricted, (0, 0) -> (-2, 0) and (1, 0) -> (0.45, 0) cost least in total, and both pairs lie beyond 0.5 m.
+    people = [Person(1, 0.0, 0.0, 0.0, 1.0), Person(2, 1.0, 0.0, 0.0, 1.0)]
+    assert match_people(people, truth, radius=0.5) == {1: near.id}
 
 
 def test_angle_differences_wrap():

@@ -5,6 +5,7 @@ from __future__ import annotations
 import importlib.util
 import math
 import re
+import sys
 from collections import Counter
 from dataclasses import dataclass, field
 from typing import Any
@@ -14,6 +15,7 @@ import pytest
 
 from sid.distribution import install_hint
 from sid.experiments import synthetic_tracking
+from sid.experiments.crowd import evaluate_crowd
 from sid.experiments.synthetic_tracking import (
     MissingDependencyError,
     TrackingEvalSettings,
@@ -125,3 +127,14 @@ def test_walkers_crossing_closer_than_0_4_m_keep_their_tracks() -> None:
     scores, walkers = _replay("close_crossing", 3.5)  # a second past the crossing
     _assert_one_track_each(scores, walkers)
     assert walkers.closest < 0.4
+
+
+def test_both_evaluations_refuse_a_missing_motmetrics_with_the_one_message(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setitem(sys.modules, "motmetrics", None)  # as if not installed: find_spec answers None
+    messages = []
+    for evaluate in (evaluate_tracking, lambda: evaluate_crowd([])):
+        with pytest.raises(MissingDependencyError, match="needs py-motmetrics") as info:
+            evaluate()
+        messages.append(str(info.value))
+    assert messages[0] == messages[1]
+    assert install_hint("eval") in messages[0]

@@ -83,6 +83,18 @@ def test_groups_block_chooses_the_detection_method():
             scenario_from_dict(data)
 
 
+def test_a_bad_parameter_is_named_once_by_its_block():
+    for block, value, message in (
+        ("groups", {"method": "nope"}, 'groups: method must be one of ospace, gcff, rays, paper, got "nope"'),
+        ("layers", {"social": {"amplitude": 999}}, "layers.social: amplitude must be a finite number in [0, 252]"),
+    ):
+        data = copy.deepcopy(BASE)
+        data[block] = value
+        with pytest.raises(ScenarioError) as info:
+            scenario_from_dict(data)
+        assert str(info.value).startswith(message)
+
+
 def test_yaml_files_load_too(tmp_path):
     path = tmp_path / "s.yaml"
     path.write_text(yaml.safe_dump(BASE))
@@ -110,8 +122,8 @@ def test_yaml_files_load_too(tmp_path):
         ("obstacles", [{"type": "segment", "points": [[0, 0]]}], r"obstacles\[0\]\.points: expected at least 2"),
         ("lidar", {"beams": 0}, r"lidar\.beams: expected an integer >= 1"),
         ("groups", {"epsilon": 1}, r"groups\.epsilon: unknown field"),
-        ("layers", {"inflation": {"inflation_radius": -1}}, r"layers\.inflation: inflation: inflation_radius"),
-        ("layers", {"social": {"group_cost": 300}}, r"layers\.social: social: group_cost"),
+        ("layers", {"inflation": {"inflation_radius": -1}}, r"layers\.inflation: inflation_radius"),
+        ("layers", {"social": {"group_cost": 300}}, r"layers\.social: group_cost"),
         ("layers", {"tracked_people": {"lookahead": -1}}, r"layers\.tracked_people: .*lookahead"),
         ("layers", {"tracked_people": {"lookahead": 1e308}}, r"lookahead must be .* in \[0, 10\]"),
         ("peple", [], r"scenario\.peple: unknown field"),

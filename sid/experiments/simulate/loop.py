@@ -41,7 +41,14 @@ import numpy as np
 from costmap.grid import INSCRIBED, Costmap2D
 from costmap.scan import LaserScan
 from planner.facade import PlanResult, check_endpoints, plan, resolve_planner
-from planner.problem import DEFAULT_COST_WEIGHT, CostField, PlanningError, PlanningProblem, WalledOffError
+from planner.problem import (
+    DEFAULT_COST_WEIGHT,
+    CostField,
+    EndpointCollisionError,
+    PlanningError,
+    PlanningProblem,
+    WalledOffError,
+)
 from planner.validity import interpolate
 from sid.experiments.harness import people_walling_off
 from sid.experiments.simulate.follower import FollowerParams, follow, remaining
@@ -207,28 +214,32 @@ class _Planner:
         robot = self.world.scenario.robot
         return PlanningProblem(costmap, start, robot.goal[:2], robot.radius, self.options.cost_weight)
 
+    def _call(self, problem: PlanningProblem) -> PlanResult:
+        """One ``plan`` call, counted in ``plans`` and seeded by its number."""
+        seed = _ompl_seed(self.options.seed, self.plans)
+        self.plans += 1
+        return plan(problem, self.options.planner, self.options.plan_time_s, seed)
+
     def _plan(self, costmap: Costmap2D, xy: tuple[float, float]) -> PlanResult | None:
         t0 = time.perf_counter()
         problem = self.problem(costmap, xy)
         start = xy
         self.walled_off = False
         try:
-            result = plan(problem, self.options.planner, self.options.plan_time_s,
-                          _ompl_seed(self.options.seed, self.plans))  # fmt: skip
+            result = self._call(problem)
         except PlanningError as exc:
             self.message, self.walled_off = str(exc), isinstance(exc, WalledOffError)
-            escape = _free_start(CostField(problem), xy) if str(exc).startswith("no path: start") else None
+            in_collision = isinstance(exc, EndpointCollisionError) and exc.end == "start"
+            escape = _free_start(CostField(problem), xy) if in_collision else None
             if escape is None:
                 return None
             start = escape
             try:
-                result = plan(self.problem(costmap, start), self.options.planner, self.options.plan_time_s,
-                              _ompl_seed(self.options.seed, self.plans))  # fmt: skip
+                result = self._call(self.problem(costmap, start))
             except PlanningError as again:
                 self.message, self.walled_off = str(again), isinstance(again, WalledOffError)
                 return None
         finally:  # every call's time, a failed one's too (its endpoint checks, its search until the budget ran out)
-            self.plans += 1
             self.time_s += time.perf_counter() - t0
         if not result.success:
             self.message = result.message
@@ -271,7 +282,7 @@ def simulate(
     world: SimWorld, options: RunOptions = RunOptions(), observer: Observer | None = None, color: bool = False
 ) -> RunTrace:
     """Run the closed loop on ``world`` (see the module docstring); ``observer`` sees every step; ``color``: render
-    the camera's colour image too (see ``make_perception``)."""
+    the camera's colour image too (see ``make_sensing``)."""
     world = jittered(world, options.seed)
     scenario, settings = world.scenario, world.settings
     limits = settings.limits

@@ -5,8 +5,10 @@ each step (the groups ``sid.perception.groups.detect_groups`` finds on the exact
 Each step's segment (from the robot's position at t to its position at t + dt) is measured with
 ``sid.experiments.path_metrics`` against the people and groups of time t: length inside any group's interaction zone
 (``ospace_intrusion_m``, summed), whether it crosses the segment between two members (``crosses_group``), and its
-distance to every person's centre (``min_person_distance_m``: the smallest over the run). Map frame, metres,
-seconds.
+distance to every person's centre (``min_person_distance_m``: the smallest over the run). ``personal_space_fraction``
+means what it means for a planned path (``path_metrics``): the share of samples at most ``SAMPLE_SPACING_M`` apart
+along the driven path (every vertex included) closer than ``PERSONAL_DISTANCE_M`` to someone, each sample measured
+against the people of its step; steps spent standing still add no path and no samples. Map frame, metres, seconds.
 """
 
 from __future__ import annotations
@@ -17,11 +19,14 @@ import numpy as np
 from shapely.geometry import LineString
 from shapely.ops import unary_union
 
+from planner.validity import interpolate
 from sid.experiments.path_metrics import (
     PERSONAL_DISTANCE_M,
+    SAMPLE_SPACING_M,
     crosses_group,
     group_zones,
     min_distance_to_points,
+    nearest_distances,
     path_length,
 )
 from sid.experiments.simulate.loop import RunTrace
@@ -36,13 +41,19 @@ def run_metrics(trace: RunTrace, straight_m: float) -> dict:
     """
     trajectory = np.array(trace.trajectory, dtype=float).reshape(-1, 4)
     xy = trajectory[:, 1:3]
-    intrusion, crosses, nearest, personal = 0.0, False, math.inf, 0
+    intrusion, crosses, nearest, personal, samples = 0.0, False, math.inf, 0, 0
     for i, (people, groups) in enumerate(trace.truth):
         segment = xy[i : i + 2]
         positions = np.array([(p.x, p.y) for p in people], dtype=float).reshape(-1, 2)
-        distance = min_distance_to_points(segment, positions)
-        nearest = min(nearest, distance)
-        personal += distance < PERSONAL_DISTANCE_M
+        nearest = min(nearest, min_distance_to_points(segment, positions))
+        if len(segment) == 1:  # the final position: the path's last vertex
+            points = segment
+        elif path_length(segment) > 0:  # the segment's samples but its end, the next segment's start
+            points = interpolate(segment, SAMPLE_SPACING_M)[:-1]
+        else:
+            points = segment[:0]
+        personal += int((nearest_distances(points, positions) < PERSONAL_DISTANCE_M).sum())
+        samples += len(points)
         if groups and len(segment) == 2:
             zones = unary_union(group_zones(people, groups))
             intrusion += float(LineString(segment).intersection(zones).length)
@@ -59,7 +70,7 @@ def run_metrics(trace: RunTrace, straight_m: float) -> dict:
         "min_person_distance_m": nearest if math.isfinite(nearest) else None,
         "ospace_intrusion_m": intrusion,
         "crosses_group": crosses,
-        "personal_space_fraction": personal / max(len(trace.truth), 1),
+        "personal_space_fraction": personal / max(samples, 1),
         "replans": trace.replans,
         "plans": trace.plans,
         "planning_time_s": trace.planning_time_s,

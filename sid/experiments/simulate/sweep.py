@@ -148,13 +148,15 @@ def run_sweep(
 
 
 def sweep_summary(records: Sequence[dict], by: Sequence[str] = ("scene",)) -> list[dict]:
-    """``harness.summarise`` rows by ``by`` and costmap mode, plus ``collision_rate`` and ``median_time_to_goal_s``
-    (over successful runs) and ``mean_min_person_distance_m``."""
+    """``harness.summarise`` rows by ``by`` and costmap mode, plus ``collision_rate`` (over all runs),
+    ``median_time_to_goal_s`` and ``mean_min_person_distance_m`` (over successful runs, as summarise's median and
+    worst closest approach)."""
     rows = summarise(records, by)
     for row in rows:
         members = [r for r in records if r["social_layer"] == row["social_layer"] and all(r[k] == row[k] for k in by)]
-        times = [r["time_to_goal_s"] for r in members if r["success"]]
-        distances = [r["min_person_distance_m"] for r in members if r["min_person_distance_m"] is not None]
+        ok = [r for r in members if r["success"]]
+        times = [r["time_to_goal_s"] for r in ok]
+        distances = [r["min_person_distance_m"] for r in ok if r["min_person_distance_m"] is not None]
         row["collision_rate"] = sum(r["collisions"] > 0 for r in members) / len(members)
         row["median_time_to_goal_s"] = statistics.median(times) if times else None
         row["mean_min_person_distance_m"] = statistics.fmean(distances) if distances else None

@@ -8,7 +8,8 @@ import pytest
 from costmap.grid import LETHAL, GridSpec
 from costmap.mapfile import write_map
 from costmap.occupancy import OCC_OCCUPIED, OccupancyGrid
-from sid.experiments.simulate.loop import RunOptions, simulate
+from sid.experiments.simulate import loop
+from sid.experiments.simulate.loop import RunOptions, make_sensing, simulate
 from sid.experiments.simulate.metrics import run_metrics
 from sid.experiments.simulate.world import collision, obstacle_geometry, world_from_dict
 from sid.scenario.build import map_walls
@@ -151,3 +152,14 @@ def test_a_static_map_files_walls_are_obstacles_the_robot_collides_with(tmp_path
     geometry = obstacle_geometry(world.scenario.obstacles, map_walls(world.scenario))
     assert collision((2.0, -1.0), 0.25, geometry, [], 0.2) == "obstacle"
     assert collision((2.0, 1.2), 0.25, geometry, [], 0.2) is None  # in the gap
+
+
+def test_a_start_grazing_an_inflated_wall_escapes_in_a_second_planner_call_that_is_counted():
+    world = tiny_world(people=[])
+    planner = loop._Planner(world, RunOptions(social=False))
+    costmap = make_sensing(world, RunOptions(social=False), walls=map_walls(world.scenario)).costmap.master
+    start = (0.0, 1.6)  # 0.2 m from the wall at y = 1.8, inside the 0.25 m robot's inflation: the first call refuses
+    result = planner._plan(costmap, start)
+    assert result is not None and result.success
+    assert tuple(result.path[0]) == start and tuple(result.path[1]) != start  # the path leads out from the escape
+    assert planner.plans == 2 and "no path: start" in planner.message

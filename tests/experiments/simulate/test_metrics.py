@@ -1,5 +1,9 @@
+import math
+
+import numpy as np
 import pytest
 
+from sid.experiments.path_metrics import path_metrics
 from sid.experiments.simulate.loop import RunTrace
 from sid.experiments.simulate.metrics import run_metrics
 from sid.perception.groups import detect_groups
@@ -30,3 +34,16 @@ def test_a_trajectory_far_from_the_pair_does_not():
     assert metrics["ospace_intrusion_m"] == 0.0 and not metrics["crosses_group"]
     assert metrics["min_person_distance_m"] == pytest.approx(1.8)
     assert metrics["time_to_goal_s"] is None and metrics["length_ratio"] is None
+
+
+def test_personal_space_is_the_share_of_the_driven_path_as_for_a_planned_path():
+    """Ten steps waiting 1 m from someone, then 4 m along x in 1 m steps: within 1.2 m for 0.66 m of the 4 m."""
+    person = [Person(1, 0.0, 1.0, 0.0, 1.0)]
+    xs = [0.0] * 10 + [1.0, 2.0, 3.0, 4.0]
+    trace = RunTrace(True, "goal reached", 0, float(len(xs) - 1))
+    trace.trajectory = [(float(k), x, 0.0, 0.0) for k, x in enumerate(xs)]
+    trace.truth = [(person, [])] * len(xs)
+    driven = path_metrics(np.array([(x, 0.0) for x in (0.0, 1.0, 2.0, 3.0, 4.0)]), person, [])
+    metrics = run_metrics(trace, 4.0)
+    assert metrics["personal_space_fraction"] == pytest.approx(driven["personal_space_fraction"])
+    assert metrics["personal_space_fraction"] == pytest.approx(math.sqrt(1.2**2 - 1) / 4, abs=0.01)

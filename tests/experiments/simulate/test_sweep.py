@@ -59,3 +59,25 @@ def test_a_local_ray_instance_gives_the_same_runs(scene):
     jobs = sweep_jobs([scene], 1, RunOptions(perception="exact"))
     address = os.environ.get("SID_RAY_ADDRESS", "local")
     assert _comparable(run_sweep(jobs, ray_address=address)) == _comparable(run_sweep(jobs))
+
+
+def test_the_mean_closest_approach_is_over_the_successful_runs_as_the_median_and_worst():
+    def run(seed: int, success: bool, distance: float) -> dict:
+        return {
+            "scene": "s",
+            "seed": seed,
+            "social_layer": True,
+            "success": success,
+            "collisions": int(not success),
+            "time_to_goal_s": 10.0 if success else None,
+            "planning_time_s": 0.1,
+            "ospace_intrusion_m": 0.0,
+            "crosses_group": False,
+            "min_person_distance_m": distance,
+            "length_ratio": 1.1 if success else None,
+        }
+
+    (row,) = sweep_summary([run(0, True, 1.0), run(1, True, 1.4), run(2, False, 0.1)])
+    assert row["median_min_person_distance_m"] == pytest.approx(1.2) and row["worst_min_person_distance_m"] == 1.0
+    assert row["mean_min_person_distance_m"] == pytest.approx(1.2)  # the collision's 0.1 m is left out of all three
+    assert row["collision_rate"] == pytest.approx(1 / 3)
