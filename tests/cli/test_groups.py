@@ -179,9 +179,9 @@ def test_eval_fformation_prints_json_and_a_table(tmp_path, capsys):
     report = json.loads("\n".join(out))
     assert report["scores"]["Tiny"]["2/3"] == pytest.approx({"precision": 1.0, "recall": 2 / 3, "f1": 0.8, "frames": 3})
     assert report["params"]["eps"] == 2.0
-    code, out, _ = run_sid(["eval", "fformation", str(tiny), "--scale", "0.01", "--table", "--T", "0.5"], capsys)
+    code, out, _ = run_sid(["eval", "fformation", str(tiny), "--scale", "0.01", "--table", "--T", "0.75"], capsys)
     assert code == 0 and out[0].split() == ["dataset", "T", "frames", "precision", "recall", "F1"]
-    assert out[1].split() == ["Tiny", "1/2", "3", "1.000", "0.667", "0.800"]
+    assert out[1].split() == ["Tiny", "3/4", "3", "1.000", "0.667", "0.800"]
 
 
 def test_eval_fformation_counts_how_each_true_group_came_out(tmp_path, capsys):
@@ -346,7 +346,7 @@ def test_eval_fformation_reports_malformed_data(tmp_path, capsys):
     assert code == 2 and "cannot read" in err and "features.mat" in err
     with pytest.raises(SystemExit):
         main(["eval", "fformation", str(tmp_path / "Bad"), "--T", "3/2"])
-    assert "must lie in (0, 1]" in capsys.readouterr().err
+    assert "must lie in (1/2, 1]" in capsys.readouterr().err
 
 
 def test_eval_fformation_on_the_real_datasets(capsys):
