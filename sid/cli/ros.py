@@ -96,7 +96,10 @@ def run(args: argparse.Namespace) -> int:
             )
             if args.frames is not None and not synthetic:
                 frames = itertools.islice(frames, args.frames)
-        spin(node, frames, args.rate)
+        stopped = spin(node, frames, args.rate)
+        if stopped is not None:
+            print(f"sid ros: source stopped: {stopped}", file=sys.stderr)
+            return ExitCode.FAILURE
     except (SourceError, PoseModelError, ValueError, OSError) as exc:
         print(f"sid ros: {exc}", file=sys.stderr)
         return ExitCode.USAGE
