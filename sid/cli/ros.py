@@ -74,15 +74,20 @@ def run(args: argparse.Namespace) -> int:
         return ExitCode.USAGE
     try:
         import rclpy
+        from rclpy.impl.implementation_singleton import rclpy_implementation
         from rclpy.signals import SignalHandlerOptions
 
         from sid.ros.node import SocialCostmapNode, spin
+        from sid.ros.params import rcl_reason
     except ImportError as exc:
         print(INSTALL_HINT.format(error=exc), file=sys.stderr)
         return ExitCode.MISSING_DEPENDENCY
     ros_args = ["--ros-args", *args.ros_args] if args.ros_args is not None else []
-    # sid's own handlers turn SIGINT and SIGTERM into KeyboardInterrupt (sid.cli.main); rclpy's would not.
-    rclpy.init(args=["sid", *ros_args], signal_handler_options=SignalHandlerOptions.NO)
+    try:  # sid's own handlers turn SIGINT and SIGTERM into KeyboardInterrupt (sid.cli.main); rclpy's would not.
+        rclpy.init(args=["sid", *ros_args], signal_handler_options=SignalHandlerOptions.NO)
+    except rclpy_implementation.RCLError as exc:  # a malformed -p, a --params-file that cannot be read
+        print(f"sid ros: --ros-args: {rcl_reason(exc, 'failed to initialize rcl: ')}", file=sys.stderr)
+        return ExitCode.USAGE
     node = None
     try:
         synthetic = args.source is not None and args.source.startswith("synthetic:")

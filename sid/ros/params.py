@@ -33,6 +33,7 @@ __all__ = [
     "NodeParams",
     "PARAMETERS",
     "POSE_SOURCES",
+    "rcl_reason",
     "read_params",
     "ros_name",
 ]
@@ -177,6 +178,12 @@ def _typed(name: str, value: Any, default: object) -> Any:
     return value
 
 
+def rcl_reason(error: Exception, prefix: str) -> str:
+    """An rcl error's message for a person: without ``prefix`` (rclpy's "failed to ...: ") and the C source
+    locations rcl appends (``, at src/rcl/arguments.c:352``)."""
+    return str(error).removeprefix(prefix).split(", at ")[0]
+
+
 def _check_names(node: Node, params: NodeParams) -> None:
     """ValueError naming the parameter when a topic is not a valid ROS topic name for ``node`` (empty, a space, a
     ``//``; rcl's own reason is quoted) or a frame id is empty or starts with ``/`` (tf2 refuses such ids)."""
@@ -188,7 +195,7 @@ def _check_names(node: Node, params: NodeParams) -> None:
             try:
                 node.resolve_topic_name(value)
             except rclpy_implementation.RCLError as exc:
-                reason = str(exc).removeprefix("failed to resolve name: ").split(", at ")[0]
+                reason = rcl_reason(exc, "failed to resolve name: ")
                 raise ValueError(f"{f.name}: {value!r} is not a valid topic name ({reason})") from None
         elif f.name.endswith("_frame"):
             if not value:

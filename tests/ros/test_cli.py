@@ -142,3 +142,20 @@ def test_a_source_that_stops_with_an_error_ends_the_run_with_exit_1(
     assert codes == [ExitCode.FAILURE]
     assert "sid ros: source stopped: bag.db3: database disk image is malformed" in err
     assert "Traceback" not in err
+
+
+@pytest.mark.parametrize(
+    ("ros_args", "message"),
+    [
+        (["-p", "badformat"], "sid ros: --ros-args: Couldn't parse parameter override rule: '-p badformat'"),
+        (["--params-file", "/nonexistent.yaml"], "sid ros: --ros-args: Couldn't parse params file"),
+    ],
+)
+def test_ros_arguments_rcl_cannot_parse_are_bad_input(
+    ros_args: list[str], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """rclpy.init refusing ``--ros-args`` raised RCLError out of the command: a traceback and exit 1."""
+    pytest.importorskip("rclpy", reason="rclpy is not installed")
+    assert main(["ros", "--source", "synthetic:S4", "--ros-args", *ros_args]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert message in err and ", at " not in err
