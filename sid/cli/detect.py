@@ -341,12 +341,12 @@ def run(args: argparse.Namespace) -> int:
     try:
         # The next frame is read and posed in a worker thread while this one lifts, groups, tracks and writes.
         for item in run_ahead(_posed_frames(source, pipeline)):
+            if args.frames is not None and done + skipped >= args.frames:  # unreadable frames count too
+                break
             if isinstance(item, FrameReadError):
                 skip(item.index, item)
                 unreadable += 1
                 continue
-            if args.frames is not None and done + skipped >= args.frames:
-                break
             frame = item.frame
             if isinstance(item, _Skipped):
                 skip(frame.index, item.reason)

@@ -296,6 +296,25 @@ def test_a_source_none_of_whose_frames_can_be_read_is_bad_input(tmp_path, capsys
     assert err.count("skipped, ") == 2 and "no frame of the source could be read (2 frames tried)" in err
 
 
+def test_frames_stops_at_unreadable_frames_too(tmp_path, capsys):
+    """``--frames 2`` on a folder of five unreadable frames: the limit was checked only for frames that were read,
+    so all five were tried."""
+    (tmp_path / "color").mkdir()
+    (tmp_path / "depth").mkdir()
+    (tmp_path / "intrinsics.json").write_text(
+        json.dumps({"fx": 500.0, "fy": 500.0, "cx": 31.5, "cy": 23.5, "width": 64, "height": 48})
+    )
+    for name in "abcde":
+        (tmp_path / "color" / f"{name}.png").write_bytes(b"not a png")
+        (tmp_path / "depth" / f"{name}.png").write_bytes(b"not a png")
+    from tests.pose_models import build_yolo_pose_model
+
+    model = build_yolo_pose_model(tmp_path / "yolo.onnx", np.zeros((56, 10)))
+    assert main(["detect", "--source", str(tmp_path), "--model", str(model), "--frames", "2"]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert err.count("skipped, ") == 2 and "no frame of the source could be read (2 frames tried)" in err
+
+
 def test_a_frame_is_skipped_for_depth_only_when_no_pixel_has_any():
     from sid.cli.detect import _skip_reason
 
