@@ -275,7 +275,8 @@ def _close_source(source: Iterable[Frame]) -> None:
 
 def _tracked_json(record: dict, tracked: SessionUpdate) -> dict:
     """A frame's JSON line with its people and groups replaced by the tracks (ids: track ids), each person's 3D
-    keypoints taken from the detection it matched (null when missed), and ``reset`` when the trackers were."""
+    keypoints taken from the detection it matched (null when missed), the trackers' times (ms) added to
+    ``timing_ms`` and its ``total``, and ``reset`` when the trackers were."""
     by_id = {person["id"]: person for person in record["people"]}
     with_keypoints = any("keypoints" in person for person in record["people"])
     people = []
@@ -285,7 +286,10 @@ def _tracked_json(record: dict, tracked: SessionUpdate) -> dict:
             person["keypoints"] = by_id[track.detection]["keypoints"] if track.detection in by_id else None
         people.append(person)
     record |= {"people": people, "groups": [group.to_json() for group in tracked.groups]}
-    record["timing_ms"] |= {k: round(v, 3) for k, v in tracked.timing_ms.items()}
+    timing = record["timing_ms"]
+    total = timing.pop("total")  # the frame's stages and the trackers', as SocialStream's total
+    timing |= {k: round(v, 3) for k, v in tracked.timing_ms.items()}
+    timing["total"] = round(total + sum(tracked.timing_ms.values()), 3)
     if tracked.reset is not None:
         record["reset"] = tracked.reset
     return record
@@ -328,6 +332,7 @@ def run(args: argparse.Namespace) -> int:
         return fail("sid detect", exc)
 
     done = skipped = unreadable = 0  # unreadable: frames whose files could not be read, among the skipped
+    unconfirmed = 0  # frames written with people detected but none a confirmed track yet (tracking's people: [])
 
     def skip(index: int | None, reason: object) -> None:
         nonlocal skipped
@@ -371,7 +376,8 @@ def run(args: argparse.Namespace) -> int:
                     out.write(line, pictures)
                 print(line, flush=True)
             done += 1
-            totals.append(result.timing_ms["total"])
+            unconfirmed += not record["people"]
+            totals.append(record["timing_ms"]["total"])
     except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (sid.cli.common.Terminated)
         interrupted = 128 + int(getattr(exc, "signal_number", 2))
         print("detect: interrupted, output flushed", file=sys.stderr)
@@ -388,7 +394,9 @@ def run(args: argparse.Namespace) -> int:
     seconds = time.perf_counter() - started  # the frames' wall-clock time, start-up (imports, model load) aside
     rate = f" in {seconds:.1f} s ({(done + skipped) / seconds:.1f} frames/s)" if done + skipped else ""
     median = f", median {np.median(totals):.2f} ms per frame" if totals else ""
-    print(f"detect: {plural(done, 'frame')} with people, {skipped} skipped{rate}{median}", file=sys.stderr)
+    waiting = f", {plural(unconfirmed, 'frame')} with no confirmed track yet (people: [])" if unconfirmed else ""
+    summary = f"{plural(done - unconfirmed, 'frame')} with people{waiting}, {skipped} skipped{rate}{median}"
+    print(f"detect: {summary}", file=sys.stderr)
     if not interrupted and unreadable and unreadable == done + skipped:  # bad input, not a scene without people
         print(f"detect: no frame of the source could be read ({plural(unreadable, 'frame')} tried)", file=sys.stderr)
         return ExitCode.USAGE

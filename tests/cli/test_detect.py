@@ -275,7 +275,7 @@ def test_summary_counts_every_skipped_frame(tmp_path, capsys):
     assert main(["detect", "--source", str(tmp_path), "--model", str(model), "--no-keypoints"]) == 0
     captured = capsys.readouterr()
     assert len(_lines(captured.out)) == 1
-    assert "1 frame with people, 3 skipped" in captured.err
+    assert "0 frames with people, 1 frame with no confirmed track yet (people: []), 3 skipped" in captured.err
 
 
 def test_a_source_none_of_whose_frames_can_be_read_is_bad_input(tmp_path, capsys):
