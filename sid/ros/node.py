@@ -68,7 +68,8 @@ class SocialCostmapNode:
         self.node: Node = rclpy.create_node(NODE_NAME)
         self.params = p = read_params(self.node)
         self.pose = pose
-        self.stream = self._new_stream()
+        pipeline = Pipeline(pose, p.mount, group=False)
+        self.stream = SocialStream(pipeline, p.grid, p.layers)
         self.fixed_robot = False
         """Whether frames are placed with the robot fixed at the origin (pose_source auto, no pose arrived yet)."""
         self.frames = 0
@@ -127,10 +128,6 @@ class SocialCostmapNode:
                 f"waiting for {p.camera_info_topic}, {p.color_topic} and {p.depth_topic} (realsense2_camera's topics; "
                 "remap them with --ros-args -p color_topic:=... if yours differ)"
             )
-
-    def _new_stream(self) -> SocialStream:
-        pipeline = Pipeline(self.pose, self.params.mount, group=False)
-        return SocialStream(pipeline, self.params.grid, self.params.layers)
 
     def _pose_source(self) -> str:
         chosen = self.params.pose_source
@@ -309,7 +306,7 @@ class SocialCostmapNode:
         elif pose is not None and self.fixed_robot:
             self.fixed_robot = False
             log.info(f"frame {frame.index}: robot pose from {self.pose_source} from now on; tracking starts afresh")
-            self.stream = self._new_stream()
+            self.stream.reset()  # the tracks were placed with the robot at the origin; new ones get new ids
         return pose if pose is not None else RobotPose(0.0, 0.0, 0.0)
 
     def _pose_origin(self) -> str:
