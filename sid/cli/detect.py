@@ -90,7 +90,6 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="RealSense sources: 'none' (default) looks depth up sparsely at the keypoints, the "
         "cheapest; 'sid' or 'librealsense' align every depth frame to colour first",
     )
-    parser.add_argument("--show", action="store_true", help="show overlays in a window (needs an OpenCV GUI build)")
     parser.add_argument("--camera-height", type=float, default=CameraMount.height, help="metres above the ground")
     parser.add_argument("--camera-tilt", type=float, default=CameraMount.tilt, help="downward pitch, radians")
     parser.add_argument(
@@ -296,13 +295,6 @@ def _tracked_json(record: dict, tracked: SessionUpdate) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.show:
-        print(
-            "detect: --show needs an OpenCV build with a GUI; this install is headless, use --out DIR to write "
-            "the overlay pictures instead",
-            file=sys.stderr,
-        )
-        return 2
     if args.out is not None:
         try:
             check_output_folder(args.out)  # before the model loads and the camera opens

@@ -129,9 +129,14 @@ def test_detect_reports_an_unknown_source(capsys):
     assert "S9" in capsys.readouterr().err
 
 
-def test_show_explains_the_headless_build(capsys):
-    assert main(["detect", "--source", "synthetic:S1", "--show"]) == 2
-    assert "--out" in capsys.readouterr().err
+def test_there_is_no_show_option(capsys):
+    """``--show`` was offered in --help but always refused (opencv-python-headless has no window): it is gone."""
+    with pytest.raises(SystemExit):
+        main(["detect", "--help"])
+    assert "--show" not in capsys.readouterr().out
+    with pytest.raises(SystemExit) as stop:
+        main(["detect", "--source", "synthetic:S1", "--show"])
+    assert stop.value.code == ExitCode.USAGE and "unrecognized arguments: --show" in capsys.readouterr().err
 
 
 def test_five_people_walking_in_a_file(capsys):
