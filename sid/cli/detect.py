@@ -110,7 +110,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--group-method",
         choices=GROUP_METHODS,
         default=GroupParams.method,
-        help="group detector: 'ospace' (default), 'rays' or 'paper' (the paper's Algorithm 1); docs/groups.md",
+        help=f"group detector: one of {', '.join(GROUP_METHODS)} (default: {GroupParams.method}; 'paper' is the "
+        "paper's Algorithm 1); docs/groups.md",
     )
     parser.set_defaults(func=run)
 

@@ -237,8 +237,9 @@ class SocialCostmapNode:
         self.on_frame(frame, color.item.header.stamp)
 
     def robot_pose(self, stamp: Any | None, wait: bool = True) -> RobotPose | None:
-        """base_frame's pose in global_frame at ``stamp`` (a builtin_interfaces/Time; None: the latest), or None
-        when it is not known yet. ``wait``: wait up to ``transform_timeout`` for the transform (pose source tf)."""
+        """base_frame's pose in global_frame, or None when it is not known yet. Pose source tf: the transform at
+        ``stamp`` (a builtin_interfaces/Time; None: the latest), waiting up to ``transform_timeout`` for it when
+        ``wait``; odom: the latest odometry message, whatever ``stamp``; none: the origin."""
         if self.pose_source == "none":
             return RobotPose(0.0, 0.0, 0.0)
         if self.pose_source == "odom":
