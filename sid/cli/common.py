@@ -34,6 +34,7 @@ __all__ = [
     "LOCK_NAME",
     "LineHandler",
     "LineTooLong",
+    "LinesProcess",
     "MAX_LINE_BYTES",
     "OutputFolderError",
     "OutputFolderInUse",
@@ -222,9 +223,14 @@ def bounded_lines(stream: IO[Any]) -> Iterator[str | bytes]:
         yield line
 
 
-def run_json_lines(command: str, file: str, handle: LineHandler, *, strict: bool = False) -> int:
-    """``process_json_lines`` on ``file`` read as bytes (``-``: stdin), writing to stdout; its exit code, or 2 when
-    ``file`` cannot be read: a device or a folder (a FIFO is read as a stream), a line longer than
+LinesProcess = Callable[[Iterable[str | bytes], TextIO, TextIO], int]
+"""A JSON-lines command's work on its input lines, its output and its error stream (a ``process_json_lines`` call
+with the command's handler): the exit code."""
+
+
+def run_json_lines(command: str, file: str, process: LinesProcess) -> int:
+    """``process`` on the lines of ``file`` read as bytes (``-``: stdin), writing to stdout and stderr; its exit code,
+    or 2 when ``file`` cannot be read: a device or a folder (a FIFO is read as a stream), a line longer than
     ``MAX_LINE_BYTES``. A failing stdout raises ``StandardOutputError`` (``sid.cli.main`` reports it)."""
     special = None if file == "-" else special_file(file, streams=True)  # a FIFO is read line by line
     if special:
@@ -241,7 +247,7 @@ def run_json_lines(command: str, file: str, handle: LineHandler, *, strict: bool
         return 2
     with stream:
         try:
-            return process_json_lines(command, bounded_lines(stream), sys.stdout, sys.stderr, handle, strict=strict)
+            return process(bounded_lines(stream), sys.stdout, sys.stderr)
         except LineTooLong as exc:
             print(f"{command}: {'stdin' if file == '-' else file}: {exc}", file=sys.stderr)
             return 2
