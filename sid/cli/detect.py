@@ -18,6 +18,7 @@ import numpy as np
 from costmap.grid import Costmap2D, GridSpec
 from sid.ahead import run_ahead
 from sid.cli.common import (
+    SYNTHETIC_FRAMES,
     ExitCode,
     OutputFolderError,
     add_bag_topic_options,
@@ -25,6 +26,7 @@ from sid.cli.common import (
     clear_owned,
     fail,
     output_folder_lock,
+    pose_model,
     positive_int,
     signals_deferred,
 )
@@ -38,7 +40,7 @@ from sid.perception.lifting import LiftParams
 from sid.perception.mount import CameraMount
 from sid.perception.overlay import draw_detections
 from sid.perception.people import Person
-from sid.perception.pipeline import FrameResult, Pipeline, PosedFrame, PoseFn, image_pose
+from sid.perception.pipeline import FrameResult, Pipeline, PosedFrame
 from sid.perception.pose.contracts import PoseModelError
 from sid.perception.pose.session import PROVIDER_CHOICES
 from sid.sources import BAG_TOPICS, RECORDING_SUFFIXES, FrameReadError, SourceError, frames_or_errors, open_source
@@ -81,7 +83,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="onnxruntime execution provider for the pose model: 'auto' (default) uses OpenVINO when "
         f"onnxruntime-openvino is installed ({install_hint('openvino')}), else CPU",
     )
-    parser.add_argument("--frames", type=positive_int, help="stop after this many frames (default: all; synthetic: 30)")
+    parser.add_argument(
+        "--frames", type=positive_int, help=f"stop after this many frames (default: all; synthetic: {SYNTHETIC_FRAMES})"
+    )
     parser.add_argument("--out", type=Path, help="also write detections.jsonl, overlay and top-view PNGs here")
     parser.add_argument(
         "--align",
@@ -116,26 +120,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.set_defaults(func=run)
 
 
-def _pose(args: argparse.Namespace) -> PoseFn:
-    if args.model is not None:
-        from sid.perception.pose import load_pose_estimator
-        from sid.perception.pose.session import quiet_load_warnings
-
-        quiet_load_warnings()
-        return image_pose(
-            load_pose_estimator(args.model, contract=args.contract, threads=args.threads, providers=args.provider)
-        )
-    if args.source.startswith("synthetic:"):
-        from sid.synthetic.pose import TruthPose
-
-        return TruthPose()
-    raise SourceError("a real source needs a pose model: --model FILE.onnx (see docs/models.md)")
-
-
 def _source_options(args: argparse.Namespace) -> dict:
     topics = {name: getattr(args, name) for name in BAG_TOPICS}  # refused by open_source for a source without topics
     if args.source.startswith("synthetic:"):
-        return {"frames": args.frames or 30} | topics
+        return {"frames": args.frames or SYNTHETIC_FRAMES} | topics
     if args.source == "realsense" or Path(args.source).suffix.lower() in RECORDING_SUFFIXES:
         return {"align": args.align} | topics
     return topics
@@ -212,17 +200,13 @@ def _pictures(frame: Frame, result: FrameResult, records: PictureRecords, mount:
         Costmap2D.filled(TOP_VIEW),
         records.people,
         records.groups,
-        title=f"frame {frame.index}: {_count(len(records.people), 'person', 'people')}, "
-        f"{_count(len(records.groups), 'group', 'groups')}",
+        title=f"frame {frame.index}: {plural(len(records.people), 'person', 'people')}, "
+        f"{plural(len(records.groups), 'group')}",
         camera=camera_view(frame.calibration, mount),
         scale=6,
     )
     images = {f"overlay_{frame.index:06d}.png": overlay, f"topview_{frame.index:06d}.png": top}
     return {name: cv2.imencode(".png", image)[1].tobytes() for name, image in images.items()}
-
-
-def _count(n: int, one: str, many: str) -> str:
-    return f"{n} {one if n == 1 else many}"
 
 
 class _OutFolder:
@@ -304,7 +288,9 @@ def run(args: argparse.Namespace) -> int:
     try:
         lift = LiftParams() if args.keypoint_threshold is None else LiftParams(min_score=args.keypoint_threshold)
         mount = CameraMount(args.camera_height, args.camera_tilt)
-        pose = _pose(args)
+        pose = pose_model(
+            args.model, args.source, contract=args.contract, threads=args.threads, providers=args.provider
+        )
         source = open_source(args.source, **_source_options(args))
         single = isinstance(source, Sized) and len(source) == 1
         tracking = not (args.no_tracking or single)

@@ -8,10 +8,9 @@ import sys
 from collections.abc import Iterable
 from pathlib import Path
 
-from sid.cli.common import ExitCode, add_bag_topic_options, positive_int, positive_number
+from sid.cli.common import ExitCode, add_bag_topic_options, pose_model, positive_int, positive_number
 from sid.distribution import install_hint
 from sid.perception.frame import Frame
-from sid.perception.pipeline import PoseFn, image_pose
 from sid.perception.pose.contracts import PoseModelError
 from sid.sources import BAG_TOPICS, SourceError, open_source
 
@@ -91,7 +90,7 @@ def run(args: argparse.Namespace) -> int:
     node = None
     try:
         synthetic = args.source is not None and args.source.startswith("synthetic:")
-        pose = _pose(args.model, synthetic)
+        pose = pose_model(args.model, args.source)
         node = SocialCostmapNode(pose, camera_topics=args.source is None)
         frames: Iterable[Frame] | None = None
         if args.source is not None:
@@ -133,18 +132,3 @@ def _source_option_without_source(args: argparse.Namespace) -> str | None:
     if args.frames is not None:
         return "--frames: stops a --source; without one, stop the node (Ctrl-C)"
     return None
-
-
-def _pose(model: Path | None, synthetic: bool) -> PoseFn:
-    """The pose model's function, or the synthetic frames' ground truth when there is no model."""
-    if model is not None:
-        from sid.perception.pose import load_pose_estimator
-        from sid.perception.pose.session import quiet_load_warnings
-
-        quiet_load_warnings()
-        return image_pose(load_pose_estimator(model))
-    if synthetic:
-        from sid.synthetic.pose import TruthPose
-
-        return TruthPose()
-    raise SourceError("a pose model is needed for camera frames: --model FILE.onnx (see docs/models.md)")

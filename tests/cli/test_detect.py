@@ -330,3 +330,20 @@ def test_a_frame_is_skipped_for_depth_only_when_no_pixel_has_any():
     cases = {"whole": frame.depth, "one pixel": sparse, "none": np.zeros_like(frame.depth), "nan/inf": nan_and_inf}
     reasons = {name: _skip_reason(replace(frame, depth=depth)) for name, depth in cases.items()}
     assert reasons == {"whole": None, "one pixel": None, "none": "no depth", "nan/inf": "no depth"}
+
+
+def test_one_rule_gives_the_pose_function_of_detect_and_ros(tmp_path, capsys):
+    """The model's poses, else a synthetic source's true poses, else an error: one function for ``sid detect`` and
+    ``sid ros`` (each had its own copy, with its own message)."""
+    from sid.cli.common import pose_model
+    from sid.sources import SourceError
+
+    assert isinstance(pose_model(None, "synthetic:S1"), TruthPose)
+    for source in (str(tmp_path), None):
+        with pytest.raises(SourceError, match=r"needs a pose model: --model FILE\.onnx"):
+            pose_model(None, source)
+    assert main(["detect", "--source", str(tmp_path)]) == ExitCode.USAGE
+    detect_message = capsys.readouterr().err.strip().removeprefix("detect: ")
+    pytest.importorskip("rclpy", reason="rclpy is not installed")
+    assert main(["ros"]) == ExitCode.USAGE
+    assert capsys.readouterr().err.strip().removeprefix("sid ros: ") == detect_message
