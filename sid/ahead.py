@@ -45,9 +45,9 @@ def _ahead(items: Iterable[T], depth: int) -> Iterator[T]:
         error: BaseException | None = None
         try:
             for item in iterator:
-                if stop.is_set():
+                ready.put((item, None))  # blocks while the queue is full: the consumer may close meanwhile
+                if stop.is_set():  # now, before making another item
                     break
-                ready.put((item, None))
         except BaseException as exc:  # handed to the consumer, which raises it in its own thread
             error = exc
         finally:

@@ -71,6 +71,31 @@ def test_stopping_early_stops_the_worker_and_closes_the_items():
     assert len(made) <= 3 + 1 + 2 + 1  # at most the depth plus the one being made beyond what was used
 
 
+def test_closing_stops_the_worker_after_the_item_it_is_making():
+    """depth 1: the consumer holds item 0, item 1 waits in the queue, and the worker has made item 2 and waits to
+    put it. Closing then lets that put through; the worker made item 3 too before it looked at the stop."""
+    made: list[int] = []
+    third_made = threading.Event()
+    closed = threading.Event()
+
+    def items() -> Iterator[int]:
+        try:
+            for k in range(10):
+                made.append(k)
+                if k == 2:
+                    third_made.set()
+                yield k
+        finally:
+            closed.set()
+
+    stream = run_ahead(items(), depth=1)
+    assert next(stream) == 0
+    assert third_made.wait(TIMEOUT)
+    stream.close()
+    assert closed.wait(TIMEOUT)
+    assert made == [0, 1, 2]
+
+
 def test_an_exception_in_the_consumer_stops_the_worker():
     closed = threading.Event()
 

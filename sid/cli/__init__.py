@@ -62,7 +62,7 @@ EXIT_CODES = (
             (ExitCode.OK, "done"),
             (ExitCode.FAILURE, "the run failed (e.g. a file could not be written)"),
             (ExitCode.USAGE, "bad command line or input"),
-            (ExitCode.NO_PATH, "no path / goal not reached (plan, demo, simulate, reproduce navigation)"),
+            (ExitCode.NO_PATH, "no path / goal not reached (plan, demo, compare, simulate, reproduce navigation)"),
             (ExitCode.MISSING_DEPENDENCY, "an optional package is missing (the message says how to install it)"),
             (ExitCode.DIFFERENT, "two pose models' results differ (model quantize, model compare)"),
         )

@@ -23,21 +23,26 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from enum import IntEnum
 from pathlib import Path
-from typing import IO, Any, TextIO, cast
+from typing import IO, TYPE_CHECKING, Any, TextIO, cast
 
 from sid.distribution import MissingDependencyError
 from sid.documents import TEMPORARY_PREFIX, plural, special_file, unique_keys
 from sid.errors import SidError
+
+if TYPE_CHECKING:  # the pipeline and the sources are imported only by the commands that read frames
+    from sid.perception.pipeline import PoseFn
 
 __all__ = [
     "ExitCode",
     "LOCK_NAME",
     "LineHandler",
     "LineTooLong",
+    "LinesProcess",
     "MAX_LINE_BYTES",
     "OutputFolderError",
     "OutputFolderInUse",
     "StagedOutput",
+    "SYNTHETIC_FRAMES",
     "StandardOutputError",
     "Terminated",
     "add_bag_topic_options",
@@ -53,6 +58,7 @@ __all__ = [
     "positive_int",
     "positive_number",
     "positive_seconds",
+    "pose_model",
     "print_written",
     "process_json_lines",
     "read_json_lines",
@@ -222,9 +228,14 @@ def bounded_lines(stream: IO[Any]) -> Iterator[str | bytes]:
         yield line
 
 
-def run_json_lines(command: str, file: str, handle: LineHandler, *, strict: bool = False) -> int:
-    """``process_json_lines`` on ``file`` read as bytes (``-``: stdin), writing to stdout; its exit code, or 2 when
-    ``file`` cannot be read: a device or a folder (a FIFO is read as a stream), a line longer than
+LinesProcess = Callable[[Iterable[str | bytes], TextIO, TextIO], int]
+"""A JSON-lines command's work on its input lines, its output and its error stream (a ``process_json_lines`` call
+with the command's handler): the exit code."""
+
+
+def run_json_lines(command: str, file: str, process: LinesProcess) -> int:
+    """``process`` on the lines of ``file`` read as bytes (``-``: stdin), writing to stdout and stderr; its exit code,
+    or 2 when ``file`` cannot be read: a device or a folder (a FIFO is read as a stream), a line longer than
     ``MAX_LINE_BYTES``. A failing stdout raises ``StandardOutputError`` (``sid.cli.main`` reports it)."""
     special = None if file == "-" else special_file(file, streams=True)  # a FIFO is read line by line
     if special:
@@ -241,7 +252,7 @@ def run_json_lines(command: str, file: str, handle: LineHandler, *, strict: bool
         return 2
     with stream:
         try:
-            return process_json_lines(command, bounded_lines(stream), sys.stdout, sys.stderr, handle, strict=strict)
+            return process(bounded_lines(stream), sys.stdout, sys.stderr)
         except LineTooLong as exc:
             print(f"{command}: {'stdin' if file == '-' else file}: {exc}", file=sys.stderr)
             return 2
@@ -566,3 +577,27 @@ def add_bag_topic_options(parser: argparse.ArgumentParser) -> None:
             metavar="TOPIC",
             help=f"rosbag2 sources: the {what} topic (default: realsense2_camera's, under any namespace)",
         )
+
+
+SYNTHETIC_FRAMES = 30
+"""Frames of a ``synthetic:SCENE`` source in ``sid detect`` (unless --frames) and, per source, in ``sid model``."""
+
+
+def pose_model(model: Path | None, source: str | None, **load: Any) -> PoseFn:
+    """The pose function frames of ``source`` (a source spec; None: camera topics) are run through: the pose model
+    ``model`` (an .onnx file, loaded with the ``load`` options of ``load_pose_estimator``), else, for a
+    ``synthetic:SCENE`` source, its people's true poses (``TruthPose``). SourceError when neither applies."""
+    if model is not None:
+        from sid.perception.pipeline import image_pose
+        from sid.perception.pose import load_pose_estimator
+        from sid.perception.pose.session import quiet_load_warnings
+
+        quiet_load_warnings()
+        return image_pose(load_pose_estimator(model, **load))
+    if source is not None and source.startswith("synthetic:"):
+        from sid.synthetic.pose import TruthPose
+
+        return TruthPose()
+    from sid.sources import SourceError
+
+    raise SourceError("a real source needs a pose model: --model FILE.onnx (see docs/models.md)")

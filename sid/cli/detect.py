@@ -18,6 +18,7 @@ import numpy as np
 from costmap.grid import Costmap2D, GridSpec
 from sid.ahead import run_ahead
 from sid.cli.common import (
+    SYNTHETIC_FRAMES,
     ExitCode,
     OutputFolderError,
     add_bag_topic_options,
@@ -25,6 +26,7 @@ from sid.cli.common import (
     clear_owned,
     fail,
     output_folder_lock,
+    pose_model,
     positive_int,
     signals_deferred,
 )
@@ -38,7 +40,7 @@ from sid.perception.lifting import LiftParams
 from sid.perception.mount import CameraMount
 from sid.perception.overlay import draw_detections
 from sid.perception.people import Person
-from sid.perception.pipeline import FrameResult, Pipeline, PosedFrame, PoseFn, image_pose
+from sid.perception.pipeline import FrameResult, Pipeline, PosedFrame
 from sid.perception.pose.contracts import PoseModelError
 from sid.perception.pose.session import PROVIDER_CHOICES
 from sid.sources import BAG_TOPICS, RECORDING_SUFFIXES, FrameReadError, SourceError, frames_or_errors, open_source
@@ -81,7 +83,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="onnxruntime execution provider for the pose model: 'auto' (default) uses OpenVINO when "
         f"onnxruntime-openvino is installed ({install_hint('openvino')}), else CPU",
     )
-    parser.add_argument("--frames", type=positive_int, help="stop after this many frames (default: all; synthetic: 30)")
+    parser.add_argument(
+        "--frames", type=positive_int, help=f"stop after this many frames (default: all; synthetic: {SYNTHETIC_FRAMES})"
+    )
     parser.add_argument("--out", type=Path, help="also write detections.jsonl, overlay and top-view PNGs here")
     parser.add_argument(
         "--align",
@@ -90,7 +94,6 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="RealSense sources: 'none' (default) looks depth up sparsely at the keypoints, the "
         "cheapest; 'sid' or 'librealsense' align every depth frame to colour first",
     )
-    parser.add_argument("--show", action="store_true", help="show overlays in a window (needs an OpenCV GUI build)")
     parser.add_argument("--camera-height", type=float, default=CameraMount.height, help="metres above the ground")
     parser.add_argument("--camera-tilt", type=float, default=CameraMount.tilt, help="downward pitch, radians")
     parser.add_argument(
@@ -111,31 +114,16 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--group-method",
         choices=GROUP_METHODS,
         default=GroupParams.method,
-        help="group detector: 'ospace' (default), 'rays' or 'paper' (the paper's Algorithm 1); docs/groups.md",
+        help=f"group detector: one of {', '.join(GROUP_METHODS)} (default: {GroupParams.method}; 'paper' is the "
+        "paper's Algorithm 1); docs/groups.md",
     )
     parser.set_defaults(func=run)
-
-
-def _pose(args: argparse.Namespace) -> PoseFn:
-    if args.model is not None:
-        from sid.perception.pose import load_pose_estimator
-        from sid.perception.pose.session import quiet_load_warnings
-
-        quiet_load_warnings()
-        return image_pose(
-            load_pose_estimator(args.model, contract=args.contract, threads=args.threads, providers=args.provider)
-        )
-    if args.source.startswith("synthetic:"):
-        from sid.synthetic.pose import TruthPose
-
-        return TruthPose()
-    raise SourceError("a real source needs a pose model: --model FILE.onnx (see docs/models.md)")
 
 
 def _source_options(args: argparse.Namespace) -> dict:
     topics = {name: getattr(args, name) for name in BAG_TOPICS}  # refused by open_source for a source without topics
     if args.source.startswith("synthetic:"):
-        return {"frames": args.frames or 30} | topics
+        return {"frames": args.frames or SYNTHETIC_FRAMES} | topics
     if args.source == "realsense" or Path(args.source).suffix.lower() in RECORDING_SUFFIXES:
         return {"align": args.align} | topics
     return topics
@@ -212,17 +200,13 @@ def _pictures(frame: Frame, result: FrameResult, records: PictureRecords, mount:
         Costmap2D.filled(TOP_VIEW),
         records.people,
         records.groups,
-        title=f"frame {frame.index}: {_count(len(records.people), 'person', 'people')}, "
-        f"{_count(len(records.groups), 'group', 'groups')}",
+        title=f"frame {frame.index}: {plural(len(records.people), 'person', 'people')}, "
+        f"{plural(len(records.groups), 'group')}",
         camera=camera_view(frame.calibration, mount),
         scale=6,
     )
     images = {f"overlay_{frame.index:06d}.png": overlay, f"topview_{frame.index:06d}.png": top}
     return {name: cv2.imencode(".png", image)[1].tobytes() for name, image in images.items()}
-
-
-def _count(n: int, one: str, many: str) -> str:
-    return f"{n} {one if n == 1 else many}"
 
 
 class _OutFolder:
@@ -275,7 +259,8 @@ def _close_source(source: Iterable[Frame]) -> None:
 
 def _tracked_json(record: dict, tracked: SessionUpdate) -> dict:
     """A frame's JSON line with its people and groups replaced by the tracks (ids: track ids), each person's 3D
-    keypoints taken from the detection it matched (null when missed), and ``reset`` when the trackers were."""
+    keypoints taken from the detection it matched (null when missed), the trackers' times (ms) added to
+    ``timing_ms`` and its ``total``, and ``reset`` when the trackers were."""
     by_id = {person["id"]: person for person in record["people"]}
     with_keypoints = any("keypoints" in person for person in record["people"])
     people = []
@@ -285,20 +270,16 @@ def _tracked_json(record: dict, tracked: SessionUpdate) -> dict:
             person["keypoints"] = by_id[track.detection]["keypoints"] if track.detection in by_id else None
         people.append(person)
     record |= {"people": people, "groups": [group.to_json() for group in tracked.groups]}
-    record["timing_ms"] |= {k: round(v, 3) for k, v in tracked.timing_ms.items()}
+    timing = record["timing_ms"]
+    total = timing.pop("total")  # the frame's stages and the trackers', as SocialStream's total
+    timing |= {k: round(v, 3) for k, v in tracked.timing_ms.items()}
+    timing["total"] = round(total + sum(tracked.timing_ms.values()), 3)
     if tracked.reset is not None:
         record["reset"] = tracked.reset
     return record
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.show:
-        print(
-            "detect: --show needs an OpenCV build with a GUI; this install is headless, use --out DIR to write "
-            "the overlay pictures instead",
-            file=sys.stderr,
-        )
-        return 2
     if args.out is not None:
         try:
             check_output_folder(args.out)  # before the model loads and the camera opens
@@ -307,7 +288,9 @@ def run(args: argparse.Namespace) -> int:
     try:
         lift = LiftParams() if args.keypoint_threshold is None else LiftParams(min_score=args.keypoint_threshold)
         mount = CameraMount(args.camera_height, args.camera_tilt)
-        pose = _pose(args)
+        pose = pose_model(
+            args.model, args.source, contract=args.contract, threads=args.threads, providers=args.provider
+        )
         source = open_source(args.source, **_source_options(args))
         single = isinstance(source, Sized) and len(source) == 1
         tracking = not (args.no_tracking or single)
@@ -328,6 +311,7 @@ def run(args: argparse.Namespace) -> int:
         return fail("sid detect", exc)
 
     done = skipped = unreadable = 0  # unreadable: frames whose files could not be read, among the skipped
+    unconfirmed = 0  # frames written with people detected but none a confirmed track yet (tracking's people: [])
 
     def skip(index: int | None, reason: object) -> None:
         nonlocal skipped
@@ -341,12 +325,12 @@ def run(args: argparse.Namespace) -> int:
     try:
         # The next frame is read and posed in a worker thread while this one lifts, groups, tracks and writes.
         for item in run_ahead(_posed_frames(source, pipeline)):
+            if args.frames is not None and done + skipped >= args.frames:  # unreadable frames count too
+                break
             if isinstance(item, FrameReadError):
                 skip(item.index, item)
                 unreadable += 1
                 continue
-            if args.frames is not None and done + skipped >= args.frames:
-                break
             frame = item.frame
             if isinstance(item, _Skipped):
                 skip(frame.index, item.reason)
@@ -371,7 +355,8 @@ def run(args: argparse.Namespace) -> int:
                     out.write(line, pictures)
                 print(line, flush=True)
             done += 1
-            totals.append(result.timing_ms["total"])
+            unconfirmed += not record["people"]
+            totals.append(record["timing_ms"]["total"])
     except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (sid.cli.common.Terminated)
         interrupted = 128 + int(getattr(exc, "signal_number", 2))
         print("detect: interrupted, output flushed", file=sys.stderr)
@@ -388,7 +373,9 @@ def run(args: argparse.Namespace) -> int:
     seconds = time.perf_counter() - started  # the frames' wall-clock time, start-up (imports, model load) aside
     rate = f" in {seconds:.1f} s ({(done + skipped) / seconds:.1f} frames/s)" if done + skipped else ""
     median = f", median {np.median(totals):.2f} ms per frame" if totals else ""
-    print(f"detect: {plural(done, 'frame')} with people, {skipped} skipped{rate}{median}", file=sys.stderr)
+    waiting = f", {plural(unconfirmed, 'frame')} with no confirmed track yet (people: [])" if unconfirmed else ""
+    summary = f"{plural(done - unconfirmed, 'frame')} with people{waiting}, {skipped} skipped{rate}{median}"
+    print(f"detect: {summary}", file=sys.stderr)
     if not interrupted and unreadable and unreadable == done + skipped:  # bad input, not a scene without people
         print(f"detect: no frame of the source could be read ({plural(unreadable, 'frame')} tried)", file=sys.stderr)
         return ExitCode.USAGE

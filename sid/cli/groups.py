@@ -42,11 +42,14 @@ def run(args: argparse.Namespace) -> int:
         params = group_params_from(args)
     except ValueError as exc:
         return fail("sid groups", exc)
-    return run_json_lines("sid groups", args.file, lambda data, _note: _groups_line(data, params), strict=args.strict)
+    return run_json_lines(
+        "sid groups", args.file, lambda lines, out, err: process(lines, out, err, params, args.strict)
+    )
 
 
 def process(lines: Iterable[str | bytes], out: TextIO, err: TextIO, params: GroupParams, strict: bool = False) -> int:
-    """Detect groups frame by frame; returns the exit code (2 when --strict stopped at a bad line).
+    """Detect groups frame by frame, writing one JSON line per good line on ``out`` and each problem on ``err``;
+    returns the exit code (2 when ``strict`` stopped at a bad line).
 
     ``lines`` are text, or bytes decoded here line by line as UTF-8 (a byte-order mark before the first is dropped).
     """

@@ -10,7 +10,15 @@ import sys
 from collections.abc import Iterator
 from pathlib import Path
 
-from sid.cli.common import ExitCode, add_bag_topic_options, fail, positive_int, whole_number
+from sid.cli.common import (
+    SYNTHETIC_FRAMES,
+    ExitCode,
+    add_bag_topic_options,
+    fail,
+    plain_text,
+    positive_int,
+    whole_number,
+)
 from sid.distribution import MissingDependencyError
 from sid.perception.frame import Frame
 from sid.perception.pose.contracts import PoseModelError
@@ -20,7 +28,6 @@ from sid.sources import BAG_TOPICS, FrameReadError, SourceError, open_source, sk
 __all__ = [
     "DEFAULT_FRAMES",
     "INPUT_ERRORS",
-    "SYNTHETIC_FRAMES",
     "add_parser",
     "run_compare",
     "run_quantize",
@@ -29,12 +36,11 @@ __all__ = [
 
 DEFAULT_FRAMES = 100
 """At most this many frames (all sources together) calibrate or are compared, unless --frames says otherwise."""
-SYNTHETIC_FRAMES = 30  # frames of a synthetic:SCENE source, as sid detect
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
-        "model", help="quantize a pose model to INT8, or compare two pose models", description=__doc__.replace("``", "")
+        "model", help="quantize a pose model to INT8, or compare two pose models", description=plain_text(__doc__)
     )
     tasks = parser.add_subparsers(dest="task", required=True, metavar="TASK")
     quantize = tasks.add_parser(

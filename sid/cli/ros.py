@@ -8,10 +8,9 @@ import sys
 from collections.abc import Iterable
 from pathlib import Path
 
-from sid.cli.common import ExitCode, add_bag_topic_options, positive_int, positive_number
+from sid.cli.common import ExitCode, add_bag_topic_options, pose_model, positive_int, positive_number
 from sid.distribution import install_hint
 from sid.perception.frame import Frame
-from sid.perception.pipeline import PoseFn, image_pose
 from sid.perception.pose.contracts import PoseModelError
 from sid.sources import BAG_TOPICS, SourceError, open_source
 
@@ -74,19 +73,24 @@ def run(args: argparse.Namespace) -> int:
         return ExitCode.USAGE
     try:
         import rclpy
+        from rclpy.impl.implementation_singleton import rclpy_implementation
         from rclpy.signals import SignalHandlerOptions
 
         from sid.ros.node import SocialCostmapNode, spin
+        from sid.ros.params import rcl_reason
     except ImportError as exc:
         print(INSTALL_HINT.format(error=exc), file=sys.stderr)
         return ExitCode.MISSING_DEPENDENCY
     ros_args = ["--ros-args", *args.ros_args] if args.ros_args is not None else []
-    # sid's own handlers turn SIGINT and SIGTERM into KeyboardInterrupt (sid.cli.main); rclpy's would not.
-    rclpy.init(args=["sid", *ros_args], signal_handler_options=SignalHandlerOptions.NO)
+    try:  # sid's own handlers turn SIGINT and SIGTERM into KeyboardInterrupt (sid.cli.main); rclpy's would not.
+        rclpy.init(args=["sid", *ros_args], signal_handler_options=SignalHandlerOptions.NO)
+    except rclpy_implementation.RCLError as exc:  # a malformed -p, a --params-file that cannot be read
+        print(f"sid ros: --ros-args: {rcl_reason(exc, 'failed to initialize rcl: ')}", file=sys.stderr)
+        return ExitCode.USAGE
     node = None
     try:
         synthetic = args.source is not None and args.source.startswith("synthetic:")
-        pose = _pose(args.model, synthetic)
+        pose = pose_model(args.model, args.source)
         node = SocialCostmapNode(pose, camera_topics=args.source is None)
         frames: Iterable[Frame] | None = None
         if args.source is not None:
@@ -96,7 +100,10 @@ def run(args: argparse.Namespace) -> int:
             )
             if args.frames is not None and not synthetic:
                 frames = itertools.islice(frames, args.frames)
-        spin(node, frames, args.rate)
+        stopped = spin(node, frames, args.rate)
+        if stopped is not None:
+            print(f"sid ros: source stopped: {stopped}", file=sys.stderr)
+            return ExitCode.FAILURE
     except (SourceError, PoseModelError, ValueError, OSError) as exc:
         print(f"sid ros: {exc}", file=sys.stderr)
         return ExitCode.USAGE
@@ -125,18 +132,3 @@ def _source_option_without_source(args: argparse.Namespace) -> str | None:
     if args.frames is not None:
         return "--frames: stops a --source; without one, stop the node (Ctrl-C)"
     return None
-
-
-def _pose(model: Path | None, synthetic: bool) -> PoseFn:
-    """The pose model's function, or the synthetic frames' ground truth when there is no model."""
-    if model is not None:
-        from sid.perception.pose import load_pose_estimator
-        from sid.perception.pose.session import quiet_load_warnings
-
-        quiet_load_warnings()
-        return image_pose(load_pose_estimator(model))
-    if synthetic:
-        from sid.synthetic.pose import TruthPose
-
-        return TruthPose()
-    raise SourceError("a pose model is needed for camera frames: --model FILE.onnx (see docs/models.md)")

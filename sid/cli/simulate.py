@@ -48,6 +48,14 @@ SUMMARY_KEYS = (
 )
 
 
+_SEEDS = 5
+"""Seeds per scene and mode of a sweep without ``--seeds``."""
+_SINGLE_RUN_OPTIONS = (("scene", "SCENE"), ("seed", "--seed"), ("gif", "--gif"), ("still", "--still"))
+"""The options a sweep would ignore (attribute, as written): its scenes follow --sweep, its seeds are 1..K."""
+_SWEEP_OPTIONS = ("seeds", "workers", "ray")
+"""The options only a sweep reads."""
+
+
 def _seed(text: str) -> int:
     try:
         value = int(text)
@@ -69,7 +77,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--no-social", action="store_true", help="the robot without recognition (LiDAR + inflation)")
     add_planner_option(parser, default=RunOptions.planner)
     parser.add_argument(
-        "--seed", type=_seed, default=0, metavar="N",
+        "--seed", type=_seed, default=None, metavar="N",
         help="0: the scene as written (default); N >= 1: people jittered by 5 cm / 5 deg, and the sensor noise, from N",
     )  # fmt: skip
     parser.add_argument("--model", default=None, metavar="M.onnx", help="a pose model instead of TruthPose")
@@ -90,8 +98,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--list", action="store_true", help="list the built-in scenes and exit")
     sweep = parser.add_argument_group("sweeps")
     sweep.add_argument("--sweep", nargs="+", default=None, metavar="SCENE", help="scenes (or 'all') to sweep")
-    sweep.add_argument("--seeds", type=int, default=5, metavar="K", help="seeds per scene and mode (5)")
-    sweep.add_argument("--workers", type=int, default=1, metavar="N", help="parallel worker processes (1)")
+    sweep.add_argument("--seeds", type=int, default=None, metavar="K", help=f"seeds per scene and mode ({_SEEDS})")
+    sweep.add_argument("--workers", type=int, default=None, metavar="N", help="parallel worker processes (1)")
     sweep.add_argument(
         "--ray", default=None, metavar="ADDRESS",
         help="run on a Ray cluster ('local' starts one here, 'auto' joins a running head); needs sid-social[cluster]",
@@ -103,7 +111,7 @@ def _options(args: argparse.Namespace) -> RunOptions:
     return RunOptions(
         social=not args.no_social,
         planner=args.planner,
-        seed=args.seed,
+        seed=args.seed or 0,
         model=None if args.model is None else Path(args.model),
         perception=args.perception,
         unknown_map=args.unknown_map,
@@ -115,6 +123,9 @@ def run(args: argparse.Namespace) -> int:
         for name, description in scene_list():
             print(f"{name:10s} {description}")
         return 0
+    problem = _option_of_the_other_mode(args)
+    if problem:
+        return fail("sid simulate", ValueError(problem))
     if args.sweep:
         return _sweep(args)
     if args.scene is None:
@@ -145,6 +156,24 @@ def run(args: argparse.Namespace) -> int:
     return ExitCode.OK if record["success"] else ExitCode.NO_PATH
 
 
+def _option_of_the_other_mode(args: argparse.Namespace) -> str | None:
+    """What is wrong when an option of one run is given with ``--sweep``, or one of a sweep without it (either
+    would be ignored in silence), or None."""
+    if args.sweep:
+        for name, written in _SINGLE_RUN_OPTIONS:
+            value = getattr(args, name)
+            if value is not None and value is not False:
+                return (
+                    f"{written}: applies to one run, not to a --sweep (its scenes follow --sweep, its seeds are "
+                    "1..--seeds, and it writes no pictures of a run)"
+                )
+        return None
+    for name in _SWEEP_OPTIONS:
+        if getattr(args, name) is not None:
+            return f"--{name}: applies to a --sweep only; one run takes a SCENE (and --seed N)"
+    return None
+
+
 def _sweep(args: argparse.Namespace) -> int:
     from sid.experiments.simulate.report import sweep_markdown, write_sweep_report
     from sid.experiments.simulate.sweep import run_sweep, sweep_jobs
@@ -154,10 +183,11 @@ def _sweep(args: argparse.Namespace) -> int:
     try:
         options = _options(args)
         check_output_folder(args.out)
-        jobs = sweep_jobs(scenes, args.seeds, options)
-        executor = f"Ray at {args.ray}" if args.ray else plural(args.workers, "worker process", "worker processes")
+        jobs = sweep_jobs(scenes, _SEEDS if args.seeds is None else args.seeds, options)
+        workers = 1 if args.workers is None else args.workers
+        executor = f"Ray at {args.ray}" if args.ray else plural(workers, "worker process", "worker processes")
         start = time.perf_counter()
-        records = run_sweep(jobs, args.workers, args.ray, ProgressBar("sweep"))
+        records = run_sweep(jobs, workers, args.ray, ProgressBar("sweep"))
         wall = time.perf_counter() - start
         print(sweep_markdown(records, command, wall, executor))
         with staged_output(args.out, SWEEP_FILES) as staged:

@@ -52,9 +52,8 @@ def run(args: argparse.Namespace) -> int:
         session = TrackingSession(group_params=group_params_from(args))
     except ValueError as exc:
         return fail("sid track", exc)
-    gaps = _Gaps()
     return run_json_lines(
-        "sid track", args.file, lambda data, note: _track_line(data, session, gaps, note), strict=args.strict
+        "sid track", args.file, lambda lines, out, err: process(lines, out, err, session, args.strict)
     )
 
 

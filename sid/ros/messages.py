@@ -5,7 +5,6 @@ geometry_msgs, visualization_msgs). ``nav2_msgs`` and ``hri_msgs`` are optional:
 from __future__ import annotations
 
 import array
-import math
 from collections.abc import Sequence
 from typing import Any
 
@@ -15,7 +14,7 @@ from nav_msgs.msg import MapMetaData, OccupancyGrid
 from std_msgs.msg import ColorRGBA, Header
 from visualization_msgs.msg import Marker, MarkerArray
 
-from sid.ros.convert import GridFields, MarkerFields
+from sid.ros.convert import GridFields, MarkerFields, quaternion_from_yaw
 
 __all__ = [
     "KEEPOUT_FILTER",
@@ -26,7 +25,6 @@ __all__ = [
     "ids_list_type",
     "marker_array",
     "occupancy_grid",
-    "time_msg",
 ]
 
 MARKER_TYPES = {
@@ -37,12 +35,6 @@ MARKER_TYPES = {
 }
 KEEPOUT_FILTER = 0
 """``nav2_msgs/CostmapFilterInfo.type`` of a keepout mask."""
-
-
-def time_msg(seconds: float) -> Time:
-    """A stamp (s since the epoch) as builtin_interfaces/Time."""
-    sec = math.floor(seconds)
-    return Time(sec=int(sec), nanosec=min(int(round((seconds - sec) * 1e9)), 999_999_999))
 
 
 def header(frame_id: str, stamp: Time) -> Header:
@@ -67,7 +59,7 @@ def marker_array(markers: Sequence[MarkerFields], frame_id: str, stamp: Time) ->
     """DELETEALL (the last frame's markers go) followed by one ADD marker per ``MarkerFields``."""
     out = [Marker(header=header(frame_id, stamp), action=Marker.DELETEALL)]
     for m in markers:
-        qx, qy, qz, qw = 0.0, 0.0, math.sin(m.yaw / 2), math.cos(m.yaw / 2)
+        qx, qy, qz, qw = quaternion_from_yaw(m.yaw)
         out.append(
             Marker(
                 header=header(frame_id, stamp),

@@ -39,7 +39,7 @@ from sid.perception.robot_pose import RobotPose
 from sid.ros import messages
 from sid.ros.convert import grid_fields, groups_document, scene_markers, yaw_from_quaternion
 from sid.ros.params import NODE_NAME, read_params
-from sid.sources import FrameReadError, skip_unreadable
+from sid.sources import FrameReadError, SourceError, skip_unreadable
 from sid.sources.ros_messages import StampPairer, intrinsics_from_camera_info, rgbd_frame, stamp_seconds
 from sid.stream import SocialStream, StreamUpdate
 
@@ -68,10 +68,14 @@ class SocialCostmapNode:
         self.node: Node = rclpy.create_node(NODE_NAME)
         self.params = p = read_params(self.node)
         self.pose = pose
-        self.stream = self._new_stream()
+        pipeline = Pipeline(pose, p.mount, group=False)
+        self.stream = SocialStream(pipeline, p.grid, p.layers)
         self.fixed_robot = False
         """Whether frames are placed with the robot fixed at the origin (pose_source auto, no pose arrived yet)."""
         self.frames = 0
+        self.source_stopped = threading.Event()
+        """Set by ``feed`` when its source stopped with an error (``source_error``); ``spin`` then returns."""
+        self.source_error: SourceError | None = None
         self.costmap_pub = self.node.create_publisher(OccupancyGrid, p.costmap_topic, LATCHED)
         self.markers_pub = self.node.create_publisher(MarkerArray, p.markers_topic, 10)
         self.groups_pub = self.node.create_publisher(String, p.groups_topic, 10)
@@ -124,10 +128,6 @@ class SocialCostmapNode:
                 f"waiting for {p.camera_info_topic}, {p.color_topic} and {p.depth_topic} (realsense2_camera's topics; "
                 "remap them with --ros-args -p color_topic:=... if yours differ)"
             )
-
-    def _new_stream(self) -> SocialStream:
-        pipeline = Pipeline(self.pose, self.params.mount, group=False)
-        return SocialStream(pipeline, self.params.grid, self.params.layers)
 
     def _pose_source(self) -> str:
         chosen = self.params.pose_source
@@ -237,8 +237,9 @@ class SocialCostmapNode:
         self.on_frame(frame, color.item.header.stamp)
 
     def robot_pose(self, stamp: Any | None, wait: bool = True) -> RobotPose | None:
-        """base_frame's pose in global_frame at ``stamp`` (a builtin_interfaces/Time; None: the latest), or None
-        when it is not known yet. ``wait``: wait up to ``transform_timeout`` for the transform (pose source tf)."""
+        """base_frame's pose in global_frame, or None when it is not known yet. Pose source tf: the transform at
+        ``stamp`` (a builtin_interfaces/Time; None: the latest), waiting up to ``transform_timeout`` for it when
+        ``wait``; odom: the latest odometry message, whatever ``stamp``; none: the origin."""
         if self.pose_source == "none":
             return RobotPose(0.0, 0.0, 0.0)
         if self.pose_source == "odom":
@@ -306,7 +307,7 @@ class SocialCostmapNode:
         elif pose is not None and self.fixed_robot:
             self.fixed_robot = False
             log.info(f"frame {frame.index}: robot pose from {self.pose_source} from now on; tracking starts afresh")
-            self.stream = self._new_stream()
+            self.stream.reset()  # the tracks were placed with the robot at the origin; new ones get new ids
         return pose if pose is not None else RobotPose(0.0, 0.0, 0.0)
 
     def _pose_origin(self) -> str:
@@ -329,27 +330,35 @@ class SocialCostmapNode:
 
     def feed(self, frames: Iterable[Frame], rate: float = 0.0) -> None:
         """Run every frame of a sid source through ``on_frame`` (unreadable ones logged and skipped), at most
-        ``rate`` frames per second (0: as fast as they come)."""
+        ``rate`` frames per second (0: as fast as they come). A source that stops with a SourceError (a camera
+        failing again and again, a damaged recording) is kept as ``source_error`` and ``source_stopped`` is set."""
 
         def report(error: FrameReadError) -> None:
             self.node.get_logger().error(f"frame {error.index}: skipped, {error}")
 
         period = 1.0 / rate if rate > 0 else 0.0
-        for frame in skip_unreadable(frames, report):
-            start = time.monotonic()
-            if not rclpy.ok():
-                return
-            self.on_frame(frame)
-            while rclpy.ok() and (left := period - (time.monotonic() - start)) > 0:
-                time.sleep(min(left, SPIN_WAIT))  # in short waits: a period of 1e300 s would overflow time.sleep
+        try:
+            for frame in skip_unreadable(frames, report):
+                start = time.monotonic()
+                if not rclpy.ok():
+                    return
+                self.on_frame(frame)
+                while rclpy.ok() and (left := period - (time.monotonic() - start)) > 0:
+                    time.sleep(min(left, SPIN_WAIT))  # in short waits: a period of 1e300 s would overflow time.sleep
+        except SourceError as exc:
+            self.source_error = exc
+            self.source_stopped.set()
+            return
         self.node.get_logger().info("source ended; the last costmap stays published")
 
 
-def spin(node: SocialCostmapNode, frames: Iterable[Frame] | None = None, rate: float = 0.0) -> None:
-    """Spin ``node`` until shutdown or KeyboardInterrupt; with ``frames``, feed them from a thread meanwhile.
+def spin(node: SocialCostmapNode, frames: Iterable[Frame] | None = None, rate: float = 0.0) -> SourceError | None:
+    """Spin ``node`` until shutdown, KeyboardInterrupt or its source stopping with an error; with ``frames``, feed
+    them from a thread meanwhile. Returns the SourceError that stopped the source, or None.
 
     Spins in short waits, so the signal handlers of ``sid.cli`` (SIGINT, SIGTERM -> KeyboardInterrupt) run."""
     if frames is not None:
         threading.Thread(target=node.feed, args=(frames, rate), daemon=True, name="sid-source").start()
-    while rclpy.ok():
+    while rclpy.ok() and not node.source_stopped.is_set():
         rclpy.spin_once(node.node, timeout_sec=SPIN_WAIT)
+    return node.source_error

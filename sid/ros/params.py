@@ -33,6 +33,7 @@ __all__ = [
     "NodeParams",
     "PARAMETERS",
     "POSE_SOURCES",
+    "rcl_reason",
     "read_params",
     "ros_name",
 ]
@@ -177,6 +178,12 @@ def _typed(name: str, value: Any, default: object) -> Any:
     return value
 
 
+def rcl_reason(error: Exception, prefix: str) -> str:
+    """An rcl error's message for a person: without ``prefix`` (rclpy's "failed to ...: ") and the C source
+    locations rcl appends (``, at src/rcl/arguments.c:352``)."""
+    return str(error).removeprefix(prefix).split(", at ")[0]
+
+
 def _check_names(node: Node, params: NodeParams) -> None:
     """ValueError naming the parameter when a topic is not a valid ROS topic name for ``node`` (empty, a space, a
     ``//``; rcl's own reason is quoted) or a frame id is empty or starts with ``/`` (tf2 refuses such ids)."""
@@ -188,7 +195,7 @@ def _check_names(node: Node, params: NodeParams) -> None:
             try:
                 node.resolve_topic_name(value)
             except rclpy_implementation.RCLError as exc:
-                reason = str(exc).removeprefix("failed to resolve name: ").split(", at ")[0]
+                reason = rcl_reason(exc, "failed to resolve name: ")
                 raise ValueError(f"{f.name}: {value!r} is not a valid topic name ({reason})") from None
         elif f.name.endswith("_frame"):
             if not value:
@@ -206,30 +213,49 @@ def _declare(node: Node, name: str, default: object, description: str) -> Any:
     return node.declare_parameter(name, default, descriptor).value
 
 
+_SHARED_SECTIONS = {"tracked_people": "social"}
+"""Plugin -> the plugin whose ``CostmapParams`` section its layers also read: the tracked-people layer draws standing
+people with the social plugin's parameters (``costmap.social.*``), listed or not."""
+
+
 def _layer_parameters(node: Node, names: Sequence[str]) -> dict[str, Any]:
     """Declare and read the parameters of the layer instances ``names``, as the sections of a scenario file's
     ``layers`` block (the mapping ``sid.scenario.loader.layers_from_dict`` reads): a plugin's own name -> its section
-    (``costmap.social.FIELD`` -> ``social: {FIELD: ...}``), another name -> ``{plugin: P, FIELD: ...}``."""
+    (``costmap.social.FIELD`` -> ``social: {FIELD: ...}``), another name -> ``{plugin: P, FIELD: ...}``; and the
+    section of a plugin a listed instance's plugin also reads (``_SHARED_SECTIONS``), listed or not."""
     mapping: dict[str, Any] = {}
+    shared: list[str] = []  # plugins whose sections listed instances read besides their own
     for name in dict.fromkeys(names):  # a name listed twice is refused by the loader, declared once here
-        entry: dict[str, Any]
         if name in PLUGINS:
-            plugin, entry = name, {}
+            plugin: Any = name
             if name in SECTIONS:
-                mapping[SECTIONS[name]] = entry
+                mapping[SECTIONS[name]] = _section_parameters(node, name, name)
         else:
             description = f"plugin of the layer instance {name}: one of {', '.join(NODE_PLUGINS)}"
             plugin = _declare(node, f"costmap.{name}.plugin", "", description)
             entry = {"plugin": plugin} if plugin != "" else {}
+            if isinstance(plugin, str) and plugin in SECTIONS:
+                entry |= _section_parameters(node, name, plugin)
             mapping[name] = entry
-        section = SECTIONS.get(plugin) if isinstance(plugin, str) else None
-        if section is None:
-            continue
-        record = getattr(CostmapParams(), section)
-        for f in fields(record):
-            description = f"{f.name} of the {name} layer ({plugin} plugin; docs/scenario.md, layer parameters)"
-            entry[f.name] = _declare(node, f"costmap.{name}.{f.name}", getattr(record, f.name), description)
+        if isinstance(plugin, str) and plugin in _SHARED_SECTIONS:
+            shared.append(_SHARED_SECTIONS[plugin])
+    for plugin in dict.fromkeys(shared):
+        if SECTIONS[plugin] not in mapping:  # else declared as a listed instance's
+            readers = ", ".join(p for p, section in _SHARED_SECTIONS.items() if section == plugin)
+            mapping[SECTIONS[plugin]] = _section_parameters(node, plugin, plugin, f"the {readers} layers draw with it")
     return mapping
+
+
+def _section_parameters(node: Node, name: str, plugin: str, use: str = "") -> dict[str, Any]:
+    """Declare and read ``costmap.NAME.FIELD`` for each field of ``plugin``'s parameters (its defaults: its
+    ``CostmapParams`` section); ``use``: what else reads them, for the descriptions."""
+    record = getattr(CostmapParams(), SECTIONS[plugin])
+    values = {}
+    also = f"; {use}" if use else ""
+    for f in fields(record):
+        description = f"{f.name} of the {name} layer ({plugin} plugin{also}; docs/scenario.md, layer parameters)"
+        values[f.name] = _declare(node, f"costmap.{name}.{f.name}", getattr(record, f.name), description)
+    return values
 
 
 def read_params(node: Node) -> NodeParams:

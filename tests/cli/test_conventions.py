@@ -91,6 +91,25 @@ def test_each_exit_code_has_one_meaning_listed_in_the_help_and_the_readme() -> N
         )
 
 
+def test_the_help_names_the_commands_that_exit_3_as_the_readme_does() -> None:
+    """README's row for exit 3 names ``sid compare`` (a scenario's task found impossible); the epilog left it out."""
+    epilog = " ".join(build_parser().format_help().split())
+    help_commands = set(re.search(r"3 no path / goal not reached \(([^)]*)\)", epilog)[1].split(", "))
+    readme = (REPO_ROOT / "README.md").read_text()
+    row = re.search(r"^\| 3 \|(.*)$", readme, flags=re.MULTILINE)[1]
+    commands = {name.removeprefix("sid ") for name in PARSERS}
+    readme_commands = {c for c in re.findall(r"`(?:sid )?([a-z ]+)`", row) if c in commands}
+    assert help_commands == readme_commands == {"plan", "demo", "compare", "simulate", "reproduce navigation"}
+
+
+def test_detect_group_method_help_names_every_method() -> None:
+    """``sid detect --group-method`` listed ospace, rays and paper, not gcff."""
+    from sid.perception.groups import GROUP_METHODS
+
+    (action,) = [a for a in PARSERS["sid detect"]._actions if "--group-method" in a.option_strings]
+    assert all(method in (action.help or "") for method in GROUP_METHODS)
+
+
 def test_a_run_that_cannot_write_its_files_fails_with_exit_1(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -129,9 +129,14 @@ def test_detect_reports_an_unknown_source(capsys):
     assert "S9" in capsys.readouterr().err
 
 
-def test_show_explains_the_headless_build(capsys):
-    assert main(["detect", "--source", "synthetic:S1", "--show"]) == 2
-    assert "--out" in capsys.readouterr().err
+def test_there_is_no_show_option(capsys):
+    """``--show`` was offered in --help but always refused (opencv-python-headless has no window): it is gone."""
+    with pytest.raises(SystemExit):
+        main(["detect", "--help"])
+    assert "--show" not in capsys.readouterr().out
+    with pytest.raises(SystemExit) as stop:
+        main(["detect", "--source", "synthetic:S1", "--show"])
+    assert stop.value.code == ExitCode.USAGE and "unrecognized arguments: --show" in capsys.readouterr().err
 
 
 def test_five_people_walking_in_a_file(capsys):
@@ -275,7 +280,7 @@ def test_summary_counts_every_skipped_frame(tmp_path, capsys):
     assert main(["detect", "--source", str(tmp_path), "--model", str(model), "--no-keypoints"]) == 0
     captured = capsys.readouterr()
     assert len(_lines(captured.out)) == 1
-    assert "1 frame with people, 3 skipped" in captured.err
+    assert "0 frames with people, 1 frame with no confirmed track yet (people: []), 3 skipped" in captured.err
 
 
 def test_a_source_none_of_whose_frames_can_be_read_is_bad_input(tmp_path, capsys):
@@ -296,6 +301,25 @@ def test_a_source_none_of_whose_frames_can_be_read_is_bad_input(tmp_path, capsys
     assert err.count("skipped, ") == 2 and "no frame of the source could be read (2 frames tried)" in err
 
 
+def test_frames_stops_at_unreadable_frames_too(tmp_path, capsys):
+    """``--frames 2`` on a folder of five unreadable frames: the limit was checked only for frames that were read,
+    so all five were tried."""
+    (tmp_path / "color").mkdir()
+    (tmp_path / "depth").mkdir()
+    (tmp_path / "intrinsics.json").write_text(
+        json.dumps({"fx": 500.0, "fy": 500.0, "cx": 31.5, "cy": 23.5, "width": 64, "height": 48})
+    )
+    for name in "abcde":
+        (tmp_path / "color" / f"{name}.png").write_bytes(b"not a png")
+        (tmp_path / "depth" / f"{name}.png").write_bytes(b"not a png")
+    from tests.pose_models import build_yolo_pose_model
+
+    model = build_yolo_pose_model(tmp_path / "yolo.onnx", np.zeros((56, 10)))
+    assert main(["detect", "--source", str(tmp_path), "--model", str(model), "--frames", "2"]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert err.count("skipped, ") == 2 and "no frame of the source could be read (2 frames tried)" in err
+
+
 def test_a_frame_is_skipped_for_depth_only_when_no_pixel_has_any():
     from sid.cli.detect import _skip_reason
 
@@ -306,3 +330,20 @@ def test_a_frame_is_skipped_for_depth_only_when_no_pixel_has_any():
     cases = {"whole": frame.depth, "one pixel": sparse, "none": np.zeros_like(frame.depth), "nan/inf": nan_and_inf}
     reasons = {name: _skip_reason(replace(frame, depth=depth)) for name, depth in cases.items()}
     assert reasons == {"whole": None, "one pixel": None, "none": "no depth", "nan/inf": "no depth"}
+
+
+def test_one_rule_gives_the_pose_function_of_detect_and_ros(tmp_path, capsys):
+    """The model's poses, else a synthetic source's true poses, else an error: one function for ``sid detect`` and
+    ``sid ros`` (each had its own copy, with its own message)."""
+    from sid.cli.common import pose_model
+    from sid.sources import SourceError
+
+    assert isinstance(pose_model(None, "synthetic:S1"), TruthPose)
+    for source in (str(tmp_path), None):
+        with pytest.raises(SourceError, match=r"needs a pose model: --model FILE\.onnx"):
+            pose_model(None, source)
+    assert main(["detect", "--source", str(tmp_path)]) == ExitCode.USAGE
+    detect_message = capsys.readouterr().err.strip().removeprefix("detect: ")
+    pytest.importorskip("rclpy", reason="rclpy is not installed")
+    assert main(["ros"]) == ExitCode.USAGE
+    assert capsys.readouterr().err.strip().removeprefix("sid ros: ") == detect_message

@@ -29,6 +29,20 @@ def test_detect_reports_tracks_with_stable_ids_velocities_and_groups(capsys) -> 
     assert "group" not in records[-1]["timing_ms"]  # the frame's own grouping, unused with tracking, is skipped
 
 
+def test_the_summary_and_the_total_time_are_those_of_the_printed_tracks(capsys) -> None:
+    """With tracking, the first two frames print ``people: []`` (no track confirmed yet): the summary counted them
+    as frames with people. Each line's ``timing_ms.total`` left the trackers out, though SocialStream's counts them."""
+    assert main(["detect", "--source", "synthetic:S1", "--frames", "4", "--no-keypoints"]) == 0
+    captured = capsys.readouterr()
+    records = _lines(captured.out)
+    assert [len(r["people"]) for r in records] == [0, 0, 2, 2]
+    assert "detect: 2 frames with people, 2 frames with no confirmed track yet (people: []), 0 skipped" in captured.err
+    for record in records:
+        timing = record["timing_ms"]
+        assert list(timing)[-1] == "total" and {"track", "track_groups"} <= timing.keys()
+        assert abs(timing["total"] - sum(v for k, v in timing.items() if k != "total")) < 0.01
+
+
 def test_detect_keeps_each_persons_keypoints_from_the_matched_detection(capsys) -> None:
     assert main(["detect", "--source", "synthetic:S1", "--frames", "4"]) == 0
     record = _lines(capsys.readouterr().out)[-1]
@@ -86,6 +100,6 @@ def test_a_frame_out_of_time_order_is_skipped_and_the_tracks_go_on(capsys, monke
     records = _lines(captured.out)
     assert [r["frame"] for r in records] == [0, 1, 2, 3, 4, 6, 7]
     assert "detect: frame 5: skipped, frame 5 is out of time order" in captured.err
-    assert "7 frames with people, 1 skipped" in captured.err
+    assert "5 frames with people, 2 frames with no confirmed track yet (people: []), 1 skipped" in captured.err
     ids = [sorted(p["id"] for p in r["people"]) for r in records[2:]]
     assert all(i == ids[0] for i in ids) and len(ids[0]) == 2

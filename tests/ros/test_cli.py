@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -10,6 +11,7 @@ import pytest
 from sid.cli import main
 from sid.cli.common import ExitCode
 from sid.distribution import install_hint
+from sid.perception.frame import Frame
 
 
 def test_without_rclpy_it_says_how_to_install_it(
@@ -108,3 +110,52 @@ def test_a_tiny_rate_waits_without_overflowing_and_stops_with_the_node() -> None
     thread.join(timeout=5)
     node.node.destroy_node()
     assert not thread.is_alive() and errors == []
+
+
+def test_a_source_that_stops_with_an_error_ends_the_run_with_exit_1(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A SourceError mid-stream (a camera failing again and again, a damaged bag) escaped the source's thread: a
+    traceback, and the node kept spinning with nothing to publish. It now ends the run: ``source stopped``, exit 1."""
+    rclpy = pytest.importorskip("rclpy", reason="rclpy is not installed")
+    import threading
+
+    import sid.cli.ros
+    from sid.sources import SourceError
+    from sid.sources.synthetic import synthetic_source
+
+    def failing(spec: str, **options: object) -> Iterator[Frame]:
+        yield from synthetic_source("synthetic:S4", frames=3)
+        raise SourceError("bag.db3: database disk image is malformed")
+
+    monkeypatch.setattr(sid.cli.ros, "open_source", failing)
+    codes: list[int] = []
+    run = threading.Thread(
+        target=lambda: codes.append(main(["ros", "--source", "synthetic:S4", "--ros-args", "-p", "pose_source:=none"]))
+    )
+    run.start()
+    run.join(timeout=30)
+    if run.is_alive():  # still spinning: stop it so that the test fails instead of hanging
+        rclpy.try_shutdown()
+        run.join(timeout=10)
+    err = capsys.readouterr().err
+    assert codes == [ExitCode.FAILURE]
+    assert "sid ros: source stopped: bag.db3: database disk image is malformed" in err
+    assert "Traceback" not in err
+
+
+@pytest.mark.parametrize(
+    ("ros_args", "message"),
+    [
+        (["-p", "badformat"], "sid ros: --ros-args: Couldn't parse parameter override rule: '-p badformat'"),
+        (["--params-file", "/nonexistent.yaml"], "sid ros: --ros-args: Couldn't parse params file"),
+    ],
+)
+def test_ros_arguments_rcl_cannot_parse_are_bad_input(
+    ros_args: list[str], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """rclpy.init refusing ``--ros-args`` raised RCLError out of the command: a traceback and exit 1."""
+    pytest.importorskip("rclpy", reason="rclpy is not installed")
+    assert main(["ros", "--source", "synthetic:S4", "--ros-args", *ros_args]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert message in err and ", at " not in err

@@ -9,6 +9,8 @@ import pytest
 
 pytest.importorskip("rclpy", reason="rclpy is not installed (pip install 'sid-social[ros]' or source ROS 2)")
 
+from builtin_interfaces.msg import Time  # noqa: E402
+
 from costmap.grid import Costmap2D, GridSpec  # noqa: E402
 from sid.ros import messages  # noqa: E402
 from sid.ros.convert import MarkerFields, grid_fields  # noqa: E402
@@ -17,7 +19,7 @@ from sid.ros.convert import MarkerFields, grid_fields  # noqa: E402
 def test_occupancy_grid_message() -> None:
     costmap = Costmap2D.filled(GridSpec(0.05, -1.0, 2.0, 4, 3), 0)
     costmap.costs[2, 3] = 254
-    msg = messages.occupancy_grid(grid_fields(costmap, "map"), messages.time_msg(12.25))
+    msg = messages.occupancy_grid(grid_fields(costmap, "map"), Time(sec=12, nanosec=250_000_000))
     assert msg.header.frame_id == "map" and (msg.header.stamp.sec, msg.header.stamp.nanosec) == (12, 250_000_000)
     assert (msg.info.width, msg.info.height) == (4, 3) and msg.info.resolution == pytest.approx(0.05)
     assert (msg.info.origin.position.x, msg.info.origin.position.y, msg.info.origin.orientation.w) == (-1.0, 2.0, 1.0)
@@ -30,7 +32,7 @@ def test_marker_array_clears_then_adds() -> None:
         MarkerFields("group_zones", 1, "line_strip", 0, 0, 0, 0, (0.05, 0, 0), (1, 0, 0, 1), ((0, 0), (1, 0), (0, 0))),
         MarkerFields("facing", 4, "arrow", 1.0, 2.0, 1.0, math.pi / 2, (0.6, 0.06, 0.06), (0, 0, 1, 1)),
     ]
-    msg = messages.marker_array(fields, "map", messages.time_msg(1.0))
+    msg = messages.marker_array(fields, "map", Time(sec=1))
     first, cylinder, strip, arrow = msg.markers
     assert first.action == first.DELETEALL
     assert (cylinder.ns, cylinder.id, cylinder.type, cylinder.header.frame_id) == (

@@ -33,3 +33,39 @@ def test_odometry_in_another_frame_than_the_costmap_is_warned_of_once(capfd: pyt
     assert "frame 0: skipped, no robot pose yet (odometry on /robot/odom)" in err
     warning = "odometry on /robot/odom is in frame 'odom', not global_frame 'map'"
     assert err.count(warning) == 1 and "-p global_frame:=odom" in err
+
+
+def test_tracks_started_afresh_when_the_robot_pose_arrives_get_new_ids() -> None:
+    """pose_source auto: frames without a pose are placed with the robot at the origin until the first pose arrives;
+    tracking then starts afresh. The node built a new stream there, so track ids began again at 1 and a listener
+    took the new tracks for the old ones. The ids now keep counting up."""
+    from dataclasses import replace
+
+    from nav_msgs.msg import Odometry
+
+    from sid.ros.node import SocialCostmapNode
+    from sid.sources.synthetic import SyntheticSource
+    from sid.synthetic.pose import TruthPose
+
+    rclpy.init(args=["sid", "--ros-args", "-p", "pose_source:=auto"])
+    try:
+        node = SocialCostmapNode(TruthPose(), camera_topics=False)
+        try:
+            frames = [replace(frame, robot_pose=None) for frame in SyntheticSource("S4", frames=10)]
+
+            def ids(frame: object) -> set[int]:
+                pose = node.frame_pose(frame, None)
+                return {person.id for person in node.stream.update(frame, pose).people}
+
+            before = set().union(*(ids(frame) for frame in frames[:5]))
+            assert node.fixed_robot and len(before) == 4
+            odometry = Odometry()
+            odometry.header.frame_id = "map"
+            node._on_odometry(odometry)
+            after = set().union(*(ids(frame) for frame in frames[5:]))
+            assert not node.fixed_robot and len(after) == 4
+        finally:
+            node.node.destroy_node()
+    finally:
+        rclpy.shutdown()
+    assert after.isdisjoint(before) and min(after) > max(before)

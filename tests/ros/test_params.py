@@ -80,6 +80,27 @@ def test_a_parameters_file_names_two_tracked_people_layers_with_their_own_lookah
         assert layer.costs[tuple(inside)] > 0 and layer.costs[tuple(beyond)] == 0, name
 
 
+def test_the_social_parameters_the_tracked_people_layer_draws_with_are_parameters_without_a_social_layer() -> None:
+    """The tracked_people layer draws standing people with the social plugin's parameters, but costmap.social.* was
+    declared only with a social layer listed: ``-p costmap.social.sigma_front:=3.0`` was ignored in silence."""
+    from sid.ros.node import SocialCostmapNode
+
+    rclpy.init(args=["sid", "--ros-args", "-p", "costmap.social.sigma_front:=3.0", "-p", "pose_source:=none"])
+    try:
+        node = SocialCostmapNode(lambda frame: [], camera_topics=False)
+        try:
+            assert node.params.layers.plugins == ("tracked_people",)
+            assert node.params.layers.social.sigma_front == 3.0
+            description = node.node.describe_parameter("costmap.social.sigma_front").description
+            assert "the tracked_people layers draw with it" in description
+            layer = node.stream.costmap.layer("tracked_people")
+            assert isinstance(layer, TrackedPeopleLayer) and layer.social.sigma_front == 3.0
+        finally:
+            node.node.destroy_node()
+    finally:
+        rclpy.shutdown()
+
+
 def test_the_node_builds_its_costmap_from_the_layer_instances() -> None:
     from sid.ros.node import SocialCostmapNode
 
