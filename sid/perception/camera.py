@@ -194,7 +194,8 @@ class Extrinsics:
 class Calibration:
     """Everything needed to align depth to colour and lift colour pixels to 3D.
 
-    ``depth`` is None when the depth image is already registered to the colour image.
+    ``depth`` is None when the depth image is already registered to the colour image; ``depth_to_color`` must
+    then be the identity (a ValueError otherwise: its depth intrinsics are missing, e.g. a misspelt section).
     ``depth_to_color`` maps depth-camera points to colour-camera points. ``depth_scale`` is metres per
     depth unit (0.001 for millimetre PNGs and the D435i default).
     """
@@ -205,7 +206,15 @@ class Calibration:
     depth_scale: float = 0.001
 
     def __post_init__(self) -> None:
-        baseline = float(np.linalg.norm(self.depth_to_color.translation))
+        extrinsics = self.depth_to_color
+        identity = np.array_equal(extrinsics.rotation, np.eye(3)) and not extrinsics.translation.any()
+        if self.depth is None and not identity:
+            raise ValueError(
+                "depth_to_color is not the identity but there are no depth intrinsics: without them the depth "
+                "image is taken as registered to colour and the transform would be ignored; give the depth section "
+                "(or drop depth_to_color if the depth image is registered)"
+            )
+        baseline = float(np.linalg.norm(extrinsics.translation))
         if baseline > MAX_BASELINE:
             raise ValueError(
                 f"depth_to_color: translation {baseline:g} m is more than {MAX_BASELINE:g} m; the two sensors of an "
@@ -222,40 +231,43 @@ class Calibration:
         ``depth_scale_m`` is accepted for ``depth_scale``; a flat dict with ``"depth_aligned_to_color": false`` is
         refused (unregistered depth needs the depth intrinsics and extrinsics). Every error is a ValueError naming
         the file, and the field and its value when one is at fault. Other fields are ignored, but an InputWarning
-        names those holding numbers (a misspelt ``depth_scale`` would leave depth ten times off), and one names
-        distortion coefficients that are not all zero (they are not applied).
+        names those holding numbers or objects (a misspelt ``depth_scale`` would leave depth ten times off, a
+        misspelt ``depth`` section would leave the depth taken as registered), and one names distortion
+        coefficients that are not all zero (they are not applied).
         """
         path = Path(path)
         data = load_document(path, "calibration JSON")  # names the file itself
         if not isinstance(data, dict):
             raise ValueError(f"calibration {path}: expected a JSON object, got {summary(data)}")
         depth_scale = _depth_scale(data, f"calibration {path}")
+        if "color" in data:
+            extrinsics = data.get("depth_to_color")
+            sections = [
+                ("", data, ("color", "depth", "depth_to_color", "depth_scale", "depth_scale_m")),
+                ("color: ", data["color"], INTRINSICS_FIELDS),
+                ("depth: ", data.get("depth"), INTRINSICS_FIELDS),
+                ("depth_to_color: ", extrinsics, ("rotation", "translation")),
+            ]
+        else:
+            flat = (*INTRINSICS_FIELDS, "depth_scale", "depth_scale_m", "depth_aligned_to_color")
+            sections = [("", data, flat)]
+        for where, section, known in sections:  # before the checks: an unread section may explain an error
+            if isinstance(section, dict):
+                _warn_unused(f"calibration {path}: {where}", section, known)
         try:
             if "color" in data:
-                extrinsics = data.get("depth_to_color")
                 calibration = cls(
                     Intrinsics.from_dict(data["color"], "color"),
                     Intrinsics.from_dict(data["depth"], "depth") if data.get("depth") is not None else None,
                     Extrinsics.from_dict(extrinsics, "depth_to_color") if extrinsics is not None else Extrinsics(),
                     depth_scale,
                 )
-                sections = [
-                    ("", data, ("color", "depth", "depth_to_color", "depth_scale", "depth_scale_m")),
-                    ("color: ", data["color"], INTRINSICS_FIELDS),
-                    ("depth: ", data.get("depth"), INTRINSICS_FIELDS),
-                    ("depth_to_color: ", extrinsics, ("rotation", "translation")),
-                ]
             else:
                 if data.get("depth_aligned_to_color") is False:
                     raise ValueError("depth is not aligned to colour; give color, depth and depth_to_color sections")
                 calibration = cls(Intrinsics.from_dict(data), depth_scale=depth_scale)
-                flat = (*INTRINSICS_FIELDS, "depth_scale", "depth_scale_m", "depth_aligned_to_color")
-                sections = [("", data, flat)]
         except ValueError as exc:
             raise ValueError(f"calibration {path}: {exc}") from None
-        for where, section, known in sections:
-            if isinstance(section, dict):
-                _warn_unused(f"calibration {path}: {where}", section, known)
         return calibration
 
     def to_dict(self) -> dict[str, Any]:
@@ -275,12 +287,13 @@ def _depth_scale(data: dict[str, Any], where: str) -> float:
 
 def _warn_unused(where: str, data: dict[str, Any], known: tuple[str, ...]) -> None:
     """InputWarnings for what a calibration section ``data`` gives that sid does not use: fields not in ``known``
-    that hold numbers (a misspelt field keeps its default silently otherwise; text, such as a note, is let be), and
-    distortion coefficients not all zero (every function here treats the camera as an ideal pinhole)."""
-    unread = [key for key, value in data.items() if key not in known and _numeric(value)]
+    that hold numbers or objects (a misspelt field or section keeps its default silently otherwise; text, such as
+    a note, is let be), and distortion coefficients not all zero (every function here treats the camera as an
+    ideal pinhole)."""
+    unread = [key for key, value in data.items() if key not in known and (_numeric(value) or isinstance(value, dict))]
     if unread:
         warnings.warn(
-            f"{where}numbers sid does not read: {summary(unread)} (it reads {', '.join(known)}); a misspelt field "
+            f"{where}fields sid does not read: {summary(unread)} (it reads {', '.join(known)}); a misspelt field "
             "keeps its default",
             InputWarning,
             stacklevel=3,

@@ -187,6 +187,22 @@ def test_calibration_values_that_are_right_still_load(tmp_path):
     assert calib.depth_scale == 0.0001 and calib.color.coeffs == (0.1,) * 5 and calib.depth is not None
 
 
+def test_misspelt_depth_section_is_warned_and_its_extrinsics_refused(tmp_path):
+    """A misspelt depth section left the depth taken as registered, its non-identity depth_to_color ignored, without
+    a word; the unread section is now named, and a calibration without depth intrinsics but with extrinsics is
+    refused."""
+    path = tmp_path / "calibration.json"
+    path.write_text(json.dumps({k: v for k, v in FULL.items() if k != "depth"} | {"depth_intrinsics": FULL["depth"]}))
+    with (
+        pytest.warns(InputWarning, match=r'fields sid does not read: \["depth_intrinsics"\]'),
+        pytest.raises(ValueError, match=f"calibration {path}: depth_to_color is not the identity but there are no"),
+    ):
+        Calibration.from_json(path)
+    with pytest.raises(ValueError, match="no depth intrinsics"):
+        Calibration(Intrinsics(640, 480, 600.0, 600.0, 320.0, 240.0), None, Extrinsics(np.eye(3), [0.015, 0, 0]))
+    Calibration(Intrinsics(640, 480, 600.0, 600.0, 320.0, 240.0), None, Extrinsics())  # registered: fine
+
+
 def test_calibration_numbers_sid_does_not_use_are_said(tmp_path, recwarn):
     """A misspelt depth_scale (0.1 mm depth read as millimetres: every depth ten times too far) and distortion sid
     does not apply were accepted without a word; each is now an InputWarning naming the file and the field. Text
@@ -197,7 +213,7 @@ def test_calibration_numbers_sid_does_not_use_are_said(tmp_path, recwarn):
         calib = Calibration.from_json(path)
     assert calib.depth_scale == 0.001
     assert [str(w.message) for w in warned] == [
-        f'calibration {path}: numbers sid does not read: ["depth_scal", "k1"] (it reads width, height, fx, fy, cx, cy, '
+        f'calibration {path}: fields sid does not read: ["depth_scal", "k1"] (it reads width, height, fx, fy, cx, cy, '
         "ppx, ppy, model, coeffs, depth_scale, depth_scale_m, depth_aligned_to_color); a misspelt field keeps its "
         "default"
     ]
