@@ -96,6 +96,14 @@ def _validate_depth(depth_m: np.ndarray, intr: Intrinsics, what: str) -> np.ndar
     return depth_m
 
 
+def _check_options(mode: SplatMode, value: StoredValue) -> None:
+    """ValueError naming an unknown splat ``mode`` or stored ``value``."""
+    if mode not in ("rectangle", "point"):
+        raise ValueError(f"unknown splat mode {mode!r}; use 'rectangle' or 'point'")
+    if value not in ("z", "depth"):
+        raise ValueError(f"unknown stored value {value!r}; use 'z' or 'depth'")
+
+
 def _reduce_patches(values: np.ndarray, method: PatchMethod, min_support: int = _MIN_SUPPORT) -> np.ndarray:
     """(N, P) patch depths (NaN = no reading) -> (N,) one depth per patch, NaN where the patch has no reading.
 
@@ -171,9 +179,11 @@ def _check_pixels(pixels: np.ndarray, patch: int) -> np.ndarray:
     return pixels
 
 
-def _registered_patches(depth_m: np.ndarray, pixels: np.ndarray, patch: int) -> np.ndarray:
-    """(N, patch*patch) depths around each (rounded) pixel; NaN outside the image, at 0/NaN/inf readings, at NaN
-    pixels (an infinite reading is no reading, as in ``_reduce_patches``)."""
+def _registered_patches(
+    depth_m: np.ndarray, pixels: np.ndarray, patch: int, depth_min: float, depth_max: float
+) -> np.ndarray:
+    """(N, patch*patch) depths around each (rounded) pixel; NaN outside the image, at NaN pixels and at readings
+    outside [depth_min, depth_max] (metres; 0, NaN and inf among them: no reading)."""
     h, w = depth_m.shape
     finite = np.all(np.isfinite(pixels), axis=1)
     centre = np.floor(np.where(finite[:, None], pixels, -(10**6)) + 0.5).astype(np.int64)
@@ -183,7 +193,7 @@ def _registered_patches(depth_m: np.ndarray, pixels: np.ndarray, patch: int) -> 
     inside = (u >= 0) & (u < w) & (v >= 0) & (v < h)
     values = depth_m[np.clip(v, 0, h - 1), np.clip(u, 0, w - 1)].astype(float)
     with np.errstate(invalid="ignore"):
-        values[~inside | ~(values > 0) | (values == np.inf)] = np.nan
+        values[~inside | ~((values >= depth_min) & (values <= depth_max))] = np.nan
     return values
 
 
@@ -283,10 +293,7 @@ class Aligner:
     def __init__(self, calib: Calibration, mode: SplatMode = "rectangle", value: StoredValue = "z") -> None:
         if calib.depth is None:
             raise ValueError("Aligner: the calibration has no depth intrinsics (depth already registered to colour)")
-        if mode not in ("rectangle", "point"):
-            raise ValueError(f"unknown splat mode {mode!r}; use 'rectangle' or 'point'")
-        if value not in ("z", "depth"):
-            raise ValueError(f"unknown stored value {value!r}; use 'z' or 'depth'")
+        _check_options(mode, value)
         self.calib, self.mode, self.value = calib, mode, value
         kd, kc = calib.depth, calib.color
         m = kc.K @ calib.depth_to_color.rotation
@@ -446,7 +453,8 @@ def depth_at_color_pixels(
 
     depth_m: the frame's depth (float metres, 0/NaN = no reading), registered to colour when ``calib.depth`` is
     None, else in the depth camera's grid. pixels: (N, 2) colour pixels (u, v); a NaN pixel gives NaN.
-    Returns (N,) metres, NaN where the ``patch`` x ``patch`` window around the pixel holds no valid depth.
+    Returns (N,) metres, NaN where the ``patch`` x ``patch`` window around the pixel holds no valid depth: a reading
+    outside [``depth_min``, ``depth_max``] (metres) is no reading, registered or not.
 
     Reduction (``method``): ``"nearest"`` (default) sorts the patch's readings, splits them into surfaces at depth
     jumps and returns the median of the nearest surface with at least 3 pixels: a keypoint on a person's silhouette
@@ -475,15 +483,16 @@ def depth_at_color_pixels(
     """
     if search not in ("exact", "window"):
         raise ValueError(f"unknown depth search {search!r}; use 'exact' or 'window'")
+    _check_options(mode, value)
+    if not (0 < depth_min < depth_max and math.isfinite(depth_max)):
+        raise ValueError(f"need 0 < depth_min < depth_max < inf, got {depth_min}, {depth_max}")
     pixels = _check_pixels(pixels, patch)
     if calib.depth is None:
         depth_m = _validate_depth(depth_m, calib.color, "depth_at_color_pixels")
         if len(pixels) == 0:
             return np.zeros(0)
-        return _reduce_patches(_registered_patches(depth_m, pixels, patch), method)
+        return _reduce_patches(_registered_patches(depth_m, pixels, patch, depth_min, depth_max), method)
     depth_m = _validate_depth(depth_m, calib.depth, "depth_at_color_pixels")
-    if not (0 < depth_min < depth_max and math.isfinite(depth_max)):
-        raise ValueError(f"need 0 < depth_min < depth_max < inf, got {depth_min}, {depth_max}")
     if len(pixels) == 0:
         return np.zeros(0)
     if search == "window":
@@ -559,8 +568,6 @@ def _window_depth(
     depth_max: float,
 ) -> np.ndarray:
     """``depth_at_color_pixels(search="window")``: (N,) metres, NaN where the window holds no reading in range."""
-    if value not in ("z", "depth"):
-        raise ValueError(f"unknown stored value {value!r}; use 'z' or 'depth'")
     assert calib.depth is not None
     kd, kc = calib.depth, calib.color
     rotation, translation = calib.depth_to_color.rotation, calib.depth_to_color.translation
@@ -624,10 +631,6 @@ def _unregistered_patches(
     depth_max: float,
 ) -> np.ndarray:
     """(N, patch*patch) aligned depths in each colour patch, computed from a depth window per pixel (NaN = none)."""
-    if mode not in ("rectangle", "point"):
-        raise ValueError(f"unknown splat mode {mode!r}; use 'rectangle' or 'point'")
-    if value not in ("z", "depth"):
-        raise ValueError(f"unknown stored value {value!r}; use 'z' or 'depth'")
     assert calib.depth is not None
     kd, kc = calib.depth, calib.color
     n = len(pixels)

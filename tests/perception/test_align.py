@@ -319,3 +319,22 @@ def test_window_search_compares_float32_readings_with_the_range_in_float64() -> 
 def test_window_search_is_checked_by_name() -> None:
     with pytest.raises(ValueError, match="unknown depth search 'fast'"):
         depth_at_color_pixels(scene(seed=1), np.zeros((1, 2)), CALIB, search="fast")  # type: ignore[arg-type]
+
+
+def test_registered_lookups_check_their_options_and_apply_the_depth_range():
+    """The registered path ignored mode, value, depth_min and depth_max (a typo passed, a far wall decided)."""
+    depth = np.zeros((COLOR.height, COLOR.width), np.float32)
+    depth[28:33, 38:43] = 8.0  # a wall behind ...
+    depth[30, 39:41] = 3.0  # ... two readings of someone in front: too few to be a surface on their own
+    pixel = np.array([[40.0, 30.0]])
+    assert depth_at_color_pixels(depth, pixel, Calibration(COLOR))[0] == 8.0
+    assert depth_at_color_pixels(depth, pixel, Calibration(COLOR), depth_max=6.0)[0] == 3.0
+    assert np.isnan(depth_at_color_pixels(depth, pixel, Calibration(COLOR), depth_min=3.5, depth_max=6.0)[0])
+    for option, match in [
+        ({"mode": "points"}, "unknown splat mode 'points'"),
+        ({"value": "Z"}, "unknown stored value 'Z'"),
+        ({"depth_min": 0.0}, "need 0 < depth_min < depth_max"),
+        ({"depth_max": math.inf}, "need 0 < depth_min < depth_max"),
+    ]:
+        with pytest.raises(ValueError, match=match):
+            depth_at_color_pixels(depth, pixel, Calibration(COLOR), **option)
