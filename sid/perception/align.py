@@ -354,11 +354,13 @@ class Aligner:
                 np.floor(coord, out=coord)
             valid = (d > 0) & (z > 0) & (u >= 0) & (u < kc.width) & (v >= 0) & (v < kc.height)
         keep = np.flatnonzero(valid)
-        v *= kc.width
-        v += u
+        # Flat indices in int64: float32 holds integers exactly only up to 2^24, fewer than a large image's pixels.
+        cell = v[keep].astype(np.int64)
+        cell *= kc.width
+        cell += u[keep].astype(np.int64)
         out = self._image[0]
         out.fill(np.inf)
-        np.minimum.at(out, v[keep].astype(np.int64), z[keep] if self.value == "z" else d[keep])
+        np.minimum.at(out, cell, z[keep] if self.value == "z" else d[keep])
         return out.reshape(kc.height, kc.width)
 
     def _rectangles(self, d: np.ndarray) -> np.ndarray:
@@ -383,7 +385,7 @@ class Aligner:
         # Work on a canvas padded by the largest rectangle, so that no rectangle needs clipping.
         pad = int(max(span_x.max(initial=0), span_y.max(initial=0))) + 1
         width, height = kc.width + 2 * pad, kc.height + 2 * pad
-        cell = ((y0 + pad) * width + (x0 + pad)).astype(np.int64)  # top-left cell on the padded canvas
+        cell = (y0.astype(np.int64) + pad) * width + (x0.astype(np.int64) + pad)  # top-left cell, padded canvas
         # Every rectangle at least as large as the base size (the most common one, from a subsample) is the union of
         # base-size rectangles at 1-4 offsets; those are z-buffered at their top-left cells and one grey erosion with
         # the base rectangle (bottom-right anchor: out[q] = min over corners c in [q - base, q]) spreads them.
