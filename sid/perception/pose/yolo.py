@@ -130,7 +130,7 @@ class YoloPose:
         clip_corners(points[:, NUM_KEYPOINTS:], image_hw)
         scores = kept[:, 7::3].astype(float)
         return [
-            PoseDetection(p[:NUM_KEYPOINTS], s, p[NUM_KEYPOINTS:], c)
+            PoseDetection(p[:NUM_KEYPOINTS], s, p[NUM_KEYPOINTS:].reshape(4), c)
             for p, s, c in zip(points, scores, kept[:, 4].tolist(), strict=True)
         ]
 
