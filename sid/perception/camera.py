@@ -5,7 +5,8 @@ librealsense: (0, 0) is the centre of the top-left pixel, u grows to the right, 
 
 Distortion: the D435i colour and depth streams report (near-)zero distortion ("Brown-Conrady" with zero
 coefficients, or "inverse Brown-Conrady" on colour); the coefficients are kept in the record but every
-function here treats the camera as an ideal pinhole. Undistort images first if your camera has real distortion.
+function here treats the camera as an ideal pinhole. Undistort images first if your camera has real distortion:
+every reader of a calibration (JSON, RealSense, ROS CameraInfo) says so with ``warn_distortion``.
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ __all__ = [
     "MIN_FOCAL_PER_PIXEL",
     "deproject",
     "project",
+    "warn_distortion",
 ]
 
 MAX_IMAGE_SIDE = 100_000
@@ -98,8 +100,8 @@ class Intrinsics:
 
     @classmethod
     def from_rs(cls, intr: Any) -> Intrinsics:
-        """From a ``pyrealsense2.intrinsics`` object."""
-        return cls(
+        """From a ``pyrealsense2.intrinsics`` object (an InputWarning when its distortion is not zero)."""
+        intrinsics = cls(
             int(intr.width),
             int(intr.height),
             float(intr.fx),
@@ -109,6 +111,8 @@ class Intrinsics:
             str(intr.model).split(".")[-1],
             tuple(float(c) for c in intr.coeffs),
         )
+        warn_distortion(intrinsics, "realsense intrinsics")
+        return intrinsics
 
     @classmethod
     def from_dict(cls, data: Any, where: str = "intrinsics") -> Intrinsics:
@@ -268,6 +272,9 @@ class Calibration:
                 calibration = cls(Intrinsics.from_dict(data), depth_scale=depth_scale)
         except ValueError as exc:
             raise ValueError(f"calibration {path}: {exc}") from None
+        for name, intrinsics in (("color", calibration.color), ("depth", calibration.depth)):
+            if intrinsics is not None:
+                warn_distortion(intrinsics, f"calibration {path}: {name}" if "color" in data else f"calibration {path}")
         return calibration
 
     def to_dict(self) -> dict[str, Any]:
@@ -286,10 +293,9 @@ def _depth_scale(data: dict[str, Any], where: str) -> float:
 
 
 def _warn_unused(where: str, data: dict[str, Any], known: tuple[str, ...]) -> None:
-    """InputWarnings for what a calibration section ``data`` gives that sid does not use: fields not in ``known``
+    """An InputWarning for the fields of a calibration section ``data`` that sid does not read: those not in ``known``
     that hold numbers or objects (a misspelt field or section keeps its default silently otherwise; text, such as
-    a note, is let be), and distortion coefficients not all zero (every function here treats the camera as an
-    ideal pinhole)."""
+    a note, is let be)."""
     unread = [key for key, value in data.items() if key not in known and (_numeric(value) or isinstance(value, dict))]
     if unread:
         warnings.warn(
@@ -298,13 +304,18 @@ def _warn_unused(where: str, data: dict[str, Any], known: tuple[str, ...]) -> No
             InputWarning,
             stacklevel=3,
         )
-    coeffs = data.get("coeffs") if "coeffs" in known else None
-    if isinstance(coeffs, list) and any(c != 0 for c in coeffs):
+
+
+def warn_distortion(intrinsics: Intrinsics, where: str) -> None:
+    """An InputWarning naming ``where`` when ``intrinsics`` has distortion coefficients that are not all zero: every
+    function here treats the camera as an ideal pinhole, so they are not applied."""
+    if any(c != 0 for c in intrinsics.coeffs):
+        coeffs = ", ".join(f"{c:.6g}" for c in intrinsics.coeffs)  # float32 readings (librealsense) shown short
         warnings.warn(
-            f"{where}distortion coefficients {summary(coeffs)} are not applied: sid treats the camera as an ideal "
+            f"{where}: distortion coefficients [{coeffs}] are not applied: sid treats the camera as an ideal "
             "pinhole; undistort the images first",
             InputWarning,
-            stacklevel=3,
+            stacklevel=2,
         )
 
 
