@@ -16,7 +16,6 @@ COCO_KEYPOINTS: tuple[str, ...] = (
 NUM_KEYPOINTS = len(COCO_KEYPOINTS)
 KP = {name: index for index, name in enumerate(COCO_KEYPOINTS)}
 LEFT_SHOULDER, RIGHT_SHOULDER = KP["left_shoulder"], KP["right_shoulder"]
-LEFT_HIP, RIGHT_HIP = KP["left_hip"], KP["right_hip"]
 
 # Bones drawn in overlays (pairs of keypoint indices).
 SKELETON: tuple[tuple[int, int], ...] = (
