@@ -46,7 +46,7 @@ from typing import Literal
 import cv2
 import numpy as np
 
-from sid.perception.camera import Calibration, Intrinsics
+from sid.perception.camera import Calibration, Intrinsics, pixel_rays
 
 __all__ = [
     "Aligner",
@@ -228,8 +228,7 @@ def _project_depth_points(
     assert calib.depth is not None
     kd, kc = calib.depth, calib.color
     r, t = calib.depth_to_color.rotation, calib.depth_to_color.translation
-    x = (u_d - kd.cx) / kd.fx
-    y = (v_d - kd.cy) / kd.fy
+    x, y = pixel_rays(u_d, v_d, kd)
     # p_c = d * (R @ [x, y, 1]) + t, then K_c: homogeneous colour pixel = d * (K_c R ray) + K_c t.
     m = kc.K @ r
     b = kc.K @ t
@@ -255,8 +254,8 @@ def _search_windows(
     half = patch // 2 + 0.5
     centre = np.floor(pixels + 0.5)
     # Rays through the patch's 4 corners, (4, N) per component; colour-frame point = z * (x, y, 1).
-    x = (centre[:, 0] + np.array([-half, half, -half, half])[:, None] - kc.cx) / kc.fx
-    y = (centre[:, 1] + np.array([-half, -half, half, half])[:, None] - kc.cy) / kc.fy
+    corner_u, corner_v = np.array([-half, half, -half, half])[:, None], np.array([-half, -half, half, half])[:, None]
+    x, y = pixel_rays(centre[:, 0] + corner_u, centre[:, 1] + corner_v, kc)
     # Depth-frame point R^T (p_c - t) = z * (R^T ray) - R^T t.
     rt = calib.depth_to_color.rotation.T
     shift = rt @ calib.depth_to_color.translation
@@ -301,8 +300,7 @@ class Aligner:
         v, u = np.mgrid[0 : kd.height, 0 : kd.width].astype(np.float64)
 
         def rays(shift: float) -> np.ndarray:
-            x = ((u + shift - kd.cx) / kd.fx).ravel()
-            y = ((v + shift - kd.cy) / kd.fy).ravel()
+            x, y = (a.ravel() for a in pixel_rays(u + shift, v + shift, kd))
             return (m[:, :2] @ np.stack([x, y]) + m[:, 2:]).astype(np.float32)  # (3, H_d * W_d)
 
         self._centre = rays(0.0) if mode == "point" or value == "z" else None
@@ -582,7 +580,7 @@ def _window_depth(
     with np.errstate(divide="ignore", invalid="ignore"):  # NaN pixels, rays that miss the depth camera
         # Colour ray (x, y, 1) per pixel (NaN for a NaN pixel, never seen), in the depth frame: a point at colour
         # depth z is z * ray - R^T t; while z is unknown, the ray's direction.
-        colour_ray[:2] = ((pixels - (kc.cx, kc.cy)) / (kc.fx, kc.fy)).T
+        colour_ray[:2] = pixel_rays(pixels[:, 0], pixels[:, 1], kc)
         point = ray = rotation.T @ colour_ray
         for step in range(_WINDOW_STEPS):
             index, inside = _window_cells(point, geometry, kd.width, kd.height)

@@ -31,6 +31,7 @@ __all__ = [
     "MAX_IMAGE_SIDE",
     "MIN_FOCAL_PER_PIXEL",
     "deproject",
+    "pixel_rays",
     "project",
     "warn_distortion",
 ]
@@ -357,13 +358,22 @@ def _numbers(data: dict[str, Any], key: str, where: str, count: int, rule: str) 
     return np.array(flat, dtype=float)
 
 
+def pixel_rays(u: Any, v: Any, intrinsics: Intrinsics) -> tuple[Any, Any]:
+    """Pixel columns ``u`` and rows ``v`` -> normalised image coordinates x = (u - cx) / fx, y = (v - cy) / fy.
+
+    The camera-frame viewing ray through pixel (u, v) is K^-1 [u v 1] = (x, y, 1) (optical frame), its point at
+    depth z (metres) z * (x, y, 1). ``u`` and ``v`` are numbers or arrays, each mapped on its own (their shapes need
+    not match: a row of columns and a column of rows give each pixel's x and y).
+    """
+    return (u - intrinsics.cx) / intrinsics.fx, (v - intrinsics.cy) / intrinsics.fy
+
+
 def deproject(pixels: np.ndarray, depth_m: np.ndarray, intrinsics: Intrinsics) -> np.ndarray:
     """Pixels (N, 2) as (u, v) with depths (N,) in metres -> (N, 3) camera-frame points: d * K^-1 [u v 1]."""
     pixels = np.asarray(pixels, dtype=float).reshape(-1, 2)
     depth_m = np.asarray(depth_m, dtype=float).reshape(-1)
-    x = (pixels[:, 0] - intrinsics.cx) / intrinsics.fx * depth_m
-    y = (pixels[:, 1] - intrinsics.cy) / intrinsics.fy * depth_m
-    return np.stack([x, y, depth_m], axis=1)
+    x, y = pixel_rays(pixels[:, 0], pixels[:, 1], intrinsics)
+    return np.stack([x * depth_m, y * depth_m, depth_m], axis=1)
 
 
 def project(points: np.ndarray, intrinsics: Intrinsics) -> np.ndarray:

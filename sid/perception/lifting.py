@@ -45,7 +45,7 @@ import numpy as np
 
 from sid.checks import check_limit, check_number, check_numbers, check_whole
 from sid.perception.align import Search, depth_at_color_pixels
-from sid.perception.camera import Calibration
+from sid.perception.camera import Calibration, pixel_rays
 from sid.perception.keypoints import KP, NUM_KEYPOINTS, PoseDetection
 from sid.perception.mount import CameraMount
 from sid.perception.orientation import EAR_SEPARATION, HIP_SEPARATION, SHOULDER_SEPARATION, estimate_orientations
@@ -201,8 +201,7 @@ def lift_people(
 
     # Each keypoint's viewing ray (camera frame, through K_c^-1 [u v 1] = (ray_x, ray_y, 1)) and its range along it
     # (m; NaN where unusable); depth z and range r: r = z * |(ray_x, ray_y, 1)|.
-    intr = calib.color
-    ray = (keypoints - (intr.cx, intr.cy)) / (intr.fx, intr.fy)  # (P, 17, 2) as (ray_x, ray_y)
+    ray = np.stack(pixel_rays(keypoints[..., 0], keypoints[..., 1], calib.color), axis=-1)  # (P, 17, 2)
     ray_x, ray_y = ray[..., 0], ray[..., 1]
     norm = np.sqrt(ray_x * ray_x + ray_y * ray_y + 1.0)
     ranges = np.where(usable, depth * norm + params.surface_offset, np.nan)

@@ -10,7 +10,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from sid.documents import InputWarning
-from sid.perception.camera import Calibration, Extrinsics, Intrinsics, deproject, project
+from sid.perception.camera import Calibration, Extrinsics, Intrinsics, deproject, pixel_rays, project
 from sid.perception.mount import CameraMount
 
 D435_COLOR = Intrinsics(1280, 720, 910.0, 910.0, 640.0, 360.0)
@@ -228,3 +228,14 @@ def test_calibration_numbers_sid_does_not_use_are_said(tmp_path, recwarn):
     recwarn.clear()
     Calibration.from_json(path)
     assert not [w for w in recwarn if issubclass(w.category, InputWarning)]
+
+
+def test_pixel_rays_are_k_inverse_of_the_pixels():
+    intr = Intrinsics(640, 480, 525.0, 530.0, 319.5, 239.5)
+    pixels = np.array([[0.0, 0.0], [319.5, 239.5], [639.0, 100.0], [-0.5, 479.5]])
+    x, y = pixel_rays(pixels[:, 0], pixels[:, 1], intr)
+    expected = np.linalg.solve(intr.K, np.c_[pixels, np.ones(4)].T)  # K^-1 [u v 1] = (x, y, 1)
+    np.testing.assert_allclose(np.stack([x, y]), expected[:2], rtol=1e-12, atol=1e-15)
+    np.testing.assert_array_equal(deproject(pixels, np.full(4, 2.0), intr)[:, :2], 2.0 * np.stack([x, y], axis=1))
+    columns, rows = pixel_rays(np.arange(640), np.arange(480)[:, None], intr)  # each axis on its own
+    assert columns.shape == (640,) and rows.shape == (480, 1) and columns[0] == x[0] and rows[0, 0] == y[0]
