@@ -135,6 +135,26 @@ def build_yolo_pose_model(
     return _build(path, nodes, x_info, y_info, consts)
 
 
+def build_model_with_output(
+    path: str | Path, output: np.ndarray, declared: Sequence[int | str], input_shape: Sequence[int | str]
+) -> Path:
+    """Float32 input of ``input_shape`` -> float32 ``output``, declared as ``declared`` (str entries dynamic).
+
+    The output goes through a Reshape whose target depends on the input's values, so onnxruntime cannot infer
+    its shape and reports the declared one, as it does for a real export with dynamic axes.
+    """
+    nodes, consts = _marker_nodes(channels_last=input_shape[-1] == 3)
+    consts |= {"base": np.asarray(output, np.float32).ravel(), "dims": np.array(output.shape, np.int64)}
+    nodes += [
+        helper.make_node("Mul", ["index", "c0"], ["zero"]),  # 0, but only known when the model runs
+        helper.make_node("Add", ["dims", "zero"], ["target"]),
+        helper.make_node("Reshape", ["base", "target"], ["Y"]),
+    ]
+    x_info = helper.make_tensor_value_info("X", TensorProto.FLOAT, list(input_shape))
+    y_info = helper.make_tensor_value_info("Y", TensorProto.FLOAT, list(declared))
+    return _build(path, nodes, x_info, y_info, consts)
+
+
 def yolo_candidate(box_xywh: Sequence[float], score: float, keypoints_xy: np.ndarray, visibility: float = 0.9):
     """One (56,) YOLO candidate column from a box (cx, cy, w, h), a score and (17, 2) keypoints (x, y)."""
     kpts = np.concatenate([np.asarray(keypoints_xy, float).reshape(17, 2), np.full((17, 1), visibility)], axis=1)

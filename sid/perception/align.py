@@ -46,7 +46,7 @@ from typing import Literal
 import cv2
 import numpy as np
 
-from sid.perception.camera import Calibration, Intrinsics
+from sid.perception.camera import Calibration, Intrinsics, pixel_rays
 
 __all__ = [
     "Aligner",
@@ -94,6 +94,14 @@ def _validate_depth(depth_m: np.ndarray, intr: Intrinsics, what: str) -> np.ndar
     if depth_m.dtype.kind != "f":  # floating (np.issubdtype costs more than the lookups it guards)
         raise ValueError(f"{what}: depth must be float metres, got dtype {depth_m.dtype} (multiply by depth_scale)")
     return depth_m
+
+
+def _check_options(mode: SplatMode, value: StoredValue) -> None:
+    """ValueError naming an unknown splat ``mode`` or stored ``value``."""
+    if mode not in ("rectangle", "point"):
+        raise ValueError(f"unknown splat mode {mode!r}; use 'rectangle' or 'point'")
+    if value not in ("z", "depth"):
+        raise ValueError(f"unknown stored value {value!r}; use 'z' or 'depth'")
 
 
 def _reduce_patches(values: np.ndarray, method: PatchMethod, min_support: int = _MIN_SUPPORT) -> np.ndarray:
@@ -171,9 +179,11 @@ def _check_pixels(pixels: np.ndarray, patch: int) -> np.ndarray:
     return pixels
 
 
-def _registered_patches(depth_m: np.ndarray, pixels: np.ndarray, patch: int) -> np.ndarray:
-    """(N, patch*patch) depths around each (rounded) pixel; NaN outside the image, at 0/NaN/inf readings, at NaN
-    pixels (an infinite reading is no reading, as in ``_reduce_patches``)."""
+def _registered_patches(
+    depth_m: np.ndarray, pixels: np.ndarray, patch: int, depth_min: float, depth_max: float
+) -> np.ndarray:
+    """(N, patch*patch) depths around each (rounded) pixel; NaN outside the image, at NaN pixels and at readings
+    outside [depth_min, depth_max] (metres; 0, NaN and inf among them: no reading)."""
     h, w = depth_m.shape
     finite = np.all(np.isfinite(pixels), axis=1)
     centre = np.floor(np.where(finite[:, None], pixels, -(10**6)) + 0.5).astype(np.int64)
@@ -183,7 +193,7 @@ def _registered_patches(depth_m: np.ndarray, pixels: np.ndarray, patch: int) -> 
     inside = (u >= 0) & (u < w) & (v >= 0) & (v < h)
     values = depth_m[np.clip(v, 0, h - 1), np.clip(u, 0, w - 1)].astype(float)
     with np.errstate(invalid="ignore"):
-        values[~inside | ~(values > 0) | (values == np.inf)] = np.nan
+        values[~inside | ~((values >= depth_min) & (values <= depth_max))] = np.nan
     return values
 
 
@@ -218,8 +228,7 @@ def _project_depth_points(
     assert calib.depth is not None
     kd, kc = calib.depth, calib.color
     r, t = calib.depth_to_color.rotation, calib.depth_to_color.translation
-    x = (u_d - kd.cx) / kd.fx
-    y = (v_d - kd.cy) / kd.fy
+    x, y = pixel_rays(u_d, v_d, kd)
     # p_c = d * (R @ [x, y, 1]) + t, then K_c: homogeneous colour pixel = d * (K_c R ray) + K_c t.
     m = kc.K @ r
     b = kc.K @ t
@@ -245,8 +254,8 @@ def _search_windows(
     half = patch // 2 + 0.5
     centre = np.floor(pixels + 0.5)
     # Rays through the patch's 4 corners, (4, N) per component; colour-frame point = z * (x, y, 1).
-    x = (centre[:, 0] + np.array([-half, half, -half, half])[:, None] - kc.cx) / kc.fx
-    y = (centre[:, 1] + np.array([-half, -half, half, half])[:, None] - kc.cy) / kc.fy
+    corner_u, corner_v = np.array([-half, half, -half, half])[:, None], np.array([-half, -half, half, half])[:, None]
+    x, y = pixel_rays(centre[:, 0] + corner_u, centre[:, 1] + corner_v, kc)
     # Depth-frame point R^T (p_c - t) = z * (R^T ray) - R^T t.
     rt = calib.depth_to_color.rotation.T
     shift = rt @ calib.depth_to_color.translation
@@ -283,10 +292,7 @@ class Aligner:
     def __init__(self, calib: Calibration, mode: SplatMode = "rectangle", value: StoredValue = "z") -> None:
         if calib.depth is None:
             raise ValueError("Aligner: the calibration has no depth intrinsics (depth already registered to colour)")
-        if mode not in ("rectangle", "point"):
-            raise ValueError(f"unknown splat mode {mode!r}; use 'rectangle' or 'point'")
-        if value not in ("z", "depth"):
-            raise ValueError(f"unknown stored value {value!r}; use 'z' or 'depth'")
+        _check_options(mode, value)
         self.calib, self.mode, self.value = calib, mode, value
         kd, kc = calib.depth, calib.color
         m = kc.K @ calib.depth_to_color.rotation
@@ -294,8 +300,7 @@ class Aligner:
         v, u = np.mgrid[0 : kd.height, 0 : kd.width].astype(np.float64)
 
         def rays(shift: float) -> np.ndarray:
-            x = ((u + shift - kd.cx) / kd.fx).ravel()
-            y = ((v + shift - kd.cy) / kd.fy).ravel()
+            x, y = (a.ravel() for a in pixel_rays(u + shift, v + shift, kd))
             return (m[:, :2] @ np.stack([x, y]) + m[:, 2:]).astype(np.float32)  # (3, H_d * W_d)
 
         self._centre = rays(0.0) if mode == "point" or value == "z" else None
@@ -347,11 +352,13 @@ class Aligner:
                 np.floor(coord, out=coord)
             valid = (d > 0) & (z > 0) & (u >= 0) & (u < kc.width) & (v >= 0) & (v < kc.height)
         keep = np.flatnonzero(valid)
-        v *= kc.width
-        v += u
+        # Flat indices in int64: float32 holds integers exactly only up to 2^24, fewer than a large image's pixels.
+        cell = v[keep].astype(np.int64)
+        cell *= kc.width
+        cell += u[keep].astype(np.int64)
         out = self._image[0]
         out.fill(np.inf)
-        np.minimum.at(out, v[keep].astype(np.int64), z[keep] if self.value == "z" else d[keep])
+        np.minimum.at(out, cell, z[keep] if self.value == "z" else d[keep])
         return out.reshape(kc.height, kc.width)
 
     def _rectangles(self, d: np.ndarray) -> np.ndarray:
@@ -376,7 +383,7 @@ class Aligner:
         # Work on a canvas padded by the largest rectangle, so that no rectangle needs clipping.
         pad = int(max(span_x.max(initial=0), span_y.max(initial=0))) + 1
         width, height = kc.width + 2 * pad, kc.height + 2 * pad
-        cell = ((y0 + pad) * width + (x0 + pad)).astype(np.int64)  # top-left cell on the padded canvas
+        cell = (y0.astype(np.int64) + pad) * width + (x0.astype(np.int64) + pad)  # top-left cell, padded canvas
         # Every rectangle at least as large as the base size (the most common one, from a subsample) is the union of
         # base-size rectangles at 1-4 offsets; those are z-buffered at their top-left cells and one grey erosion with
         # the base rectangle (bottom-right anchor: out[q] = min over corners c in [q - base, q]) spreads them.
@@ -446,7 +453,8 @@ def depth_at_color_pixels(
 
     depth_m: the frame's depth (float metres, 0/NaN = no reading), registered to colour when ``calib.depth`` is
     None, else in the depth camera's grid. pixels: (N, 2) colour pixels (u, v); a NaN pixel gives NaN.
-    Returns (N,) metres, NaN where the ``patch`` x ``patch`` window around the pixel holds no valid depth.
+    Returns (N,) metres, NaN where the ``patch`` x ``patch`` window around the pixel holds no valid depth: a reading
+    outside [``depth_min``, ``depth_max``] (metres) is no reading, registered or not.
 
     Reduction (``method``): ``"nearest"`` (default) sorts the patch's readings, splits them into surfaces at depth
     jumps and returns the median of the nearest surface with at least 3 pixels: a keypoint on a person's silhouette
@@ -475,15 +483,16 @@ def depth_at_color_pixels(
     """
     if search not in ("exact", "window"):
         raise ValueError(f"unknown depth search {search!r}; use 'exact' or 'window'")
+    _check_options(mode, value)
+    if not (0 < depth_min < depth_max and math.isfinite(depth_max)):
+        raise ValueError(f"need 0 < depth_min < depth_max < inf, got {depth_min}, {depth_max}")
     pixels = _check_pixels(pixels, patch)
     if calib.depth is None:
         depth_m = _validate_depth(depth_m, calib.color, "depth_at_color_pixels")
         if len(pixels) == 0:
             return np.zeros(0)
-        return _reduce_patches(_registered_patches(depth_m, pixels, patch), method)
+        return _reduce_patches(_registered_patches(depth_m, pixels, patch, depth_min, depth_max), method)
     depth_m = _validate_depth(depth_m, calib.depth, "depth_at_color_pixels")
-    if not (0 < depth_min < depth_max and math.isfinite(depth_max)):
-        raise ValueError(f"need 0 < depth_min < depth_max < inf, got {depth_min}, {depth_max}")
     if len(pixels) == 0:
         return np.zeros(0)
     if search == "window":
@@ -559,8 +568,6 @@ def _window_depth(
     depth_max: float,
 ) -> np.ndarray:
     """``depth_at_color_pixels(search="window")``: (N,) metres, NaN where the window holds no reading in range."""
-    if value not in ("z", "depth"):
-        raise ValueError(f"unknown stored value {value!r}; use 'z' or 'depth'")
     assert calib.depth is not None
     kd, kc = calib.depth, calib.color
     rotation, translation = calib.depth_to_color.rotation, calib.depth_to_color.translation
@@ -573,7 +580,7 @@ def _window_depth(
     with np.errstate(divide="ignore", invalid="ignore"):  # NaN pixels, rays that miss the depth camera
         # Colour ray (x, y, 1) per pixel (NaN for a NaN pixel, never seen), in the depth frame: a point at colour
         # depth z is z * ray - R^T t; while z is unknown, the ray's direction.
-        colour_ray[:2] = ((pixels - (kc.cx, kc.cy)) / (kc.fx, kc.fy)).T
+        colour_ray[:2] = pixel_rays(pixels[:, 0], pixels[:, 1], kc)
         point = ray = rotation.T @ colour_ray
         for step in range(_WINDOW_STEPS):
             index, inside = _window_cells(point, geometry, kd.width, kd.height)
@@ -624,10 +631,6 @@ def _unregistered_patches(
     depth_max: float,
 ) -> np.ndarray:
     """(N, patch*patch) aligned depths in each colour patch, computed from a depth window per pixel (NaN = none)."""
-    if mode not in ("rectangle", "point"):
-        raise ValueError(f"unknown splat mode {mode!r}; use 'rectangle' or 'point'")
-    if value not in ("z", "depth"):
-        raise ValueError(f"unknown stored value {value!r}; use 'z' or 'depth'")
     assert calib.depth is not None
     kd, kc = calib.depth, calib.color
     n = len(pixels)

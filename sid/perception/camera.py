@@ -5,7 +5,8 @@ librealsense: (0, 0) is the centre of the top-left pixel, u grows to the right, 
 
 Distortion: the D435i colour and depth streams report (near-)zero distortion ("Brown-Conrady" with zero
 coefficients, or "inverse Brown-Conrady" on colour); the coefficients are kept in the record but every
-function here treats the camera as an ideal pinhole. Undistort images first if your camera has real distortion.
+function here treats the camera as an ideal pinhole. Undistort images first if your camera has real distortion:
+every reader of a calibration (JSON, RealSense, ROS CameraInfo) says so with ``warn_distortion``.
 """
 
 from __future__ import annotations
@@ -30,7 +31,9 @@ __all__ = [
     "MAX_IMAGE_SIDE",
     "MIN_FOCAL_PER_PIXEL",
     "deproject",
+    "pixel_rays",
     "project",
+    "warn_distortion",
 ]
 
 MAX_IMAGE_SIDE = 100_000
@@ -98,8 +101,8 @@ class Intrinsics:
 
     @classmethod
     def from_rs(cls, intr: Any) -> Intrinsics:
-        """From a ``pyrealsense2.intrinsics`` object."""
-        return cls(
+        """From a ``pyrealsense2.intrinsics`` object (an InputWarning when its distortion is not zero)."""
+        intrinsics = cls(
             int(intr.width),
             int(intr.height),
             float(intr.fx),
@@ -109,6 +112,8 @@ class Intrinsics:
             str(intr.model).split(".")[-1],
             tuple(float(c) for c in intr.coeffs),
         )
+        warn_distortion(intrinsics, "realsense intrinsics")
+        return intrinsics
 
     @classmethod
     def from_dict(cls, data: Any, where: str = "intrinsics") -> Intrinsics:
@@ -194,7 +199,8 @@ class Extrinsics:
 class Calibration:
     """Everything needed to align depth to colour and lift colour pixels to 3D.
 
-    ``depth`` is None when the depth image is already registered to the colour image.
+    ``depth`` is None when the depth image is already registered to the colour image; ``depth_to_color`` must
+    then be the identity (a ValueError otherwise: its depth intrinsics are missing, e.g. a misspelt section).
     ``depth_to_color`` maps depth-camera points to colour-camera points. ``depth_scale`` is metres per
     depth unit (0.001 for millimetre PNGs and the D435i default).
     """
@@ -205,7 +211,15 @@ class Calibration:
     depth_scale: float = 0.001
 
     def __post_init__(self) -> None:
-        baseline = float(np.linalg.norm(self.depth_to_color.translation))
+        extrinsics = self.depth_to_color
+        identity = np.array_equal(extrinsics.rotation, np.eye(3)) and not extrinsics.translation.any()
+        if self.depth is None and not identity:
+            raise ValueError(
+                "depth_to_color is not the identity but there are no depth intrinsics: without them the depth "
+                "image is taken as registered to colour and the transform would be ignored; give the depth section "
+                "(or drop depth_to_color if the depth image is registered)"
+            )
+        baseline = float(np.linalg.norm(extrinsics.translation))
         if baseline > MAX_BASELINE:
             raise ValueError(
                 f"depth_to_color: translation {baseline:g} m is more than {MAX_BASELINE:g} m; the two sensors of an "
@@ -222,40 +236,46 @@ class Calibration:
         ``depth_scale_m`` is accepted for ``depth_scale``; a flat dict with ``"depth_aligned_to_color": false`` is
         refused (unregistered depth needs the depth intrinsics and extrinsics). Every error is a ValueError naming
         the file, and the field and its value when one is at fault. Other fields are ignored, but an InputWarning
-        names those holding numbers (a misspelt ``depth_scale`` would leave depth ten times off), and one names
-        distortion coefficients that are not all zero (they are not applied).
+        names those holding numbers or objects (a misspelt ``depth_scale`` would leave depth ten times off, a
+        misspelt ``depth`` section would leave the depth taken as registered), and one names distortion
+        coefficients that are not all zero (they are not applied).
         """
         path = Path(path)
         data = load_document(path, "calibration JSON")  # names the file itself
         if not isinstance(data, dict):
             raise ValueError(f"calibration {path}: expected a JSON object, got {summary(data)}")
         depth_scale = _depth_scale(data, f"calibration {path}")
+        if "color" in data:
+            extrinsics = data.get("depth_to_color")
+            sections = [
+                ("", data, ("color", "depth", "depth_to_color", "depth_scale", "depth_scale_m")),
+                ("color: ", data["color"], INTRINSICS_FIELDS),
+                ("depth: ", data.get("depth"), INTRINSICS_FIELDS),
+                ("depth_to_color: ", extrinsics, ("rotation", "translation")),
+            ]
+        else:
+            flat = (*INTRINSICS_FIELDS, "depth_scale", "depth_scale_m", "depth_aligned_to_color")
+            sections = [("", data, flat)]
+        for where, section, known in sections:  # before the checks: an unread section may explain an error
+            if isinstance(section, dict):
+                _warn_unused(f"calibration {path}: {where}", section, known)
         try:
             if "color" in data:
-                extrinsics = data.get("depth_to_color")
                 calibration = cls(
                     Intrinsics.from_dict(data["color"], "color"),
                     Intrinsics.from_dict(data["depth"], "depth") if data.get("depth") is not None else None,
                     Extrinsics.from_dict(extrinsics, "depth_to_color") if extrinsics is not None else Extrinsics(),
                     depth_scale,
                 )
-                sections = [
-                    ("", data, ("color", "depth", "depth_to_color", "depth_scale", "depth_scale_m")),
-                    ("color: ", data["color"], INTRINSICS_FIELDS),
-                    ("depth: ", data.get("depth"), INTRINSICS_FIELDS),
-                    ("depth_to_color: ", extrinsics, ("rotation", "translation")),
-                ]
             else:
                 if data.get("depth_aligned_to_color") is False:
                     raise ValueError("depth is not aligned to colour; give color, depth and depth_to_color sections")
                 calibration = cls(Intrinsics.from_dict(data), depth_scale=depth_scale)
-                flat = (*INTRINSICS_FIELDS, "depth_scale", "depth_scale_m", "depth_aligned_to_color")
-                sections = [("", data, flat)]
         except ValueError as exc:
             raise ValueError(f"calibration {path}: {exc}") from None
-        for where, section, known in sections:
-            if isinstance(section, dict):
-                _warn_unused(f"calibration {path}: {where}", section, known)
+        for name, intrinsics in (("color", calibration.color), ("depth", calibration.depth)):
+            if intrinsics is not None:
+                warn_distortion(intrinsics, f"calibration {path}: {name}" if "color" in data else f"calibration {path}")
         return calibration
 
     def to_dict(self) -> dict[str, Any]:
@@ -274,24 +294,29 @@ def _depth_scale(data: dict[str, Any], where: str) -> float:
 
 
 def _warn_unused(where: str, data: dict[str, Any], known: tuple[str, ...]) -> None:
-    """InputWarnings for what a calibration section ``data`` gives that sid does not use: fields not in ``known``
-    that hold numbers (a misspelt field keeps its default silently otherwise; text, such as a note, is let be), and
-    distortion coefficients not all zero (every function here treats the camera as an ideal pinhole)."""
-    unread = [key for key, value in data.items() if key not in known and _numeric(value)]
+    """An InputWarning for the fields of a calibration section ``data`` that sid does not read: those not in ``known``
+    that hold numbers or objects (a misspelt field or section keeps its default silently otherwise; text, such as
+    a note, is let be)."""
+    unread = [key for key, value in data.items() if key not in known and (_numeric(value) or isinstance(value, dict))]
     if unread:
         warnings.warn(
-            f"{where}numbers sid does not read: {summary(unread)} (it reads {', '.join(known)}); a misspelt field "
+            f"{where}fields sid does not read: {summary(unread)} (it reads {', '.join(known)}); a misspelt field "
             "keeps its default",
             InputWarning,
             stacklevel=3,
         )
-    coeffs = data.get("coeffs") if "coeffs" in known else None
-    if isinstance(coeffs, list) and any(c != 0 for c in coeffs):
+
+
+def warn_distortion(intrinsics: Intrinsics, where: str) -> None:
+    """An InputWarning naming ``where`` when ``intrinsics`` has distortion coefficients that are not all zero: every
+    function here treats the camera as an ideal pinhole, so they are not applied."""
+    if any(c != 0 for c in intrinsics.coeffs):
+        coeffs = ", ".join(f"{c:.6g}" for c in intrinsics.coeffs)  # float32 readings (librealsense) shown short
         warnings.warn(
-            f"{where}distortion coefficients {summary(coeffs)} are not applied: sid treats the camera as an ideal "
+            f"{where}: distortion coefficients [{coeffs}] are not applied: sid treats the camera as an ideal "
             "pinhole; undistort the images first",
             InputWarning,
-            stacklevel=3,
+            stacklevel=2,
         )
 
 
@@ -333,13 +358,22 @@ def _numbers(data: dict[str, Any], key: str, where: str, count: int, rule: str) 
     return np.array(flat, dtype=float)
 
 
+def pixel_rays(u: Any, v: Any, intrinsics: Intrinsics) -> tuple[Any, Any]:
+    """Pixel columns ``u`` and rows ``v`` -> normalised image coordinates x = (u - cx) / fx, y = (v - cy) / fy.
+
+    The camera-frame viewing ray through pixel (u, v) is K^-1 [u v 1] = (x, y, 1) (optical frame), its point at
+    depth z (metres) z * (x, y, 1). ``u`` and ``v`` are numbers or arrays, each mapped on its own (their shapes need
+    not match: a row of columns and a column of rows give each pixel's x and y).
+    """
+    return (u - intrinsics.cx) / intrinsics.fx, (v - intrinsics.cy) / intrinsics.fy
+
+
 def deproject(pixels: np.ndarray, depth_m: np.ndarray, intrinsics: Intrinsics) -> np.ndarray:
     """Pixels (N, 2) as (u, v) with depths (N,) in metres -> (N, 3) camera-frame points: d * K^-1 [u v 1]."""
     pixels = np.asarray(pixels, dtype=float).reshape(-1, 2)
     depth_m = np.asarray(depth_m, dtype=float).reshape(-1)
-    x = (pixels[:, 0] - intrinsics.cx) / intrinsics.fx * depth_m
-    y = (pixels[:, 1] - intrinsics.cy) / intrinsics.fy * depth_m
-    return np.stack([x, y, depth_m], axis=1)
+    x, y = pixel_rays(pixels[:, 0], pixels[:, 1], intrinsics)
+    return np.stack([x * depth_m, y * depth_m, depth_m], axis=1)
 
 
 def project(points: np.ndarray, intrinsics: Intrinsics) -> np.ndarray:

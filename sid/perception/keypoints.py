@@ -16,7 +16,6 @@ COCO_KEYPOINTS: tuple[str, ...] = (
 NUM_KEYPOINTS = len(COCO_KEYPOINTS)
 KP = {name: index for index, name in enumerate(COCO_KEYPOINTS)}
 LEFT_SHOULDER, RIGHT_SHOULDER = KP["left_shoulder"], KP["right_shoulder"]
-LEFT_HIP, RIGHT_HIP = KP["left_hip"], KP["right_hip"]
 
 # Bones drawn in overlays (pairs of keypoint indices).
 SKELETON: tuple[tuple[int, int], ...] = (
@@ -39,7 +38,16 @@ class PoseDetection:
     box_score: float
 
     def __post_init__(self) -> None:
-        self.keypoints = np.asarray(self.keypoints, dtype=float).reshape(NUM_KEYPOINTS, 2)
-        self.scores = np.asarray(self.scores, dtype=float).reshape(NUM_KEYPOINTS)
-        self.box = np.asarray(self.box, dtype=float).reshape(4)
+        self.keypoints = _exact("keypoints", self.keypoints, (NUM_KEYPOINTS, 2))
+        self.scores = _exact("scores", self.scores, (NUM_KEYPOINTS,))
+        self.box = _exact("box", self.box, (4,))
         self.box_score = float(self.box_score)
+
+
+def _exact(field: str, value: object, shape: tuple[int, ...]) -> np.ndarray:
+    """``value`` as a float array of exactly ``shape``: a ValueError naming ``field`` and the shape otherwise (a
+    reshape would accept a (2, 17) array for (17, 2) and scramble it)."""
+    array = np.asarray(value, dtype=float)
+    if array.shape != shape:
+        raise ValueError(f"pose detection: {field} must have shape {shape}, got {array.shape}")
+    return array

@@ -45,7 +45,7 @@ import numpy as np
 
 from sid.checks import check_limit, check_number, check_numbers, check_whole
 from sid.perception.align import Search, depth_at_color_pixels
-from sid.perception.camera import Calibration
+from sid.perception.camera import Calibration, pixel_rays
 from sid.perception.keypoints import KP, NUM_KEYPOINTS, PoseDetection
 from sid.perception.mount import CameraMount
 from sid.perception.orientation import EAR_SEPARATION, HIP_SEPARATION, SHOULDER_SEPARATION, estimate_orientations
@@ -84,10 +84,12 @@ class LiftParams:
       around it, several times faster than "exact" and within millimetres of it at the median (docs/benchmarks.md,
       "Depth at the keypoints"); the far outliers (a window that reads the wall beside a silhouette) are what
       ``depth_gate`` drops. "exact": the splat search, equal to aligning the whole frame.
-    min_range: keypoints nearer than this to the camera (m, optical z) are dropped. 0.2: a D435's minimum depth at
-      848x480 is about 0.2 m, so a nearer reading is an artefact or a corrupt depth image (1 mm everywhere would
-      otherwise place people 7 cm from the lens).
-    max_range: keypoints farther than this from the camera (m, optical z) are dropped. 6.0: D435-class depth
+    min_range: keypoints nearer than this to the camera (m, optical z, above 0) are dropped, and readings nearer
+      than this are no reading where a keypoint's depth is looked up. 0.2: a D435's minimum depth at 848x480 is
+      about 0.2 m, so a nearer reading is an artefact or a corrupt depth image (1 mm everywhere would otherwise
+      place people 7 cm from the lens).
+    max_range: keypoints farther than this from the camera (m, optical z) are dropped, and readings farther than
+      this are no reading where a keypoint's depth is looked up. 6.0: D435-class depth
       noise grows with range squared (~2 % at 2 m, ~20 cm at 6 m), beyond which body orientation is noise.
     depth_gate: keypoints whose depth differs from the person's median keypoint depth by more than this (m) are
       dropped. 0.6: a standing body spans ~0.3 m in depth even in side view; a keypoint beyond that read the wall
@@ -138,7 +140,7 @@ class LiftParams:
         if self.depth_search not in ("exact", "window"):
             raise ValueError(f"lift: depth_search must be 'exact' or 'window', got {self.depth_search!r}")
         check_number("lift", "occluder_gap", self.occluder_gap, low=0, allow_inf=True, unit="metres")  # inf: off
-        check_number("lift", "min_range", self.min_range, low=0, unit="metres")
+        check_number("lift", "min_range", self.min_range, low=0, low_open=True, unit="metres")
         if self.min_range >= self.max_range:
             raise ValueError(f"lift: min_range ({self.min_range} m) must be below max_range ({self.max_range} m)")
         metres = ("max_range", "depth_gate", "shoulder_separation", "hip_separation", "ear_separation")
@@ -175,7 +177,13 @@ def lift_people(
     confident = scores >= params.min_score  # (comparisons with NaN: False; a NaN keypoint gets no depth)
     depth = np.full(scores.shape, np.nan)
     depth[confident] = depth_at_color_pixels(
-        depth_m, keypoints[confident], calib, patch=params.patch, search=params.depth_search
+        depth_m,
+        keypoints[confident],
+        calib,
+        patch=params.patch,
+        search=params.depth_search,
+        depth_min=params.min_range,
+        depth_max=params.max_range,
     )
     usable = (depth >= params.min_range) & (depth <= params.max_range)  # NaN (not confident, no reading): False
     # Median depth per person over its usable keypoints (unusable ones sort last as +inf; np.nanmedian is much
@@ -193,8 +201,7 @@ def lift_people(
 
     # Each keypoint's viewing ray (camera frame, through K_c^-1 [u v 1] = (ray_x, ray_y, 1)) and its range along it
     # (m; NaN where unusable); depth z and range r: r = z * |(ray_x, ray_y, 1)|.
-    intr = calib.color
-    ray = (keypoints - (intr.cx, intr.cy)) / (intr.fx, intr.fy)  # (P, 17, 2) as (ray_x, ray_y)
+    ray = np.stack(pixel_rays(keypoints[..., 0], keypoints[..., 1], calib.color), axis=-1)  # (P, 17, 2)
     ray_x, ray_y = ray[..., 0], ray[..., 1]
     norm = np.sqrt(ray_x * ray_x + ray_y * ray_y + 1.0)
     ranges = np.where(usable, depth * norm + params.surface_offset, np.nan)

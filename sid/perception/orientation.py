@@ -186,4 +186,5 @@ def _facing(
     planarity = 1.0 - max(l3, 0.0) / l2
     evidence = min(1.0, abs(across) / (_FULL_FRACTION * typical))
     quality = planarity * horizontal * evidence
-    return math.atan2(fy, fx), min(max(quality, 0.0), 1.0)
+    yaw = math.atan2(fy, fx)  # -pi for (-1, -0.0): the same direction as pi, which the range (-pi, pi] keeps
+    return math.pi if yaw == -math.pi else yaw, min(max(quality, 0.0), 1.0)

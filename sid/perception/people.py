@@ -19,7 +19,9 @@ class Person:
     """One person on the ground plane (base_footprint or map, metres, radians).
 
     theta is None when the orientation is unknown (too few keypoints, degenerate geometry).
-    orientation_quality in [0, 1]: how planar the keypoints are (1 = clean plane, 0 = unknown).
+    orientation_quality in [0, 1]: how far theta can be trusted, the product of how planar the keypoints are, how
+    horizontal that plane's normal is and how much left/right evidence tells front from back
+    (``sid.perception.orientation.estimate_orientation``); 0 = unknown.
     keypoints_world: optional (17, 3) keypoints in the same frame (z up from the ground), NaN rows where a keypoint
     was unusable.
     """

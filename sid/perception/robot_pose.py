@@ -49,7 +49,8 @@ class RobotPose:
 
     def yaw_to_map(self, yaw: float) -> float:
         """A heading in base_footprint (rad) -> the same heading in the map, wrapped to (-pi, pi]."""
-        return math.remainder(yaw + self.yaw, math.tau)
+        wrapped = math.remainder(yaw + self.yaw, math.tau)  # in [-pi, pi]: -pi is the same heading as pi
+        return math.pi if wrapped == -math.pi else wrapped
 
     def person_to_map(self, person: Person) -> Person:
         """The same person with position, facing and 3D keypoints moved from base_footprint to the map (heights

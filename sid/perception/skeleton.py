@@ -10,7 +10,7 @@ import numpy as np
 
 from sid.perception.keypoints import COCO_KEYPOINTS
 
-__all__ = ["BODY_FRACTIONS", "skeleton_world"]
+__all__ = ["skeleton_world"]
 
 # Joint centres of an upright person with arms hanging, as fractions of body height: (forward, left, up) in the
 # person's own frame, origin on the ground between the feet. Heights follow the anthropometric segment proportions
@@ -18,7 +18,7 @@ __all__ = ["BODY_FRACTIONS", "skeleton_world"]
 # hip 0.530 h, knee 0.285 h, ankle 0.039 h, eyes 0.936 h. Joint centres sit inside the outer body widths of that
 # table (shoulders 0.259 h, hips 0.191 h): we take 0.22 h between shoulder joints and 0.11 h between hip joints.
 # The face (nose, eyes) sits in front of the ears.
-_BODY_FRACTIONS = {
+_JOINT_FRACTIONS = {
     "nose": (0.055, 0.0, 0.915),
     "left_eye": (0.045, 0.018, 0.936),
     "right_eye": (0.045, -0.018, 0.936),
@@ -37,7 +37,7 @@ _BODY_FRACTIONS = {
     "left_ankle": (0.0, 0.055, 0.039),
     "right_ankle": (0.0, -0.055, 0.039),
 }
-BODY_FRACTIONS: np.ndarray = np.array([_BODY_FRACTIONS[name] for name in COCO_KEYPOINTS])
+_BODY_FRACTIONS = np.array([_JOINT_FRACTIONS[name] for name in COCO_KEYPOINTS])
 """(17, 3) keypoints of a person of height 1 in their own (forward, left, up) frame, COCO order."""
 
 
@@ -48,7 +48,7 @@ def skeleton_world(x: float, y: float, theta: float, height: float = 1.7) -> np.
     if not (np.isfinite(height) and height > 0):
         raise ValueError(f"skeleton: height must be positive (metres), got {height}")
     c, s = np.cos(theta), np.sin(theta)
-    body = BODY_FRACTIONS * height
+    body = _BODY_FRACTIONS * height
     world = np.empty_like(body)
     world[:, 0] = x + c * body[:, 0] - s * body[:, 1]
     world[:, 1] = y + s * body[:, 0] + c * body[:, 1]

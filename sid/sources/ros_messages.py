@@ -17,7 +17,7 @@ import cv2
 import numpy as np
 
 from sid.checks import check_number
-from sid.perception.camera import Calibration, Intrinsics
+from sid.perception.camera import Calibration, Intrinsics, warn_distortion
 from sid.perception.frame import Frame
 
 __all__ = [
@@ -96,13 +96,13 @@ def intrinsics_from_camera_info(msg: Any) -> Intrinsics:
 
     ROS pixel centres are at integer coordinates, as in sid (librealsense), so cx, cy carry over unchanged. The
     distortion model and coefficients are kept; sid treats the camera as an ideal pinhole (realsense2_camera
-    reports zero distortion).
+    reports zero distortion), and an InputWarning says so when ``d`` is not all zero.
     """
     k = [float(v) for v in msg.k]
     if len(k) != 9:
         raise ValueError(f"camera_info: k must hold 9 numbers, got {len(k)}")
     try:
-        return Intrinsics(
+        intrinsics = Intrinsics(
             int(msg.width),
             int(msg.height),
             k[0],
@@ -114,6 +114,8 @@ def intrinsics_from_camera_info(msg: Any) -> Intrinsics:
         )
     except ValueError as exc:
         raise ValueError(f"camera_info: {exc} (k = {k})") from None
+    warn_distortion(intrinsics, "camera_info")
+    return intrinsics
 
 
 def rgbd_frame(

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sid.checks import check_number
-from sid.perception.camera import Extrinsics, Intrinsics
+from sid.perception.camera import Extrinsics, Intrinsics, pixel_rays
 
 __all__ = ["Background", "Capsule", "LABEL_GROUND", "LABEL_NONE", "LABEL_WALL", "RayCaster", "Rendering"]
 
@@ -131,8 +131,8 @@ class RayCaster:
         self.intrinsics = intrinsics
         self.world_to_camera = world_to_camera
         self.background = background or Background()
-        self._ray_x = (np.arange(intrinsics.width) - intrinsics.cx) / intrinsics.fx  # (W,) x/z of each column
-        self._ray_y = (np.arange(intrinsics.height) - intrinsics.cy) / intrinsics.fy  # (H,) y/z of each row
+        # (W,) x/z of each column and (H,) y/z of each row
+        self._ray_x, self._ray_y = pixel_rays(np.arange(intrinsics.width), np.arange(intrinsics.height), intrinsics)
         self._bg_depth, self._bg_label, self._bg_shade, self._bg_world = self._render_background()
 
     def _render_background(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

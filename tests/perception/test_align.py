@@ -10,7 +10,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from sid.perception.align import Aligner, align_depth_to_color, depth_at_color_pixels
-from sid.perception.camera import Calibration, Extrinsics, Intrinsics
+from sid.perception.camera import Calibration, Extrinsics, Intrinsics, deproject, project
 
 DEPTH = Intrinsics(48, 36, 40.0, 41.0, 23.2, 17.6)
 COLOR = Intrinsics(80, 60, 60.0, 60.5, 39.7, 29.1)
@@ -319,3 +319,42 @@ def test_window_search_compares_float32_readings_with_the_range_in_float64() -> 
 def test_window_search_is_checked_by_name() -> None:
     with pytest.raises(ValueError, match="unknown depth search 'fast'"):
         depth_at_color_pixels(scene(seed=1), np.zeros((1, 2)), CALIB, search="fast")  # type: ignore[arg-type]
+
+
+def test_registered_lookups_check_their_options_and_apply_the_depth_range():
+    """The registered path ignored mode, value, depth_min and depth_max (a typo passed, a far wall decided)."""
+    depth = np.zeros((COLOR.height, COLOR.width), np.float32)
+    depth[28:33, 38:43] = 8.0  # a wall behind ...
+    depth[30, 39:41] = 3.0  # ... two readings of someone in front: too few to be a surface on their own
+    pixel = np.array([[40.0, 30.0]])
+    assert depth_at_color_pixels(depth, pixel, Calibration(COLOR))[0] == 8.0
+    assert depth_at_color_pixels(depth, pixel, Calibration(COLOR), depth_max=6.0)[0] == 3.0
+    assert np.isnan(depth_at_color_pixels(depth, pixel, Calibration(COLOR), depth_min=3.5, depth_max=6.0)[0])
+    for option, match in [
+        ({"mode": "points"}, "unknown splat mode 'points'"),
+        ({"value": "Z"}, "unknown stored value 'Z'"),
+        ({"depth_min": 0.0}, "need 0 < depth_min < depth_max"),
+        ({"depth_max": math.inf}, "need 0 < depth_min < depth_max"),
+    ]:
+        with pytest.raises(ValueError, match=match):
+            depth_at_color_pixels(depth, pixel, Calibration(COLOR), **option)
+
+
+@pytest.mark.parametrize("mode", ["point", "rectangle"])
+def test_alignment_places_pixels_exactly_in_images_above_2_to_the_24_pixels(mode):
+    """Flat colour-pixel indices were float32, which holds integers exactly only up to 2^24 (16.8 M): in the lower
+    part of a 6144 x 3456 image (21.2 M pixels, within the image-size limit) pixels landed up to a column off."""
+    color = Intrinsics(6144, 3456, 4800.0, 4800.0, 3071.5, 1727.5)
+    depth_intr = Intrinsics(64, 36, 50.3, 50.2, 31.3, 17.7)  # one depth pixel covers ~96 x 96 colour pixels
+    depth = np.zeros((depth_intr.height, depth_intr.width), np.float32)
+    depth[1::3, 1::3] = 2.0  # sparse: each rectangle's edges show, not hidden under its neighbours'
+    aligned = Aligner(Calibration(color, depth_intr), mode)(depth)
+    v, u = np.nonzero(depth)
+    expected = np.zeros(aligned.shape, bool)
+    shifts = [0.0] if mode == "point" else [-0.5, 0.5]  # pixel centre, or the rectangle's two corners
+    corners = [project(deproject(np.stack([u + s, v + s], 1), np.full(u.size, 2.0), depth_intr), color) for s in shifts]
+    lo, hi = (np.floor(c + 0.5).astype(int) for c in (corners[0], corners[-1]))
+    for (u0, v0), (u1, v1) in zip(lo, hi, strict=True):
+        expected[max(v0, 0) : v1 + 1, max(u0, 0) : u1 + 1] = True
+    np.testing.assert_array_equal(aligned > 0, expected)
+    assert (aligned[expected] == 2.0).all()

@@ -10,7 +10,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from sid.documents import InputWarning
-from sid.perception.camera import Calibration, Extrinsics, Intrinsics, deproject, project
+from sid.perception.camera import Calibration, Extrinsics, Intrinsics, deproject, pixel_rays, project
 from sid.perception.mount import CameraMount
 
 D435_COLOR = Intrinsics(1280, 720, 910.0, 910.0, 640.0, 360.0)
@@ -187,6 +187,22 @@ def test_calibration_values_that_are_right_still_load(tmp_path):
     assert calib.depth_scale == 0.0001 and calib.color.coeffs == (0.1,) * 5 and calib.depth is not None
 
 
+def test_misspelt_depth_section_is_warned_and_its_extrinsics_refused(tmp_path):
+    """A misspelt depth section left the depth taken as registered, its non-identity depth_to_color ignored, without
+    a word; the unread section is now named, and a calibration without depth intrinsics but with extrinsics is
+    refused."""
+    path = tmp_path / "calibration.json"
+    path.write_text(json.dumps({k: v for k, v in FULL.items() if k != "depth"} | {"depth_intrinsics": FULL["depth"]}))
+    with (
+        pytest.warns(InputWarning, match=r'fields sid does not read: \["depth_intrinsics"\]'),
+        pytest.raises(ValueError, match=f"calibration {path}: depth_to_color is not the identity but there are no"),
+    ):
+        Calibration.from_json(path)
+    with pytest.raises(ValueError, match="no depth intrinsics"):
+        Calibration(Intrinsics(640, 480, 600.0, 600.0, 320.0, 240.0), None, Extrinsics(np.eye(3), [0.015, 0, 0]))
+    Calibration(Intrinsics(640, 480, 600.0, 600.0, 320.0, 240.0), None, Extrinsics())  # registered: fine
+
+
 def test_calibration_numbers_sid_does_not_use_are_said(tmp_path, recwarn):
     """A misspelt depth_scale (0.1 mm depth read as millimetres: every depth ten times too far) and distortion sid
     does not apply were accepted without a word; each is now an InputWarning naming the file and the field. Text
@@ -197,7 +213,7 @@ def test_calibration_numbers_sid_does_not_use_are_said(tmp_path, recwarn):
         calib = Calibration.from_json(path)
     assert calib.depth_scale == 0.001
     assert [str(w.message) for w in warned] == [
-        f'calibration {path}: numbers sid does not read: ["depth_scal", "k1"] (it reads width, height, fx, fy, cx, cy, '
+        f'calibration {path}: fields sid does not read: ["depth_scal", "k1"] (it reads width, height, fx, fy, cx, cy, '
         "ppx, ppy, model, coeffs, depth_scale, depth_scale_m, depth_aligned_to_color); a misspelt field keeps its "
         "default"
     ]
@@ -212,3 +228,14 @@ def test_calibration_numbers_sid_does_not_use_are_said(tmp_path, recwarn):
     recwarn.clear()
     Calibration.from_json(path)
     assert not [w for w in recwarn if issubclass(w.category, InputWarning)]
+
+
+def test_pixel_rays_are_k_inverse_of_the_pixels():
+    intr = Intrinsics(640, 480, 525.0, 530.0, 319.5, 239.5)
+    pixels = np.array([[0.0, 0.0], [319.5, 239.5], [639.0, 100.0], [-0.5, 479.5]])
+    x, y = pixel_rays(pixels[:, 0], pixels[:, 1], intr)
+    expected = np.linalg.solve(intr.K, np.c_[pixels, np.ones(4)].T)  # K^-1 [u v 1] = (x, y, 1)
+    np.testing.assert_allclose(np.stack([x, y]), expected[:2], rtol=1e-12, atol=1e-15)
+    np.testing.assert_array_equal(deproject(pixels, np.full(4, 2.0), intr)[:, :2], 2.0 * np.stack([x, y], axis=1))
+    columns, rows = pixel_rays(np.arange(640), np.arange(480)[:, None], intr)  # each axis on its own
+    assert columns.shape == (640,) and rows.shape == (480, 1) and columns[0] == x[0] and rows[0, 0] == y[0]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -318,6 +319,7 @@ def test_bad_input_is_rejected():
         ("patch", 4),
         ("max_range", 0.0),
         ("min_range", -0.1),
+        ("min_range", 0.0),  # a reading of 0 is no reading
         ("min_range", 7.0),  # not below max_range
         ("depth_gate", -1),
         ("surface_offset", -0.01),
@@ -342,6 +344,27 @@ def test_depth_nearer_than_the_minimum_range_places_nobody():
     near = np.where(depth > 0, 0.15, 0.0).astype(depth.dtype)  # below the default 0.2 m minimum
     assert lift_people(detections, near, REGISTERED, MOUNT) == []
     assert len(lift_people(detections, near, REGISTERED, MOUNT, LiftParams(min_range=0.1, depth_gate=1.0))) == 2
+
+
+def test_the_lift_range_reaches_the_depth_lookup_registered_or_not():
+    """Unregistered depth was looked up between the lookup's own 0.1 and 10 m, whatever the lift's range: a person
+    12 m away with max_range=20 was placed from registered depth and not from unregistered depth; and registered
+    lookups read patches without any range. The lift's range now bounds the readings on both paths."""
+    depth_intr = Intrinsics(640, 480, 580.0, 580.0, 318.0, 241.0)
+    unregistered = Calibration(COLOR, depth_intr, Extrinsics(np.eye(3), [0.015, 0.0, 0.0]))
+    detections, _, _ = scene([(12.0, 0.0, math.pi)])
+    params = LiftParams(max_range=20.0)
+    far = np.full((480, 640), 12.0, np.float32)  # one uniform depth, read alike in both grids
+    [registered_person] = lift_people(detections, far, REGISTERED, MOUNT, params)
+    for search in ("window", "exact"):
+        [person] = lift_people(detections, far, unregistered, MOUNT, replace(params, depth_search=search))
+        assert person.x == pytest.approx(registered_person.x, abs=0.02)
+        assert person.y == pytest.approx(registered_person.y, abs=0.02)
+        assert (
+            np.isnan(person.keypoints_world).all(axis=1).tolist()
+            == np.isnan(registered_person.keypoints_world).all(axis=1).tolist()
+        )
+    assert lift_people(detections, far, REGISTERED, MOUNT, LiftParams(max_range=11.0)) == []
 
 
 def test_bench_lifting_four_people(benchmark):

@@ -248,3 +248,12 @@ if __name__ == "__main__":  # the failure table quoted in the module docstring
                 f"{distance} m yaw {yaw_deg:5d}: median error {np.median(err):5.1f} deg, "
                 f"flips {np.mean(err > 90):5.1%}, median quality {q:.2f}"
             )
+
+
+def test_a_person_facing_minus_x_exactly_gets_pi_not_minus_pi():
+    """Keypoints all in the plane x = 2 make the normal exactly (+-1, 0, 0); turned to face -x it was (-1, -0.0), and
+    atan2 gave -pi, outside the module's (-pi, pi]."""
+    keypoints = skeleton_world(2.0, 0.0, np.pi)
+    keypoints[:, 0] = 2.0
+    assert estimate_orientation(keypoints)[0] == np.pi
+    assert estimate_orientations(keypoints[None])[0][0] == np.pi

@@ -93,3 +93,9 @@ def test_a_turned_offset_camera_sees_people_where_they_stand_on_the_robot() -> N
         true = min(frame.truth.people, key=lambda t: math.hypot(person.x - t.x, person.y - t.y))
         assert math.hypot(person.x - true.x, person.y - true.y) < 0.05
         assert person.theta is not None and abs(math.remainder(person.theta - true.theta, math.tau)) < 0.15
+
+
+@pytest.mark.parametrize(("robot_yaw", "heading"), [(0.0, -math.pi), (-math.pi / 2, -math.pi / 2), (math.pi, 0.0)])
+def test_yaw_to_map_keeps_its_range_minus_pi_open(robot_yaw, heading) -> None:
+    """math.remainder gives -pi for an odd multiple of pi, outside the promised (-pi, pi]: it is pi now."""
+    assert RobotPose(0.0, 0.0, robot_yaw).yaw_to_map(heading) == math.pi

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from sid.documents import InputWarning
 from sid.perception.align import Aligner
 from sid.perception.camera import Calibration, Extrinsics, Intrinsics
 from sid.sources import FrameReadError, skip_unreadable
@@ -164,9 +165,19 @@ def test_bad_recordings_get_clear_errors(tmp_path: Path) -> None:
         record_synthetic(tmp_path / "x.db3", [(synthetic_frames(1)[0][0], np.zeros((480, 848), np.float32))], CALIB)
 
 
+def test_realsense_intrinsics_without_distortion_pass_quietly(recwarn) -> None:
+    blank = rs.intrinsics()  # made without a camera: zero coefficients, as a D435i reports
+    blank.width, blank.height, blank.fx, blank.fy, blank.ppx, blank.ppy = 640, 480, 600.0, 600.0, 320.0, 240.0
+    assert Intrinsics.from_rs(blank).coeffs == (0.0,) * 5
+    assert not [w for w in recwarn if issubclass(w.category, InputWarning)]
+
+
 def test_intrinsics_and_extrinsics_round_trip_through_pyrealsense2() -> None:
     intr = Intrinsics(640, 480, 612.5, 611.75, 318.25, 241.5, "inverse_brown_conrady", (0.1, -0.2, 0.001, 0.002, 0.03))
-    back = Intrinsics.from_rs(rs_intrinsics(intr))
+    with pytest.warns(
+        InputWarning, match=r"realsense intrinsics: distortion coefficients \[0.1, -0.2, 0.001, 0.002, 0.03\] are not"
+    ):
+        back = Intrinsics.from_rs(rs_intrinsics(intr))  # the distortion is kept, and said not to be applied
     assert (back.width, back.height, back.model) == (640, 480, "inverse_brown_conrady")
     np.testing.assert_allclose([back.fx, back.fy, back.cx, back.cy], [612.5, 611.75, 318.25, 241.5])
     np.testing.assert_allclose(back.coeffs, intr.coeffs, rtol=1e-6)

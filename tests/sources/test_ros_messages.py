@@ -8,6 +8,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from sid.documents import InputWarning
 from sid.sources.ros_messages import StampPairer, color_rgb, depth_metres, intrinsics_from_camera_info, rgbd_frame
 
 
@@ -67,6 +68,19 @@ def test_camera_info_and_frame() -> None:
     assert frame.depth[0, 0] == pytest.approx(1.5)
     with pytest.raises(ValueError, match="depth image is 4x3, camera_info says 5x4"):
         rgbd_frame(0, image(rgb, "rgb8"), image(mm[:3, :4], "16UC1"), intr, 0.001)
+
+
+def test_camera_info_distortion_is_said_not_applied(recwarn) -> None:
+    """Non-zero distortion in a CameraInfo was taken as an ideal pinhole without a word, as it is said for a JSON."""
+    info = SimpleNamespace(
+        width=5, height=4, k=[50, 0, 2, 0, 51, 1.5, 0, 0, 1], d=[0.1, -0.2, 0, 0, 0], distortion_model="plumb_bob"
+    )
+    with pytest.warns(InputWarning, match=r"camera_info: distortion coefficients \[0.1, -0.2, 0, 0, 0\] are not"):
+        assert intrinsics_from_camera_info(info).coeffs == (0.1, -0.2, 0.0, 0.0, 0.0)
+    recwarn.clear()
+    info.d = [0.0] * 5
+    intrinsics_from_camera_info(info)
+    assert not [w for w in recwarn if issubclass(w.category, InputWarning)]
 
 
 def test_pairing_by_stamp() -> None:

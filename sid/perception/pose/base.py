@@ -98,11 +98,6 @@ class Letterbox:
         uv = np.asarray(uv, dtype=float)
         return (uv + 0.5) * self.scale + np.array([self.pad_x, self.pad_y]) - 0.5
 
-    def to_image(self, uv: np.ndarray) -> np.ndarray:
-        """Model-input pixels (..., 2) as (u, v) -> image pixels (u, v), both pixel-centre convention."""
-        uv = np.asarray(uv, dtype=float)
-        return (uv + 0.5 - np.array([self.pad_x, self.pad_y])) / self.scale - 0.5
-
     def normalised_to_image(self, xy: np.ndarray) -> np.ndarray:
         """Model outputs normalised to the input, (..., 2) as (x, y) in [0, 1] -> image pixels (u, v)."""
         return self.normalised_to_image_in_place(np.array(xy, dtype=float))

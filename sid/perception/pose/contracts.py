@@ -97,9 +97,22 @@ def _spec(arg: Any) -> TensorSpec:  # an onnxruntime.NodeArg
 
 
 def fixed_hw(dims: Sequence[int | None]) -> tuple[int, int] | None:
-    """An input's two spatial dimensions (height, width) in pixels, or None when either is dynamic."""
+    """An input's two spatial dimensions (height, width) in pixels, or None when both are dynamic.
+
+    The contracts refuse an input with one side fixed and the other dynamic, so ``dims`` has both or neither.
+    """
     height, width = dims[0], dims[1]
     return None if height is None or width is None else (height, width)
+
+
+def _half_dynamic(height: int | None, width: int | None) -> str | None:
+    if (height is None) == (width is None):
+        return None
+    dims = " x ".join("?" if d is None else str(d) for d in (height, width))
+    return (
+        f"input height x width {dims} has one side fixed and the other dynamic; export the model with both "
+        "fixed or both dynamic"
+    )
 
 
 def _dim_is(dim: int | None, *allowed: int) -> bool:
@@ -117,7 +130,7 @@ def _nhwc_image(spec: TensorSpec, dtypes: tuple[type, ...]) -> str | None:
         return f"input dtype {spec.dtype}, expected {' or '.join(np.dtype(d).name for d in dtypes)}"
     if len(spec.shape) != 4 or not _dim_is(spec.shape[0], 1) or not _dim_is(spec.shape[3], 3):
         return f"input shape {list(spec.shape)}, expected [1, H, W, 3]"
-    return None
+    return _half_dynamic(spec.shape[1], spec.shape[2])
 
 
 def _multipose_mismatch(sig: ModelSignature) -> str | None:
@@ -167,7 +180,9 @@ def _yolo_mismatch(sig: ModelSignature) -> str | None:
         or not all(map(_dim_is, out.shape[:2], (1, 56)))
     ):
         return f"output {out.dtype} {list(out.shape)}, expected float32 [1, 56, N]"
-    return None
+    if out.shape[1] is None and out.shape[2] == 56:
+        return f"output {list(out.shape)} looks transposed ([1, N, 56]), expected float32 [1, 56, N]"
+    return _half_dynamic(*(spec.shape[2:4] if yolo_layout(spec) == "nchw" else spec.shape[1:3]))
 
 
 CONTRACTS: dict[str, Contract] = {

@@ -154,7 +154,7 @@ class MoveNetMultiPose:
         clip_corners(points[:, NUM_KEYPOINTS:], image_hw)
         scores = rows[:, 2:51:3].astype(float)
         return [
-            PoseDetection(p[:NUM_KEYPOINTS], s, p[NUM_KEYPOINTS:], r)
+            PoseDetection(p[:NUM_KEYPOINTS], s, p[NUM_KEYPOINTS:].reshape(4), r)
             for p, s, r in zip(points, scores, rows[:, 55].tolist(), strict=True)
         ]
 

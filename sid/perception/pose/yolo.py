@@ -62,7 +62,8 @@ class YoloPose:
             self._size = (h, w)
         self._dtype = spec.dtype
         self._pixel_unit = 1.0 / np.array(self._size[::-1], dtype=float)  # input px -> [0, 1], for pixel exports
-        self.normalised = self._outputs_normalised() if normalised is None else bool(normalised)
+        probed = self._outputs_normalised()  # also checks the output's real shape, so it runs either way
+        self.normalised = probed if normalised is None else bool(normalised)
 
     @property
     def input_size(self) -> tuple[int, int]:
@@ -71,17 +72,23 @@ class YoloPose:
     def _outputs_normalised(self) -> bool:
         """Run once on a grey image: are candidate centres normalised to the input (all within ~[0, 1])?
 
-        Also warms the session up, so the first real frame is not slowed by one-off allocations.
+        Also checks that the output really is [1, 56, N] (a declared shape may be dynamic), and warms the session
+        up, so the first real frame is not slowed by one-off allocations.
         """
         h, w = self._size
         tensor, _ = self.preprocess(np.full((h, w, 3), PAD_VALUE, np.uint8))
-        centres = self.infer(tensor).reshape(56, -1)[:2]
-        if centres.size == 0:
+        output = self.infer(tensor)
+        if output.ndim != 3 or output.shape[:2] != (1, 56):
+            raise PoseModelError(
+                f"yolo: {self.model.path}: the model answers an output of shape {list(output.shape)} for a "
+                f"{h} x {w} input; a YOLO pose export answers [1, 56, N], one column of 56 values per candidate"
+            )
+        if output.shape[2] == 0:
             raise PoseModelError(
                 f"yolo: {self.model.path}: the model answers no candidates (output [1, 56, 0]); a YOLO pose export "
                 "answers one per anchor, e.g. 8400 at 640 x 640"
             )
-        return bool(np.nanmax(np.abs(centres)) <= NORMALISED_LIMIT)
+        return bool(np.nanmax(np.abs(output[0, :2])) <= NORMALISED_LIMIT)
 
     def preprocess(self, color_rgb: np.ndarray) -> tuple[np.ndarray, Letterbox]:
         """RGB uint8 image -> float [1, H, W, 3] or [1, 3, H, W] input in 0..1, and the letterbox that made it."""
@@ -123,7 +130,7 @@ class YoloPose:
         clip_corners(points[:, NUM_KEYPOINTS:], image_hw)
         scores = kept[:, 7::3].astype(float)
         return [
-            PoseDetection(p[:NUM_KEYPOINTS], s, p[NUM_KEYPOINTS:], c)
+            PoseDetection(p[:NUM_KEYPOINTS], s, p[NUM_KEYPOINTS:].reshape(4), c)
             for p, s, c in zip(points, scores, kept[:, 4].tolist(), strict=True)
         ]
 

@@ -59,6 +59,19 @@ def test_multipose_input_must_be_a_multiple_of_32():
         detect_contract(_signature(np.int32, (1, 250, 256, 3), (1, 6, 56)), "movenet_multipose")
 
 
+@pytest.mark.parametrize(
+    ("in_dtype", "in_shape", "out_shape"),
+    [
+        (np.int32, (1, 256, None, 3), (1, 6, 56)),
+        (np.uint8, (1, None, 192, 3), (1, 1, 17, 3)),
+        (np.float32, (1, 3, 256, None), (1, 56, None)),
+    ],
+)
+def test_half_dynamic_inputs_fit_no_contract(in_dtype, in_shape, out_shape):
+    with pytest.raises(PoseModelError, match="one side fixed and the other dynamic"):
+        detect_contract(_signature(in_dtype, in_shape, out_shape))
+
+
 def test_explicit_contract_must_exist_and_fit():
     multipose = _signature(np.int32, (1, None, None, 3), (1, 6, 56))
     assert detect_contract(multipose, "movenet_multipose") == "movenet_multipose"

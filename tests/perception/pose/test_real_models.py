@@ -6,7 +6,7 @@ import cv2
 import numpy as np
 import pytest
 
-from sid.perception.keypoints import LEFT_HIP, LEFT_SHOULDER, RIGHT_HIP, RIGHT_SHOULDER
+from sid.perception.keypoints import KP, LEFT_SHOULDER, RIGHT_SHOULDER
 from sid.perception.overlay import draw_detections
 from sid.perception.pose import load_pose_estimator
 from tests.conftest import shared_path
@@ -31,7 +31,7 @@ def yolo_people(color):
 def _on_body(keypoints: np.ndarray, box: np.ndarray) -> None:
     """Shoulders and hips inside the person's box, shoulders above hips, and (backs to the camera) the person's
     left side on the image's left."""
-    torso = keypoints[[LEFT_SHOULDER, RIGHT_SHOULDER, LEFT_HIP, RIGHT_HIP]]
+    torso = keypoints[[LEFT_SHOULDER, RIGHT_SHOULDER, KP["left_hip"], KP["right_hip"]]]
     assert np.all((torso[:, 0] >= box[0]) & (torso[:, 0] <= box[2]) & (torso[:, 1] >= box[1]) & (torso[:, 1] <= box[3]))
     assert max(torso[0, 1], torso[1, 1]) < min(torso[2, 1], torso[3, 1])
     assert torso[0, 0] < torso[1, 0] and torso[2, 0] < torso[3, 0]
@@ -56,11 +56,11 @@ def test_movenet_singlepose_on_each_crop_puts_shoulders_and_hips_on_the_body(yol
     for person, box in zip(found, boxes, strict=True):
         np.testing.assert_array_equal(person.box, box)
         assert person.box_score > estimator.score_threshold
-        assert person.scores[[LEFT_SHOULDER, RIGHT_SHOULDER, LEFT_HIP, RIGHT_HIP]].min() > 0.3
+        assert person.scores[[LEFT_SHOULDER, RIGHT_SHOULDER, KP["left_hip"], KP["right_hip"]]].min() > 0.3
         _on_body(person.keypoints, box)
         # Agrees with YOLO's own torso keypoints to within a tenth of the person's height.
         yolo = next(d for d in yolo_people if np.array_equal(d.box, box))
-        torso = [LEFT_SHOULDER, RIGHT_SHOULDER, LEFT_HIP, RIGHT_HIP]
+        torso = [LEFT_SHOULDER, RIGHT_SHOULDER, KP["left_hip"], KP["right_hip"]]
         assert np.abs(person.keypoints[torso] - yolo.keypoints[torso]).max() < 0.1 * (box[3] - box[1])
 
 

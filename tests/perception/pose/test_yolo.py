@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from sid.perception.pose import YoloPose, load_pose_estimator
-from tests.pose_models import build_yolo_pose_model, yolo_candidate
+from sid.perception.pose.contracts import PoseModelError
+from tests.pose_models import build_model_with_output, build_yolo_pose_model, yolo_candidate
 
 IMAGE = np.zeros((480, 640, 3), np.uint8)  # in 256x256: scale 0.4, 32 px bands above and below
 
@@ -89,3 +90,24 @@ def test_dynamic_size_defaults_to_640_and_accepts_a_choice(tmp_path, candidates)
     assert load_pose_estimator(path, input_size=(384, 512)).input_size == (384, 512)
     with pytest.raises(ValueError, match="multiples of 32"):
         load_pose_estimator(path, input_size=500)
+
+
+@pytest.mark.parametrize(
+    ("declared", "match"),
+    [
+        ([1, "n", "c"], r"output of shape \[1, 30, 56\].*answers \[1, 56, N\]"),  # checked when loaded
+        ([1, "n", 56], r"output \[1, None, 56\] looks transposed"),  # refused by the contract
+    ],
+)
+def test_transposed_output_is_refused_naming_its_shape(tmp_path, declared, match):
+    transposed = np.zeros((1, 30, 56), np.float32)  # [1, N, 56]: reshaped to [56, N] it would be garbage
+    path = build_model_with_output(tmp_path / "t.onnx", transposed, declared, [1, 256, 256, 3])
+    with pytest.raises(PoseModelError, match=match):
+        load_pose_estimator(path)
+
+
+@pytest.mark.parametrize(("input_hw", "layout"), [((256, None), "nchw"), ((None, 320), "nhwc")])
+def test_half_dynamic_input_is_refused_naming_its_sides(tmp_path, candidates, input_hw, layout):
+    path = build_yolo_pose_model(tmp_path / "y.onnx", candidates, input_hw=input_hw, layout=layout)
+    with pytest.raises(PoseModelError, match="one side fixed and the other dynamic"):
+        load_pose_estimator(path, input_size=(256, 320))
