@@ -331,16 +331,17 @@ def test_lifting_refuses_more_detections_than_the_limit():
 
 def test_a_mirror_or_a_baseline_in_millimetres_as_depth_to_colour_is_refused(tmp_path):
     folder = one_frame_folder(tmp_path)
+    sections = {k: v for k, v in INTRINSICS.items() if k != "depth_scale"}  # a stream's section has no depth scale
     mirror = [[-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]  # orthonormal, determinant -1
     extrinsics = {"rotation": mirror, "translation": [0.0, 0.0, 0.0]}
     (folder / "intrinsics.json").write_text(
-        json.dumps({"color": INTRINSICS, "depth": INTRINSICS, "depth_to_color": extrinsics})
+        json.dumps({"color": sections, "depth": sections, "depth_to_color": extrinsics})
     )
     with pytest.raises(ValueError, match="depth_to_color: rotation has determinant -1, a mirror rather than a rota"):
         Calibration.from_json(folder / "intrinsics.json")
     millimetres = {"rotation": np.eye(3).tolist(), "translation": [15.0, 0.0, 0.0]}  # 15 mm written as 15 m
     (folder / "intrinsics.json").write_text(
-        json.dumps({"color": INTRINSICS, "depth": INTRINSICS, "depth_to_color": millimetres})
+        json.dumps({"color": sections, "depth": sections, "depth_to_color": millimetres})
     )
     with pytest.raises(ValueError, match="depth_to_color: translation 15 m is more than 1 m; the two sensors"):
         Calibration.from_json(folder / "intrinsics.json")
