@@ -586,7 +586,8 @@ SYNTHETIC_FRAMES = 30
 def pose_model(model: Path | None, source: str | None, **load: Any) -> PoseFn:
     """The pose function frames of ``source`` (a source spec; None: camera topics) are run through: the pose model
     ``model`` (an .onnx file, loaded with the ``load`` options of ``load_pose_estimator``), else, for a
-    ``synthetic:SCENE`` source, its people's true poses (``TruthPose``). SourceError when neither applies."""
+    ``synthetic:SCENE`` source, its people's true poses (``TruthPose``), when no ``load`` option is given (else
+    ValueError: they would be ignored). SourceError when neither applies."""
     if model is not None:
         from sid.perception.pipeline import image_pose
         from sid.perception.pose import load_pose_estimator
@@ -597,6 +598,13 @@ def pose_model(model: Path | None, source: str | None, **load: Any) -> PoseFn:
     if source is not None and source.startswith("synthetic:"):
         from sid.synthetic.pose import TruthPose
 
+        options = {"threads": "--threads", "providers": "--provider", "contract": "--contract"}
+        given = [options.get(name, name) for name, value in load.items() if value not in (None, "auto")]
+        if given:  # they set up a model's session: without a model they would be ignored in silence
+            raise ValueError(
+                f"{', '.join(given)}: an option of the pose model's session, and there is no --model (the synthetic "
+                "source's true poses stand in for one); give --model to run a model"
+            )
         return TruthPose()
     from sid.sources import SourceError
 

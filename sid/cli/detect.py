@@ -74,14 +74,15 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         type=positive_int,
         default=None,
         metavar="N",
-        help="pose model threads (default: the physical cores this process may use)",
+        help="pose model (--model) threads (default: the physical cores this process may use)",
     )
     parser.add_argument(
         "--provider",
         choices=PROVIDER_CHOICES,
         default="auto",
-        help="onnxruntime execution provider for the pose model: 'auto' (default) uses OpenVINO when "
-        f"onnxruntime-openvino is installed ({install_hint('openvino')}), else CPU",
+        help="onnxruntime execution provider for the pose model (--model): 'auto' (default) uses TensorRT or CUDA "
+        "when this onnxruntime offers them, else OpenVINO when onnxruntime-openvino is installed "
+        f"({install_hint('openvino')}), else CPU",
     )
     parser.add_argument(
         "--frames", type=positive_int, help=f"stop after this many frames (default: all; synthetic: {SYNTHETIC_FRAMES})"
@@ -94,8 +95,18 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="RealSense sources: 'none' (default) looks depth up sparsely at the keypoints, the "
         "cheapest; 'sid' or 'librealsense' align every depth frame to colour first",
     )
-    parser.add_argument("--camera-height", type=float, default=CameraMount.height, help="metres above the ground")
-    parser.add_argument("--camera-tilt", type=float, default=CameraMount.tilt, help="downward pitch, radians")
+    parser.add_argument(
+        "--camera-height",
+        type=float,
+        default=CameraMount.height,
+        help=f"metres above the ground (default {CameraMount.height:g})",
+    )
+    parser.add_argument(
+        "--camera-tilt",
+        type=float,
+        default=CameraMount.tilt,
+        help=f"downward pitch, radians (default {CameraMount.tilt:g})",
+    )
     parser.add_argument(
         "--keypoint-threshold",
         type=float,
@@ -376,6 +387,9 @@ def run(args: argparse.Namespace) -> int:
     waiting = f", {plural(unconfirmed, 'frame')} with no confirmed track yet (people: [])" if unconfirmed else ""
     summary = f"{plural(done - unconfirmed, 'frame')} with people{waiting}, {skipped} skipped{rate}{median}"
     print(f"detect: {summary}", file=sys.stderr)
+    if args.out is not None:  # as every command that writes files says what it wrote; stdout is the JSON lines'
+        pictures = f" and {done} overlay_*.png, {done} topview_*.png beside it" if done else ""
+        print(f"detect: wrote {args.out / 'detections.jsonl'}{pictures}", file=sys.stderr)
     if not interrupted and unreadable and unreadable == done + skipped:  # bad input, not a scene without people
         print(f"detect: no frame of the source could be read ({plural(unreadable, 'frame')} tried)", file=sys.stderr)
         return ExitCode.USAGE

@@ -103,3 +103,21 @@ def test_a_frame_out_of_time_order_is_skipped_and_the_tracks_go_on(capsys, monke
     assert "5 frames with people, 2 frames with no confirmed track yet (people: []), 1 skipped" in captured.err
     ids = [sorted(p["id"] for p in r["people"]) for r in records[2:]]
     assert all(i == ids[0] for i in ids) and len(ids[0]) == 2
+
+
+def test_the_files_written_are_named_on_stderr_and_stdout_stays_json(tmp_path, capsys) -> None:
+    assert main(["detect", "--source", "synthetic:S1", "--frames", "3", "--out", str(tmp_path)]) == 0
+    captured = capsys.readouterr()
+    assert all(line.startswith("{") for line in captured.out.splitlines())
+    wrote = f"detect: wrote {tmp_path / 'detections.jsonl'} and 3 overlay_*.png, 3 topview_*.png beside it"
+    assert captured.err.splitlines()[-1] == wrote
+    assert len(list(tmp_path.glob("overlay_*.png"))) == len(list(tmp_path.glob("topview_*.png"))) == 3
+
+
+def test_session_options_without_a_model_are_refused_not_ignored(capsys) -> None:
+    # A synthetic source without --model runs its true poses: --provider and --threads would change nothing.
+    for option in (["--provider", "openvino"], ["--threads", "1"], ["--contract", "yolo"]):
+        assert main(["detect", "--source", "synthetic:S1", "--frames", "2", *option]) == 2
+        assert f"detect: {option[0]}: an option of the pose model's session, and there is no --model" in (
+            capsys.readouterr().err
+        )
