@@ -388,8 +388,8 @@ def run(args: argparse.Namespace) -> int:
     summary = f"{plural(done - unconfirmed, 'frame')} with people{waiting}, {skipped} skipped{rate}{median}"
     print(f"detect: {summary}", file=sys.stderr)
     if args.out is not None:  # as every command that writes files says what it wrote; stdout is the JSON lines'
-        pictures = f" and {done} overlay_*.png, {done} topview_*.png beside it" if done else ""
-        print(f"detect: wrote {args.out / 'detections.jsonl'}{pictures}", file=sys.stderr)
+        beside = f" and {done} overlay_*.png, {done} topview_*.png beside it" if done else ""
+        print(f"detect: wrote {args.out / 'detections.jsonl'}{beside}", file=sys.stderr)
     if not interrupted and unreadable and unreadable == done + skipped:  # bad input, not a scene without people
         print(f"detect: no frame of the source could be read ({plural(unreadable, 'frame')} tried)", file=sys.stderr)
         return ExitCode.USAGE
