@@ -241,6 +241,14 @@ class SyntheticCamera:
         self._cached_groups: tuple[tuple, list[TruthGroup]] | None = None
         self._views: dict[tuple[CameraMount, float | None], _Views] = {}
 
+    def forget_renders(self) -> None:
+        """Drop the kept exact renders, bodies and group geometry: the next ``capture`` casts its scene afresh. The
+        ray casters of each mount and background stay (they are built once per stream)."""
+        self._cached = None
+        self._still = None
+        self._bodies = {}
+        self._cached_groups = None
+
     @property
     def depth_intrinsics(self) -> Intrinsics:
         return self.calibration.depth or self.calibration.color

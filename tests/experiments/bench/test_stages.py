@@ -274,3 +274,33 @@ def test_frame_and_lift_stages_without_shared_data(tmp_path):
         _check_stage(report["stages"][f"frame/2/{part}"])
     assert report["stages"]["lift/4"]["people"] == 4
     assert any("pose = TruthPose" in note for note in report["notes"])
+
+
+def test_render_stage_casts_every_timed_frame_and_noise_stage_reuses_the_render(tmp_path, monkeypatch):
+    """``synthetic/render`` times a fresh ray cast per call (not the camera's kept render); ``synthetic/noise``
+    times the kept-render path, which casts only while building the first frame."""
+    from sid.synthetic import render as render_module
+
+    casts = []
+    original = render_module.RayCaster.render
+    monkeypatch.setattr(
+        render_module.RayCaster, "render", lambda self, *a, **k: casts.append(1) or original(self, *a, **k)
+    )
+    settings = RunSettings(warmup=1, min_runs=3, max_runs=3, budget_s=1e-9)
+    ctx = _context(tmp_path, settings)
+    items = benchmarks(ctx)
+    stages = run_suite(select(items, "synthetic/render"), ctx).stages
+    assert stages["synthetic/render"]["runs"] == 3
+    assert len(casts) >= 1 + 3 + 3  # the empty floor, then at least one cast per call (warm-up and timed)
+    casts.clear()
+    stages = run_suite(select(items, "synthetic/noise"), ctx).stages
+    _check_stage(stages["synthetic/noise"])
+    first_frame = len(casts)
+    assert first_frame >= 1
+    casts.clear()
+    from sid.experiments.bench.stages.inputs import frame_scene
+    from sid.synthetic import SyntheticCamera
+
+    camera, scene = SyntheticCamera(), frame_scene(4)
+    camera.capture(scene, index=0)
+    assert len(casts) == first_frame  # the noise stage's 4 calls cast no more than one frame needs
