@@ -304,3 +304,25 @@ def test_render_stage_casts_every_timed_frame_and_noise_stage_reuses_the_render(
     camera, scene = SyntheticCamera(), frame_scene(4)
     camera.capture(scene, index=0)
     assert len(casts) == first_frame  # the noise stage's 4 calls cast no more than one frame needs
+
+
+def test_compare_shows_minimums_and_warns_about_other_settings_and_other_work():
+    def report(quick: bool, provider: str, pose: str, min_ms: float) -> dict:
+        return {
+            "machine": {"cpu": "same cpu"},
+            "settings": {"quick": quick, "pose_provider": provider, "pose_threads": 2, "plan_runs": 5},
+            "stages": {
+                "frame/4": {"median_ms": 10.0, "min_ms": min_ms, "max_ms": 12.0, "runs": 9, "pose": pose},
+                "pose/m": {"median_ms": 5.0, "min_ms": 4.0, "max_ms": 6.0, "runs": 9, "provider": provider},
+            },
+        }
+
+    same = format_comparison(report(False, "cpu", "yolo", 8.0), report(False, "cpu", "yolo", 7.5))
+    assert "warning" not in same
+    header, row = same.splitlines()[0].split(), next(r for r in same.splitlines() if r.startswith("frame/4 ")).split()
+    assert header == ["stage", "old", "median", "new", "median", "new/old", "old", "min", "new", "min"]
+    assert row == ["frame/4", "10.000", "10.000", "1.00", "8.000", "7.500"]
+    changed = format_comparison(report(False, "cpu", "yolo", 8.0), report(True, "cuda", "TruthPose", 8.0))
+    assert "warning: different run settings (quick False -> True; pose_provider 'cpu' -> 'cuda')" in changed
+    assert "warning: frame/4 timed other work (pose 'yolo' -> 'TruthPose')" in changed
+    assert "warning: pose/m timed other work (provider 'cpu' -> 'cuda')" in changed
