@@ -153,15 +153,13 @@ def check_number(
     unit: str = "",
     error: type[Exception] = ValueError,
 ) -> None:
-    """Raise ``error`` unless ``value`` is a finite number within [low, high] (bounds optional).
+    """Raise ``error`` unless ``value`` is a finite real number (``is_real``: not a bool, a string or bytes) within
+    [low, high] (bounds optional).
 
     low_open / high_open exclude that bound; allow_inf also accepts +inf (a switch-off value, e.g. a radius);
     unit (e.g. "metres") only words the message.
     """
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        number = math.nan
+    number = float(value) if is_real(value) else math.nan
     ok = math.isfinite(number) or (allow_inf and number == math.inf)
     ok = ok and (low is None or (number > low if low_open else number >= low))
     ok = ok and (high is None or (number < high if high_open else number <= high))
