@@ -197,9 +197,11 @@ class SyntheticCamera:
     """Renders scenes as a D435i-like RGB-D camera would see them.
 
     calibration: default ``d435i_calibration(registered)``; with ``calibration.depth`` None the depth is rendered in
-    the colour grid. noise / keypoint_noise: see ``sid.synthetic.noise`` (``DepthNoise.exact()`` and
-    ``KeypointNoise(0, 0)`` for perfect data). sensor_focal_px: focal length (px) of the stereo pair for the noise
-    model when depth is registered (default the D435's 420 px at 848x480). occlusion_margin (m): a keypoint is
+    the colour grid. registered: only without a calibration (one that says otherwise is refused). noise /
+    keypoint_noise: see ``sid.synthetic.noise`` (``DepthNoise.exact()`` and ``KeypointNoise(0, 0)`` for perfect
+    data). sensor_focal_px: focal length (px, > 0) of the stereo pair for the noise model when depth is registered
+    (default the D435's 420 px at 848x480); with depth intrinsics the noise uses their fx, and another value is
+    refused. occlusion_margin (m): a keypoint is
     hidden when another person's surface lies this much nearer at its pixel. self_occlusion_margin (m): a keypoint
     is self-occluded when its own body's surface lies this much nearer (joints sit 4-11 cm inside limbs and torso
     seen from the front; 0.15 m catches the face seen from behind, ~0.18 m deep, and the far shoulder of someone in
@@ -211,22 +213,37 @@ class SyntheticCamera:
     def __init__(
         self,
         calibration: Calibration | None = None,
-        registered: bool = False,
+        registered: bool | None = None,
         noise: DepthNoise | None = None,
         keypoint_noise: KeypointNoise | None = None,
-        sensor_focal_px: float = 420.0,
+        sensor_focal_px: float | None = None,
         occlusion_margin: float = 0.10,
         self_occlusion_margin: float | None = 0.15,
         shaded_color: bool = True,
         fps: float = 30.0,
         group_params: GroupParams | None = None,
     ):
-        self.calibration = calibration or d435i_calibration(registered)
+        if calibration is not None and registered is not None and registered != (calibration.depth is None):
+            said = "registered" if calibration.depth is None else "not registered (it has depth intrinsics)"
+            raise ValueError(
+                f"synthetic camera: registered={registered} contradicts the calibration, whose depth is {said}; "
+                "pass registered only without a calibration"
+            )
+        self.calibration = calibration or d435i_calibration(bool(registered))
         self.noise = noise if noise is not None else DepthNoise()
         self.keypoint_noise = keypoint_noise if keypoint_noise is not None else KeypointNoise()
+        depth = self.calibration.depth
+        if depth is not None and sensor_focal_px is not None and sensor_focal_px != depth.fx:
+            raise ValueError(
+                f"synthetic camera: sensor_focal_px {sensor_focal_px} contradicts the calibration's depth fx "
+                f"{depth.fx}; sensor_focal_px is for registered depth only (unregistered depth uses its own fx)"
+            )
+        if depth is not None:
+            sensor_focal_px = depth.fx
+        elif sensor_focal_px is None:
+            sensor_focal_px = D435I_DEPTH.fx
+        check_number("synthetic camera", "sensor_focal_px", sensor_focal_px, low=0, low_open=True, unit="pixels")
         self.sensor_focal_px = float(sensor_focal_px)
-        if self.calibration.depth is not None:
-            self.sensor_focal_px = self.calibration.depth.fx
         self.occlusion_margin = float(occlusion_margin)
         self.self_occlusion_margin = None if self_occlusion_margin is None else float(self_occlusion_margin)
         margins = ["occlusion_margin"] + ([] if self.self_occlusion_margin is None else ["self_occlusion_margin"])
