@@ -309,6 +309,7 @@ class SyntheticCamera:
             if pose is not None:
                 keypoints = np.column_stack([pose.to_map(keypoints[:, :2]), keypoints[:, 2]])
             vx, vy = velocities.get(person.id, (0.0, 0.0))
+            # each frame's truth owns its arrays: the render they come from is kept for the next frames
             truth_people.append(
                 TruthPerson(
                     person.id,
@@ -316,13 +317,13 @@ class SyntheticCamera:
                     person.y,
                     person.theta,
                     person.height,
-                    keypoints,
-                    render.keypoints_px[i],
-                    render.visible[i],
-                    render.self_occluded[i],
+                    keypoints.copy() if pose is None else keypoints,
+                    render.keypoints_px[i].copy(),
+                    render.visible[i].copy(),
+                    render.self_occluded[i].copy(),
                     observed_px,
                     render.visible[i] & kept,
-                    render.boxes[i],
+                    render.boxes[i].copy(),
                     vx,
                     vy,
                     vx != 0.0 or vy != 0.0,
