@@ -10,7 +10,7 @@ import pytest
 import yaml
 
 from sid.perception.people import Person
-from sid.synthetic.layouts import LAYOUTS, VARIATIONS, layout, variations
+from sid.synthetic.layouts import LAYOUTS, VARIATIONS, Formation, layout, variations
 from sid.synthetic.scene import Scene
 from sid.synthetic.sequence import SyntheticSequence, load_scene_file
 from tests.conftest import REPO_ROOT
@@ -54,6 +54,24 @@ def test_all_variations_stand_1_5_to_3_m_in_front_of_the_camera(name: str) -> No
         x = _xy(scene)[:, 0]
         assert x.min() >= 1.5 and x.max() <= 3.05
     assert len({tuple(map(tuple, _xy(s).round(6))) for s in scenes}) == len(VARIATIONS)  # all different
+
+
+def test_variations_apply_to_the_callers_formation() -> None:
+    """Nearer/further move from the caller's centre distance, turns add to the caller's rotation, the jitter
+    variations' seeds add to the caller's; the options the jitter variations set are refused."""
+    scenes = variations("S3", centre_distance=3.0, rotation=0.3, seed=5)
+    centres = [float(np.mean(_xy(s)[:, 0])) for s in scenes[:5]]  # the triangle's centroid is its centre
+    np.testing.assert_allclose(centres, [3.0, 3.0, 3.0, 2.85, 3.15], atol=1e-9)
+    turn = np.radians(LAYOUTS["S3"].turn_deg)
+    for scene, rotation in zip(scenes[:3], (0.3, 0.3 - turn, 0.3 + turn), strict=True):
+        assert scene == layout("S3", centre_distance=3.0, rotation=rotation)
+    assert scenes[5] == layout(
+        "S3", centre_distance=3.0, rotation=0.3, jitter_xy=0.05, jitter_theta=np.radians(5.0), seed=6
+    )
+    assert scenes[5] != variations("S3", centre_distance=3.0, rotation=0.3)[5]
+    assert variations("S3") == variations("S3", formation=Formation())
+    with pytest.raises(ValueError, match="variations of S3: jitter_xy are set by the jitter variations"):
+        variations("S3", jitter_xy=0.1)
 
 
 def test_focus_offset_opens_the_group_towards_the_camera() -> None:
