@@ -203,11 +203,11 @@ def check_whole(
     return int(number)
 
 
-def check_yaw(owner: str, name: str, value: float) -> None:
-    """ValueError unless ``value`` is a yaw within two turns of 0 (``YAW_LIMIT_RAD``): 90 or 180 is a facing in
+def check_yaw(owner: str, name: str, value: float, error: type[Exception] = ValueError) -> None:
+    """Raise ``error`` unless ``value`` is a yaw within two turns of 0 (``YAW_LIMIT_RAD``): 90 or 180 is a facing in
     degrees, which read as radians points anywhere. ``value`` is a finite number already."""
     if abs(value) > YAW_LIMIT_RAD:
-        raise ValueError(f"{owner}: {name} {value:g} is beyond two turns (4 pi): radians expected, not degrees")
+        raise error(f"{owner}: {name} {value:g} is beyond two turns (4 pi): radians expected, not degrees")
 
 
 def check_numbers(owner: str, record: object, names: Iterable[str], **bounds: Any) -> None:

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from sid.checks import check_numbers
+from sid.checks import check_numbers, check_yaw
 from sid.documents import load_document
 from sid.perception.mount import CameraMount
 from sid.perception.people import Person
@@ -36,6 +36,7 @@ class ScenePerson:
 
     def __post_init__(self) -> None:
         check_numbers(f"scene person {self.id}", self, ("x", "y", "theta", "height"))
+        check_yaw(f"scene person {self.id}", "theta", self.theta)
         if not 0.5 <= self.height <= 2.5:
             raise ValueError(f"scene person {self.id}: height {self.height} m is not a standing person (0.5-2.5 m)")
 
