@@ -65,21 +65,34 @@ class Stats:
 
 def measure_parts(fn: Callable[[], dict[str, float]], settings: RunSettings) -> dict[str, Stats]:
     """Time a call that reports its own parts: ``fn()`` returns milliseconds per part name (the same names on
-    every call). Returns the statistics of each part over the timed calls."""
+    every call). Returns the statistics of each part over the timed calls; ValueError when a call reports no part
+    or other names than the first call."""
+    names: list[str] | None = None
+
+    def call() -> dict[str, float]:
+        nonlocal names
+        parts = fn()
+        if not parts:
+            raise ValueError("bench: a timed call reported no parts")
+        if names is None:
+            names = list(parts)
+        elif list(parts) != names:
+            raise ValueError(f"bench: a timed call reported parts {list(parts)}, an earlier one {names}")
+        return parts
+
     for _ in range(settings.warmup):
-        fn()
+        call()
     samples: dict[str, list[float]] = {}
     was_enabled = gc.isenabled()
     gc.collect()
     gc.disable()
     try:
-        spent_ns, budget_ns = 0, int(settings.budget_s * 1e9)
-        while len(next(iter(samples.values()), ())) < settings.max_runs and (
-            spent_ns < budget_ns or len(next(iter(samples.values()), ())) < settings.min_runs
-        ):
+        calls, spent_ns, budget_ns = 0, 0, int(settings.budget_s * 1e9)
+        while calls < settings.max_runs and (spent_ns < budget_ns or calls < settings.min_runs):
             start = time.perf_counter_ns()
-            parts = fn()
+            parts = call()
             spent_ns += time.perf_counter_ns() - start
+            calls += 1
             for name, value in parts.items():
                 samples.setdefault(name, []).append(float(value))
     finally:

@@ -168,6 +168,37 @@ def test_harness_counts_runs_and_restores_the_collector():
         RunSettings(warmup=0, min_runs=5, max_runs=2, budget_s=1.0)
 
 
+@pytest.mark.parametrize(
+    ("replies", "message"),
+    [
+        ([{}], "reported no parts"),  # looped forever: the stop counted the first part's samples
+        ([{"a": 1.0}, {"b": 1.0}], r"reported parts \['b'\], an earlier one \['a'\]"),
+        ([{"a": 1.0, "b": 2.0}, {"b": 2.0, "a": 1.0}], "an earlier one"),
+    ],
+)
+def test_harness_refuses_calls_without_parts_or_with_other_parts(replies, message):
+    import signal
+
+    calls = iter(range(10**6))
+
+    def fn() -> dict[str, float]:
+        return replies[min(next(calls), len(replies) - 1)]
+
+    def stop(*_: object) -> None:
+        raise TimeoutError("measure_parts did not return")
+
+    previous = signal.signal(signal.SIGALRM, stop)
+    signal.alarm(10)
+    try:
+        for warmup in (0, 1):
+            with pytest.raises(ValueError, match=message):
+                calls = iter(range(10**6))
+                measure_parts(fn, RunSettings(warmup=warmup, min_runs=1, max_runs=5, budget_s=60.0))
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
+
+
 @pytest.mark.parametrize("method", ["ospace", "rays"])
 def test_grouping_scene_is_seeded_one_crowd_of_circles(method):
     people = grouping_scene(20)
