@@ -7,7 +7,8 @@ robot's pose). Ground truth is in the same frame as the scene (``FrameTruth.fram
 Cameras: the colour camera's optical frame is the one the mount places on the robot (the frame the pipeline
 lifts keypoints from); the depth camera sits ``depth_to_color`` away from it (p_color = R p_depth + t). Defaults are
 typical D435i values: colour 1280x720 with fx = fy = 910 px, depth 848x480 with fx = fy = 420 px, the depth
-camera 15 mm to the left of the colour camera (depth -> colour translation +15 mm along x).
+camera 15 mm along +x of the colour optical frame, i.e. to the colour camera's right looking along its view (depth ->
+colour translation +15 mm along x).
 
 Per frame: exact depth from a ray caster (``render``), then D435-like noise (``noise.DepthNoise``); truth
 keypoints are the skeleton's joints projected with the colour intrinsics, flagged invisible when outside the
