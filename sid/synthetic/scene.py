@@ -117,18 +117,6 @@ class Scene:
         except (TypeError, ValueError) as exc:
             raise ValueError(str(exc)) from None
 
-    @classmethod
-    def from_people(
-        cls, name: str, people: list[Person], groups: tuple[tuple[int, ...], ...] = (), **options: Any
-    ) -> Scene:
-        """A scene of ``sid.perception.people.Person`` records (e.g. a costmap Scenario's ``people``); theta must be
-        known."""
-        unknown = [p.id for p in people if p.theta is None]
-        if unknown:
-            raise ValueError(f"scene {name}: people {unknown} have no facing direction (theta is None)")
-        known = tuple(ScenePerson(p.id, p.x, p.y, float(p.theta)) for p in people if p.theta is not None)
-        return cls(name, known, groups, **options)
-
     def to_dict(self) -> dict[str, Any]:
         return {
             "name": self.name,

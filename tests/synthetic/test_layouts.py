@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 import yaml
 
-from sid.perception.people import Person
 from sid.synthetic.layouts import LAYOUTS, VARIATIONS, Formation, layout, variations
 from sid.synthetic.scene import Scene
 from sid.synthetic.sequence import SyntheticSequence, load_scene_file
@@ -116,16 +115,12 @@ def test_scene_files_round_trip(tmp_path: Path) -> None:
     assert Scene.from_file(yaml_path) == scene
 
 
-def test_yaw_defaults_and_people_records(tmp_path: Path) -> None:
+def test_yaw_defaults(tmp_path: Path) -> None:
     path = tmp_path / "people.yaml"
     path.write_text("people:\n  - {x: 2.0, y: 0.5, yaw: 3.0}\n  - {x: 2.0, y: -0.5, yaw: -3.0}\n")
     scene = Scene.from_file(path)
     assert [p.id for p in scene.people] == [0, 1] and scene.people[0].theta == 3.0
     assert scene.groups == () and scene.mount.height == 0.9 and scene.name == "people"
-    from_people = Scene.from_people("p", [Person(5, 2.0, 0.0, 0.0)])
-    assert from_people.people[0].id == 5
-    with pytest.raises(ValueError, match="theta is None"):
-        Scene.from_people("p", [Person(5, 2.0, 0.0, None)])
 
 
 def test_scenario_files_are_sequences_seen_from_the_robot(tmp_path: Path) -> None:
