@@ -204,10 +204,11 @@ class SyntheticCamera:
     (default the D435's 420 px at 848x480); with depth intrinsics the noise uses their fx, and another value is
     refused. occlusion_margin (m): a keypoint is
     hidden when another person's surface lies this much nearer at its pixel. self_occlusion_margin (m): a keypoint
-    is self-occluded when its own body's surface lies this much nearer (joints sit 4-11 cm inside limbs and torso
-    seen from the front; 0.15 m catches the face seen from behind, ~0.18 m deep, and the far shoulder of someone in
-    profile, ~0.24 m, and spares the rest); None: never. shaded_color: render the colour image
-    (flat-shaded people on a checkered floor); False gives a plain grey image (faster, for metrics only).
+    is self-occluded when its own body's surface lies this much nearer (joints sit a few centimetres inside limbs and
+    torso seen from the front, the face seen from behind and the far limbs of someone in profile much deeper; the
+    default lies between them: docs/reproduction.md, "The self-occlusion margin"); None: never. shaded_color: render
+    the colour image (flat-shaded people on a checkered floor); False gives a plain grey image (faster, for metrics
+    only).
     group_params: detector parameters used for the groups' exact interest point and area (see ``truth``).
     """
 
@@ -477,7 +478,8 @@ def _inside(px: np.ndarray, intr: Intrinsics) -> np.ndarray:
 
 def _body_box(keypoints: np.ndarray, height: float, to_color: Extrinsics, intr: Intrinsics) -> np.ndarray:
     """Box (u_min, v_min, u_max, v_max) of the body in colour pixels: keypoints, the top of the head and the
-    floor under the feet, widened by 0.12 m (body radius) at each point's depth; clipped to the image."""
+    floor under the feet, widened sideways (u only) by 0.12 m (body radius) at each point's depth; v spans the
+    points as they are; clipped to the image."""
     centre = keypoints[[15, 16]].mean(axis=0)
     extra = np.array([[centre[0], centre[1], height], [centre[0], centre[1], 0.0]])
     points = to_color.apply(np.vstack([keypoints, extra]))

@@ -38,7 +38,7 @@ class RunSettings:
 
 
 QUICK = RunSettings(warmup=2, min_runs=3, max_runs=20, budget_s=0.15)
-"""``sid bench --quick``: a smoke run for tests and CI (the whole suite in well under 30 s)."""
+"""``sid bench --quick``: a smoke run for tests and CI, a few calls per stage (its length here: docs/benchmarks.md)."""
 FULL = RunSettings(warmup=5, min_runs=20, max_runs=500, budget_s=2.0)
 """``sid bench``: up to 2 s and 500 runs per stage (the run's length: docs/benchmarks.md)."""
 
