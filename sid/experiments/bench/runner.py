@@ -65,8 +65,8 @@ class Stats:
 
 def measure_parts(fn: Callable[[], dict[str, float]], settings: RunSettings) -> dict[str, Stats]:
     """Time a call that reports its own parts: ``fn()`` returns milliseconds per part name (the same names on
-    every call). Returns the statistics of each part over the timed calls; ValueError when a call reports no part
-    or other names than the first call."""
+    every call, in any order). Returns the statistics of each part over the timed calls; ValueError when a call
+    reports no part or other names than the first call."""
     names: list[str] | None = None
 
     def call() -> dict[str, float]:
@@ -76,7 +76,7 @@ def measure_parts(fn: Callable[[], dict[str, float]], settings: RunSettings) -> 
             raise ValueError("bench: a timed call reported no parts")
         if names is None:
             names = list(parts)
-        elif list(parts) != names:
+        elif set(parts) != set(names):  # in any order: a stage may time its parts in turns
             raise ValueError(f"bench: a timed call reported parts {list(parts)}, an earlier one {names}")
         return parts
 
