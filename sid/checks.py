@@ -153,15 +153,13 @@ def check_number(
     unit: str = "",
     error: type[Exception] = ValueError,
 ) -> None:
-    """Raise ``error`` unless ``value`` is a finite number within [low, high] (bounds optional).
+    """Raise ``error`` unless ``value`` is a finite real number (``is_real``: not a bool, a string or bytes) within
+    [low, high] (bounds optional).
 
     low_open / high_open exclude that bound; allow_inf also accepts +inf (a switch-off value, e.g. a radius);
     unit (e.g. "metres") only words the message.
     """
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        number = math.nan
+    number = float(value) if is_real(value) else math.nan
     ok = math.isfinite(number) or (allow_inf and number == math.inf)
     ok = ok and (low is None or (number > low if low_open else number >= low))
     ok = ok and (high is None or (number < high if high_open else number <= high))
@@ -205,11 +203,11 @@ def check_whole(
     return int(number)
 
 
-def check_yaw(owner: str, name: str, value: float) -> None:
-    """ValueError unless ``value`` is a yaw within two turns of 0 (``YAW_LIMIT_RAD``): 90 or 180 is a facing in
+def check_yaw(owner: str, name: str, value: float, error: type[Exception] = ValueError) -> None:
+    """Raise ``error`` unless ``value`` is a yaw within two turns of 0 (``YAW_LIMIT_RAD``): 90 or 180 is a facing in
     degrees, which read as radians points anywhere. ``value`` is a finite number already."""
     if abs(value) > YAW_LIMIT_RAD:
-        raise ValueError(f"{owner}: {name} {value:g} is beyond two turns (4 pi): radians expected, not degrees")
+        raise error(f"{owner}: {name} {value:g} is beyond two turns (4 pi): radians expected, not degrees")
 
 
 def check_numbers(owner: str, record: object, names: Iterable[str], **bounds: Any) -> None:

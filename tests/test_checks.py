@@ -24,6 +24,10 @@ from sid.checks import YAW_LIMIT_RAD, check_number, check_numbers, check_whole, 
         (0.5, {"low": 0, "high": 0.5, "low_open": True, "high_open": True}, "a finite number in (0, 0.5)"),
         (-math.inf, {"low": 0, "allow_inf": True}, "a number >= 0 (or inf)"),
         ("north", {}, "a finite number"),
+        ("0.1", {}, "a finite number"),  # float() accepts these; they are not numbers
+        (b"1", {}, "a finite number"),
+        (True, {"low": 0}, "a finite number >= 0"),
+        (np.array(0.5), {}, "a finite number"),
     ],
 )
 def test_out_of_range_values_are_named_with_the_rule(value, bounds, rule):

@@ -24,7 +24,7 @@ from costmap.layers.inflation import check_reach
 from costmap.mapfile import MapFileError, read_map
 from costmap.occupancy import OccupancyGrid
 from costmap.plugins import PEOPLE_LAYERS, PLUGINS, SECTIONS, CostmapParams, LayerInstance
-from sid.checks import YAW_LIMIT_RAD, LimitError, amount, check_limit
+from sid.checks import LimitError, amount, check_limit, check_yaw
 from sid.documents import InputWarning, is_number, load_document, summary
 from sid.errors import SidError
 from sid.perception.groups import GroupParams
@@ -325,7 +325,8 @@ def _person(value: Any, name: str, index: int) -> Person:
     if theta is not None:
         if not is_number(theta):
             raise _fail(f"{name}.theta", "a finite number of radians, or null when unknown", theta)
-        theta = _yaw(float(theta), f"{name}.theta")
+        theta = float(theta)
+        check_yaw(name, "theta", theta, error=ScenarioError)
     quality = _number(data.get("orientation_quality", 0.0 if theta is None else 1.0), f"{name}.orientation_quality")
     if not 0 <= quality <= 1:
         raise _fail(f"{name}.orientation_quality", "a number in [0, 1]", quality)
@@ -393,15 +394,9 @@ def _conversations(value: Any, people: list[Person]) -> tuple[tuple[int, ...], .
 
 def _pose(value: Any, name: str) -> tuple[float, float, float]:
     pose = _point(value, name, (2, 3))
-    return (pose[0], pose[1], _yaw(pose[2], f"{name}[2]") if len(pose) == 3 else 0.0)
-
-
-def _yaw(value: float, name: str) -> float:
-    """``value`` (rad) unless it lies beyond two turns (``YAW_LIMIT_RAD``): 90 or 180 is a yaw in degrees, which
-    read as radians would point anywhere."""
-    if abs(value) > YAW_LIMIT_RAD:
-        raise _fail(name, "radians (a yaw within two turns of 0), not degrees", value)
-    return value
+    if len(pose) == 3:
+        check_yaw(name, "yaw", pose[2], error=ScenarioError)
+    return (pose[0], pose[1], pose[2] if len(pose) == 3 else 0.0)
 
 
 def _inside(grid: GridSpec, xy: tuple[float, ...], name: str) -> None:

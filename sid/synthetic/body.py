@@ -33,10 +33,10 @@ _HAND_RADIUS = 0.045
 _NECK_RADIUS = 0.055
 _FOOT_RADIUS = 0.040
 _FOOT_LENGTH = 0.15  # ankle to toe tip along the facing direction
-_TORSO_SEMI = (0.17, 0.11, 0.08)  # lateral, front-back, rounded ends (m)
+_TORSO_SEMI = (0.11, 0.17, 0.08)  # front-back, lateral, rounded ends (m)
 _TORSO_BELOW_HIPS = 0.06  # the torso reaches this far below the hip joints (pelvis)
 _TORSO_ABOVE_SHOULDERS = 0.04
-_HEAD_SEMI = (0.085, 0.10, 0.115)  # lateral (ears included), front-back, vertical (m)
+_HEAD_SEMI = (0.10, 0.085, 0.115)  # front-back, lateral (ears included), vertical (m)
 
 
 def _scaled(semi_axes: tuple[float, float, float], s: float) -> tuple[float, float, float]:
@@ -44,14 +44,14 @@ def _scaled(semi_axes: tuple[float, float, float], s: float) -> tuple[float, flo
 
 
 def body_frame(keypoints: np.ndarray) -> np.ndarray:
-    """(3, 3) rotation whose columns are the body's left, forward and up directions (world frame), from the
-    shoulders and hips of (17, 3) world keypoints."""
+    """(3, 3) rotation (determinant +1) whose columns are the body's forward, left and up directions (world frame,
+    as REP-103's x, y, z), from the shoulders and hips of (17, 3) world keypoints."""
     mid_hip = (keypoints[KP["left_hip"]] + keypoints[KP["right_hip"]]) / 2
     mid_shoulder = (keypoints[KP["left_shoulder"]] + keypoints[KP["right_shoulder"]]) / 2
     up = _unit(mid_shoulder - mid_hip, "hips and shoulders coincide")
     left = keypoints[KP["left_shoulder"]] - keypoints[KP["right_shoulder"]]
     left = _unit(left - (left @ up) * up, "shoulders lie on the body axis")
-    return np.stack([left, np.cross(left, up), up], axis=1)
+    return np.stack([np.cross(left, up), left, up], axis=1)
 
 
 def body_capsules(keypoints: np.ndarray, height: float = REFERENCE_HEIGHT) -> list[Capsule]:
@@ -62,7 +62,7 @@ def body_capsules(keypoints: np.ndarray, height: float = REFERENCE_HEIGHT) -> li
     check_number("body", "height", height, low=0, low_open=True, unit="metres")
     s = height / REFERENCE_HEIGHT
     frame = body_frame(keypoints)
-    left, forward, up = frame.T
+    forward, left, up = frame.T
     kp = {name: keypoints[index] for name, index in KP.items()}
     mid_hip = (kp["left_hip"] + kp["right_hip"]) / 2
     mid_shoulder = (kp["left_shoulder"] + kp["right_shoulder"]) / 2

@@ -139,22 +139,35 @@ def layout(
 
 
 def variations(name: str, **options: Any) -> list[Scene]:
-    """The scenes of layout ``name`` under each entry of ``VARIATIONS`` (``options`` go to ``layout``).
+    """The scenes of layout ``name`` under each entry of ``VARIATIONS``, each applied to the formation the caller's
+    ``options`` (``layout``'s keywords) describe.
 
-    ``distance_offset`` moves the formation centre from the layout's default distance (m); ``turn`` rotates the
-    formation by that multiple of the layout's ``turn_deg``.
+    ``distance_offset`` moves the formation centre from the caller's centre distance (default the layout's; m);
+    ``turn`` adds that multiple of the layout's ``turn_deg`` to the caller's rotation; a variation's ``seed`` is
+    added to the caller's. ``jitter_xy`` and ``jitter_theta`` are the jitter variations' own and are refused here
+    (ValueError): pass them to ``layout``.
     """
     spec = _spec(name)
+    own = sorted({"jitter_xy", "jitter_theta"} & set(options))
+    if own:
+        raise ValueError(
+            f"variations of {name}: {', '.join(own)} are set by the jitter variations; use layout() instead"
+        )
+    options = dict(options)
+    fields = Formation.__dataclass_fields__
+    formation = replace(
+        options.pop("formation", None) or Formation(), **{k: options.pop(k) for k in list(options) if k in fields}
+    )
+    centre = spec.centre_distance if formation.centre_distance is None else formation.centre_distance
     scenes = []
     for variation in VARIATIONS:
         variation = dict(variation)
-        offset = variation.pop("distance_offset", 0.0)
-        if offset:
-            variation["centre_distance"] = spec.centre_distance + offset
-        turn = variation.pop("turn", 0.0)
-        if turn:
-            variation["rotation"] = np.radians(turn * spec.turn_deg)
-        scenes.append(layout(name, **{**options, **variation}))
+        changes = {
+            "centre_distance": centre + variation.pop("distance_offset", 0.0),
+            "rotation": formation.rotation + np.radians(variation.pop("turn", 0.0) * spec.turn_deg),
+            "seed": formation.seed + variation.pop("seed", 0),
+        }
+        scenes.append(layout(name, replace(formation, **changes, **variation), **options))
     return scenes
 
 

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from sid.checks import check_number, check_numbers
+from sid.checks import check_number, check_numbers, check_whole
 
 __all__ = ["DepthNoise", "KeypointNoise", "visible_to_right_imager"]
 
@@ -33,10 +33,11 @@ class DepthNoise:
     subpixel: disparity RMS error (px). baseline_m: stereo baseline (m). focal_px: depth focal length (px), None:
     take the depth camera's fx. correlation_px: Gaussian correlation length of the noise (px, 0 = independent
     pixels). hole_fraction: probability that any pixel is a hole. edge_holes: probability that a pixel within
-    ``edge_width_px`` of a depth jump larger than ``edge_jump_m`` is a hole. stereo_shadow: invalidate pixels the
-    right imager cannot see (the right imager sits ``baseline_m`` along +x of the depth camera). min_range_m,
-    max_range_m: readings outside are dropped (D435 minimum distance ~0.28 m at 848x480, ~10 m useful range).
-    depth_unit_m: quantisation step (the D435 default depth unit is 1 mm; 0 disables quantisation).
+    ``edge_width_px`` (a whole number >= 1; ``edge_holes`` 0 turns these holes off) of a depth jump larger than
+    ``edge_jump_m`` is a hole. stereo_shadow: invalidate pixels the right imager cannot see (the right imager sits
+    ``baseline_m`` along +x of the depth camera). min_range_m, max_range_m: readings outside are dropped (D435
+    minimum distance ~0.28 m at 848x480, ~10 m useful range). depth_unit_m: quantisation step (the D435 default
+    depth unit is 1 mm; 0 disables quantisation).
     """
 
     subpixel: float = 0.08
@@ -59,8 +60,7 @@ class DepthNoise:
         check_numbers("depth noise", self, ("hole_fraction", "edge_holes"), low=0, high=1)
         if self.focal_px is not None:
             check_number("depth noise", "focal_px", self.focal_px, low=0, low_open=True)
-        if self.edge_width_px < 0:
-            raise ValueError(f"depth noise: edge_width_px must be >= 0, got {self.edge_width_px}")
+        check_whole("depth noise", "edge_width_px", self.edge_width_px, low=1)
         if self.max_range_m <= self.min_range_m:
             raise ValueError("depth noise: max_range_m must exceed min_range_m")
 

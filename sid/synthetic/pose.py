@@ -71,5 +71,5 @@ class TruthPose:
             scores[person.observed & ~person.self_occluded] = self.score_observed
             scores[person.observed & person.self_occluded & ~_FACE] = self.score_self_occluded
             box_score = self.score_observed * count / NUM_KEYPOINTS
-            detections.append(PoseDetection(person.observed_px, scores, person.box, box_score))
+            detections.append(PoseDetection(person.observed_px.copy(), scores, person.box.copy(), box_score))
         return detections

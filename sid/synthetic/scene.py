@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from sid.checks import check_numbers
+from sid.checks import check_numbers, check_yaw
 from sid.documents import load_document
 from sid.perception.mount import CameraMount
 from sid.perception.people import Person
@@ -36,6 +36,7 @@ class ScenePerson:
 
     def __post_init__(self) -> None:
         check_numbers(f"scene person {self.id}", self, ("x", "y", "theta", "height"))
+        check_yaw(f"scene person {self.id}", "theta", self.theta)
         if not 0.5 <= self.height <= 2.5:
             raise ValueError(f"scene person {self.id}: height {self.height} m is not a standing person (0.5-2.5 m)")
 
@@ -115,18 +116,6 @@ class Scene:
             )
         except (TypeError, ValueError) as exc:
             raise ValueError(str(exc)) from None
-
-    @classmethod
-    def from_people(
-        cls, name: str, people: list[Person], groups: tuple[tuple[int, ...], ...] = (), **options: Any
-    ) -> Scene:
-        """A scene of ``sid.perception.people.Person`` records (e.g. a costmap Scenario's ``people``); theta must be
-        known."""
-        unknown = [p.id for p in people if p.theta is None]
-        if unknown:
-            raise ValueError(f"scene {name}: people {unknown} have no facing direction (theta is None)")
-        known = tuple(ScenePerson(p.id, p.x, p.y, float(p.theta)) for p in people if p.theta is not None)
-        return cls(name, known, groups, **options)
 
     def to_dict(self) -> dict[str, Any]:
         return {

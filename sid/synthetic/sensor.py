@@ -7,7 +7,8 @@ robot's pose). Ground truth is in the same frame as the scene (``FrameTruth.fram
 Cameras: the colour camera's optical frame is the one the mount places on the robot (the frame the pipeline
 lifts keypoints from); the depth camera sits ``depth_to_color`` away from it (p_color = R p_depth + t). Defaults are
 typical D435i values: colour 1280x720 with fx = fy = 910 px, depth 848x480 with fx = fy = 420 px, the depth
-camera 15 mm to the left of the colour camera (depth -> colour translation +15 mm along x).
+camera 15 mm along +x of the colour optical frame, i.e. to the colour camera's right looking along its view (depth ->
+colour translation +15 mm along x).
 
 Per frame: exact depth from a ray caster (``render``), then D435-like noise (``noise.DepthNoise``); truth
 keypoints are the skeleton's joints projected with the colour intrinsics, flagged invisible when outside the
@@ -197,36 +198,54 @@ class SyntheticCamera:
     """Renders scenes as a D435i-like RGB-D camera would see them.
 
     calibration: default ``d435i_calibration(registered)``; with ``calibration.depth`` None the depth is rendered in
-    the colour grid. noise / keypoint_noise: see ``sid.synthetic.noise`` (``DepthNoise.exact()`` and
-    ``KeypointNoise(0, 0)`` for perfect data). sensor_focal_px: focal length (px) of the stereo pair for the noise
-    model when depth is registered (default the D435's 420 px at 848x480). occlusion_margin (m): a keypoint is
+    the colour grid. registered: only without a calibration (one that says otherwise is refused). noise /
+    keypoint_noise: see ``sid.synthetic.noise`` (``DepthNoise.exact()`` and ``KeypointNoise(0, 0)`` for perfect
+    data). sensor_focal_px: focal length (px, > 0) of the stereo pair for the noise model when depth is registered
+    (default the D435's 420 px at 848x480); with depth intrinsics the noise uses their fx, and another value is
+    refused. occlusion_margin (m): a keypoint is
     hidden when another person's surface lies this much nearer at its pixel. self_occlusion_margin (m): a keypoint
-    is self-occluded when its own body's surface lies this much nearer (joints sit 4-11 cm inside limbs and torso
-    seen from the front; 0.15 m catches the face seen from behind, ~0.18 m deep, and the far shoulder of someone in
-    profile, ~0.24 m, and spares the rest); None: never. shaded_color: render the colour image
-    (flat-shaded people on a checkered floor); False gives a plain grey image (faster, for metrics only).
+    is self-occluded when its own body's surface lies this much nearer (joints sit a few centimetres inside limbs and
+    torso seen from the front, the face seen from behind and the far limbs of someone in profile much deeper; the
+    default lies between them: docs/reproduction.md, "The self-occlusion margin"); None: never. shaded_color: render
+    the colour image (flat-shaded people on a checkered floor); False gives a plain grey image (faster, for metrics
+    only).
     group_params: detector parameters used for the groups' exact interest point and area (see ``truth``).
     """
 
     def __init__(
         self,
         calibration: Calibration | None = None,
-        registered: bool = False,
+        registered: bool | None = None,
         noise: DepthNoise | None = None,
         keypoint_noise: KeypointNoise | None = None,
-        sensor_focal_px: float = 420.0,
+        sensor_focal_px: float | None = None,
         occlusion_margin: float = 0.10,
         self_occlusion_margin: float | None = 0.15,
         shaded_color: bool = True,
         fps: float = 30.0,
         group_params: GroupParams | None = None,
     ):
-        self.calibration = calibration or d435i_calibration(registered)
+        if calibration is not None and registered is not None and registered != (calibration.depth is None):
+            said = "registered" if calibration.depth is None else "not registered (it has depth intrinsics)"
+            raise ValueError(
+                f"synthetic camera: registered={registered} contradicts the calibration, whose depth is {said}; "
+                "pass registered only without a calibration"
+            )
+        self.calibration = calibration or d435i_calibration(bool(registered))
         self.noise = noise if noise is not None else DepthNoise()
         self.keypoint_noise = keypoint_noise if keypoint_noise is not None else KeypointNoise()
+        depth = self.calibration.depth
+        if depth is not None and sensor_focal_px is not None and sensor_focal_px != depth.fx:
+            raise ValueError(
+                f"synthetic camera: sensor_focal_px {sensor_focal_px} contradicts the calibration's depth fx "
+                f"{depth.fx}; sensor_focal_px is for registered depth only (unregistered depth uses its own fx)"
+            )
+        if depth is not None:
+            sensor_focal_px = depth.fx
+        elif sensor_focal_px is None:
+            sensor_focal_px = D435I_DEPTH.fx
+        check_number("synthetic camera", "sensor_focal_px", sensor_focal_px, low=0, low_open=True, unit="pixels")
         self.sensor_focal_px = float(sensor_focal_px)
-        if self.calibration.depth is not None:
-            self.sensor_focal_px = self.calibration.depth.fx
         self.occlusion_margin = float(occlusion_margin)
         self.self_occlusion_margin = None if self_occlusion_margin is None else float(self_occlusion_margin)
         margins = ["occlusion_margin"] + ([] if self.self_occlusion_margin is None else ["self_occlusion_margin"])
@@ -240,6 +259,14 @@ class SyntheticCamera:
         self._bodies: dict[ScenePerson, tuple[np.ndarray, list[Capsule]]] = {}
         self._cached_groups: tuple[tuple, list[TruthGroup]] | None = None
         self._views: dict[tuple[CameraMount, float | None], _Views] = {}
+
+    def forget_renders(self) -> None:
+        """Drop the kept exact renders, bodies and group geometry: the next ``capture`` casts its scene afresh. The
+        ray casters of each mount and background stay (they are built once per stream)."""
+        self._cached = None
+        self._still = None
+        self._bodies = {}
+        self._cached_groups = None
 
     @property
     def depth_intrinsics(self) -> Intrinsics:
@@ -284,6 +311,7 @@ class SyntheticCamera:
             if pose is not None:
                 keypoints = np.column_stack([pose.to_map(keypoints[:, :2]), keypoints[:, 2]])
             vx, vy = velocities.get(person.id, (0.0, 0.0))
+            # each frame's truth owns its arrays: the render they come from is kept for the next frames
             truth_people.append(
                 TruthPerson(
                     person.id,
@@ -291,13 +319,13 @@ class SyntheticCamera:
                     person.y,
                     person.theta,
                     person.height,
-                    keypoints,
-                    render.keypoints_px[i],
-                    render.visible[i],
-                    render.self_occluded[i],
+                    keypoints.copy() if pose is None else keypoints,
+                    render.keypoints_px[i].copy(),
+                    render.visible[i].copy(),
+                    render.self_occluded[i].copy(),
                     observed_px,
                     render.visible[i] & kept,
-                    render.boxes[i],
+                    render.boxes[i].copy(),
                     vx,
                     vy,
                     vx != 0.0 or vy != 0.0,
@@ -450,7 +478,8 @@ def _inside(px: np.ndarray, intr: Intrinsics) -> np.ndarray:
 
 def _body_box(keypoints: np.ndarray, height: float, to_color: Extrinsics, intr: Intrinsics) -> np.ndarray:
     """Box (u_min, v_min, u_max, v_max) of the body in colour pixels: keypoints, the top of the head and the
-    floor under the feet, widened by 0.12 m (body radius) at each point's depth; clipped to the image."""
+    floor under the feet, widened sideways (u only) by 0.12 m (body radius) at each point's depth; v spans the
+    points as they are; clipped to the image."""
     centre = keypoints[[15, 16]].mean(axis=0)
     extra = np.array([[centre[0], centre[1], height], [centre[0], centre[1], 0.0]])
     points = to_color.apply(np.vstack([keypoints, extra]))

@@ -105,8 +105,8 @@ def test_yaml_files_load_too(tmp_path):
     "path,value,message",
     [
         ("people.1.theta", "north", r"people\[1\]\.theta: expected a finite number"),
-        ("people.1.theta", 180, r"people\[1\]\.theta: expected radians .*, not degrees, got 180"),
-        ("robot.goal", [8, 0, 90], r"robot\.goal\[2\]: expected radians .*, not degrees, got 90"),
+        ("people.1.theta", 180, r"people\[1\]: theta 180 is beyond two turns \(4 pi\): radians expected, not degrees"),
+        ("robot.goal", [8, 0, 90], r"robot\.goal: yaw 90 is beyond two turns \(4 pi\): radians expected, not degrees"),
         ("people.0.x", math.nan, r"people\[0\]\.x: expected a finite number"),
         ("people.0.x", 42.0, r"people\[0\]: \(42.0, 0.5\) is outside the map"),
         ("people.1.id", 1, r"people\[1\]\.id: 1 is already used by people\[0\]"),

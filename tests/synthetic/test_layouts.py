@@ -9,8 +9,7 @@ import numpy as np
 import pytest
 import yaml
 
-from sid.perception.people import Person
-from sid.synthetic.layouts import LAYOUTS, VARIATIONS, layout, variations
+from sid.synthetic.layouts import LAYOUTS, VARIATIONS, Formation, layout, variations
 from sid.synthetic.scene import Scene
 from sid.synthetic.sequence import SyntheticSequence, load_scene_file
 from tests.conftest import REPO_ROOT
@@ -56,6 +55,24 @@ def test_all_variations_stand_1_5_to_3_m_in_front_of_the_camera(name: str) -> No
     assert len({tuple(map(tuple, _xy(s).round(6))) for s in scenes}) == len(VARIATIONS)  # all different
 
 
+def test_variations_apply_to_the_callers_formation() -> None:
+    """Nearer/further move from the caller's centre distance, turns add to the caller's rotation, the jitter
+    variations' seeds add to the caller's; the options the jitter variations set are refused."""
+    scenes = variations("S3", centre_distance=3.0, rotation=0.3, seed=5)
+    centres = [float(np.mean(_xy(s)[:, 0])) for s in scenes[:5]]  # the triangle's centroid is its centre
+    np.testing.assert_allclose(centres, [3.0, 3.0, 3.0, 2.85, 3.15], atol=1e-9)
+    turn = np.radians(LAYOUTS["S3"].turn_deg)
+    for scene, rotation in zip(scenes[:3], (0.3, 0.3 - turn, 0.3 + turn), strict=True):
+        assert scene == layout("S3", centre_distance=3.0, rotation=rotation)
+    assert scenes[5] == layout(
+        "S3", centre_distance=3.0, rotation=0.3, jitter_xy=0.05, jitter_theta=np.radians(5.0), seed=6
+    )
+    assert scenes[5] != variations("S3", centre_distance=3.0, rotation=0.3)[5]
+    assert variations("S3") == variations("S3", formation=Formation())
+    with pytest.raises(ValueError, match="variations of S3: jitter_xy are set by the jitter variations"):
+        variations("S3", jitter_xy=0.1)
+
+
 def test_focus_offset_opens_the_group_towards_the_camera() -> None:
     scene = layout("S1", focus_offset=0.4)
     for person in scene.people:  # both face (1.8, 0): 45 deg from each other, towards the camera
@@ -98,16 +115,12 @@ def test_scene_files_round_trip(tmp_path: Path) -> None:
     assert Scene.from_file(yaml_path) == scene
 
 
-def test_yaw_defaults_and_people_records(tmp_path: Path) -> None:
+def test_yaw_defaults(tmp_path: Path) -> None:
     path = tmp_path / "people.yaml"
     path.write_text("people:\n  - {x: 2.0, y: 0.5, yaw: 3.0}\n  - {x: 2.0, y: -0.5, yaw: -3.0}\n")
     scene = Scene.from_file(path)
     assert [p.id for p in scene.people] == [0, 1] and scene.people[0].theta == 3.0
     assert scene.groups == () and scene.mount.height == 0.9 and scene.name == "people"
-    from_people = Scene.from_people("p", [Person(5, 2.0, 0.0, 0.0)])
-    assert from_people.people[0].id == 5
-    with pytest.raises(ValueError, match="theta is None"):
-        Scene.from_people("p", [Person(5, 2.0, 0.0, None)])
 
 
 def test_scenario_files_are_sequences_seen_from_the_robot(tmp_path: Path) -> None:

@@ -120,6 +120,13 @@ def test_bad_noise_parameters_are_rejected(options: dict[str, float]) -> None:
         DepthNoise(**options)
 
 
+@pytest.mark.parametrize("width", [0, 2.5, True, "2"])
+def test_edge_width_must_be_a_whole_number_of_pixels_from_one(width: object) -> None:
+    """0 acted as 1 and 2.5 failed later in the dilation with a TypeError."""
+    with pytest.raises(ValueError, match="depth noise: edge_width_px must be a whole number >= 1"):
+        DepthNoise(edge_width_px=width)  # type: ignore[arg-type]
+
+
 def test_bad_keypoint_noise_is_rejected() -> None:
     with pytest.raises(ValueError, match="sigma_px"):
         KeypointNoise(sigma_px=-1.0)

@@ -98,7 +98,9 @@ def test_person_torso_is_seen_at_its_distance_and_labelled() -> None:
 def test_body_frame_and_shapes_follow_the_facing_direction() -> None:
     theta = 0.7
     keypoints = skeleton_world(1.0, 2.0, theta, height=1.8)
-    left, forward, up = body_frame(keypoints).T
+    frame = body_frame(keypoints)
+    assert np.linalg.det(frame) == pytest.approx(1.0)  # a rotation, not a reflection
+    forward, left, up = frame.T
     np.testing.assert_allclose(forward, [np.cos(theta), np.sin(theta), 0.0], atol=1e-9)
     np.testing.assert_allclose(up, [0.0, 0.0, 1.0], atol=1e-9)
     np.testing.assert_allclose(left, [-np.sin(theta), np.cos(theta), 0.0], atol=1e-9)

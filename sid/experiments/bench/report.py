@@ -30,7 +30,9 @@ from sid.cpu import physical_cores, usable_cpus
 from sid.documents import is_number, load_document, plural
 
 __all__ = [
+    "COMPARED_SETTINGS",
     "FIXED_FIELDS",
+    "IDENTITY_EXTRAS",
     "FORMAT",
     "LIBRARIES",
     "PAPER_COLUMN",
@@ -50,6 +52,9 @@ PAPER_COLUMN = "paper (Jetson Orin NX, another machine) ms"
 # A change beyond these ratios is flagged by ``format_comparison``: timings on a shared machine move by about that
 # much between runs (docs/benchmarks.md, "Measuring a change side by side").
 SLOWER, FASTER = 1.10, 1 / 1.10
+# Settings and stage extras that change what a stage times: ``format_comparison`` warns when they differ.
+COMPARED_SETTINGS = ("quick", "pose_provider", "pose_threads", "plan_runs")
+IDENTITY_EXTRAS = ("pose", "provider", "threads", "image")
 
 
 def _cpu_model() -> str:
@@ -194,18 +199,20 @@ def write_report(report: dict[str, Any], out_dir: str | Path, comparison: str | 
 
 
 def format_comparison(old: dict[str, Any], new: dict[str, Any]) -> str:
-    """Per stage present in both: old and new median (ms) and new / old, flagged beyond +-10 %; then the stages
-    found in only one of them (counted, not listed, for old stages left out by ``--only``), and a warning when the
-    two ran on different CPUs."""
+    """Per stage present in both: old and new median (ms), new / old (flagged beyond +-10 %), and old and new
+    minimum (ms); then the stages found in only one of them (counted, not listed, for old stages left out by
+    ``--only``), and warnings: run settings that differ (``COMPARED_SETTINGS``, where both reports record them),
+    stages whose identity extras differ (``IDENTITY_EXTRAS``: the same name timed other work), and different CPUs."""
     old_stages, new_stages = old["stages"], new["stages"]
     common = [name for name in new_stages if name in old_stages]
-    rows = [("stage", "old ms", "new ms", "new/old", "")]
+    rows = [("stage", "old median", "new median", "new/old", "old min", "new min", "")]
     for name in common:
-        before, after = old_stages[name]["median_ms"], new_stages[name]["median_ms"]
-        ratio = after / before if before > 0 else float("inf")
+        before, after = old_stages[name], new_stages[name]
+        ratio = after["median_ms"] / before["median_ms"] if before["median_ms"] > 0 else float("inf")
         flag = "slower" if ratio > SLOWER else "faster" if ratio < FASTER else ""
-        rows.append((name, _ms(before), _ms(after), f"{ratio:.2f}", flag))
-    widths = [max(len(r[i]) for r in rows) for i in range(5)]
+        rows.append((name, _ms(before["median_ms"]), _ms(after["median_ms"]), f"{ratio:.2f}", _min_ms(before),
+                     _min_ms(after), flag))  # fmt: skip
+    widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
     lines = ["  ".join(c.ljust(w) if i == 0 else c.rjust(w) for i, (c, w) in enumerate(zip(r, widths, strict=True)))
              .rstrip() for r in rows]  # fmt: skip
     only_old = [n for n in old_stages if n not in new_stages]
@@ -216,9 +223,25 @@ def format_comparison(old: dict[str, Any], new: dict[str, Any]) -> str:
         lines.append("only in the old report: " + ", ".join(only_old))
     if only_new:
         lines.append("only in the new report: " + ", ".join(only_new))
+    old_settings, new_settings = old.get("settings") or {}, new.get("settings") or {}
+    changed = [f"{key} {old_settings[key]!r} -> {new_settings[key]!r}" for key in COMPARED_SETTINGS
+               if key in old_settings and key in new_settings and old_settings[key] != new_settings[key]]  # fmt: skip
+    if changed:
+        lines.append("warning: different run settings (" + "; ".join(changed) + "); ratios mix settings and code")
+    for name in common:
+        extras = [f"{key} {old_stages[name].get(key)!r} -> {new_stages[name].get(key)!r}" for key in IDENTITY_EXTRAS
+                  if old_stages[name].get(key) != new_stages[name].get(key)]  # fmt: skip
+        if extras:
+            lines.append(f"warning: {name} timed other work (" + "; ".join(extras) + ")")
     old_cpu, new_cpu = old.get("machine", {}).get("cpu"), new.get("machine", {}).get("cpu")
     if old_cpu != new_cpu:
         lines.append(f"warning: different machines (old: {old_cpu}, new: {new_cpu}); ratios mix machine and code")
     if not common:
         lines.append("no stage in common")
     return "\n".join(lines)
+
+
+def _min_ms(stage: dict[str, Any]) -> str:
+    """A stage's minimum for the comparison table; "-" when the report has none."""
+    value = stage.get("min_ms")
+    return _ms(value) if is_number(value) else "-"

@@ -38,7 +38,7 @@ class RunSettings:
 
 
 QUICK = RunSettings(warmup=2, min_runs=3, max_runs=20, budget_s=0.15)
-"""``sid bench --quick``: a smoke run for tests and CI (the whole suite in well under 30 s)."""
+"""``sid bench --quick``: a smoke run for tests and CI, a few calls per stage (its length here: docs/benchmarks.md)."""
 FULL = RunSettings(warmup=5, min_runs=20, max_runs=500, budget_s=2.0)
 """``sid bench``: up to 2 s and 500 runs per stage (the run's length: docs/benchmarks.md)."""
 
@@ -65,21 +65,34 @@ class Stats:
 
 def measure_parts(fn: Callable[[], dict[str, float]], settings: RunSettings) -> dict[str, Stats]:
     """Time a call that reports its own parts: ``fn()`` returns milliseconds per part name (the same names on
-    every call). Returns the statistics of each part over the timed calls."""
+    every call, in any order). Returns the statistics of each part over the timed calls; ValueError when a call
+    reports no part or other names than the first call."""
+    names: list[str] | None = None
+
+    def call() -> dict[str, float]:
+        nonlocal names
+        parts = fn()
+        if not parts:
+            raise ValueError("bench: a timed call reported no parts")
+        if names is None:
+            names = list(parts)
+        elif set(parts) != set(names):  # in any order: a stage may time its parts in turns
+            raise ValueError(f"bench: a timed call reported parts {list(parts)}, an earlier one {names}")
+        return parts
+
     for _ in range(settings.warmup):
-        fn()
+        call()
     samples: dict[str, list[float]] = {}
     was_enabled = gc.isenabled()
     gc.collect()
     gc.disable()
     try:
-        spent_ns, budget_ns = 0, int(settings.budget_s * 1e9)
-        while len(next(iter(samples.values()), ())) < settings.max_runs and (
-            spent_ns < budget_ns or len(next(iter(samples.values()), ())) < settings.min_runs
-        ):
+        calls, spent_ns, budget_ns = 0, 0, int(settings.budget_s * 1e9)
+        while calls < settings.max_runs and (spent_ns < budget_ns or calls < settings.min_runs):
             start = time.perf_counter_ns()
-            parts = fn()
+            parts = call()
             spent_ns += time.perf_counter_ns() - start
+            calls += 1
             for name, value in parts.items():
                 samples.setdefault(name, []).append(float(value))
     finally:

@@ -164,8 +164,41 @@ def test_harness_counts_runs_and_restores_the_collector():
     assert gc.isenabled()
     settings = RunSettings(warmup=0, min_runs=1, max_runs=3, budget_s=60.0)
     assert measure_parts(lambda: {"a": 0.0}, settings)["a"].runs == 3
+    turns = iter([{"a": 1.0, "b": 2.0}, {"b": 2.0, "a": 1.0}, {"a": 1.0, "b": 2.0}])
+    assert measure_parts(lambda: next(turns), settings)["b"] == Stats(2.0, 2.0, 2.0, 3)  # parts timed in turns
     with pytest.raises(ValueError, match="min_runs"):
         RunSettings(warmup=0, min_runs=5, max_runs=2, budget_s=1.0)
+
+
+@pytest.mark.parametrize(
+    ("replies", "message"),
+    [
+        ([{}], "reported no parts"),  # looped forever: the stop counted the first part's samples
+        ([{"a": 1.0}, {"b": 1.0}], r"reported parts \['b'\], an earlier one \['a'\]"),
+        ([{"a": 1.0, "b": 2.0}, {"b": 2.0}], r"reported parts \['b'\], an earlier one \['a', 'b'\]"),
+    ],
+)
+def test_harness_refuses_calls_without_parts_or_with_other_parts(replies, message):
+    import signal
+
+    calls = iter(range(10**6))
+
+    def fn() -> dict[str, float]:
+        return replies[min(next(calls), len(replies) - 1)]
+
+    def stop(*_: object) -> None:
+        raise TimeoutError("measure_parts did not return")
+
+    previous = signal.signal(signal.SIGALRM, stop)
+    signal.alarm(10)
+    try:
+        for warmup in (0, 1):
+            with pytest.raises(ValueError, match=message):
+                calls = iter(range(10**6))
+                measure_parts(fn, RunSettings(warmup=warmup, min_runs=1, max_runs=5, budget_s=60.0))
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
 
 
 @pytest.mark.parametrize("method", ["ospace", "rays"])
@@ -274,3 +307,55 @@ def test_frame_and_lift_stages_without_shared_data(tmp_path):
         _check_stage(report["stages"][f"frame/2/{part}"])
     assert report["stages"]["lift/4"]["people"] == 4
     assert any("pose = TruthPose" in note for note in report["notes"])
+
+
+def test_render_stage_casts_every_timed_frame_and_noise_stage_reuses_the_render(tmp_path, monkeypatch):
+    """``synthetic/render`` times a fresh ray cast per call (not the camera's kept render); ``synthetic/noise``
+    times the kept-render path, which casts only while building the first frame."""
+    from sid.synthetic import render as render_module
+
+    casts = []
+    original = render_module.RayCaster.render
+    monkeypatch.setattr(
+        render_module.RayCaster, "render", lambda self, *a, **k: casts.append(1) or original(self, *a, **k)
+    )
+    settings = RunSettings(warmup=1, min_runs=3, max_runs=3, budget_s=1e-9)
+    ctx = _context(tmp_path, settings)
+    items = benchmarks(ctx)
+    stages = run_suite(select(items, "synthetic/render"), ctx).stages
+    assert stages["synthetic/render"]["runs"] == 3
+    assert len(casts) >= 1 + 3 + 3  # the empty floor, then at least one cast per call (warm-up and timed)
+    casts.clear()
+    stages = run_suite(select(items, "synthetic/noise"), ctx).stages
+    _check_stage(stages["synthetic/noise"])
+    first_frame = len(casts)
+    assert first_frame >= 1
+    casts.clear()
+    from sid.experiments.bench.stages.inputs import frame_scene
+    from sid.synthetic import SyntheticCamera
+
+    camera, scene = SyntheticCamera(), frame_scene(4)
+    camera.capture(scene, index=0)
+    assert len(casts) == first_frame  # the noise stage's 4 calls cast no more than one frame needs
+
+
+def test_compare_shows_minimums_and_warns_about_other_settings_and_other_work():
+    def report(quick: bool, provider: str, pose: str, min_ms: float) -> dict:
+        return {
+            "machine": {"cpu": "same cpu"},
+            "settings": {"quick": quick, "pose_provider": provider, "pose_threads": 2, "plan_runs": 5},
+            "stages": {
+                "frame/4": {"median_ms": 10.0, "min_ms": min_ms, "max_ms": 12.0, "runs": 9, "pose": pose},
+                "pose/m": {"median_ms": 5.0, "min_ms": 4.0, "max_ms": 6.0, "runs": 9, "provider": provider},
+            },
+        }
+
+    same = format_comparison(report(False, "cpu", "yolo", 8.0), report(False, "cpu", "yolo", 7.5))
+    assert "warning" not in same
+    header, row = same.splitlines()[0].split(), next(r for r in same.splitlines() if r.startswith("frame/4 ")).split()
+    assert header == ["stage", "old", "median", "new", "median", "new/old", "old", "min", "new", "min"]
+    assert row == ["frame/4", "10.000", "10.000", "1.00", "8.000", "7.500"]
+    changed = format_comparison(report(False, "cpu", "yolo", 8.0), report(True, "cuda", "TruthPose", 8.0))
+    assert "warning: different run settings (quick False -> True; pose_provider 'cpu' -> 'cuda')" in changed
+    assert "warning: frame/4 timed other work (pose 'yolo' -> 'TruthPose')" in changed
+    assert "warning: pose/m timed other work (provider 'cpu' -> 'cuda')" in changed
