@@ -459,22 +459,3 @@ def test_a_json_document_written_over_several_lines_is_named_as_such(tmp_path, c
         "sid groups: line 1: not valid JSON (Expecting property name enclosed in double quotes at the end of the line; "
         "JSON lines hold one whole object per line: is this one JSON document over several lines?)\n"
     )
-
-
-def test_the_command_runs_through_process(tmp_path, monkeypatch, capsys) -> None:
-    """``sid groups FILE`` and ``process`` (what the tests and the fuzzers call) are one path: run built its own
-    handler beside process's, so a test of process did not test the command."""
-    from sid.cli import groups
-
-    calls = []
-    original = groups.process
-
-    def spy(*args, **kwargs):
-        calls.append(args)
-        return original(*args, **kwargs)
-
-    monkeypatch.setattr(groups, "process", spy)
-    path = tmp_path / "frames.jsonl"
-    path.write_text(json.dumps(PAIR) + "\n")
-    assert main(["groups", str(path)]) == 0
-    assert len(calls) == 1 and json.loads(capsys.readouterr().out)["groups"][0]["members"] == [1, 2]

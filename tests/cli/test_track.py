@@ -307,23 +307,3 @@ def test_an_id_given_twice_names_both_people_and_a_default_id(tmp_path, capsys):
         "its id)",
         "sid track: line 2: people[0] and people[2] have one id, 4",
     ]
-
-
-def test_the_command_runs_through_process(tmp_path: Path, monkeypatch, capsys) -> None:
-    """``sid track FILE`` and ``process`` (what the tests and the fuzzers call) are one path: run built its own
-    handler beside process's, so a test of process did not test the command."""
-    from sid.cli import track
-
-    calls = []
-    original = track.process
-
-    def spy(*args, **kwargs):
-        calls.append(args)
-        return original(*args, **kwargs)
-
-    monkeypatch.setattr(track, "process", spy)
-    path = tmp_path / "steps.jsonl"
-    path.write_text("".join(json.dumps(line) + "\n" for line in scene(3)[0]))
-    assert main(["track", str(path)]) == 0
-    out = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
-    assert len(calls) == 1 and len(out) == 3 and len(out[-1]["people"]) == 5
