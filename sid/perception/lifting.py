@@ -51,10 +51,15 @@ from sid.perception.mount import CameraMount
 from sid.perception.orientation import EAR_SEPARATION, HIP_SEPARATION, SHOULDER_SEPARATION, estimate_orientations
 from sid.perception.people import Person
 
-__all__ = ["LiftParams", "lift_people"]
+__all__ = ["LOOKUP_RANGE", "LiftParams", "lift_people"]
 
 # Far-side completion. Root keypoints and their partner a fixed separation away, as (root, partner): shoulders,
 # hips, ears (``widths`` order), left roots then right ones.
+LOOKUP_RANGE = (0.1, 10.0)
+"""Readings (m) a keypoint's depth lookup always accepts, whatever the lift's range: a depth camera's span (a D435
+sees from about 0.1 m; beyond 10 m its readings are noise). ``LiftParams.min_range`` / ``max_range`` gate the looked-up
+keypoints afterwards."""
+
 _ROOT_PAIRS = tuple(
     (KP[f"{side}_{part}"], KP[f"{other}_{part}"])
     for side, other in (("left", "right"), ("right", "left"))
@@ -84,12 +89,12 @@ class LiftParams:
       around it, several times faster than "exact" and within millimetres of it at the median (docs/benchmarks.md,
       "Depth at the keypoints"); the far outliers (a window that reads the wall beside a silhouette) are what
       ``depth_gate`` drops. "exact": the splat search, equal to aligning the whole frame.
-    min_range: keypoints nearer than this to the camera (m, optical z, above 0) are dropped, and readings nearer
-      than this are no reading where a keypoint's depth is looked up. 0.2: a D435's minimum depth at 848x480 is
+    min_range: keypoints nearer than this to the camera (m, optical z, above 0) are dropped (readings down to it are
+      looked up, and down to ``LOOKUP_RANGE``'s). 0.2: a D435's minimum depth at 848x480 is
       about 0.2 m, so a nearer reading is an artefact or a corrupt depth image (1 mm everywhere would otherwise
       place people 7 cm from the lens).
-    max_range: keypoints farther than this from the camera (m, optical z) are dropped, and readings farther than
-      this are no reading where a keypoint's depth is looked up. 6.0: D435-class depth
+    max_range: keypoints farther than this from the camera (m, optical z) are dropped (readings up to it are looked
+      up, and up to ``LOOKUP_RANGE``'s). 6.0: D435-class depth
       noise grows with range squared (~2 % at 2 m, ~20 cm at 6 m), beyond which body orientation is noise.
     depth_gate: keypoints whose depth differs from the person's median keypoint depth by more than this (m) are
       dropped. 0.6: a standing body spans ~0.3 m in depth even in side view; a keypoint beyond that read the wall
@@ -182,8 +187,11 @@ def lift_people(
         calib,
         patch=params.patch,
         search=params.depth_search,
-        depth_min=params.min_range,
-        depth_max=params.max_range,
+        # Readings the lookup may use: the sensor's span, widened to the lift's range but never cut to it, so that a
+        # person just beyond max_range reads beyond it and is gated below (readings cut at max_range would leave the
+        # nearer half of their noise, a person placed just inside).
+        depth_min=min(params.min_range, LOOKUP_RANGE[0]),
+        depth_max=max(params.max_range, LOOKUP_RANGE[1]),
     )
     usable = (depth >= params.min_range) & (depth <= params.max_range)  # NaN (not confident, no reading): False
     # Median depth per person over its usable keypoints (unusable ones sort last as +inf; np.nanmedian is much

@@ -349,7 +349,8 @@ def test_depth_nearer_than_the_minimum_range_places_nobody():
 def test_the_lift_range_reaches_the_depth_lookup_registered_or_not():
     """Unregistered depth was looked up between the lookup's own 0.1 and 10 m, whatever the lift's range: a person
     12 m away with max_range=20 was placed from registered depth and not from unregistered depth; and registered
-    lookups read patches without any range. The lift's range now bounds the readings on both paths."""
+    lookups read patches without any range. The lookup now reads the lift's range (widened to LOOKUP_RANGE) on both
+    paths."""
     depth_intr = Intrinsics(640, 480, 580.0, 580.0, 318.0, 241.0)
     unregistered = Calibration(COLOR, depth_intr, Extrinsics(np.eye(3), [0.015, 0.0, 0.0]))
     detections, _, _ = scene([(12.0, 0.0, math.pi)])
@@ -372,3 +373,22 @@ def test_bench_lifting_four_people(benchmark):
     detections, depth, _ = scene([(2.5, -0.6, 2.5), (2.5, 0.6, -2.5), (3.2, -0.3, 3.0), (3.2, 0.5, 3.3)])
     people = benchmark(lift_people, detections, depth, REGISTERED, MOUNT)
     assert len(people) == 4 and all(p.theta is not None for p in people)
+
+
+@pytest.mark.parametrize("registered", [True, False])
+def test_a_person_just_beyond_the_maximum_range_is_dropped_not_pulled_inside(registered):
+    """Readings cut at max_range (6 m) left a person at 6.08 m the nearer half of their noise: placed at about 5.96 m
+    (the built-in walking_pairs sequence gained 6 false tracks). The lookup reads the sensor's whole span, and the
+    lift's gate then drops the keypoints beyond max_range."""
+    calibration = (
+        REGISTERED
+        if registered
+        else Calibration(
+            COLOR, Intrinsics(640, 480, 580.0, 580.0, 318.0, 241.0), Extrinsics(np.eye(3), [0.015, 0.0, 0.0])
+        )
+    )
+    detections, _, _ = scene([(6.08, 0.0, math.pi)])
+    noisy = 6.08 + np.random.default_rng(3).normal(0.0, 0.1, (480, 640)).astype(np.float32)
+    assert lift_people(detections, noisy, calibration, MOUNT, LiftParams()) == []
+    [person] = lift_people(detections, noisy, calibration, MOUNT, LiftParams(max_range=7.0))
+    assert person.x == pytest.approx(6.08, abs=0.15)
