@@ -53,6 +53,7 @@ __all__ = [
     "exit_code",
     "fail",
     "guarded_standard_output",
+    "name_width",
     "output_folder_lock",
     "plain_text",
     "positive_int",
@@ -151,6 +152,12 @@ def add_output_option(parser: argparse.ArgumentParser, command: str, what: str) 
 def plain_text(doc: str) -> str:
     """A docstring as ``--help`` text: without the backquotes of its literals (reStructuredText or Markdown)."""
     return doc.replace("`", "")
+
+
+def name_width(names: Iterable[str], least: int = 16) -> int:
+    """Width of a table's first column: the longest of ``names`` (datasets are named by their folders), at least
+    ``least`` characters, so that a long name does not push its row's numbers out of their columns."""
+    return max([least, *(len(name) for name in names)])
 
 
 def whole_number(low: int) -> Callable[[str], int]:

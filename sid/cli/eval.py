@@ -10,7 +10,7 @@ import math
 import sys
 from pathlib import Path
 
-from sid.cli.common import fail, positive_number, whole_number
+from sid.cli.common import fail, name_width, positive_number, whole_number
 from sid.cli.eval_crowd import add_crowd_parser
 from sid.cli.grouping import add_group_params, group_params_from
 from sid.distribution import MissingDependencyError
@@ -262,10 +262,11 @@ def _dataset_name(folder: str, taken: dict) -> str:
 
 def _folds(folds: list[Fold], table: dict[tuple[float, ...], dict[str, float]]) -> str:
     """Each fold's choice and scores, then the spread of the held-out F1."""
-    lines = [f"{'held out':<16} {'F1 there':>8} {'F1 others':>9}  chosen"]
+    w = name_width(fold.held_out for fold in folds)
+    lines = [f"{'held out':<{w}} {'F1 there':>8} {'F1 others':>9}  chosen"]
     for fold in folds:
         chosen = " ".join(f"{k}={v:g}" for k, v in fold.chosen.items())
-        lines.append(f"{fold.held_out:<16} {fold.held_out_f1:>8.3f} {fold.train_f1:>9.3f}  {chosen}")
+        lines.append(f"{fold.held_out:<{w}} {fold.held_out_f1:>8.3f} {fold.train_f1:>9.3f}  {chosen}")
     held = [fold.held_out_f1 for fold in folds]
     lines.append(
         f"held-out F1 {min(held):.3f}-{max(held):.3f} (spread {max(held) - min(held):.3f}), {len(table)} grid points"
@@ -286,22 +287,25 @@ def _folds_json(
 def _errors_table(errors: dict[str, dict[str, int]]) -> str:
     """How the true groups came out, per dataset: counts and, for the true groups, their shares."""
     columns = [*GROUP_ERRORS, "false_groups"]
-    lines = [f"{'dataset':<16} {'true groups':>11} " + " ".join(f"{c.replace('_', ' '):>13}" for c in columns)]
+    w = name_width(errors)
+    lines = [f"{'dataset':<{w}} {'true groups':>11} " + " ".join(f"{c.replace('_', ' '):>13}" for c in columns)]
     for name, counts in errors.items():
         true = sum(counts[c] for c in GROUP_ERRORS)
         cells = [
             f"{counts[c]} ({counts[c] / true:.0%})" if true and c in GROUP_ERRORS else str(counts[c]) for c in columns
         ]
-        lines.append(f"{name:<16} {true:>11} " + " ".join(f"{cell:>13}" for cell in cells))
+        lines.append(f"{name:<{w}} {true:>11} " + " ".join(f"{cell:>13}" for cell in cells))
     return "\n".join(lines)
 
 
 def _table(scores: dict[str, dict[str, dict[str, float]]]) -> str:
-    lines = [f"{'dataset':<16} {'T':>4} {'frames':>6} {'precision':>9} {'recall':>7} {'F1':>6}"]
+    w = name_width(scores)
+    lines = [f"{'dataset':<{w}} {'T':>4} {'frames':>6} {'precision':>9} {'recall':>7} {'F1':>6}"]
     for name, by_threshold in scores.items():
         for threshold, s in by_threshold.items():
             lines.append(
-                f"{name:<16} {threshold:>4} {s['frames']:>6} {s['precision']:>9.3f} {s['recall']:>7.3f} {s['f1']:>6.3f}"
+                f"{name:<{w}} {threshold:>4} {s['frames']:>6} "
+                f"{s['precision']:>9.3f} {s['recall']:>7.3f} {s['f1']:>6.3f}"
             )
     return "\n".join(lines)
 

@@ -14,7 +14,7 @@ import math
 import sys
 from typing import Any
 
-from sid.cli.common import fail, plain_text, whole_number
+from sid.cli.common import fail, name_width, plain_text, whole_number
 from sid.distribution import MissingDependencyError
 from sid.experiments.crowd import DEFAULT_GRID, CrowdSettings, cross_validate, evaluate_crowd
 from sid.experiments.trajectories import ReplaySettings, TrajectoryError, TrajectorySet, load_trajectory_set
@@ -124,15 +124,16 @@ def _view_pose(text: str) -> tuple[float, float, float]:
 
 
 def _table(result: dict[str, Any]) -> str:
+    w = name_width(result["sets"], 12)
     lines = [
-        f"{'set':<12} {'frames':>6} {'MOTA':>6} {'IDF1':>6} {'IDsw':>5} {'/100':>5} | "
+        f"{'set':<{w}} {'frames':>6} {'MOTA':>6} {'IDF1':>6} {'IDsw':>5} {'/100':>5} | "
         f"{'G-MITRE P':>9} {'R':>5} {'F1':>5} {'T=2/3 F1':>8} {'T=1 F1':>6} | "
         f"{'coherent G-MITRE F1':>19} {'T=2/3 F1':>8}"
     ]
     for name, s in result["sets"].items():
         people, ours, ref = s["people"], s["groups"], s["coherent_motion"]
         lines.append(
-            f"{name:<12} {s['frames']:>6} {people['mota']:>6.3f} {people['idf1']:>6.3f} {people['id_switches']:>5} "
+            f"{name:<{w}} {s['frames']:>6} {people['mota']:>6.3f} {people['idf1']:>6.3f} {people['id_switches']:>5} "
             f"{people['id_switches_per_100_tracks']:>5.1f} | {ours['gmitre']['precision']:>9.3f} "
             f"{ours['gmitre']['recall']:>5.3f} {ours['gmitre']['f1']:>5.3f} {ours['groups_T2/3']['f1']:>8.3f} "
             f"{ours['groups_T1']['f1']:>6.3f} | {ref['gmitre']['f1']:>19.3f} {ref['groups_T2/3']['f1']:>8.3f}"
@@ -141,14 +142,15 @@ def _table(result: dict[str, Any]) -> str:
 
 
 def _folds_table(result: dict[str, Any]) -> str:
-    lines = [f"{'held out':<12} {'stage':<9} {'train':>6} {'held out':>8}  chosen"]
+    w = name_width((fold["held_out"] for fold in result["folds"]), 12)
+    lines = [f"{'held out':<{w}} {'stage':<9} {'train':>6} {'held out':>8}  chosen"]
     for fold in result["folds"]:
         for stage, score in (("tracker", "idf1"), ("groups", "f1"), ("coherent", "f1")):
             entry = fold[stage]
             chosen = ", ".join(f"{k}={v:g}" for k, v in entry["chosen"].items())
             metric = "IDF1" if score == "idf1" else "G-MITRE F1"
             lines.append(
-                f"{fold['held_out']:<12} {stage:<9} {entry[f'train_{score}']:>6.3f} "
+                f"{fold['held_out']:<{w}} {stage:<9} {entry[f'train_{score}']:>6.3f} "
                 f"{entry[f'held_out_{score}']:>8.3f}  {chosen} ({metric})"
             )
     return "\n".join(lines)

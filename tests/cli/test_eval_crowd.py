@@ -27,6 +27,15 @@ def test_the_table_has_a_row_per_set_with_both_group_trackers(tmp_path: Path, ca
     assert progress[-1].endswith("south: scoring the reference")
 
 
+def test_a_long_set_name_keeps_the_columns(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    # The name column was 12 characters wide: a longer folder name pushed its row's numbers out of their columns.
+    folders = [str(pair_and_strangers(tmp_path / name, frames=12)) for name in ("a", "students003_left_half")]
+    assert main(["eval", "crowd", *folders]) == 0
+    header, *rows = capsys.readouterr().out.splitlines()
+    assert len({line.index(" | ") for line in (header, *rows)}) == 1
+    assert all(row.index(" | ") == header.index(" | ") for row in rows)
+
+
 def test_json_holds_the_settings_and_every_score(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
     folder = pair_and_strangers(tmp_path / "scene", frames=20)
     argv = ["eval", "crowd", str(folder), "--json", "--rate", "5", "--noise", "0.05", "--view=-2,0.3,0", "--fov=60"]

@@ -184,6 +184,21 @@ def test_eval_fformation_prints_json_and_a_table(tmp_path, capsys):
     assert out[1].split() == ["Tiny", "3/4", "3", "1.000", "0.667", "0.800"]
 
 
+def test_eval_fformation_tables_keep_their_columns_for_a_long_dataset_name(tmp_path, capsys):
+    # The name column was 16 characters wide: a longer folder name pushed its row's numbers out of their columns.
+    truth = {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]}
+    folders = [
+        str(write_sequence(tmp_path / name, tiny_frames(), truth)) for name in ("Tiny", "Poster_session_day_two")
+    ]
+    for extra in ([], ["--errors"]):
+        code, out, _ = run_sid(["eval", "fformation", *folders, "--scale", "0.01", "--table", *extra], capsys)
+        assert code == 0
+        tables = "\n".join(out).split("\n\n")  # the scores, then with --errors how the groups came out
+        assert len(tables) == 1 + len(extra)
+        for table in tables:
+            assert len({len(line) for line in table.splitlines()}) == 1, table  # every column right-aligned
+
+
 def test_eval_fformation_counts_how_each_true_group_came_out(tmp_path, capsys):
     tiny = write_sequence(tmp_path / "Tiny", tiny_frames(), {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]})
     code, out, _ = run_sid(["eval", "fformation", str(tiny), "--errors"], capsys)
