@@ -22,7 +22,7 @@ from sid.perception.pipeline import FrameResult
 from sid.perception.robot_pose import RobotPose
 from sid.tracking.groups import GroupTracker, GroupTrackerParams
 from sid.tracking.records import TrackedGroup, TrackedPerson
-from sid.tracking.tracker import PeopleTracker, TrackerParams, TrackingError, check_time_order
+from sid.tracking.tracker import PeopleTracker, TrackerParams, TrackingError, check_people, check_time_order
 from sid.tracking.view import View
 
 __all__ = ["SessionUpdate", "TrackingParams", "TrackingSession"]
@@ -87,6 +87,7 @@ class TrackingSession:
         self.check(result.timestamp, result.robot_pose, f"frame {result.frame}")
         reset = self._reset_reason(result)
         if reset is not None:
+            check_people(result.people)  # bad people refuse the frame before the reset forgets the tracks
             self.people.reset()
             self.groups.reset()
         update = self._track(result.people, result.timestamp, view)  # a TrackingError here keeps the last frame

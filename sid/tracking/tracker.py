@@ -31,7 +31,7 @@ from sid.tracking.motion import MotionStates
 from sid.tracking.records import TIME_TOLERANCE, TrackedPerson
 from sid.tracking.view import View, ViewCone
 
-__all__ = ["OCCLUDER_RADIUS", "PeopleTracker", "TrackerParams", "TrackingError", "check_time_order"]
+__all__ = ["OCCLUDER_RADIUS", "PeopleTracker", "TrackerParams", "TrackingError", "check_people", "check_time_order"]
 
 OCCLUDER_RADIUS = 0.2
 """A person's half-width (m) seen from above, to tell who is behind whom in the camera's view (``ViewCone.behind``)."""
@@ -304,6 +304,12 @@ def _behind(view: View | None, positions: np.ndarray, detections: np.ndarray) ->
     if not isinstance(view, ViewCone):
         return np.zeros(len(positions), dtype=bool)
     return view.behind(positions, detections, OCCLUDER_RADIUS)
+
+
+def check_people(people: Sequence[Person]) -> None:
+    """Raise TrackingError, as ``PeopleTracker.update`` would, when ``people`` hold an id that is not a whole number
+    or given twice, or a position, facing or orientation quality that is not a finite number in range."""
+    _measurements(people)
 
 
 def _measurements(people: Sequence[Person]) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[int]]:

@@ -8,6 +8,7 @@ import pytest
 
 from sid.perception.people import Person
 from sid.perception.pipeline import FrameResult
+from sid.perception.robot_pose import RobotPose
 from sid.tracking import TrackingError, TrackingSession
 
 
@@ -24,3 +25,23 @@ def test_a_result_with_bad_people_is_refused_and_leaves_the_session_as_it_was() 
     update = session.update(_result(4, 0.3, [Person(0, 2.0, 0.0, 0.0)]))  # after the last good one
     assert [p.id for p in update.people] == [1]
     assert update.people[0].last_seen == 0.3
+
+
+@pytest.mark.parametrize("jump", [RobotPose(5.0, 0.0, 0.0), None], ids=["pose jump", "frame change"])
+def test_a_result_with_bad_people_that_would_reset_the_trackers_leaves_them_as_they_were(
+    jump: RobotPose | None,
+) -> None:
+    # The reset (a pose jump, or positions in another frame) ran before the people were checked: the refused result
+    # had already made the session forget its tracks, and the person came back under a new id.
+    session = TrackingSession()
+    for k in range(3):
+        session.update(
+            FrameResult(k, k * 0.1, [], [Person(0, 2.0, 0.0, 0.0)], [], frame_id="map", robot_pose=RobotPose(0, 0, 0))
+        )
+    bad = [Person(0, 2.0, 0.0, 0.0), Person(0, 3.0, 0.0, 0.0)]
+    frame_id = "map" if jump else "base_footprint"
+    with pytest.raises(TrackingError, match="person id 0 appears twice"):
+        session.update(FrameResult(3, 0.3, [], bad, [], frame_id=frame_id, robot_pose=jump))
+    good = FrameResult(4, 0.4, [], [Person(0, 2.0, 0.0, 0.0)], [], frame_id="map", robot_pose=RobotPose(0, 0, 0))
+    update = session.update(good)
+    assert update.reset is None and [p.id for p in update.people] == [1]
