@@ -60,6 +60,18 @@ def test_people_blocking_the_corridor_for_good_end_at_the_time_limit():
     )
 
 
+def test_a_person_standing_on_the_goal_is_named_at_the_time_limit():
+    # the goal lay inside person 1's body: the reason read only "it lies inside an obstacle", as if a wall stood there
+    people = [{"id": 1, "x": 4.0, "y": 0.0, "theta": 3.1416}]
+    trace = simulate(tiny_world(people=people, simulation={"time_limit_s": 1.0}), EXACT)
+    assert not trace.success and trace.collisions == 0
+    assert trace.reason.startswith("time limit (1 s) reached: no path: goal (4.00, 0.00) is in collision")
+    assert trace.reason.endswith(
+        "the goal is 0.00 m from person 1 at (4.00, 0.00): a person is an obstacle of radius 0.20 m "
+        "(lidar.body_radius) and the robot a disc of radius 0.25 m (robot.radius)"
+    )
+
+
 def test_the_unknown_map_is_discovered_by_the_lidar():
     box = {"type": "box", "min": [1.5, -0.5], "max": [2.5, 0.5]}
     world = tiny_world(obstacles=[*TINY["obstacles"], box], people=[])
