@@ -112,15 +112,15 @@ def prepare(scenario: Scenario, cost_weight: float = DEFAULT_COST_WEIGHT, labels
     return Task(scenario, groups, costmaps, problems, dict(labels or {}))
 
 
-def zone_warnings(task: Task) -> list[str]:
-    """Messages for the robot's start and goal when they lie inside a group's interaction zone. The plan is still
-    made: the robot may stand there, or have to go there (to join or serve the group), and the metrics report the
-    intrusion."""
+def zone_warnings(scenario: Scenario, groups: Sequence[Group]) -> list[str]:
+    """Messages for the robot's start and goal when they lie inside the interaction zone of one of ``groups`` (of
+    ``scenario.people``). The plan is still made: the robot may stand there, or have to go there (to join or serve
+    the group), and the metrics report the intrusion."""
     warnings = []
-    for end, pose, verb in (("start", task.scenario.robot.start, "leave"), ("goal", task.scenario.robot.goal, "enter")):
+    for end, pose, verb in (("start", scenario.robot.start, "leave"), ("goal", scenario.robot.goal, "enter")):
         point = Point(pose[:2])
-        for group in task.groups:
-            if group_zone_polygon(group, task.scenario.people).covers(point):
+        for group in groups:
+            if group_zone_polygon(group, scenario.people).covers(point):
                 warnings.append(
                     f"the {end} lies inside the interaction zone of group {group.members}: the path has to {verb} it "
                     "(by the shortest way the costs allow); see ospace_intrusion_m"
