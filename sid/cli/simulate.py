@@ -84,8 +84,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--model", default=None, metavar="M.onnx", help="a pose model instead of TruthPose")
     parser.add_argument(
         "--perception", choices=PERCEPTIONS, default="camera",
-        help="camera: rendered frames through the real pipeline and trackers (default); exact: true poses of the "
-        "people in view",
+        help="camera: rendered frames through the real pipeline and trackers (default); exact: true poses and "
+        "velocities of the people in view",
     )  # fmt: skip
     parser.add_argument("--unknown-map", action="store_true", help="no known map: the LiDAR discovers obstacles too")
     parser.add_argument("--gif", action="store_true", help="also write run.gif (every other frame)")

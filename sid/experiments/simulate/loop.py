@@ -160,12 +160,12 @@ def make_sensing(world: SimWorld, options: RunOptions, color: bool = False, wall
         known = replace(known, obstacles=[], static_map=None)
     if not options.social:
         return LidarSensing(build_costmap(known, social=False, groups=[]))
-    if options.perception == "exact":
-        costmap = build_costmap(known, social=True, groups=[])
-        return ExactSensing(costmap, scenario.obstacles, scenario.group_params, scenario.lidar.body_radius,
-                            walls=walls)  # fmt: skip
+    # people come as tracks (the camera's, or exact perception's perfect ones): the social layer draws tracks instead
     plugins = tuple("tracked_people" if name == "social" else name for name in scenario.layers.plugins)
     costmap = build_costmap(known, social=True, groups=[], params=replace(scenario.layers, plugins=plugins))
+    if options.perception == "exact":
+        return ExactSensing(costmap, scenario.obstacles, scenario.group_params, scenario.walks,
+                            world.settings.rate_hz, scenario.lidar.body_radius, walls=walls)  # fmt: skip
     if options.model is None:
         pose: PoseFn = TruthPose()
     else:
