@@ -52,7 +52,7 @@ def run(args: argparse.Namespace) -> int:
             )
     except (*INPUT_ERRORS, OSError) as exc:
         return fail("sid demo", exc)
-    warn_zones("sid demo", comparison)
+    warn_zones("sid demo", comparison.task.scenario, comparison.task.groups)
     print()
     print(format_table(comparison))
     print()

@@ -51,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
         )
     except INPUT_ERRORS as exc:
         return fail("sid plan", exc)
-    warn_zones("sid plan", comparison)
+    warn_zones("sid plan", comparison.task.scenario, comparison.task.groups)
     try:
         with staged_output(args.out, ()) as staged:
             files = {key: staged.final(path) for key, path in write_plan(comparison, staged.path).items()}

@@ -5,13 +5,15 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Sequence
 
 from costmap.mapfile import MapFileError
 from planner.facade import DEFAULT_PLANNER, DEFAULT_SOFT_LIMIT_S, MAX_SEED, PLANNERS
 from planner.problem import DEFAULT_COST_WEIGHT, PlanningError
 from sid.cli.common import add_output_option, positive_seconds
-from sid.experiments.harness import Comparison, zone_warnings
-from sid.scenario.loader import ScenarioError
+from sid.experiments.harness import zone_warnings
+from sid.perception.group import Group
+from sid.scenario.loader import Scenario, ScenarioError
 
 __all__ = [
     "INPUT_ERRORS",
@@ -89,7 +91,8 @@ def add_planning_options(
     )
 
 
-def warn_zones(command: str, comparison: Comparison) -> None:
-    """Warn on stderr when the task's start or goal lies inside a group zone (the plan is still made and reported)."""
-    for warning in zone_warnings(comparison.task):
+def warn_zones(command: str, scenario: Scenario, groups: Sequence[Group]) -> None:
+    """Warn on stderr when the scenario's start or goal lies inside the zone of one of ``groups`` (the task is
+    still planned, or run, and reported)."""
+    for warning in zone_warnings(scenario, groups):
         print(f"{command}: warning: {warning}", file=sys.stderr)

@@ -20,12 +20,13 @@ from sid.cli.common import (
     print_written,
     staged_output,
 )
-from sid.cli.planning import INPUT_ERRORS, add_planner_option
+from sid.cli.planning import INPUT_ERRORS, add_planner_option, warn_zones
 from sid.distribution import MissingDependencyError
 from sid.documents import plural, special_file
 from sid.experiments.progress import ProgressBar
 from sid.experiments.simulate.loop import PERCEPTIONS, RunOptions
 from sid.experiments.simulate.scenes import SCENE_ORDER, load_scene, scene_list
+from sid.perception.groups import detect_groups
 
 __all__ = ["RUN_FILES", "SUMMARY_KEYS", "SWEEP_FILES", "add_parser", "run"]
 
@@ -83,8 +84,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--model", default=None, metavar="M.onnx", help="a pose model instead of TruthPose")
     parser.add_argument(
         "--perception", choices=PERCEPTIONS, default="camera",
-        help="camera: rendered frames through the real pipeline and trackers (default); exact: true poses of the "
-        "people in view",
+        help="camera: rendered frames through the real pipeline and trackers (default); exact: true poses and "
+        "velocities of the people in view",
     )  # fmt: skip
     parser.add_argument("--unknown-map", action="store_true", help="no known map: the LiDAR discovers obstacles too")
     parser.add_argument("--gif", action="store_true", help="also write run.gif (every other frame)")
@@ -142,6 +143,8 @@ def run(args: argparse.Namespace) -> int:
             quiet_load_warnings()
         out = check_output_folder(args.out)
         world = load_scene(args.scene)
+        scenario = world.scenario
+        warn_zones("sid simulate", scenario, detect_groups(scenario.people, scenario.group_params))
         with staged_output(out, RUN_FILES) as staged:  # whole files only, even when interrupted; earlier ones go
             record = write_run(
                 world, options, staged.path, gif=args.gif, progress=ProgressBar("simulate"), still_s=args.still

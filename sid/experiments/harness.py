@@ -56,6 +56,7 @@ __all__ = [
     "Task",
     "compare_with_without",
     "people_at_ends",
+    "people_in_the_way",
     "people_walling_off",
     "prepare",
     "run_matrix",
@@ -96,16 +97,11 @@ class Task:
         with those people named (``people_walling_off``)."""
         try:
             return plan(self.problems[mode], planner, **budget)
-        except EndpointCollisionError as exc:
-            people = people_at_ends(self.scenario, (exc.end,))
-            if not people:
+        except PlanningError as exc:
+            people = people_in_the_way(exc, self.scenario, self.problems[mode])
+            if people is None:
                 raise
-            raise EndpointCollisionError(f"{exc}; {people[0]}", exc.end) from exc
-        except WalledOffError as exc:
-            wall = people_walling_off(self.scenario, self.problems[mode])
-            if wall is None:
-                raise
-            raise WalledOffError(f"{exc}; {wall}") from exc
+            raise type(exc)(f"{exc}; {people}", *exc.args[1:]) from exc
 
 
 def prepare(scenario: Scenario, cost_weight: float = DEFAULT_COST_WEIGHT, labels: dict | None = None) -> Task:
@@ -116,15 +112,15 @@ def prepare(scenario: Scenario, cost_weight: float = DEFAULT_COST_WEIGHT, labels
     return Task(scenario, groups, costmaps, problems, dict(labels or {}))
 
 
-def zone_warnings(task: Task) -> list[str]:
-    """Messages for the robot's start and goal when they lie inside a group's interaction zone. The plan is still
-    made: the robot may stand there, or have to go there (to join or serve the group), and the metrics report the
-    intrusion."""
+def zone_warnings(scenario: Scenario, groups: Sequence[Group]) -> list[str]:
+    """Messages for the robot's start and goal when they lie inside the interaction zone of one of ``groups`` (of
+    ``scenario.people``). The plan is still made: the robot may stand there, or have to go there (to join or serve
+    the group), and the metrics report the intrusion."""
     warnings = []
-    for end, pose, verb in (("start", task.scenario.robot.start, "leave"), ("goal", task.scenario.robot.goal, "enter")):
+    for end, pose, verb in (("start", scenario.robot.start, "leave"), ("goal", scenario.robot.goal, "enter")):
         point = Point(pose[:2])
-        for group in task.groups:
-            if group_zone_polygon(group, task.scenario.people).covers(point):
+        for group in groups:
+            if group_zone_polygon(group, scenario.people).covers(point):
                 warnings.append(
                     f"the {end} lies inside the interaction zone of group {group.members}: the path has to {verb} it "
                     "(by the shortest way the costs allow); see ospace_intrusion_m"
@@ -158,6 +154,18 @@ def people_at_ends(scenario: Scenario, ends: Sequence[str] = ("start", "goal")) 
                 f"{robot.radius:.2f} m (robot.radius)"
             )
     return sentences
+
+
+def people_in_the_way(error: PlanningError, scenario: Scenario, problem: PlanningProblem) -> str | None:
+    """A sentence naming the people (``scenario.people``) who make ``problem`` fail with ``error``: for a start or
+    goal in collision the person at that end (``people_at_ends``), for a start and goal walled off from each other
+    those who close the way (``people_walling_off``); None for another failure or when no person is to blame."""
+    if isinstance(error, EndpointCollisionError):
+        people = people_at_ends(scenario, (error.end,))
+        return people[0] if people else None
+    if isinstance(error, WalledOffError):
+        return people_walling_off(scenario, problem)
+    return None
 
 
 def people_walling_off(scenario: Scenario, problem: PlanningProblem) -> str | None:

@@ -107,12 +107,15 @@ def test_a_task_whose_goal_is_its_start_has_no_ratios():
 def test_zone_warnings_name_the_end_and_the_group():
     data = copy.deepcopy(DEMO_SCENARIO)
     data["robot"]["goal"] = [4.5, 0.0, 0.0]  # the conversation's o-space centre
-    (warning,) = zone_warnings(prepare(scenario_from_dict(data)))
+    task = prepare(scenario_from_dict(data))
+    (warning,) = zone_warnings(task.scenario, task.groups)
     assert warning.startswith("the goal lies inside the interaction zone of group (1, 2, 3): the path has to enter it")
     data["robot"]["start"], data["robot"]["goal"] = data["robot"]["goal"], DEMO_SCENARIO["robot"]["goal"]
-    (warning,) = zone_warnings(prepare(scenario_from_dict(data)))
+    task = prepare(scenario_from_dict(data))
+    (warning,) = zone_warnings(task.scenario, task.groups)
     assert warning.startswith("the start lies inside the interaction zone of group (1, 2, 3): the path has to leave it")
-    assert zone_warnings(prepare(demo_scenario())) == []
+    task = prepare(demo_scenario())
+    assert zone_warnings(task.scenario, task.groups) == []
 
 
 def _record(social: bool, success: bool, **values) -> dict:

@@ -47,10 +47,9 @@ from planner.problem import (
     EndpointCollisionError,
     PlanningError,
     PlanningProblem,
-    WalledOffError,
 )
 from planner.validity import interpolate
-from sid.experiments.harness import people_walling_off
+from sid.experiments.harness import people_in_the_way
 from sid.experiments.simulate.follower import FollowerParams, follow, remaining
 from sid.experiments.simulate.perception import (
     SIM_CALIBRATION,
@@ -161,12 +160,12 @@ def make_sensing(world: SimWorld, options: RunOptions, color: bool = False, wall
         known = replace(known, obstacles=[], static_map=None)
     if not options.social:
         return LidarSensing(build_costmap(known, social=False, groups=[]))
-    if options.perception == "exact":
-        costmap = build_costmap(known, social=True, groups=[])
-        return ExactSensing(costmap, scenario.obstacles, scenario.group_params, scenario.lidar.body_radius,
-                            walls=walls)  # fmt: skip
+    # people come as tracks (the camera's, or exact perception's perfect ones): the social layer draws tracks instead
     plugins = tuple("tracked_people" if name == "social" else name for name in scenario.layers.plugins)
     costmap = build_costmap(known, social=True, groups=[], params=replace(scenario.layers, plugins=plugins))
+    if options.perception == "exact":
+        return ExactSensing(costmap, scenario.obstacles, scenario.group_params, scenario.walks,
+                            world.settings.rate_hz, scenario.lidar.body_radius, walls=walls)  # fmt: skip
     if options.model is None:
         pose: PoseFn = TruthPose()
     else:
@@ -208,7 +207,7 @@ class _Planner:
         self.plans = self.replans = 0
         self.time_s = 0.0
         self.message = ""
-        self.walled_off = False  # the last plan failed on a start and goal in separate free regions
+        self.failure: PlanningError | None = None  # why the last plan failed, when the planner refused the task
 
     def problem(self, costmap: Costmap2D, start: tuple[float, float]) -> PlanningProblem:
         robot = self.world.scenario.robot
@@ -224,11 +223,11 @@ class _Planner:
         t0 = time.perf_counter()
         problem = self.problem(costmap, xy)
         start = xy
-        self.walled_off = False
+        self.failure = None
         try:
             result = self._call(problem)
         except PlanningError as exc:
-            self.message, self.walled_off = str(exc), isinstance(exc, WalledOffError)
+            self.message, self.failure = str(exc), exc
             in_collision = isinstance(exc, EndpointCollisionError) and exc.end == "start"
             escape = _free_start(CostField(problem), xy) if in_collision else None
             if escape is None:
@@ -237,7 +236,7 @@ class _Planner:
             try:
                 result = self._call(self.problem(costmap, start))
             except PlanningError as again:
-                self.message, self.walled_off = str(again), isinstance(again, WalledOffError)
+                self.message, self.failure = str(again), again
                 return None
         finally:  # every call's time, a failed one's too (its endpoint checks, its search until the budget ran out)
             self.time_s += time.perf_counter() - t0
@@ -320,10 +319,10 @@ def simulate(
             break
         if t >= settings.time_limit_s - 1e-9:
             why = f": {planner.message}" if planner.path is None and planner.message else ""
-            if why and planner.walled_off:  # who closes the way, where they truly stand (the robot saw them)
+            if why and planner.failure is not None:  # who is in the way, where they truly stand (the robot saw them)
                 problem = planner.problem(sensing.costmap.master, (state.x, state.y))
-                wall = people_walling_off(replace(scenario, people=people), problem)
-                why += f"; {wall}" if wall else ""
+                blame = people_in_the_way(planner.failure, replace(scenario, people=people), problem)
+                why += f"; {blame}" if blame else ""
             trace.reason = f"time limit ({settings.time_limit_s:g} s) reached{why}"
             break
         pose = RobotPose(state.x, state.y, state.yaw)

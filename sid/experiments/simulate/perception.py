@@ -10,10 +10,12 @@ updates its layered costmap and returns what the robot now believes (``Seen``):
   the real perception pipeline (``TruthPose`` with its documented keypoint noise, or an ONNX pose model), the
   people and group trackers, and the costmap with the tracked-people layer. The camera sees people only:
   obstacles are not rendered, so a wall hides nobody from it.
-- ``ExactSensing``: the true poses of the people inside the camera's field of view and depth range whose centre
-  or a side of the body the camera can see past obstacles and other people (rays in the LiDAR plane), grouped by
-  ``sid.perception.groups.detect_groups``, on the social layer; no noise, no tracking (out of view is forgotten).
-  It isolates navigation from perception.
+- ``ExactSensing``: the true poses and velocities of the people inside the camera's field of view and depth range
+  whose centre or a side of the body the camera can see past obstacles and other people (rays in the LiDAR plane),
+  the standing ones grouped by ``sid.perception.groups.detect_groups`` (walkers are in no conversation, as in the
+  scene's truth), as perfect tracks on the tracked-people layer that the camera's tracks feed: a walker's cost is
+  stretched along their true velocity. No noise, no tracking (out of view is forgotten). It isolates navigation
+  from perception.
 - ``LidarSensing`` (without the social layer): the scan alone.
 """
 
@@ -31,6 +33,7 @@ from costmap.layer import LayerInputs
 from costmap.layered import LayeredCostmap
 from costmap.layers.obstacle import SCAN
 from costmap.layers.social import GROUPS, PEOPLE
+from costmap.layers.tracked import TRACKS
 from costmap.scan import LaserScan
 from sid.perception.camera import Calibration, Extrinsics, Intrinsics
 from sid.perception.group import Group
@@ -45,6 +48,7 @@ from sid.stream import SocialStream
 from sid.synthetic.noise import DepthNoise
 from sid.synthetic.sensor import SyntheticCamera
 from sid.synthetic.sequence import SyntheticSequence
+from sid.tracking.records import TrackedGroup, TrackedPerson, Tracks
 
 __all__ = [
     "CameraSensing",
@@ -114,24 +118,40 @@ def in_view(pose: RobotPose, people: list[Person], fov: float, range_m: tuple[fl
 
 @dataclass
 class ExactSensing:
-    """True poses of the people in view and not hidden, on the social layer (see the module docstring)."""
+    """True poses and velocities of the people in view and not hidden, as perfect tracks on the tracked-people layer
+    (see the module docstring). ``walks``: the scene's scripted motion by person id (``Scenario.walks``);
+    ``rate_hz``: steps per second, so that step ``k`` is time ``k / rate_hz`` (s)."""
 
     costmap: LayeredCostmap
     obstacles: list[Obstacle]
     group_params: GroupParams
+    walks: dict[int, Trajectory]
+    rate_hz: float
     body_radius: float = 0.2
     fov: float = FIELD_OF_VIEW
     range_m: tuple[float, float] = (DepthNoise().min_range_m, DepthNoise().max_range_m)
     walls: Costmap2D | None = None  # a static map file's walls (``sid.scenario.build.map_walls``): they hide people
 
     def __call__(self, step: int, pose: RobotPose, people: list[Person], scan: LaserScan) -> Seen:
-        seen = []
+        t = step / self.rate_hz
+        seen, tracks = [], []
         for person in in_view(pose, people, self.fov, self.range_m):
             others = [p for p in people if p.id != person.id]
             if any(self._clear(pose, person, others, side) for side in (0.0, -0.8, 0.8)):
+                walk = self.walks.get(person.id)
+                state = None if walk is None else walk.at(t)
+                vx, vy = (0.0, 0.0) if state is None else (state.vx, state.vy)
+                walking = state is not None and state.moving
                 seen.append(person)
-        groups = detect_groups(seen, self.group_params)
-        self.costmap.update(LayerInputs({PEOPLE: seen, GROUPS: groups, SCAN: scan}))
+                tracks.append(TrackedPerson(person.id, person.x, person.y, vx, vy, person.theta,
+                                            "walking" if walking else "standing", True, True, t, person.id, 0.0,
+                                            person.orientation_quality))  # fmt: skip
+        standing = [p for p, track in zip(seen, tracks, strict=True) if not track.walking]
+        groups = detect_groups(standing, self.group_params)
+        conversations = [TrackedGroup(i, "conversation", g.members, g.interest_point, g.zone, g.area, g.spread,
+                                      (0.0, 0.0), t) for i, g in enumerate(groups, start=1)]  # fmt: skip
+        tracked = Tracks(tracks, conversations)
+        self.costmap.update(LayerInputs({PEOPLE: seen, GROUPS: groups, SCAN: scan, TRACKS: tracked}))
         return Seen(seen, groups)
 
     def _clear(self, pose: RobotPose, person: Person, others: list[Person], side: float) -> bool:

@@ -5,7 +5,8 @@ A simulation file is a scenario file (docs/scenario.md: people may walk along ``
 optional block, ``simulation``: ``max_speed`` (m/s, 0.5), ``max_turn_rate`` (rad/s, 1.5), ``max_accel`` (m/s^2,
 1.0), ``time_limit_s`` (60), ``rate_hz`` (10), ``goal_tolerance_m`` (0.25), ``description`` (text for ``--list``).
 Every person who stands (no ``path``) needs a ``theta``: the world is ground truth, and the camera renders each body
-from its facing.
+from its facing. For the same reason no body may overlap an obstacle, where it stands or along its walk, or another
+body at time 0.
 
 Seeds (``jittered``): seed 0 is the scene as written; seed k >= 1 moves every standing person by Gaussian jitter of
 ``JITTER_XY_M`` and turns them by ``JITTER_THETA_RAD`` (drawn from ``[k, 7]``), so that sweeps over seeds see
@@ -18,11 +19,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from itertools import combinations
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-from shapely.geometry import Point, box
+from shapely.geometry import LineString, Point, box
 from shapely.ops import unary_union
 
 from costmap.grid import LETHAL, Costmap2D
@@ -30,6 +32,7 @@ from sid.checks import LimitError, check_limit
 from sid.documents import is_number, summary
 from sid.experiments.simulate.robot import DriveLimits
 from sid.perception.people import Person
+from sid.scenario.build import map_walls
 from sid.scenario.loader import Scenario, ScenarioError, read_scenario_file, scenario_from_dict
 from sid.scenario.obstacles import Obstacle, shape
 
@@ -37,6 +40,7 @@ __all__ = [
     "JITTER_THETA_RAD",
     "JITTER_XY_M",
     "RATE_HZ",
+    "TOUCH_M",
     "SIM_FIELDS",
     "SimSettings",
     "SimWorld",
@@ -49,6 +53,9 @@ __all__ = [
 
 JITTER_XY_M = 0.05
 JITTER_THETA_RAD = math.radians(5.0)
+TOUCH_M = 1e-6
+"""How far (m) a body may reach into an obstacle or another body and still count as touching it (a person drawn with
+their back to a wall, ``body_radius`` from it, lies a rounding error nearer)."""
 RATE_HZ = (0.1, 1000.0)
 """The range of ``simulation.rate_hz`` (Hz): steps per second and run.mp4's frame rate, which OpenCV's mp4v writer
 cannot open at 1e-3 or 1e5 frames per second."""
@@ -140,7 +147,38 @@ def world_from_dict(data: Any, base_dir: Path | None = None, default_name: str =
                 f"people[{i}].theta: a simulated standing person needs a facing (radians): the camera renders their "
                 "body from it; an unknown facing is what perception reports, not part of the world"
             )
+    _check_bodies(scenario)
     return SimWorld(scenario, replace(settings, limits=replace(settings.limits, radius=scenario.robot.radius)))
+
+
+def _check_bodies(scenario: Scenario) -> None:
+    """Refuse a world in which a person's body (``lidar.body_radius``) overlaps an obstacle (or the ``static_map``
+    file's walls) where they stand or anywhere along their scripted walk, or two people's bodies overlap at time 0:
+    the scene is the true world, and the robot would see, plan round and collide with bodies no one could have."""
+    body = scenario.lidar.body_radius
+    named = [(f"obstacles[{j}]", shape(obstacle)) for j, obstacle in enumerate(scenario.obstacles)]
+    walls = map_walls(scenario)
+    if walls is not None and (walls.costs == LETHAL).any():
+        named.append(("the static_map file's walls", obstacle_geometry([], walls)))
+    for i, person in enumerate(scenario.people):
+        walk = scenario.walks.get(person.id)
+        where = Point(person.x, person.y) if walk is None else LineString([(walk.x, walk.y), *walk.path])
+        for name, geometry in named:
+            gap = geometry.distance(where)
+            if gap < body - TOUCH_M:
+                what = f"stands at ({person.x:.2f}, {person.y:.2f})" if walk is None else "walks along its path"
+                near = f"on or inside {name}" if gap == 0.0 else f"{gap:.2f} m from {name}"
+                raise ScenarioError(
+                    f"people[{i}]: person {person.id} {what} {near}: a body of radius {body:.2f} m "
+                    "(lidar.body_radius) would overlap it"
+                )
+    for (i, a), (j, b) in combinations(enumerate(scenario.people), 2):
+        gap = math.hypot(a.x - b.x, a.y - b.y)
+        if gap < 2 * body - TOUCH_M:
+            raise ScenarioError(
+                f"people[{j}]: person {b.id} at ({b.x:.2f}, {b.y:.2f}) is {gap:.2f} m from person {a.id} (people[{i}]) "
+                f"at time 0: two bodies of radius {body:.2f} m (lidar.body_radius) would overlap"
+            )
 
 
 def load_world(path: str | Path) -> SimWorld:

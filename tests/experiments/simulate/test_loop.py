@@ -12,7 +12,9 @@ from sid.experiments.simulate import loop
 from sid.experiments.simulate.loop import RunOptions, make_sensing, simulate
 from sid.experiments.simulate.metrics import run_metrics
 from sid.experiments.simulate.world import collision, obstacle_geometry, world_from_dict
+from sid.perception.robot_pose import RobotPose
 from sid.scenario.build import map_walls
+from sid.scenario.lidar import simulate_scan
 from tests.experiments.simulate.tiny import TINY, tiny_world
 
 EXACT = RunOptions(perception="exact")
@@ -60,6 +62,18 @@ def test_people_blocking_the_corridor_for_good_end_at_the_time_limit():
     )
 
 
+def test_a_person_standing_on_the_goal_is_named_at_the_time_limit():
+    # the goal lay inside person 1's body: the reason read only "it lies inside an obstacle", as if a wall stood there
+    people = [{"id": 1, "x": 4.0, "y": 0.0, "theta": 3.1416}]
+    trace = simulate(tiny_world(people=people, simulation={"time_limit_s": 1.0}), EXACT)
+    assert not trace.success and trace.collisions == 0
+    assert trace.reason.startswith("time limit (1 s) reached: no path: goal (4.00, 0.00) is in collision")
+    assert trace.reason.endswith(
+        "the goal is 0.00 m from person 1 at (4.00, 0.00): a person is an obstacle of radius 0.20 m "
+        "(lidar.body_radius) and the robot a disc of radius 0.25 m (robot.radius)"
+    )
+
+
 def test_the_unknown_map_is_discovered_by_the_lidar():
     box = {"type": "box", "min": [1.5, -0.5], "max": [2.5, 0.5]}
     world = tiny_world(obstacles=[*TINY["obstacles"], box], people=[])
@@ -81,6 +95,38 @@ def test_a_walker_that_runs_into_the_robot_is_a_collision():
     trace = simulate(world_from_dict(data), RunOptions(social=False))
     assert not trace.success and trace.collisions == 1
     assert trace.reason.startswith("collision with person 1")
+
+
+def _headon_corridor() -> dict:
+    """An 8 m corridor 2.4 m wide; a walker comes down its middle at 1.2 m/s, head-on, towards a robot of 0.5 m/s."""
+    data = copy.deepcopy(TINY)
+    data["map"] = {"resolution": 0.05, "origin": [-0.5, -1.5], "size": [9.0, 3.0]}
+    data["obstacles"] = [{"type": "segment", "points": [[-0.5, y], [8.5, y]]} for y in (1.2, -1.2)]
+    data["people"] = [{"id": 1, "x": 8.3, "y": 0.0, "path": [[-0.4, 0.0]], "speed": 1.2}]
+    data["robot"]["goal"] = [7.5, 0.0, 0.0]
+    data["simulation"] = {"max_speed": 0.5, "time_limit_s": 30.0}
+    return data
+
+
+def test_exact_perception_knows_a_walkers_velocity_and_steps_aside():
+    # exact perception painted the walker as if standing (no velocity): the robot kept to the middle until the
+    # walker's body blocked its path and they collided at t = 5.3 s (the camera's tracks know the velocity)
+    trace = simulate(world_from_dict(_headon_corridor()), EXACT)
+    assert trace.success and trace.collisions == 0
+
+
+def test_exact_perception_groups_standing_people_only():
+    data = _headon_corridor()  # a pair talks across the corridor; beyond, two walkers come side by side
+    data["people"] = [
+        *({"id": i, "x": 4.0, "y": y, "path": [[-0.4, y]], "speed": 1.0} for i, y in ((1, 0.3), (2, -0.3))),
+        *({"id": i, "x": 2.0, "y": y, "theta": -1.5708 * y / abs(y)} for i, y in ((3, 0.9), (4, -0.9))),
+    ]
+    world = world_from_dict(data)
+    sensing = make_sensing(world, EXACT)
+    scan = simulate_scan((0.0, 0.0, 0.0), world.scenario.obstacles, world.people_at(0.0), beams=720, range_max=10.0)
+    seen = sensing(0, RobotPose(0.0, 0.0, 0.0), world.people_at(0.0), scan)
+    assert [p.id for p in seen.people] == [1, 2, 3, 4]
+    assert [g.members for g in seen.groups] == [(3, 4)]  # the walkers were a conversation too
 
 
 def test_a_walker_that_walks_into_a_waiting_robot_is_a_collision_that_says_so():

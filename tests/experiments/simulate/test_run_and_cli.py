@@ -37,6 +37,18 @@ def test_a_run_writes_run_json_and_a_video(scene, tmp_path, capsys):
     assert "ospace_intrusion_m" in printed and f"wrote {out / 'run.mp4'}" in printed
 
 
+def test_a_goal_inside_a_groups_zone_is_warned_of_as_sid_plan_does(tmp_path, capsys):
+    # the run entered the pair's zone (crosses_group true, ospace_intrusion_m > 0) without a word on why
+    path = tmp_path / "goal_in_zone.json"
+    robot = TINY["robot"] | {"goal": [2.0, 0.0, 0.0]}  # between the pair, who face each other
+    path.write_text(json.dumps(TINY | {"robot": robot, "simulation": {"time_limit_s": 0.2}}))
+    assert main(["simulate", str(path), "--no-social", "--out", str(tmp_path / "out")]) == ExitCode.NO_PATH
+    assert (
+        "sid simulate: warning: the goal lies inside the interaction zone of group (1, 2): the path has to enter it"
+        in (capsys.readouterr().err)
+    )
+
+
 def test_without_out_the_files_go_to_the_default_folder(scene, tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert main(["simulate", scene, "--no-social"]) == ExitCode.NO_PATH

@@ -1,7 +1,12 @@
 import copy
+import re
 
+import numpy as np
 import pytest
 
+from costmap.grid import GridSpec
+from costmap.mapfile import write_map
+from costmap.occupancy import OCC_OCCUPIED, OccupancyGrid
 from sid.experiments.simulate.world import collision, obstacle_geometry, world_from_dict
 from sid.perception.people import Person
 from sid.scenario.loader import BoxObstacle, ScenarioError, SegmentObstacle
@@ -44,6 +49,42 @@ def test_a_standing_person_without_a_facing_is_refused_by_name_whatever_the_run(
         tiny_world(people=people)
     walker = {"id": 2, "x": 2.0, "y": -0.6, "path": [[2.0, 1.0]]}  # faces the way it walks
     assert tiny_world(people=[PAIR[0], walker]).scenario.people[1].theta is None
+
+
+BOX = {"type": "box", "min": [2.5, -1.0], "max": [3.0, -0.5]}
+
+
+@pytest.mark.parametrize(
+    ("obstacles", "people", "message"),
+    [  # each was run: the robot saw, planned round and could collide with bodies no one could have
+        ([BOX], [*PAIR, {"id": 3, "x": 2.7, "y": -0.7, "theta": 0.0}],
+         "people[2]: person 3 stands at (2.70, -0.70) on or inside obstacles[2]: a body of radius 0.20 m"),
+        ([BOX], [*PAIR, {"id": 3, "x": 2.75, "y": -1.6, "path": [[2.75, 1.0]]}],
+         "people[2]: person 3 walks along its path on or inside obstacles[2]: a body of radius 0.20 m"),
+        ([], [*PAIR, {"id": 3, "x": 2.0, "y": 0.45, "theta": 0.0}],
+         "people[2]: person 3 at (2.00, 0.45) is 0.15 m from person 1 (people[0]) at time 0: two bodies of radius"),
+    ],
+)  # fmt: skip
+def test_bodies_overlapping_an_obstacle_or_each_other_are_refused_by_name(obstacles, people, message):
+    with pytest.raises(ScenarioError, match=re.escape(message)):
+        tiny_world(obstacles=[*TINY["obstacles"], *obstacles], people=people)
+
+
+def test_a_body_inside_a_static_map_files_wall_is_refused(tmp_path):
+    spec = GridSpec.from_size(0.05, (-0.5, -2.0), (5.0, 4.0))
+    xs, _ = spec.cell_centres()
+    write_map(
+        tmp_path / "wall.yaml", OccupancyGrid(spec, np.where((xs > 1.9) & (xs < 2.1), OCC_OCCUPIED, 0).astype(np.int8))
+    )
+    data = copy.deepcopy(TINY) | {"people": [{"id": 1, "x": 2.0, "y": 0.0, "theta": 0.0}], "static_map": "wall.yaml"}
+    with pytest.raises(ScenarioError, match=re.escape("person 1 stands at (2.00, 0.00) on or inside the static_map")):
+        world_from_dict(data, base_dir=tmp_path)
+
+
+def test_a_body_drawn_against_a_wall_or_touching_another_is_accepted():
+    wall_y = TINY["obstacles"][0]["points"][0][1]  # 1.8
+    people = [{"id": i + 1, "x": x, "y": wall_y - 0.2, "theta": 0.0} for i, x in enumerate((2.0, 2.4))]
+    assert len(tiny_world(people=people).scenario.people) == 2
 
 
 def test_walkers_move_along_their_path_and_face_the_way_they_go():
