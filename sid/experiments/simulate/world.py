@@ -18,6 +18,7 @@ World frame = the map frame (REP-103), metres, radians, seconds.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field, replace
 from itertools import combinations
 from pathlib import Path
@@ -29,7 +30,7 @@ from shapely.ops import unary_union
 
 from costmap.grid import LETHAL, Costmap2D
 from sid.checks import LimitError, check_limit
-from sid.documents import is_number, summary
+from sid.documents import InputWarning, is_number, summary
 from sid.experiments.simulate.robot import DriveLimits
 from sid.perception.people import Person
 from sid.scenario.build import map_walls
@@ -152,9 +153,11 @@ def world_from_dict(data: Any, base_dir: Path | None = None, default_name: str =
 
 
 def _check_bodies(scenario: Scenario) -> None:
-    """Refuse a world in which a person's body (``lidar.body_radius``) overlaps an obstacle (or the ``static_map``
-    file's walls) where they stand or anywhere along their scripted walk, or two people's bodies overlap at time 0:
-    the scene is the true world, and the robot would see, plan round and collide with bodies no one could have."""
+    """Refuse a world in which a person stands inside an obstacle (or the ``static_map`` file's walls), walks through
+    one, or stands with their centre inside another person's body (``lidar.body_radius``) at time 0: the scene is the
+    true world, and the robot would see, plan round and collide with bodies no one could have. A body that only
+    overlaps a wall or another body is warned of: the body is a disc, and real people stand closer than two of them.
+    """
     body = scenario.lidar.body_radius
     named = [(f"obstacles[{j}]", shape(obstacle)) for j, obstacle in enumerate(scenario.obstacles)]
     walls = map_walls(scenario)
@@ -163,22 +166,31 @@ def _check_bodies(scenario: Scenario) -> None:
     for i, person in enumerate(scenario.people):
         walk = scenario.walks.get(person.id)
         where = Point(person.x, person.y) if walk is None else LineString([(walk.x, walk.y), *walk.path])
+        what = f"stands at ({person.x:.2f}, {person.y:.2f})" if walk is None else "walks along its path"
         for name, geometry in named:
             gap = geometry.distance(where)
+            if gap == 0.0:
+                raise ScenarioError(f"people[{i}]: person {person.id} {what} on or inside {name}")
             if gap < body - TOUCH_M:
-                what = f"stands at ({person.x:.2f}, {person.y:.2f})" if walk is None else "walks along its path"
-                near = f"on or inside {name}" if gap == 0.0 else f"{gap:.2f} m from {name}"
-                raise ScenarioError(
-                    f"people[{i}]: person {person.id} {what} {near}: a body of radius {body:.2f} m "
-                    "(lidar.body_radius) would overlap it"
+                warnings.warn(
+                    f"people[{i}]: person {person.id} {what} {gap:.2f} m from {name}: a body of radius {body:.2f} m "
+                    "(lidar.body_radius) overlaps it",
+                    InputWarning,
+                    stacklevel=3,
                 )
     for (i, a), (j, b) in combinations(enumerate(scenario.people), 2):
         gap = math.hypot(a.x - b.x, a.y - b.y)
-        if gap < 2 * body - TOUCH_M:
-            raise ScenarioError(
-                f"people[{j}]: person {b.id} at ({b.x:.2f}, {b.y:.2f}) is {gap:.2f} m from person {a.id} (people[{i}]) "
-                f"at time 0: two bodies of radius {body:.2f} m (lidar.body_radius) would overlap"
-            )
+        if gap >= 2 * body - TOUCH_M:
+            continue
+        between = f"people[{j}]: person {b.id} at ({b.x:.2f}, {b.y:.2f}) is {gap:.2f} m from person {a.id}"
+        between += f" (people[{i}])"
+        if gap < body - TOUCH_M:
+            raise ScenarioError(f"{between} at time 0: inside their body (lidar.body_radius {body:.2f} m)")
+        warnings.warn(
+            f"{between} at time 0: two bodies of radius {body:.2f} m (lidar.body_radius) overlap",
+            InputWarning,
+            stacklevel=3,
+        )
 
 
 def load_world(path: str | Path) -> SimWorld:
