@@ -12,7 +12,7 @@ top.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -52,8 +52,10 @@ __all__ = [
     "TICK_MIN_PX",
     "ZONE",
     "axis_ticks",
+    "dashed_polyline",
     "default_scale",
     "person_colours",
+    "person_swatch",
     "render_costmap",
     "world_to_image",
 ]
@@ -206,7 +208,10 @@ class Extra:
     draw: Callable[[np.ndarray, GridSpec, int], None]
 
 
-def _person_swatch(colour: tuple[int, int, int], arrow: bool = True) -> Swatch:
+def person_swatch(colour: tuple[int, int, int], arrow: bool = True) -> Swatch:
+    """The legend's symbol of a person drawn in ``colour`` (BGR): a dot, with a facing arrow unless ``arrow`` is
+    False."""
+
     def swatch(img: np.ndarray, u: int, v: int) -> None:
         cv2.circle(img, (u - 4, v), 6, colour, -1, cv2.LINE_AA)
         if arrow:
@@ -264,17 +269,21 @@ def _members(group: Group) -> str:
 
 
 def _legend_rows(
-    people: Sequence[Person], groups: Sequence[Group], drawn: dict[str, bool], extras: Sequence[Extra]
+    people: Sequence[Person],
+    groups: Sequence[Group],
+    drawn: dict[str, bool],
+    extras: Sequence[Extra],
+    people_rows: bool = True,
 ) -> list[tuple[str, Swatch]]:
-    """The legend, in order: people alone, one row per group in its colour, then each fixed entry drawn, then the
-    callers' ``extras``."""
+    """The legend, in order: people alone (unless not ``people_rows``: the caller coloured the people), one row per
+    group in its colour, then each fixed entry drawn, then the callers' ``extras``."""
     grouped = {m for g in groups for m in g.members}
-    alone = [p for p in people if p.id not in grouped]
+    alone = [p for p in people if p.id not in grouped] if people_rows else []
     rows: list[tuple[str, Swatch]] = []
     if any(p.theta is not None for p in alone):
-        rows.append(("person in no group, facing", _person_swatch(PERSON)))
+        rows.append(("person in no group, facing", person_swatch(PERSON)))
     elif alone:  # drawn without an arrow: their facings are unknown ("unknown facing: id?")
-        rows.append(("person in no group", _person_swatch(PERSON, arrow=False)))
+        rows.append(("person in no group", person_swatch(PERSON, arrow=False)))
     for i, group in enumerate(groups[:MAX_GROUP_ENTRIES]):
         rows.append((_members(group), _group_swatch(GROUP_COLOURS[i % len(GROUP_COLOURS)])))
     if len(groups) > MAX_GROUP_ENTRIES:
@@ -362,6 +371,24 @@ def _draw_outlines(img: np.ndarray, spec: GridSpec, scale: int, outlines: Sequen
     for points, closed in outlines:
         ring = _px(np.asarray(points, dtype=float).reshape(-1, 2), spec, scale)
         cv2.polylines(img, [ring], bool(closed), OBSTACLE, 2, cv2.LINE_AA, shift=4)
+
+
+def dashed_polyline(
+    img: np.ndarray, points: ArrayLike, closed: bool, colour: tuple[int, int, int], thickness: int = 2, dash: int = 9
+) -> None:
+    """A dashed polyline through the pixel points (N, 2) (u, v; floats), drawn in place: dashes and gaps of ``dash``
+    px along the line, continued from one segment to the next; closed back to the first point when ``closed``."""
+    path = np.asarray(points, dtype=float).reshape(-1, 2)
+    if closed and len(path) > 1:
+        path = np.vstack([path, path[:1]])
+    steps = np.hypot(*np.diff(path, axis=0).T)
+    along = np.concatenate([[0.0], np.cumsum(steps)])
+    for start in np.arange(0.0, along[-1], 2 * dash):
+        stop = min(start + dash, along[-1])
+        ends = np.stack([np.interp([start, stop], along, path[:, k]) for k in (0, 1)], axis=1)
+        inner = path[(along > start) & (along < stop)]  # the corners a dash turns round
+        piece = np.vstack([ends[:1], inner, ends[1:]])
+        cv2.polylines(img, [np.rint(piece * 16).astype(np.int32)], False, colour, thickness, cv2.LINE_AA, shift=4)
 
 
 def person_colours(people: Sequence[Person], groups: Sequence[Group]) -> dict[int, tuple[int, int, int]]:
@@ -463,6 +490,7 @@ def render_costmap(
     camera: CameraView | None = None,
     outlines: Sequence[Outline] = (),
     extras: Sequence[Extra] = (),
+    colours: Mapping[int, tuple[int, int, int]] | None = None,
 ) -> np.ndarray:
     """A readable BGR picture of a costmap (world y up) with people, groups, robot task, camera and colour scale.
 
@@ -473,7 +501,9 @@ def render_costmap(
     With a LayeredCostmap, its combined grid is drawn; people, groups and scan default to the inputs it last applied,
     body radius to its social layer's, and each group's interaction zone is drawn with the social layer's margin
     (or the default margin the metrics use, without one). A plain Costmap2D draws the interaction zone only when
-    ``zone_margin`` is given. ``scale``: pixels per cell (default: a map about 800 px wide).
+    ``zone_margin`` is given. ``scale``: pixels per cell (default: a map about 800 px wide). ``colours``: each
+    person's colour (BGR) by id in place of their group's (``person_colours``); the legend then names no colour of
+    people, which the caller's ``extras`` do.
     """
     if isinstance(source, LayeredCostmap):
         costmap = source.master
@@ -494,7 +524,8 @@ def render_costmap(
     people, groups = list(people or []), list(groups or [])
     body_radius = 0.2 if body_radius is None else body_radius
     radius = max(3, int(round(body_radius * scale / spec.resolution)))
-    colours = person_colours(people, groups)
+    own_colours = colours is not None
+    colours = dict(person_colours(people, groups) if colours is None else colours)
 
     w_px, h_px = spec.width * scale, spec.height * scale
     img = np.full((MARGIN_TOP + h_px + MARGIN_BOTTOM, MARGIN_LEFT + w_px + 20, 3), 255, dtype=np.uint8)
@@ -527,7 +558,7 @@ def render_costmap(
         "goal": robot is not None,
         "camera, field of view": camera is not None,
     }
-    rows = _legend_rows(people, groups, drawn, extras)
+    rows = _legend_rows(people, groups, drawn, extras, people_rows=not own_colours)
     panel_w, panel_h = _panel_size(costmap.costs, rows)
     canvas = np.full(
         (max(img.shape[0], MARGIN_TOP + panel_h, PANEL_HEIGHT), MARGIN_LEFT + w_px + panel_w, 3), 255, np.uint8

@@ -4,13 +4,23 @@ score the trackers on the synthetic sequences; ``sid eval crowd`` (``sid.cli.eva
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import json
 import math
 import sys
 from pathlib import Path
 
-from sid.cli.common import fail, name_width, positive_number, whole_number
+from sid.cli.common import (
+    check_output_folder,
+    fail,
+    name_width,
+    positive_int,
+    positive_number,
+    print_written,
+    staged_output,
+    whole_number,
+)
 from sid.cli.eval_crowd import add_crowd_parser
 from sid.cli.grouping import add_group_params, group_params_from
 from sid.distribution import MissingDependencyError
@@ -34,8 +44,12 @@ from sid.experiments.fformation import (
     with_facing_noise,
     without_facings,
 )
+from sid.perception.groups import GroupParams
 
-__all__ = ["add_parser", "add_tracking_parser", "run", "run_tracking"]
+__all__ = ["PICTURES_MAX", "add_parser", "add_tracking_parser", "run", "run_tracking"]
+
+PICTURES_MAX = 20
+"""``--pictures``: the most frames drawn per dataset unless ``--pictures-max`` says."""
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -127,6 +141,21 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="make this share (0-1) of the facings unknown first, at random and seeded, as people half hidden "
         "behind others get none from the pipeline (default 0)",
     )
+    ff.add_argument(
+        "--pictures",
+        type=Path,
+        metavar="DIR",
+        help="also draw the frames the detector gets wrong (a true group not found exactly, or a false group), "
+        "worst first: top views frame_DATASET_NN.png (people, facings and ids; true groups dashed, coloured by how "
+        "they came out; detected groups solid) and index.csv listing them, into DIR (created if missing; a re-run "
+        "replaces them); not with --grid or --cross-validate",
+    )
+    ff.add_argument(
+        "--pictures-max",
+        type=positive_int,
+        metavar="N",
+        help=f"with --pictures: at most N pictures per dataset, its N worst frames (default {PICTURES_MAX})",
+    )
     add_group_params(ff)
     ff.set_defaults(func=run)
     add_tracking_parser(tasks)
@@ -163,6 +192,15 @@ def run(args: argparse.Namespace) -> int:
         if len(args.scale) not in (1, len(args.dirs)):
             raise ValueError(f"--scale takes one value or one per DIR ({len(args.dirs)}), got {len(args.scale)}")
         scales = args.scale * len(args.dirs) if len(args.scale) == 1 else args.scale
+        if args.pictures_max is not None and args.pictures is None:
+            raise ValueError("--pictures-max caps --pictures: give --pictures DIR too")
+        if args.pictures is not None:
+            if args.grid or args.cross_validate:
+                raise ValueError(
+                    "--pictures draws one detector's groups: it takes no --grid or --cross-validate (draw the "
+                    "chosen parameters' errors with them set, e.g. --alone-price 0.5)"
+                )
+            check_output_folder(args.pictures, "--pictures")  # before the work, not after it
         datasets: dict[str, list[LabelledFrame]] = {}
         units: dict[str, float] = {}  # each dataset's scale to metres, for its settings_gc.mat too
         for folder, scale in zip(args.dirs, scales, strict=True):
@@ -216,8 +254,45 @@ def run(args: argparse.Namespace) -> int:
         report: dict[str, object] = {"params": settings, "scores": scores}
         if errors is not None:
             report["group_errors"] = errors
-        print(json.dumps(report, indent=2))
+        print(json.dumps(report, indent=2), flush=True)
+    if args.pictures is not None:
+        try:
+            _write_pictures(args, datasets, detected, params)
+        except OSError as exc:
+            return fail("sid eval fformation", exc)
     return 0
+
+
+def _write_pictures(
+    args: argparse.Namespace,
+    datasets: dict[str, list[LabelledFrame]],
+    detected: dict[str, list[list[tuple[int, ...]]]],
+    params: GroupParams,
+) -> None:
+    """``--pictures``: the worst frames' pictures and their index, written whole into the folder (an earlier run's
+    replaced); on stderr, how many frames had errors and the files written (stdout holds the scores)."""
+    from sid.experiments.fformation_pictures import INDEX, PICTURES, write_error_pictures
+    from sid.experiments.progress import ProgressBar
+
+    method = "gcff, each sequence's settings_gc.mat" if args.gcff_settings else params.method
+    defaults = dataclasses.asdict(GroupParams(method=params.method))
+    changed = {k: v for k, v in dataclasses.asdict(params).items() if v != defaults[k]}
+    if changed and not args.gcff_settings:  # the title names what the run set, so no picture passes for the defaults'
+        method += " " + " ".join(f"{k}={v:g}" for k, v in changed.items())
+    if args.facing_noise:
+        method += f", facing noise {args.facing_noise:g} deg"
+    if args.facing_missing:
+        method += f", {args.facing_missing:.0%} of facings unknown"
+    most = PICTURES_MAX if args.pictures_max is None else args.pictures_max
+    with staged_output(args.pictures, (PICTURES, INDEX)) as staged:
+        written, counts = write_error_pictures(
+            datasets, detected, staged.path, most, args.thresholds, method, ProgressBar("pictures")
+        )
+        files = [staged.final(path) for path in written]
+    for name, (wrong, drawn) in counts.items():
+        print(f"sid eval fformation: {name}: {plural(wrong, 'frame')} with errors, {drawn} drawn", file=sys.stderr)
+    with contextlib.redirect_stdout(sys.stderr):
+        print_written(files)
 
 
 def _warn_about_data(name: str, frames: list[LabelledFrame], scale: float) -> None:

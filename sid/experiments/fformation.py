@@ -60,6 +60,8 @@ __all__ = [
     "frame_precision_recall",
     "gcff_settings",
     "group_errors",
+    "group_outcome",
+    "is_false_group",
     "load_dataset",
     "load_dataset_any_yaw",
     "load_dataset_in_metres",
@@ -479,17 +481,27 @@ def group_errors(frames: Sequence[LabelledFrame], detections: Sequence[Sequence[
         groups = [frozenset(g) for g in found if len(frozenset(g)) > 1]
         truth = [t for t in frame.truth if len(t) > 1]
         for true in truth:
-            k = most_shared(groups, true)
-            best = groups[k] if k is not None else frozenset()
-            shared, others = len(best & true), len(best - true)
-            if shared < 2:
-                counts["missed"] += 1
-            elif shared == len(true):
-                counts["exact" if not others else "one_too_many" if others == 1 else "more_too_many"] += 1
-            else:
-                counts["mixed" if others else "lacking"] += 1
-        counts["false_groups"] += sum(all(len(g & t) < 2 for t in truth) for g in groups)
+            counts[group_outcome(true, groups)] += 1
+        counts["false_groups"] += sum(is_false_group(g, truth) for g in groups)
     return counts
+
+
+def group_outcome(true: frozenset[int], groups: Sequence[frozenset[int]]) -> str:
+    """How the true group ``true`` came out among one frame's detected ``groups`` (member-id sets of two or more):
+    one of ``GROUP_ERRORS``, as ``group_errors`` counts them."""
+    k = most_shared(groups, true)
+    best = groups[k] if k is not None else frozenset()
+    shared, others = len(best & true), len(best - true)
+    if shared < 2:
+        return "missed"
+    if shared == len(true):
+        return "exact" if not others else "one_too_many" if others == 1 else "more_too_many"
+    return "mixed" if others else "lacking"
+
+
+def is_false_group(group: frozenset[int], truth: Sequence[frozenset[int]]) -> bool:
+    """Whether the detected ``group`` holds two members of none of the frame's true groups ``truth``."""
+    return all(len(group & t) < 2 for t in truth)
 
 
 def evaluate(

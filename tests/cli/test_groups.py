@@ -8,6 +8,7 @@ import math
 import subprocess
 import sys
 
+import cv2
 import numpy as np
 import pytest
 import scipy.io
@@ -474,3 +475,65 @@ def test_a_json_document_written_over_several_lines_is_named_as_such(tmp_path, c
         "sid groups: line 1: not valid JSON (Expecting property name enclosed in double quotes at the end of the line; "
         "JSON lines hold one whole object per line: is this one JSON document over several lines?)\n"
     )
+
+
+def _erring_set(tmp_path):
+    """Tiny's frames and a fifth: its pair and triangle found exactly, its back-to-back pair missed. Frame 3 (the
+    back-to-back pair alone, missed: F1 0 at T = 1) is the worst, frame 5 (F1 0.8) next, frames 1-2 are clean."""
+    pair, triangle, back_to_back, _ = tiny_frames()
+    far_triangle, far_pair = triangle + [10, 600, 0, 0], back_to_back + [0, 0, 600, 0]
+    frames = [*tiny_frames(), np.vstack([pair[:2], far_triangle, far_pair])]
+    truth = {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]], 5: [[1, 2], [11, 12, 13], [4, 5]]}
+    return write_sequence(tmp_path / "Tiny", frames, truth)
+
+
+def test_eval_fformation_draws_the_frames_with_errors_worst_first(tmp_path, capsys):
+    tiny, out_dir = _erring_set(tmp_path), tmp_path / "pictures"
+    code, out, err = run_sid(["eval", "fformation", str(tiny), "--errors", "--pictures", str(out_dir)], capsys)
+    assert code == 0 and json.loads("\n".join(out))["group_errors"]["Tiny"]["missed"] == 2  # stdout: the report
+    assert sorted(p.name for p in out_dir.iterdir()) == ["frame_Tiny_01.png", "frame_Tiny_02.png", "index.csv"]
+    index = (out_dir / "index.csv").read_text().splitlines()
+    assert [row.split(",")[4] for row in index[1:]] == ["3", "5"]  # timestamps, worst first; frames 1, 2 clean
+    assert [row.split(",")[-2:] for row in index[1:]] == [["missed 1", "frame_Tiny_01.png"],
+                                                          ["missed 1", "frame_Tiny_02.png"]]  # fmt: skip
+    for name in ("frame_Tiny_01.png", "frame_Tiny_02.png"):
+        data = (out_dir / name).read_bytes()
+        assert data[:8] == b"\x89PNG\r\n\x1a\n" and 10_000 < len(data) < 1_000_000
+        height, width = cv2.imread(str(out_dir / name)).shape[:2]
+        assert 400 < height < 2000 and 600 < width < 2500
+    assert "Tiny: 2 frames with errors, 2 drawn" in err and f"wrote {out_dir / 'index.csv'}" in err
+
+
+def test_eval_fformation_pictures_are_capped_and_a_rerun_replaces_them(tmp_path, capsys):
+    tiny, out_dir = _erring_set(tmp_path), tmp_path / "pictures"
+    code, _, _ = run_sid(["eval", "fformation", str(tiny), "--pictures", str(out_dir)], capsys)
+    assert code == 0 and len(list(out_dir.glob("frame_*.png"))) == 2
+    (out_dir / "notes.txt").write_text("mine")
+    argv = ["eval", "fformation", str(tiny), "--pictures", str(out_dir), "--pictures-max", "1", "--method", "gcff"]
+    code, _, err = run_sid([*argv, "--facing-noise", "20"], capsys)
+    assert code == 0 and "Tiny: 2 frames with errors, 1 drawn" in err
+    assert sorted(p.name for p in out_dir.iterdir()) == ["frame_Tiny_1.png", "index.csv", "notes.txt"]
+    assert len((out_dir / "index.csv").read_text().splitlines()) == 2
+    assert (out_dir / "notes.txt").read_text() == "mine"  # not the run's: kept
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        (["--cross-validate"], "--pictures draws one detector's groups: it takes no --grid or --cross-validate"),
+        (["--grid", "alone_price=0.5,0.65"], "--pictures draws one detector's groups"),
+    ],
+)
+def test_eval_fformation_refuses_pictures_where_they_make_no_sense(tmp_path, capsys, extra, message):
+    tiny, out_dir = _erring_set(tmp_path), tmp_path / "pictures"
+    code, out, err = run_sid(["eval", "fformation", str(tiny), str(tiny), "--pictures", str(out_dir), *extra], capsys)
+    assert code == 2 and message in err and out == [] and not out_dir.exists()
+
+
+def test_eval_fformation_refuses_a_picture_cap_without_pictures_and_a_file_for_a_folder(tmp_path, capsys):
+    tiny = _erring_set(tmp_path)
+    code, _, err = run_sid(["eval", "fformation", str(tiny), "--pictures-max", "3"], capsys)
+    assert code == 2 and "--pictures-max caps --pictures: give --pictures DIR too" in err
+    (tmp_path / "file").write_text("")
+    code, _, err = run_sid(["eval", "fformation", str(tiny), "--pictures", str(tmp_path / "file")], capsys)
+    assert code == 2 and "--pictures" in err and "is a file, not a folder" in err

@@ -156,3 +156,24 @@ def test_the_panel_size_is_where_the_panel_draws(values: list[int], entries: int
     assert bottom < height and drawn_cols.max() - left < width
     if entries:  # the last legend row ends the panel
         assert bottom > height - render.LEGEND_ROW
+
+
+def test_given_colours_replace_the_group_colours_and_their_legend_rows(legend) -> None:
+    """``colours`` (the F-formation error pictures colour people by how their true group came out): each person in
+    theirs, and the legend names no colour of people, which the caller's extras do."""
+    colours = {1: (0, 0, 255), 2: (0, 0, 255)}
+    img = render_costmap(Costmap2D.filled(SPEC), PAIR, [], scale=4, colours=colours)
+    assert _pixel(img, (2.0, 0.35), 4) == _pixel(img, (2.0, -0.35), 4) == (0, 0, 255)
+    assert legend[-1] == []
+
+
+def test_a_dashed_polyline_leaves_gaps_of_its_dash_length_and_turns_corners() -> None:
+    img = np.full((40, 200, 3), 255, np.uint8)
+    render.dashed_polyline(img, [(10, 20), (110, 20), (110, 35)], False, (0, 0, 0), thickness=1, dash=10)
+    row = img[20, 10:110, 0] < 128
+    assert 40 <= row.sum() <= 60  # half of 100 px, give or take the anti-aliased ends
+    assert row[2:8].all() and not row[13:17].any() and row[22:28].all()
+    assert (img[22:35, 110, 0] < 128).any()  # the dash running on round the corner
+    closed = np.full((60, 60, 3), 255, np.uint8)
+    render.dashed_polyline(closed, [(10, 10), (50, 10), (50, 50), (10, 50)], True, (0, 0, 0), thickness=1, dash=5)
+    assert (closed[12:48, 10, 0] < 128).any()  # the closing side back to the first point is drawn
