@@ -48,3 +48,20 @@ def shared() -> type:
         path = staticmethod(shared_path)
 
     return _Shared
+
+
+@pytest.fixture
+def legend(monkeypatch: pytest.MonkeyPatch) -> list[list[str]]:
+    """The legend rows of every top view (``costmap.render.render_costmap``) drawn in the test, by name: a spy on the
+    panel that draws them."""
+    import costmap.render as render
+
+    seen: list[list[str]] = []
+    panel = render._panel
+
+    def spy(img, spec, scale, costs, rows):  # type: ignore[no-untyped-def]
+        seen.append([name for name, _ in rows])
+        panel(img, spec, scale, costs, rows)
+
+    monkeypatch.setattr(render, "_panel", spy)
+    return seen

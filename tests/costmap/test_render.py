@@ -31,20 +31,6 @@ def _near(img: np.ndarray, xy: tuple[float, float], scale: int, colour: tuple[in
     return bool(np.any(np.all(img[v - 1 : v + 2, u - 1 : u + 2] == colour, axis=2)))
 
 
-@pytest.fixture
-def legend(monkeypatch) -> list[list[str]]:
-    """The legend rows of every picture drawn in the test, by name (a spy on the panel that draws them)."""
-    seen: list[list[str]] = []
-    panel = render._panel
-
-    def spy(img, spec, scale, costs, rows):  # type: ignore[no-untyped-def]
-        seen.append([name for name, _ in rows])
-        panel(img, spec, scale, costs, rows)
-
-    monkeypatch.setattr(render, "_panel", spy)
-    return seen
-
-
 def test_people_are_coloured_by_group_and_the_legend_names_each_group(legend) -> None:
     people = [*PAIR, Person(3, 4.0, 2.0, 0.0), Person(4, 4.0, -2.0, np.pi), Person(5, 4.6, -2.0, 0.0)]
     trio = Group((4, 5), (4.3, -2.0), 0.0, np.array([[4.3, -2.0]]), 0.3)

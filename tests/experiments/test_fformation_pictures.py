@@ -66,17 +66,8 @@ def test_the_pictures_and_their_index_are_written_for_the_worst_frames_up_to_the
     ]  # fmt: skip
 
 
-def test_a_true_group_absent_from_the_frame_is_named_in_the_legend(monkeypatch):
-    import costmap.render as render
-
-    seen: list[list[str]] = []
-    panel = render._panel
-
-    def spy(img, spec, scale, costs, rows):  # type: ignore[no-untyped-def]
-        seen.append([name for name, _ in rows])
-        panel(img, spec, scale, costs, rows)
-
-    monkeypatch.setattr(render, "_panel", spy)
+def test_a_true_group_absent_from_the_frame_is_named_in_the_legend(legend):
+    seen = legend
     (errors,) = error_frames("Set", [frame(1, [{8, 9}, {1, 7}])], [[]], [2 / 3])
     frame_picture(errors, "t")
     assert "true group 8, 9: not in the frame" in seen[-1] and "true group 1, 7: 7 not in the frame" in seen[-1]

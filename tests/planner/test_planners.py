@@ -322,6 +322,8 @@ def test_refine_equals_pricing_every_move(walls):
 def test_bitstar_stops_once_its_cost_settles_and_other_planners_use_their_budget(walls):
     settled = plan(walls, "bitstar", time_limit=30.0, seed=3, soft_limit=None)
     assert settled.success and settled.solve_time_s < 15.0  # stopped by the settle rule, not by the 30 s budget
+    # solve_time_s counts from the instant the budget does: it was measured from a later one, and a run that used
+    # its whole 0.3 s reported 0.2995 s
     whole = plan(walls, "bitstar", time_limit=0.3, seed=3, settle=None, soft_limit=None)
     assert whole.solve_time_s >= 0.3
     rrt = plan(walls, "rrtstar", time_limit=0.3, seed=3)  # RRT* is not stopped early (SETTLING_PLANNERS)
@@ -452,7 +454,7 @@ def test_a_timed_run_is_replayed_by_its_seed_and_iteration_count(walls, name, re
     assert next(clock) > readings  # the fake clock ran the budget out
     monkeypatch.undo()
     replay = plan(walls, name, time_limit=30.0, seed=21, max_iterations=timed.iterations)
-    assert timed.success and 0 < timed.iterations < readings
+    assert timed.success and 0 < timed.iterations <= readings  # one check per reading until the budget is out
     assert np.array_equal(timed.raw_path, replay.raw_path)
 
 
