@@ -5,8 +5,8 @@ A simulation file is a scenario file (docs/scenario.md: people may walk along ``
 optional block, ``simulation``: ``max_speed`` (m/s, 0.5), ``max_turn_rate`` (rad/s, 1.5), ``max_accel`` (m/s^2,
 1.0), ``time_limit_s`` (60), ``rate_hz`` (10), ``goal_tolerance_m`` (0.25), ``description`` (text for ``--list``).
 Every person who stands (no ``path``) needs a ``theta``: the world is ground truth, and the camera renders each body
-from its facing. For the same reason no body may overlap an obstacle, where it stands or along its walk, or another
-body at time 0.
+from its facing. For the same reason nobody may stand inside an obstacle or walk through one, or stand with their
+centre inside another's body at time 0; a body that only overlaps a wall or another body is warned of.
 
 Seeds (``jittered``): seed 0 is the scene as written; seed k >= 1 moves every standing person by Gaussian jitter of
 ``JITTER_XY_M`` and turns them by ``JITTER_THETA_RAD`` (drawn from ``[k, 7]``), so that sweeps over seeds see
