@@ -11,7 +11,8 @@ Per frame (``GroupTracker.update``), on the tracked people (``sid.tracking.track
 - each candidate is matched to a group track of its kind by member overlap (Jaccard index): as many pairs with an
   overlap of ``min_overlap`` or more as can be matched, of the greatest total overlap among those matchings
   (``sid.tracking.assignment.gated_assignment``); an unmatched candidate starts a tentative group.
-- a group is reported once it was found in ``confirm_hits`` of its last ``confirm_window`` frames; it survives
+- a conversation is reported once it was found in ``confirm_hits`` of its last ``confirm_window`` frames, a walking
+  group in ``walk_confirm_hits`` of them (1: when first found; its rule already looks back ``walk_window``); it survives
   frames in which it is not found for up to ``miss_timeout`` seconds, keeping its last geometry, but a member who
   leaves (track deleted, starts walking for a conversation or stops for a walking group, or goes farther than
   ``leave_distance`` from the interest point, or is found in another group) leaves the group at once, and one
@@ -51,8 +52,10 @@ nobody walks in and out of a walking group's reach between two looks."""
 class GroupTrackerParams:
     """Parameters of ``GroupTracker`` (metres, seconds, m/s; measured in docs/tracking.md).
 
-    confirm_hits of confirm_window: a group is reported after being found in that many of its last frames, or in
-    two frames in a row at least confirm_time apart (s; a slow detector, as ``TrackerParams.confirm_time``).
+    confirm_hits of confirm_window: a conversation is reported after being found in that many of its last frames,
+    or in two frames in a row at least confirm_time apart (s; a slow detector, as ``TrackerParams.confirm_time``).
+    walk_confirm_hits: the same for a walking group (1: reported when first found, as its rule already asks the
+    walkers to have stayed close over walk_window).
     miss_timeout: seconds a reported group survives while not found. min_overlap: the Jaccard index of member sets
     above which a candidate continues a group. leave_distance: a member of a conversation farther than this from
     its interest point (m) has left. walk_distance (m), walk_velocity_difference (m/s): walkers who stayed closer
@@ -64,6 +67,7 @@ class GroupTrackerParams:
     """
 
     confirm_hits: int = 3
+    walk_confirm_hits: int = 1
     confirm_window: int = 5
     confirm_time: float = 0.2
     miss_timeout: float = 1.0
@@ -73,16 +77,17 @@ class GroupTrackerParams:
     walk_velocity_difference: float = 0.8
     walk_window: float = 2.0
     max_speed_sigma: float = 0.4
-    moving_speed: float = 0.3
+    moving_speed: float = 0.4
 
     def __post_init__(self) -> None:
-        for name in ("confirm_hits", "confirm_window"):
+        for name in ("confirm_hits", "walk_confirm_hits", "confirm_window"):
             check_whole("group tracker", name, getattr(self, name), low=1)
-        if self.confirm_hits > self.confirm_window:
-            raise ValueError(
-                f"group tracker: confirm_hits ({self.confirm_hits}) must not exceed confirm_window "
-                f"({self.confirm_window})"
-            )
+        for name in ("confirm_hits", "walk_confirm_hits"):
+            if getattr(self, name) > self.confirm_window:
+                raise ValueError(
+                    f"group tracker: {name} ({getattr(self, name)}) must not exceed confirm_window "
+                    f"({self.confirm_window})"
+                )
         check_number("group tracker", "miss_timeout", self.miss_timeout, low=0, unit="seconds")
         check_number("group tracker", "confirm_time", self.confirm_time, low=0, unit="seconds")
         check_number("group tracker", "min_overlap", self.min_overlap, low=0, high=1, low_open=True)
@@ -178,8 +183,9 @@ class GroupTracker:
                     and self._stays(track, by_id.get(m))
                 )
             }
+            hits = p.walk_confirm_hits if track.found.kind == "walking" else p.confirm_hits
             twice = slow and len(track.history) >= 2 and track.history[-1] and track.history[-2]
-            track.confirmed |= sum(track.history) >= p.confirm_hits or twice
+            track.confirmed |= sum(track.history) >= hits or twice
             if len(track.members) >= 2:
                 kept.append(track)
         self._tracks = kept

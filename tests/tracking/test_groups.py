@@ -126,6 +126,10 @@ def test_bad_input_is_refused() -> None:
         GroupTracker().update([_person(1, 1.0, 0.0, 0.0), _person(1, 2.0, 0.0, 0.0)], 0.0)
     with pytest.raises(ValueError, match="confirm_hits"):
         GroupTrackerParams(confirm_hits=6, confirm_window=5)
+    with pytest.raises(ValueError, match="walk_confirm_hits"):
+        GroupTrackerParams(walk_confirm_hits=6, confirm_window=5)
+    with pytest.raises(ValueError, match="walk_confirm_hits"):
+        GroupTrackerParams(walk_confirm_hits=0)
     with pytest.raises(ValueError, match="min_overlap"):
         GroupTrackerParams(min_overlap=0.0)
 
@@ -212,7 +216,8 @@ def test_walkers_closing_in_become_a_group_only_once_close_for_the_whole_walk_wi
 def test_a_slow_detector_reports_a_group_found_twice_in_a_row_confirm_time_apart(
     dt: float, frames_to_report: int
 ) -> None:
-    tracker = GroupTracker(GroupTrackerParams(confirm_hits=3, confirm_window=5, confirm_time=0.2))
+    params = GroupTrackerParams(confirm_hits=3, walk_confirm_hits=3, confirm_window=5, confirm_time=0.2)
+    tracker = GroupTracker(params)
     v = (1.2, 0.0)
     reported = []
     for k in range(4):
@@ -220,6 +225,20 @@ def test_a_slow_detector_reports_a_group_found_twice_in_a_row_confirm_time_apart
         people = [_person(1, x, 0.3, 0.0, v), _person(2, x, -0.3, 0.0, v)]
         reported.append(bool(tracker.update(people, k * dt)))
     assert reported == [k + 1 >= frames_to_report for k in range(4)]
+
+
+def test_a_walking_group_is_reported_when_first_found_and_a_conversation_after_three_frames() -> None:
+    # The walking rule already looks back walk_window (close all along, moving alike): no frame count on top.
+    tracker = GroupTracker()
+    v = (1.2, 0.0)
+    walkers = [[_person(1, 1.2 * k * DT, 5.3, 0.0, v), _person(2, 1.2 * k * DT, 4.7, 0.0, v)] for k in range(3)]
+    reported = [tracker.update(walkers[k] + _circle((3, 4, 5)), k * DT) for k in range(3)]
+    assert [sorted(g.kind for g in frame) for frame in reported] == [
+        ["walking"],
+        ["walking"],
+        ["conversation", "walking"],
+    ]
+    assert len({g.id for frame in reported for g in frame if g.kind == "walking"}) == 1
 
 
 def test_young_tracks_moving_together_are_a_walking_group_before_the_tracker_calls_them_walking() -> None:
