@@ -460,14 +460,30 @@ def signals_as_interrupts() -> Iterator[None]:
 
 @contextmanager
 def signals_deferred() -> Iterator[None]:
-    """SIGINT and SIGTERM held back (blocked, then delivered) while a set of files is moved into place, so an
-    interruption lands before or after the whole set, never inside it (e.g. an overlay without its top view)."""
-    signals = {signal.SIGINT, signal.SIGTERM}
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, signals)
+    """SIGINT and SIGTERM held back while a set of files is moved into place, then delivered, so an interruption
+    lands before or after the whole set, never inside it (e.g. an overlay without its top view).
+
+    Python runs signal handlers in the main thread whichever thread the signal reached (a worker reading ahead,
+    onnxruntime's pool), so the handlers are swapped for one that notes the signal; blocking the signals in this
+    thread alone let another thread take them and the handler raise inside the set. In another thread (a command
+    run from a worker, where no handler can be set) this does nothing."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    held: list[int] = []
+
+    def hold(signum: int, frame: object) -> None:
+        if signum not in held:
+            held.append(signum)
+
+    previous = {number: signal.signal(number, hold) for number in (signal.SIGINT, signal.SIGTERM)}
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+        for number, handler in previous.items():
+            signal.signal(number, signal.SIG_DFL if handler is None else handler)
+        for signum in held:
+            signal.raise_signal(signum)  # to the handler restored: raises after the set, as it would have
 
 
 def clear_owned(folder: Path, owned: Sequence[str], keep: Iterable[str] = ()) -> list[Path]:

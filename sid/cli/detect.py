@@ -361,13 +361,13 @@ def run(args: argparse.Namespace) -> int:
             records = picture_records(result, tracked)
             pictures = _pictures(frame, result, records, mount) if args.out is not None else {}
             line = json.dumps(record)
-            with signals_deferred():  # a frame's line and both its pictures, or none of them
+            with signals_deferred():  # a frame's line and both its pictures, or none of them; and counted
                 if out is not None:
                     out.write(line, pictures)
                 print(line, flush=True)
-            done += 1
-            unconfirmed += not record["people"]
-            totals.append(record["timing_ms"]["total"])
+                done += 1
+                unconfirmed += not record["people"]
+                totals.append(record["timing_ms"]["total"])
     except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (sid.cli.common.Terminated)
         interrupted = 128 + int(getattr(exc, "signal_number", 2))
         print("detect: interrupted, output flushed", file=sys.stderr)
