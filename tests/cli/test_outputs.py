@@ -271,15 +271,32 @@ def test_a_signal_another_thread_receives_waits_for_the_deferred_set(number):
 
     worker = threading.Thread(target=send)
     finished = False
-    with signals_as_interrupts(), pytest.raises(KeyboardInterrupt):  # Terminated for SIGTERM
-        worker.start()
-        with signals_deferred():
-            entered.set()
-            assert sent.wait(5)
-            time.sleep(0.2)  # a handler due now would raise here
-            finished = True
+    # A background job (CI runs two suites side by side) starts with SIGINT ignored: give it Python's own handler.
+    interrupt = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with signals_as_interrupts(), pytest.raises(KeyboardInterrupt):  # Terminated for SIGTERM
+            worker.start()
+            with signals_deferred():
+                entered.set()
+                assert sent.wait(5)
+                time.sleep(0.2)  # a handler due now would raise here
+                finished = True
+    finally:
+        signal.signal(signal.SIGINT, interrupt)
     worker.join()
     assert finished
+
+
+def test_a_signal_ignored_before_stays_ignored_after_the_deferred_set():
+    interrupt = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        with signals_deferred():
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.1)
+        time.sleep(0.1)  # nothing raised: the signal went to the handler restored, SIG_IGN
+        assert signal.getsignal(signal.SIGINT) == signal.SIG_IGN
+    finally:
+        signal.signal(signal.SIGINT, interrupt)
 
 
 def test_signals_deferred_restores_the_handlers_and_delivers_nothing_when_none_came():
