@@ -466,7 +466,8 @@ def signals_deferred() -> Iterator[None]:
     Python runs signal handlers in the main thread whichever thread the signal reached (a worker reading ahead,
     onnxruntime's pool), so the handlers are swapped for one that notes the signal; blocking the signals in this
     thread alone let another thread take them and the handler raise inside the set. In another thread (a command
-    run from a worker, where no handler can be set) this does nothing."""
+    run from a worker, where no handler can be set) this does nothing, and a signal whose handler was installed
+    outside Python (which Python could not put back) is left alone."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
@@ -476,12 +477,13 @@ def signals_deferred() -> Iterator[None]:
         if signum not in held:
             held.append(signum)
 
-    previous = {number: signal.signal(number, hold) for number in (signal.SIGINT, signal.SIGTERM)}
+    swapped = [number for number in (signal.SIGINT, signal.SIGTERM) if signal.getsignal(number) is not None]
+    previous = {number: signal.signal(number, hold) for number in swapped}
     try:
         yield
     finally:
         for number, handler in previous.items():
-            signal.signal(number, signal.SIG_DFL if handler is None else handler)
+            signal.signal(number, handler)
         for signum in held:
             signal.raise_signal(signum)  # to the handler restored: raises after the set, as it would have
 
