@@ -161,6 +161,11 @@ def _outlines(
     return draw
 
 
+def _nothing(img: np.ndarray, a: object, b: object) -> None:
+    """An ``Extra``'s drawing (on the map) or swatch (in the legend) that draws nothing: a legend row of text alone,
+    or a group of outlines whose legend row is another entry's."""
+
+
 def _line_swatch(colour: tuple[int, int, int], dashed: bool) -> Callable[[np.ndarray, int, int], None]:
     def swatch(img: np.ndarray, u: int, v: int) -> None:
         if dashed:
@@ -192,24 +197,24 @@ def frame_picture(errors: FrameErrors, title: str) -> np.ndarray:
     true_groups = [(members, OUTCOME_COLOURS[outcome]) for members, outcome in errors.outcomes.items()]
     found = [(g, FALSE_GROUP if g in errors.false_groups else DETECTED) for g in errors.found]
     extras = [
-        Extra("true group, dashed:", lambda img, u, v: None, _outlines(by_id, true_groups, TRUE_MARGIN, True)),
+        Extra("true group, dashed:", _nothing, _outlines(by_id, true_groups, TRUE_MARGIN, True)),
         *(
-            Extra(f"  {OUTCOME_NAMES[kind]}", _line_swatch(OUTCOME_COLOURS[kind], True), lambda img, spec, scale: None)
+            Extra(f"  {OUTCOME_NAMES[kind]}", _line_swatch(OUTCOME_COLOURS[kind], True), _nothing)
             for kind in GROUP_ERRORS
             if kind in errors.outcomes.values()
         ),
         Extra("detected group, solid", _line_swatch(DETECTED, False), _outlines(by_id, found, FOUND_MARGIN, False)),
     ]
     if errors.false_groups:
-        extras.append(Extra("  false group", _line_swatch(FALSE_GROUP, False), lambda img, spec, scale: None))
+        extras.append(Extra("  false group", _line_swatch(FALSE_GROUP, False), _nothing))
     for members, outcome in errors.outcomes.items():  # annotation slips: true members the frame does not hold
         absent = sorted(members - by_id.keys())
         if absent:
             gone = "" if len(absent) == len(members) else f" {', '.join(map(str, absent))}"
             label = f"true group {', '.join(map(str, sorted(members)))}:{gone} not in the frame"
-            extras.append(Extra(label, _line_swatch(OUTCOME_COLOURS[outcome], True), lambda img, spec, scale: None))
-    if any(p.id not in colours or colours[p.id] == PERSON for p in people):
-        extras.append(Extra("person in no true group", person_swatch(PERSON), lambda img, spec, scale: None))
+            extras.append(Extra(label, _line_swatch(OUTCOME_COLOURS[outcome], True), _nothing))
+    if any(colours[p.id] == PERSON for p in people):
+        extras.append(Extra("person in no true group", person_swatch(PERSON), _nothing))
     spec = _view(people)
     return render_costmap(Costmap2D.filled(spec), people, [], title=title, extras=extras, colours=colours)
 

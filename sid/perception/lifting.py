@@ -53,13 +53,13 @@ from sid.perception.people import Person
 
 __all__ = ["LOOKUP_RANGE", "LiftParams", "lift_people"]
 
-# Far-side completion. Root keypoints and their partner a fixed separation away, as (root, partner): shoulders,
-# hips, ears (``widths`` order), left roots then right ones.
 LOOKUP_RANGE = (0.1, 10.0)
 """Readings (m) a keypoint's depth lookup always accepts, whatever the lift's range: a depth camera's span (a D435
 sees from about 0.1 m; beyond 10 m its readings are noise). ``LiftParams.min_range`` / ``max_range`` gate the looked-up
 keypoints afterwards."""
 
+# Far-side completion. Root keypoints and their partner a fixed separation away, as (root, partner): shoulders,
+# hips, ears (``widths`` order), left roots then right ones.
 _ROOT_PAIRS = tuple(
     (KP[f"{side}_{part}"], KP[f"{other}_{part}"])
     for side, other in (("left", "right"), ("right", "left"))
