@@ -66,6 +66,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="keep the last K weighted layers on every path to the outputs, and the decoding after them, float "
         "(default %(default)s; 0 quantizes everything; docs/models.md)",
     )
+    quantize.add_argument(
+        "--float-boxes",
+        action="store_true",
+        help="keep the branch that reaches only the boxes (YOLO's box regression) float too; by default it is "
+        "quantized whole: boxes serve non-maximum suppression, and the keypoints do not depend on them",
+    )
     quantize.set_defaults(func=run_quantize)
     simplify = tasks.add_parser(
         "simplify",
@@ -172,14 +178,17 @@ def run_quantize(args: argparse.Namespace) -> int:
             (frame.color for _, frame in frames),
             per_channel=not args.per_tensor,
             float_layers=args.float_layers,
+            float_boxes=args.float_boxes,
         )
         table, same = _comparison(args.model, args.output, frames)
     except INPUT_ERRORS as exc:
         return fail(command, exc)
+    boxes = f" ({report.box_branch_nodes} of them in the box branch)" if report.box_branch_nodes else ""
     print(
         f"wrote {report.output}: {report.contract}, INT8 (QDQ, {'per-tensor' if args.per_tensor else 'per-channel'} "
-        f"weights), {report.quantized_nodes} nodes quantized, {report.float_nodes} kept float, {report.removed_nodes} "
-        f"no-op nodes removed; calibrated on {report.calibration_images} frame(s) in {report.seconds:.1f} s"
+        f"weights), {report.quantized_nodes} nodes quantized{boxes}, {report.float_nodes} kept float, "
+        f"{report.removed_nodes} no-op nodes removed; calibrated on {report.calibration_images} frame(s) in "
+        f"{report.seconds:.1f} s"
     )
     print(f"against {args.model} on the calibration frames:")
     print(table)

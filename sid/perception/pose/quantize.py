@@ -12,8 +12,10 @@ loads wherever the float model does) whose convolutions and matrix products run 
    integer dot-product instructions (VNNI on x86, SDOT on ARMv8.2+); int8 activations fall back to slower kernels
    on x86. The last ``FLOAT_LAYERS`` weighted layers of every path to the outputs and the decoding after them
    (keypoint offsets, anchors, scores, the output concatenation) stay float (``decoding_nodes``): 8-bit steps there
-   move keypoints by pixels, and the facings lifted from them by degrees. See docs/models.md for what each choice
-   costs.
+   move keypoints by pixels, and the facings lifted from them by degrees. The exception is a branch that reaches
+   only the candidates' boxes (``BOX_OUTPUTS``: YOLO's box regression, which serves non-maximum suppression and
+   the box fields, not the keypoints): it is quantized whole (``box_branch_nodes``). See docs/models.md for what
+   each choice costs.
 
 Calibration tensors are made by the model's own estimator (``preprocess`` of ``sid.perception.pose``: letterbox,
 padding value, dtype, layout), from whole RGB images, exactly as ``sid detect`` feeds the model.
@@ -33,16 +35,18 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from sid.distribution import MissingDependencyError, install_hint
-from sid.perception.pose.contracts import PoseModelError
+from sid.perception.pose.contracts import YOLO_POSE, PoseModelError
 
 if TYPE_CHECKING:
     import onnx
 
 __all__ = [
+    "BOX_OUTPUTS",
     "FLOAT_LAYERS",
     "ONNX_MISSING",
     "QuantizeReport",
     "WEIGHTED_OPS",
+    "box_branch_nodes",
     "check_paths",
     "decoding_nodes",
     "quantize_model",
@@ -55,6 +59,9 @@ WEIGHTED_OPS = ("Conv", "ConvTranspose", "MatMul", "Gemm")
 FLOAT_LAYERS = 4
 """``quantize_model``'s default: the last 4 weighted layers on every path to the outputs stay float, with the decoding
 after them (docs/models.md has the measurements that chose it)."""
+BOX_OUTPUTS: dict[str, tuple[int, slice]] = {YOLO_POSE: (1, slice(0, 4))}
+"""Where a contract's output holds the candidates' boxes, as (axis, index range): rows 0-3 (cx, cy, w, h) of YOLO's
+[1, 56, N]. The layers that reach nothing else are quantized whole by ``quantize_model``."""
 ONNX_MISSING = f"editing ONNX graphs needs the onnx package: {install_hint('quantize')} (or pip install onnx)"
 
 
@@ -70,6 +77,7 @@ class QuantizeReport:
     removed_nodes: int
     quantized_nodes: int
     float_nodes: int
+    box_branch_nodes: int
     seconds: float
 
 
@@ -177,6 +185,65 @@ def decoding_nodes(model: onnx.ModelProto, layers: int = FLOAT_LAYERS) -> list[s
     return [node.name for node in nodes if after[id(node)] < layers]
 
 
+def box_branch_nodes(
+    model: onnx.ModelProto, region: Sequence[str], tensor: np.ndarray, box: tuple[int, slice]
+) -> set[str]:
+    """The nodes among ``region`` (node names) that reach only the box part of the model's output (``box``: axis and
+    index range): the weighted nodes whose weights, changed, change nothing else of the output for ``tensor`` (the
+    float model run once per node; an output element counts as changed beyond 1e-6 relative), and the nodes all of
+    whose consumers are such nodes. Weights that are not initializers, or that another node shares, count as
+    reaching everything. Only the region's weighted nodes are tried, so this costs a run per weighted node in it."""
+    import onnxruntime as ort
+    from onnx import numpy_helper
+
+    graph = model.graph
+    inits = {init.name: k for k, init in enumerate(graph.initializer)}
+    uses: dict[str, int] = {}
+    for node in graph.node:
+        for name in node.input:
+            uses[name] = uses.get(name, 0) + 1
+    options = ort.SessionOptions()
+    options.intra_op_num_threads = 1
+
+    def run(candidate: onnx.ModelProto) -> np.ndarray:
+        session = ort.InferenceSession(candidate.SerializeToString(), options, providers=["CPUExecutionProvider"])
+        return np.asarray(session.run(None, {session.get_inputs()[0].name: tensor})[0], dtype=np.float64)
+
+    reference = run(model)
+    axis, rows = box
+    others = np.ones(reference.shape[axis], dtype=bool)
+    others[rows] = False
+    inside = set(region)
+    reaching_boxes: set[str] = set()
+    for node in graph.node:
+        if node.name not in inside or node.op_type not in WEIGHTED_OPS or len(node.input) < 2:
+            continue
+        weights = node.input[1]
+        if weights not in inits or uses[weights] != 1:
+            continue
+        changed = type(model)()
+        changed.CopyFrom(model)
+        array = numpy_helper.to_array(graph.initializer[inits[weights]])
+        changed.graph.initializer[inits[weights]].CopyFrom(numpy_helper.from_array(array * 0.5 + 0.1, weights))
+        moved = np.abs(run(changed) - reference) > 1e-6 * (1.0 + np.abs(reference))
+        moved_rows = moved.any(axis=tuple(a for a in range(moved.ndim) if a != axis))
+        if moved_rows.any() and not moved_rows[others].any():
+            reaching_boxes.add(node.name)
+    consumers: dict[str, list[Any]] = {}
+    for node in graph.node:
+        for name in node.input:
+            consumers.setdefault(name, []).append(node)
+    outputs = {output.name for output in graph.output}
+    for node in reversed(graph.node):  # consumers after producers: a node's consumers are decided before it
+        if node.name not in inside or node.name in reaching_boxes or node.op_type in WEIGHTED_OPS:
+            continue
+        following = [c for name in node.output for c in consumers.get(name, [])]
+        feeds_output = any(name in outputs for name in node.output)
+        if following and not feeds_output and all(c.name in reaching_boxes for c in following):
+            reaching_boxes.add(node.name)
+    return reaching_boxes
+
+
 def simplify_model(source: str | Path, output: str | Path) -> int:
     """Write ``simplify_graph`` of the model at ``source`` to ``output`` (float, outputs unchanged); returns how
     many nodes it removed. Raises PoseModelError when ``source`` is not a pose model sid can load."""
@@ -199,6 +266,7 @@ def quantize_model(
     *,
     per_channel: bool = True,
     float_layers: int = FLOAT_LAYERS,
+    float_boxes: bool = False,
     max_images: int | None = None,
 ) -> QuantizeReport:
     """Quantize the pose model at ``source`` to INT8 (module docstring) and write it to ``output``.
@@ -206,6 +274,7 @@ def quantize_model(
     images: RGB uint8 (H, W, 3) calibration images, e.g. the colour images of a sid source; each goes through the
     model's own pre-processing. max_images: use at most this many. per_channel: weights get one scale per output
     channel (else one per tensor). float_layers: leave ``decoding_nodes`` with that many layers float (0: none).
+    float_boxes: keep the branch that reaches only the boxes (``box_branch_nodes``) float too, as the other paths.
 
     Raises PoseModelError (source missing or not a pose model, nothing to quantize, the written model not loading
     with the same contract), ValueError (no calibration image, output = source), MissingDependencyError (onnx not
@@ -237,6 +306,9 @@ def quantize_model(
         quant_pre_process(str(simplified), str(prepared), skip_symbolic_shape=True)
         prepared_model = onnx.load(str(prepared))
         keep_float = decoding_nodes(prepared_model, float_layers) if float_layers else []
+        box = BOX_OUTPUTS.get(estimator.contract)
+        boxes = set() if float_boxes or box is None else box_branch_nodes(prepared_model, keep_float, tensors[0], box)
+        keep_float = [name for name in keep_float if name not in boxes]
         quantize_static(
             str(prepared),
             str(output),
@@ -258,6 +330,7 @@ def quantize_model(
         removed,
         nodes - len(keep_float),
         len(keep_float),
+        len(boxes),
         time.perf_counter() - started,
     )
 

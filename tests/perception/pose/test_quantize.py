@@ -15,7 +15,7 @@ from sid.experiments.bench.stages import real_rgbd_folders
 from sid.experiments.pose_compare import Criteria, compare_pipelines
 from sid.perception.pipeline import Pipeline, image_pose
 from sid.perception.pose import PoseModelError, load_pose_estimator
-from sid.perception.pose.quantize import decoding_nodes, quantize_model, simplify_graph
+from sid.perception.pose.quantize import box_branch_nodes, decoding_nodes, quantize_model, simplify_graph
 from sid.sources import open_source
 from tests.conftest import shared_path
 from tests.pose_models import IR_VERSION, OPSET, build_yolo_pose_model
@@ -86,6 +86,54 @@ def test_decoding_nodes_are_the_last_layers_and_what_follows_them():
     assert decoding_nodes(model, 0) == []
 
 
+def _two_branch_graph() -> onnx.ModelProto:
+    """A trunk convolution, then a box branch (conv, ReLU, conv: 4 channels) and a keypoint branch (one conv, 2
+    channels, and a second conv sharing its weights with a third), concatenated on axis 1 into [1, 8, 64]."""
+    rng = np.random.default_rng(0)
+    consts = {
+        "wt": rng.normal(size=(4, 3, 3, 3)),
+        "wa1": rng.normal(size=(4, 4, 1, 1)),
+        "wa2": rng.normal(size=(4, 4, 1, 1)),
+        "wb": rng.normal(size=(2, 4, 1, 1)),
+        "shared": rng.normal(size=(1, 4, 1, 1)),
+        "shape": np.array([1, 8, 64]),
+    }
+    nodes = [
+        helper.make_node("Conv", ["X", "wt"], ["t"], name="trunk", pads=[1, 1, 1, 1]),
+        helper.make_node("Conv", ["t", "wa1"], ["a1"], name="box1"),
+        helper.make_node("Relu", ["a1"], ["r"], name="box_relu"),
+        helper.make_node("Conv", ["r", "wa2"], ["a2"], name="box2"),
+        helper.make_node("Conv", ["t", "wb"], ["b"], name="keypoints"),
+        helper.make_node("Conv", ["t", "shared"], ["s1"], name="shared1"),
+        helper.make_node("Conv", ["t", "shared"], ["s2"], name="shared2"),
+        helper.make_node("Concat", ["a2", "b", "s1", "s2"], ["c"], name="concat", axis=1),
+        helper.make_node("Reshape", ["c", "shape"], ["Y"], name="reshape"),
+    ]
+    graph = helper.make_graph(
+        nodes,
+        "branches",
+        [helper.make_tensor_value_info("X", TensorProto.FLOAT, [1, 3, 8, 8])],
+        [helper.make_tensor_value_info("Y", TensorProto.FLOAT, [1, 8, 64])],
+        initializer=[
+            numpy_helper.from_array(v.astype(v.dtype if k == "shape" else np.float32), k) for k, v in consts.items()
+        ],
+    )
+    model = helper.make_model(graph, opset_imports=[helper.make_opsetid("", OPSET)])
+    model.ir_version = IR_VERSION
+    return model
+
+
+def test_box_branch_nodes_are_the_layers_that_reach_only_the_boxes():
+    model = _two_branch_graph()
+    x = np.random.default_rng(1).normal(size=(1, 3, 8, 8)).astype(np.float32)
+    region = decoding_nodes(model, 2)
+    assert "trunk" not in region and "box1" in region
+    # shared1 reaches row 6 only, yet its weights are shared with shared2 (row 7): both count as reaching everything
+    assert box_branch_nodes(model, region, x, (1, slice(0, 4))) == {"box1", "box_relu", "box2"}
+    assert box_branch_nodes(model, region, x, (1, slice(4, 6))) == {"keypoints"}
+    assert box_branch_nodes(model, decoding_nodes(model, 1), x, (1, slice(0, 4))) == {"box2"}  # box1 outside
+
+
 def test_a_model_without_convolutions_is_refused(tmp_path):
     path = build_yolo_pose_model(tmp_path / "tiny.onnx", np.zeros((56, 4), np.float32))
     with pytest.raises(PoseModelError, match="no Conv"):
@@ -126,6 +174,7 @@ def test_real_model_quantized_keeps_its_contract_people_and_groups(model, people
     output = tmp_path / "int8.onnx"
     report = quantize_model(source, output, (frame.color for _, frame in frames))
     assert report.calibration_images == 6 and report.quantized_nodes > report.float_nodes > 0
+    assert (report.box_branch_nodes > 0) == (model == "yolo11n-pose-256.onnx")  # YOLO's box regression, quantized
     quantized, original = load_pose_estimator(output), load_pose_estimator(source)
     assert quantized.contract == original.contract and quantized.input_size == original.input_size
     ops = {node.op_type for node in onnx.load(str(output)).graph.node}
