@@ -78,6 +78,7 @@ DEFAULT_GRID: dict[str, dict[str, tuple[float, ...]]] = {
         "walk_velocity_difference": (0.3, 0.4, 0.5, 0.6, 0.8, 1.0),
         "moving_speed": (0.2, 0.3, 0.4),
         "walk_confirm_hits": (1, 3),
+        "walk_window": (2.0, 3.0, 4.0),
     },
     "coherent": {"distance": (1.0, 1.5, 2.0), "velocity_difference": (0.3, 0.4, 0.5, 0.6), "share": (0.4, 0.6, 0.8)},
 }

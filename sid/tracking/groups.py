@@ -74,8 +74,8 @@ class GroupTrackerParams:
     min_overlap: float = 0.5
     leave_distance: float = 1.6
     walk_distance: float = 1.5
-    walk_velocity_difference: float = 0.8
-    walk_window: float = 2.0
+    walk_velocity_difference: float = 1.0
+    walk_window: float = 4.0
     max_speed_sigma: float = 0.4
     moving_speed: float = 0.4
 
