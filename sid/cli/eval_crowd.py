@@ -66,7 +66,7 @@ def add_crowd_parser(tasks: argparse._SubParsersAction) -> None:
     parser.add_argument("--range", type=float, default=6.0, metavar="M", help="--view's range (6 m)")
     parser.add_argument(
         "--cross-validate", action="store_true",
-        help="leave one set out over the trackers' grid (sid.experiments.crowd.DEFAULT_GRID; about 10 minutes)",
+        help="leave one set out over the trackers' grid (sid.experiments.crowd.DEFAULT_GRID; about 20 minutes)",
     )  # fmt: skip
     out = parser.add_mutually_exclusive_group()
     out.add_argument("--json", action="store_true", help="print JSON (every score, the settings) instead of a table")
