@@ -307,7 +307,11 @@ def quantize_model(
         prepared_model = onnx.load(str(prepared))
         keep_float = decoding_nodes(prepared_model, float_layers) if float_layers else []
         box = BOX_OUTPUTS.get(estimator.contract)
-        boxes = set() if float_boxes or box is None else box_branch_nodes(prepared_model, keep_float, tensors[0], box)
+        boxes = (
+            box_branch_nodes(prepared_model, keep_float, tensors[0], box)
+            if keep_float and box and not float_boxes
+            else set()
+        )
         keep_float = [name for name in keep_float if name not in boxes]
         quantize_static(
             str(prepared),
