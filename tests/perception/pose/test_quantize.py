@@ -87,16 +87,15 @@ def test_decoding_nodes_are_the_last_layers_and_what_follows_them():
 
 
 def _two_branch_graph() -> onnx.ModelProto:
-    """A trunk convolution, then a box branch (conv, ReLU, conv: 4 channels) and a keypoint branch (one conv, 2
-    channels, and a second conv sharing its weights with a third), concatenated on axis 1 into [1, 8, 64]."""
+    """A trunk convolution, then a box branch (conv, ReLU, conv: rows 0-3 of the output), a keypoint branch (one conv:
+    rows 4-5) and two convs sharing one weight tensor (rows 6 and 7), concatenated on axis 1 into [1, 8, 64]."""
     rng = np.random.default_rng(0)
-    consts = {
-        "wt": rng.normal(size=(4, 3, 3, 3)),
-        "wa1": rng.normal(size=(4, 4, 1, 1)),
-        "wa2": rng.normal(size=(4, 4, 1, 1)),
-        "wb": rng.normal(size=(2, 4, 1, 1)),
-        "shared": rng.normal(size=(1, 4, 1, 1)),
-        "shape": np.array([1, 8, 64]),
+    weights = {
+        "wt": (4, 3, 3, 3),
+        "wa1": (4, 4, 1, 1),
+        "wa2": (4, 4, 1, 1),
+        "wb": (2, 4, 1, 1),
+        "shared": (1, 4, 1, 1),
     }
     nodes = [
         helper.make_node("Conv", ["X", "wt"], ["t"], name="trunk", pads=[1, 1, 1, 1]),
@@ -115,7 +114,8 @@ def _two_branch_graph() -> onnx.ModelProto:
         [helper.make_tensor_value_info("X", TensorProto.FLOAT, [1, 3, 8, 8])],
         [helper.make_tensor_value_info("Y", TensorProto.FLOAT, [1, 8, 64])],
         initializer=[
-            numpy_helper.from_array(v.astype(v.dtype if k == "shape" else np.float32), k) for k, v in consts.items()
+            *(numpy_helper.from_array(rng.normal(size=shape).astype(np.float32), k) for k, shape in weights.items()),
+            numpy_helper.from_array(np.array([1, 8, 64], np.int64), "shape"),
         ],
     )
     model = helper.make_model(graph, opset_imports=[helper.make_opsetid("", OPSET)])
