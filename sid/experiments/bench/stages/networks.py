@@ -172,6 +172,7 @@ def _bench_pose_int8(path: Path) -> Callable[[Context], Records]:
                 min_speedup=float_stats.min_ms / int8_stats.min_ms,
                 paired_speedup_over_simplified=float(paired[1]),
                 float_layers=FLOAT_LAYERS,
+                box_branch_nodes=report.box_branch_nodes,
                 calibration_frames=report.calibration_images,
                 image=image_name,
                 compared_frames=len(rows),
