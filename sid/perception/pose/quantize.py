@@ -105,10 +105,7 @@ def simplify_graph(model: onnx.ModelProto) -> int:
             dims = info.type.tensor_type.shape.dim
             shapes[info.name] = tuple(d.dim_value if d.HasField("dim_value") else None for d in dims)
     nodes = list(graph.node)  # one Python object per node for the whole pass: their ids identify them
-    consumers: dict[str, list[Any]] = {}
-    for node in nodes:
-        for name in node.input:
-            consumers.setdefault(name, []).append(node)
+    consumers = _consumers(nodes)
     outputs = {output.name for output in graph.output}
 
     def scalar_operand(node: Any, value: float, ops: tuple[str, ...], commutes: bool) -> str | None:
@@ -161,6 +158,15 @@ def simplify_graph(model: onnx.ModelProto) -> int:
     return len(removed)
 
 
+def _consumers(nodes: Iterable[Any]) -> dict[str, list[Any]]:
+    """Tensor name -> the nodes that read it, in the graph's order."""
+    consumers: dict[str, list[Any]] = {}
+    for node in nodes:
+        for name in node.input:
+            consumers.setdefault(name, []).append(node)
+    return consumers
+
+
 def _keeps_shape(shapes: dict[str, tuple[int | None, ...]], name: str, constant: np.ndarray) -> bool:
     """Whether broadcasting ``constant`` against the tensor ``name`` leaves that tensor's (inferred) shape as it is."""
     shape = shapes.get(name)
@@ -175,10 +181,7 @@ def decoding_nodes(model: onnx.ModelProto, layers: int = FLOAT_LAYERS) -> list[s
     the outputs, in the graph's order: with ``layers`` = K, the last K weighted layers of each path and everything
     after them (the decoding), without the activations that feed the first of those layers."""
     nodes = list(model.graph.node)
-    consumers: dict[str, list[Any]] = {}
-    for node in nodes:
-        for name in node.input:
-            consumers.setdefault(name, []).append(node)
+    consumers = _consumers(nodes)
     after: dict[int, int] = {}  # node -> most weighted operators on a path from its output to the graph's outputs
     for node in reversed(nodes):  # ONNX graphs are topologically sorted: consumers come after producers
         following = [c for output in node.output for c in consumers.get(output, [])]
@@ -199,10 +202,7 @@ def box_branch_nodes(
 
     graph = model.graph
     inits = {init.name: k for k, init in enumerate(graph.initializer)}
-    consumers: dict[str, list[Any]] = {}
-    for node in graph.node:
-        for name in node.input:
-            consumers.setdefault(name, []).append(node)
+    consumers = _consumers(graph.node)
     options = ort.SessionOptions()
     options.intra_op_num_threads = 1
 
