@@ -120,6 +120,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help=f"leave one DIR out at a time over the grid that chose the defaults ({grid_text}; --grid sets another)",
     )
     ff.add_argument(
+        "--workers",
+        type=positive_int,
+        metavar="N",
+        help="with --cross-validate or --grid: score the grid points in N worker processes (default 1; the same "
+        "table); progress on stderr",
+    )
+    ff.add_argument(
         "--gcff-settings",
         action="store_true",
         help="score the gcff method with each sequence's own settings_gc.mat (GCFF tuned per sequence, the "
@@ -192,6 +199,8 @@ def run(args: argparse.Namespace) -> int:
         if len(args.scale) not in (1, len(args.dirs)):
             raise ValueError(f"--scale takes one value or one per DIR ({len(args.dirs)}), got {len(args.scale)}")
         scales = args.scale * len(args.dirs) if len(args.scale) == 1 else args.scale
+        if args.workers is not None and not (args.grid or args.cross_validate):
+            raise ValueError("--workers spreads a cross-validation's grid points: give --cross-validate or --grid too")
         if args.pictures_max is not None and args.pictures is None:
             raise ValueError("--pictures-max caps --pictures: give --pictures DIR too")
         if args.pictures is not None:
@@ -226,7 +235,11 @@ def run(args: argparse.Namespace) -> int:
         if grid and args.errors:
             raise ValueError("--errors counts one detector's groups: it takes no --grid or --cross-validate")
         if grid:
-            folds, table = cross_validate(datasets, dict(grid), params, args.thresholds[0])
+            from sid.experiments.progress import ProgressBar
+
+            folds, table = cross_validate(
+                datasets, dict(grid), params, args.thresholds[0], args.workers or 1, ProgressBar("cross-validation")
+            )
             print(_folds(folds, table) if args.table else json.dumps(_folds_json(folds, table, grid), indent=2))
             return 0
         per_sequence = None

@@ -14,7 +14,7 @@ import math
 import sys
 from typing import Any
 
-from sid.cli.common import fail, name_width, plain_text, whole_number
+from sid.cli.common import fail, name_width, plain_text, positive_int, whole_number
 from sid.distribution import MissingDependencyError
 from sid.experiments.crowd import DEFAULT_GRID, CrowdSettings, cross_validate, evaluate_crowd
 from sid.experiments.trajectories import ReplaySettings, TrajectoryError, TrajectorySet, load_trajectory_set
@@ -66,7 +66,12 @@ def add_crowd_parser(tasks: argparse._SubParsersAction) -> None:
     parser.add_argument("--range", type=float, default=6.0, metavar="M", help="--view's range (6 m)")
     parser.add_argument(
         "--cross-validate", action="store_true",
-        help="leave one set out over the trackers' grid (sid.experiments.crowd.DEFAULT_GRID; about 20 minutes)",
+        help="leave one set out over the trackers' grid (sid.experiments.crowd.DEFAULT_GRID; about 20 minutes in one "
+        "process)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--workers", type=positive_int, default=None, metavar="N",
+        help="with --cross-validate: score the grid points in N worker processes (default 1; the same result)",
     )  # fmt: skip
     out = parser.add_mutually_exclusive_group()
     out.add_argument("--json", action="store_true", help="print JSON (every score, the settings) instead of a table")
@@ -78,6 +83,8 @@ def run_crowd(args: argparse.Namespace) -> int:
     from sid.experiments.progress import ProgressBar
 
     try:
+        if args.workers is not None and not args.cross_validate:
+            raise ValueError("--workers spreads the cross-validation's grid points: give --cross-validate too")
         view = None
         if args.view is not None:
             x, y, yaw = args.view
@@ -86,7 +93,7 @@ def run_crowd(args: argparse.Namespace) -> int:
         sets = _load(args.folders, args.interval)
         settings = CrowdSettings(replay=replay)
         if args.cross_validate:
-            result = cross_validate(sets, settings, DEFAULT_GRID, ProgressBar("cross-validation"))
+            result = cross_validate(sets, settings, DEFAULT_GRID, ProgressBar("cross-validation"), args.workers or 1)
         else:
             result = evaluate_crowd(sets, settings, ProgressBar("crowd"))
     except (ValueError, MissingDependencyError) as exc:  # TrajectoryError and bad settings are ValueErrors

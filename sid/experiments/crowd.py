@@ -39,6 +39,7 @@ from sid.experiments.fformation import format_threshold, frame_matches
 from sid.experiments.gmitre import LinkCounts, gmitre_counts
 from sid.experiments.synthetic_tracking import as_truth_ids, identify, merged_mot_scores, require_motmetrics
 from sid.experiments.trajectories import ReplaySettings, TrajectoryError, TrajectorySet, replay, replay_length
+from sid.experiments.workers import map_in_workers
 from sid.tracking.coherent import CoherentMotion, CoherentMotionParams
 from sid.tracking.groups import GroupTracker, GroupTrackerParams
 from sid.tracking.records import TrackedPerson
@@ -298,49 +299,36 @@ def cross_validate(
     settings: CrowdSettings | None = None,
     grid: Mapping[str, Mapping[str, Sequence[float]]] | None = None,
     progress: Progress | None = None,
+    workers: int = 1,
 ) -> dict[str, Any]:
     """Leave one set out, in two stages per held-out set: the people tracker's grid point (``grid["tracker"]``) with
     the best mean IDF1 on the other sets, then, on that tracker's tracks, the group tracker's (``grid["groups"]``) and
     the reference's (``grid["coherent"]``) points with the best mean G-MITRE F1 on the other sets; each scored on the
-    held-out set. Ties go to the first point in the grid's order."""
+    held-out set. Ties go to the first point in the grid's order. Each stage's grid points are scored in ``workers``
+    processes (``sid.experiments.workers``; the same result as one)."""
     require_motmetrics()
     settings = settings or CrowdSettings()
     for trajectories in sets:  # every set's replay checked before the first runs
         replay_view(trajectories, settings.replay)
     grid = grid if grid is not None else DEFAULT_GRID
     trackers = _points(settings.tracking.tracker, grid.get("tracker", {}))
-    candidates = {
-        "groups": _points(settings.tracking.groups, grid.get("groups", {})),
-        "coherent": _points(settings.coherent, grid.get("coherent", {})),
-    }
-    total = len(trackers) * len(sets)
-    logs: list[list[TrackLog]] = []
-    idf1 = np.zeros((len(trackers), len(sets)))
-    for row, tracker in enumerate(trackers):
-        trial = _with_tracker(settings, tracker)
-        logs.append([record_tracks(s, trial) for s in sets])
-        for col, log in enumerate(logs[row]):
-            idf1[row, col] = score_people(log, settings.match_distance)["idf1"]
-            if progress is not None:
-                progress(row * len(sets) + col + 1, total, f"tracker {row + 1}/{len(trackers)}")
-    group_f1: dict[tuple[str, int], np.ndarray] = {}  # (which, tracker row) -> (points, sets)
-
-    def f1_table(which: str, row: int) -> np.ndarray:
-        if (which, row) not in group_f1:
-            table = np.zeros((len(candidates[which]), len(sets)))
-            for k, params in enumerate(candidates[which]):
-                for col, (trajectories, log) in enumerate(zip(sets, logs[row], strict=True)):
-                    found = find_groups(log, params) if which == "groups" else find_coherent_groups(log, params)
-                    table[k, col] = score_groups(trajectories, log, found, settings)["gmitre"]["f1"]
-                if progress is not None:
-                    progress(k + 1, len(candidates[which]), f"{which} on tracker {row + 1}")
-            group_f1[which, row] = table
-        return group_f1[which, row]
-
+    candidates = [
+        (which, params)
+        for which, base in (("groups", settings.tracking.groups), ("coherent", settings.coherent))
+        for params in _points(base, grid.get(which, {}))
+    ]
+    idf1 = np.array(map_in_workers(_tracker_idf1, (sets, settings), trackers, workers, progress, "tracker points"))
+    group_f1: dict[int, np.ndarray] = {}  # tracker row -> (candidates, sets)
     folds = []
     for col, trajectories in enumerate(sets):
         train = np.delete(idf1, col, axis=1).mean(axis=1)
         row = int(np.argmax(train))
+        if row not in group_f1:  # the chosen tracker's tracks, replayed again (seeded: the same) for its groups
+            logs = [record_tracks(s, _with_tracker(settings, trackers[row])) for s in sets]
+            what = f"group points on tracker {row + 1}"
+            group_f1[row] = np.array(
+                map_in_workers(_group_f1, (sets, logs, settings), candidates, workers, progress, what)
+            )
         fold: dict[str, Any] = {
             "held_out": trajectories.name,
             "tracker": {
@@ -349,17 +337,43 @@ def cross_validate(
                 "held_out_idf1": float(idf1[row, col]),
             },
         }
-        for which, points in candidates.items():
-            table = f1_table(which, row)
+        for which in ("groups", "coherent"):
+            rows = [k for k, (kind, _) in enumerate(candidates) if kind == which]
+            table = group_f1[row][rows]
             others = np.delete(table, col, axis=1).mean(axis=1)
             best = int(np.argmax(others))
             fold[which] = {
-                "chosen": _changed(points[best], grid.get(which, {})),
+                "chosen": _changed(candidates[rows[best]][1], grid.get(which, {})),
                 "train_f1": float(others[best]),
                 "held_out_f1": float(table[best, col]),
             }
         folds.append(fold)
     return {"folds": folds, "grid": {k: {n: list(v) for n, v in g.items()} for k, g in grid.items()}}
+
+
+def _tracker_idf1(shared: tuple[Sequence[TrajectorySet], CrowdSettings], tracker: TrackerParams) -> list[float]:
+    """IDF1 of the people tracker with ``tracker``'s parameters on each set (``cross_validate``'s first stage)."""
+    sets, settings = shared
+    trial = _with_tracker(settings, tracker)
+    return [score_people(record_tracks(s, trial), settings.match_distance)["idf1"] for s in sets]
+
+
+def _group_f1(
+    shared: tuple[Sequence[TrajectorySet], Sequence[TrackLog], CrowdSettings],
+    candidate: tuple[str, GroupTrackerParams | CoherentMotionParams],
+) -> list[float]:
+    """G-MITRE F1 on each set of the group tracker's or the reference's groups with the ``candidate``'s parameters,
+    on the tracks ``shared`` holds (``cross_validate``'s second stage)."""
+    sets, logs, settings = shared
+    params = candidate[1]
+    out = []
+    for trajectories, log in zip(sets, logs, strict=True):
+        if isinstance(params, GroupTrackerParams):
+            found = find_groups(log, params)
+        else:
+            found = find_coherent_groups(log, params)
+        out.append(score_groups(trajectories, log, found, settings)["gmitre"]["f1"])
+    return out
 
 
 def _points(base: Any, axes: Mapping[str, Sequence[float]]) -> list[Any]:

@@ -37,6 +37,7 @@ import scipy.io
 from sid.checks import YAW_LIMIT_RAD, check_limit, check_number
 from sid.documents import InputWarning, plural, special_file
 from sid.errors import SidError
+from sid.experiments.workers import Progress, map_in_workers
 from sid.perception.gcff import GCFFParams
 from sid.perception.groups import GroupParams, detect_groups
 from sid.perception.people import Person
@@ -552,10 +553,13 @@ def cross_validate(
     grid: Mapping[str, Sequence[float]],
     base: GroupParams | None = None,
     threshold: float = 2 / 3,
+    workers: int = 1,
+    progress: Progress | None = None,
 ) -> tuple[list[Fold], dict[tuple[float, ...], dict[str, float]]]:
     """Leave-one-dataset-out choice of ``GroupParams`` fields over ``grid`` (field -> candidate values, the other
     fields from ``base``): per held-out dataset, the grid point with the best mean F1 at ``threshold`` over the
-    other datasets (ties: the first in grid order), scored on the held-out one.
+    other datasets (ties: the first in grid order), scored on the held-out one. The grid points are scored in
+    ``workers`` processes (``sid.experiments.workers``; the same table as one), ``progress`` after each.
 
     Returns the folds and every grid point's F1 per dataset (keyed by its values in ``grid``'s field order).
     Needs at least two datasets; raises ValueError for an unknown field or an empty grid.
@@ -568,18 +572,17 @@ def cross_validate(
     if unknown or not grid or not all(grid.values()):
         raise ValueError(f"fformation: the grid needs values for numeric fields of GroupParams, got {dict(grid)}")
     names = list(grid)
-    table: dict[tuple[float, ...], dict[str, float]] = {}
-    for values in itertools.product(*(grid[n] for n in names)):
+    points = list(itertools.product(*(grid[n] for n in names)))
+    params = []
+    for values in points:
         # Whole-number fields (min_samples, radius_steps) take the value as an int; GroupParams refuses a fraction.
         changes: dict[str, Any] = {
             n: int(v) if isinstance(getattr(base, n), int) and float(v).is_integer() else v
             for n, v in zip(names, values, strict=True)
         }
-        params = dataclasses.replace(base, **changes)
-        table[values] = {
-            name: score(frames, [[g.members for g in detect_groups(f.people, params)] for f in frames], threshold).f1
-            for name, frames in datasets.items()
-        }
+        params.append(dataclasses.replace(base, **changes))  # a bad value fails here, before any work
+    scores = map_in_workers(_grid_point_f1, (datasets, threshold), params, workers, progress, "grid points")
+    table = dict(zip(points, scores, strict=True))
     folds = []
     for held_out in datasets:
         others = [n for n in datasets if n != held_out]
@@ -587,6 +590,17 @@ def cross_validate(
         train = float(np.mean([table[best][n] for n in others]))
         folds.append(Fold(held_out, dict(zip(names, best, strict=True)), train, table[best][held_out]))
     return folds, table
+
+
+def _grid_point_f1(
+    shared: tuple[Mapping[str, Sequence[LabelledFrame]], float], params: GroupParams
+) -> dict[str, float]:
+    """F1 at the threshold of the groups ``params`` find, per dataset (``cross_validate``'s task)."""
+    datasets, threshold = shared
+    return {
+        name: score(frames, [[g.members for g in detect_groups(f.people, params)] for f in frames], threshold).f1
+        for name, frames in datasets.items()
+    }
 
 
 def format_threshold(threshold: float) -> str:

@@ -59,8 +59,11 @@ def test_cross_validation_prints_one_row_per_stage_and_held_out_set(
     monkeypatch.setattr(eval_crowd, "DEFAULT_GRID", small)
     folders = [str(pair_and_strangers(tmp_path / name, frames=12)) for name in ("a", "b")]
     assert main(["eval", "crowd", *folders, "--cross-validate"]) == 0
-    rows = [line.split()[:2] for line in capsys.readouterr().out.splitlines()[1:]]
+    out = capsys.readouterr().out
+    rows = [line.split()[:2] for line in out.splitlines()[1:]]
     assert rows == [[s, stage] for s in ("a", "b") for stage in ("tracker", "groups", "coherent")]
+    assert main(["eval", "crowd", *folders, "--cross-validate", "--workers", "2"]) == 0
+    assert capsys.readouterr().out == out  # the same table from two worker processes
 
 
 @pytest.mark.parametrize(
@@ -70,6 +73,7 @@ def test_cross_validation_prints_one_row_per_stage_and_held_out_set(
         (["--miss-rate", "1"], "replay: miss_rate must be"),
         (["--fov", "400", "--view", "0,0,0"], "fov"),
         (["--interval", "0"], "trajectories: interval must be"),
+        (["--workers", "2"], "--workers spreads the cross-validation's grid points: give --cross-validate too"),
     ],
 )
 def test_bad_settings_are_refused(tmp_path: Path, capsys: pytest.CaptureFixture, argv: list[str], message: str) -> None:

@@ -324,10 +324,18 @@ def test_eval_fformation_cross_validates_over_a_grid(tmp_path, capsys):
     for name in ("A", "B"):
         write_sequence(tmp_path / name, tiny_frames(), {1: [[1, 2]], 2: [[1, 2, 3]]})
     dirs = [str(tmp_path / "A"), str(tmp_path / "B")]
-    code, out, _ = run_sid(["eval", "fformation", *dirs, "--scale", "0.01", "--grid", "alone_price=0.01,0.65"], capsys)
+    code, out, err = run_sid(
+        ["eval", "fformation", *dirs, "--scale", "0.01", "--grid", "alone_price=0.01,0.65"], capsys
+    )
     report = json.loads("\n".join(out))
     assert code == 0 and [f["chosen"] for f in report["folds"]] == [{"alone_price": 0.65}] * 2
     assert report["grid"][0] == {"alone_price": 0.01, "f1": {"A": 0.0, "B": 0.0}}
+    assert "\ncross-validation: 2/2 (100 %)" in "\n" + err  # progress, off a terminal
+    args = ["eval", "fformation", *dirs, "--scale", "0.01", "--grid", "alone_price=0.01,0.65", "--workers", "2"]
+    code, pooled, _ = run_sid(args, capsys)
+    assert code == 0 and pooled == out  # the same report from two worker processes
+    code, _, err = run_sid(["eval", "fformation", *dirs, "--scale", "0.01", "--workers", "2"], capsys)
+    assert code == 2 and "--workers spreads a cross-validation's grid points: give --cross-validate or --grid" in err
     code, out, _ = run_sid(
         ["eval", "fformation", *dirs, "--scale", "0.01", "--table", "--grid", "group_price=0.65"], capsys
     )

@@ -94,6 +94,12 @@ def test_cross_validation_reports_each_held_out_set(tmp_path: Path) -> None:
         assert fold["tracker"]["chosen"]["timeout"] in (1.0, 1.5) and 0.5 < fold["tracker"]["held_out_idf1"] <= 1
         assert fold["groups"]["chosen"]["walk_distance"] in (1.0, 2.0)
         assert 0.0 <= fold["coherent"]["held_out_f1"] <= 1.0
+    calls: list[tuple[int, int, str]] = []
+    pooled = cross_validate(sets, CrowdSettings(), grid, lambda *call: calls.append(call), workers=2)
+    assert pooled == result  # the same folds from worker processes
+    finished = [(total, what) for done, total, what in calls if done == total]  # each stage's last call
+    assert finished[0] == (2, "tracker points") and 1 <= len(finished[1:]) <= 2  # then each chosen tracker's groups
+    assert all(total == 4 and what.startswith("group points on tracker ") for total, what in finished[1:])
 
 
 def crossing_crowds(folder: Path, crowds: int = 5, walkers: int = 6) -> Path:

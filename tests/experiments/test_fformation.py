@@ -468,6 +468,22 @@ def test_cross_validation_leaves_each_dataset_out_once(tmp_path):
         cross_validate({"A": datasets["A"]}, {"group_price": [0.65]})
 
 
+def test_cross_validation_in_worker_processes_gives_the_same_table(tmp_path):
+    frames = tiny_frames()
+    datasets = {
+        name: load_dataset(write_sequence(tmp_path / name, frames, {1: [[1, 2]], 2: [[1, 2, 3]]}), 0.01)
+        for name in ("A", "B")
+    }
+    grid = {"alone_price": [0.01, 0.3, 0.65], "group_price": [0.5, 0.8]}
+    calls: list[tuple[int, int, str]] = []
+    folds, table = cross_validate(datasets, grid)
+    pooled = cross_validate(datasets, grid, workers=2, progress=lambda *call: calls.append(call))
+    assert pooled == (folds, table) and list(pooled[1]) == list(table)  # the same points, in grid order
+    assert sorted(done for done, _, _ in calls) == list(range(1, 7)) and {(t, w) for _, t, w in calls} == {
+        (6, "grid points")
+    }
+
+
 def test_median_neighbour_distance_is_in_the_input_units(tiny):
     centimetres = median_neighbour_distance(load_dataset(tiny, 1.0))
     metres = median_neighbour_distance(load_dataset(tiny, 0.01))

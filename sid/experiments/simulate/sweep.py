@@ -16,9 +16,7 @@ import os
 import statistics
 import sys
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, replace
-from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
 
@@ -29,6 +27,7 @@ from sid.experiments.harness import summarise
 from sid.experiments.simulate.loop import RunOptions
 from sid.experiments.simulate.run import run_record
 from sid.experiments.simulate.scenes import load_scene
+from sid.experiments.workers import map_in_workers
 
 __all__ = ["Job", "Progress", "run_job", "run_sweep", "sweep_jobs", "sweep_summary"]
 
@@ -74,11 +73,15 @@ def run_job(job: Job) -> dict:
 
 
 def _worker_job(job: Job, in_force: Limits) -> dict:
-    """``run_job`` in a worker process (pool or Ray), with the allocator set as the ``sid`` command sets it and the
-    parent's limits in force (``sid.checks.use_limits``: a fresh interpreter starts with the defaults)."""
+    """``run_job`` on Ray, with the allocator set as the ``sid`` command sets it and the parent's limits in force
+    (``sid.checks.use_limits``: a fresh interpreter starts with the defaults)."""
     keep_freed_memory()
     with use_limits(in_force):
         return run_job(job)
+
+
+def _job_task(_: None, job: Job) -> dict:
+    return run_job(job)
 
 
 def _in_process(jobs: Sequence[Job], progress: Progress | None) -> list[dict]:
@@ -88,19 +91,6 @@ def _in_process(jobs: Sequence[Job], progress: Progress | None) -> list[dict]:
             progress(i, len(jobs), job.describe())
         out.append(run_job(job))
     return out
-
-
-def _in_workers(jobs: Sequence[Job], workers: int, progress: Progress | None) -> list[dict]:
-    results: list[dict | None] = [None] * len(jobs)
-    # spawn, not fork: a fresh interpreter per worker, whatever threads the parent runs (onnxruntime, Ray).
-    with ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn")) as pool:
-        futures = {pool.submit(_worker_job, job, limits()): i for i, job in enumerate(jobs)}
-        for done, future in enumerate(as_completed(futures)):
-            i = futures[future]
-            results[i] = future.result()
-            if progress:
-                progress(done + 1, len(jobs), jobs[i].describe())
-    return [r for r in results if r is not None]
 
 
 def _on_ray(jobs: Sequence[Job], address: str, progress: Progress | None) -> list[dict]:
@@ -144,7 +134,7 @@ def run_sweep(
         return _on_ray(jobs, ray_address, progress)
     if workers == 1:
         return _in_process(jobs, progress)
-    return _in_workers(jobs, workers, progress)
+    return map_in_workers(_job_task, None, jobs, workers, progress, Job.describe)
 
 
 def sweep_summary(records: Sequence[dict], by: Sequence[str] = ("scene",)) -> list[dict]:
