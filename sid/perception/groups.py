@@ -5,7 +5,8 @@ All coordinates are in the world frame (metres, REP-103, see ``sid.perception.pe
 - ``ospace`` (default): people are assigned to shared o-spaces by minimising a description-length cost
   (``sid.perception.ospace``; docs/groups.md); each group's zone, interest point and spread are then those of the
   paper, computed on its members' rays (``sid.perception.zone``), or the fitted o-space centre when no two members'
-  rays meet.
+  rays meet. With ``GroupParams.positions_only_reach`` set, the people without a facing whom the search leaves
+  alone are then grouped by their positions alone (a detector of positions only: a LiDAR leg tracker).
 - ``gcff``: the graph-cut detector of Setti et al. 2015 (``sid.perception.gcff``), the literature's reference,
   with one stride and description length for every scene; zones as for ``ospace``.
 - ``rays``: the paper's Algorithm 1 with the two additions that ``sid.perception.rays`` describes.
@@ -26,7 +27,7 @@ from sid.checks import MAX_COORDINATE, check_number, check_numbers, check_whole,
 from sid.documents import summary
 from sid.perception.gcff import GCFFParams, gcff_labels
 from sid.perception.group import Group
-from sid.perception.ospace import OSpaceModel, find_ospaces
+from sid.perception.ospace import TIE, OSpaceModel, find_ospaces
 from sid.perception.people import Person
 from sid.perception.rays import clustered_groups
 from sid.perception.rings import RingModel, joined_rings
@@ -97,6 +98,17 @@ class GroupParams:
       known facing: someone facing a partner half hidden behind them, whose facing the camera cannot tell) only when
       standing within this distance (m) of its circle; farther off they may still join an open one. 0.2, a body's
       depth; chosen by cross-validation on the benchmarks with a share of their facings removed (docs/groups.md).
+    positions_only_reach: the reach (m) of groups from positions alone, for a detector that gives no facings (a
+      LiDAR leg tracker: set 1.0); 0, the default, turns them off. The people without a facing whom the search
+      leaves alone are grouped by the same model, each facing taken as a full cone (any direction costs nothing;
+      members stand on the circle), proposals made towards the mean position of the others within this distance
+      (the nearest other when nobody is that close), and pairs this close proposing their midpoint. Off by default:
+      on the pedestrian sets, strangers waiting side by side become groups (docs/groups.md, "Positions only"); 1.0
+      chosen by cross-validation on the F-formation benchmarks with every facing removed.
+    positions_only_radius_max: largest o-space radius (m) of a group from positions alone. 0.7, chosen with
+      positions_only_reach.
+    positions_only_alone_price: price (m^2) of a person without a facing left alone, for groups from positions
+      alone (the group price is group_price). 0.8, chosen with positions_only_reach.
     body_radius: a member's line to the centre must pass farther than this (m) from everyone else (the o-space is
       exclusive). Chosen by cross-validation (docs/groups.md).
     facing_weight_floor: the facing weight is floor + (1 - floor) x orientation_quality: a doubtful facing counts
@@ -140,6 +152,9 @@ class GroupParams:
     ring_facing_tolerance: float = 0.6
     unknown_facing_cost: float = 0.5
     unknown_facing_tolerance: float = 0.2
+    positions_only_reach: float = 0.0
+    positions_only_radius_max: float = 0.7
+    positions_only_alone_price: float = 0.8
     body_radius: float = 0.1
     facing_weight_floor: float = 0.5
     gcff_stride: float = 0.45
@@ -157,6 +172,7 @@ class GroupParams:
             raise ValueError(f"groups: method must be one of {', '.join(GROUP_METHODS)}, got {summary(self.method)}")
         self.ospace_model  # noqa: B018 - builds (and so checks) the o-space fields, once per record
         self.coarse_ospace_model  # noqa: B018 - and the coarse-facing field
+        self.positions_only_model  # noqa: B018 - and the positions-only fields
         self.ring_model  # noqa: B018 - and the rings'
         self.gcff_params  # noqa: B018 - likewise the graph-cut fields
         check_number("groups", "facing_weight_floor", self.facing_weight_floor, low=0, low_open=True, high=1)
@@ -227,6 +243,23 @@ class GroupParams:
         except ValueError as exc:
             raise ValueError(str(exc).replace("ospace: pair_reach", "groups: coarse_pair_reach", 1)) from None
 
+    @cached_property
+    def positions_only_model(self) -> OSpaceModel:
+        """``ospace_model`` for the people without a facing left alone, grouped by their positions only."""
+        names = {"pair_reach": "reach", "radius_max": "radius_max", "alone_price": "alone_price"}
+        try:
+            return replace(
+                self.ospace_model,
+                pair_reach=self.positions_only_reach,
+                radius_max=self.positions_only_radius_max,
+                alone_price=self.positions_only_alone_price,
+            )
+        except ValueError as exc:
+            message = str(exc)
+            for old, new in names.items():
+                message = message.replace(f"ospace: {old} ", f"groups: positions_only_{new} ", 1)
+            raise ValueError(message.replace("ospace: ", "groups: ", 1)) from None
+
 
 def detect_groups(people: Sequence[Person], params: GroupParams = GroupParams()) -> list[Group]:
     """Interacting groups among ``people`` (world frame) by ``params.method``.
@@ -282,10 +315,70 @@ def _ospace_groups(
         slack,
         params.ring_model,
     )
+    unfaced, unfaced_centres = _positions_only(seen, seen_facing, {k for g in joined for k in g}, params)
+    joined, joined_centres = joined + unfaced, joined_centres + unfaced_centres
     members = [sorted(order[k] for k in group) for group in joined]
     centres = [centre + origin for centre in joined_centres]
     ranked = sorted(range(len(members)), key=lambda g: members[g][0])  # groups in order of their first member
     return _zoned([members[g] for g in ranked], [centres[g] for g in ranked], ids, positions, facing, params)
+
+
+def _positions_only(
+    positions: list[complex], facing: list[complex], grouped: set[int], params: GroupParams
+) -> tuple[list[list[int]], list[complex]]:
+    """Groups (indices, ascending) and their centres (the members' mean, complex m) among the people of unknown
+    ``facing`` (NaN) not in ``grouped``, from their ``positions`` (complex, m) only (``GroupParams``'
+    ``positions_only_reach`` and the two fields after it). Every comparison as the o-space search's, within ``TIE``:
+    the same people moved, turned or permuted give the same groups."""
+    if params.positions_only_reach <= 0:
+        return [], []
+    left = [k for k, f in enumerate(facing) if f != f and k not in grouped]
+    if len(left) < 2:
+        return [], []
+    xy = np.array([(positions[k].real, positions[k].imag) for k in left])
+    toward = _towards_neighbours(xy, params.positions_only_reach)
+    cone = [math.pi] * len(left)  # any direction: only standing on the circle costs
+    model = params.positions_only_model
+    found = find_ospaces([positions[k] for k in left], toward, [1.0] * len(left), model, cone)
+    joined, _ = joined_rings(
+        [ospace.members.tolist() for ospace in found],
+        [ospace.centre for ospace in found],
+        [positions[k] for k in left],
+        toward,
+        math.pi,
+        params.ring_model,
+    )
+    members = [[left[k] for k in group] for group in joined]
+    # The centre: the members' mean, which no facing can pull (the search's fit stops when the members settle).
+    centres = [
+        complex(math.fsum(positions[k].real for k in group), math.fsum(positions[k].imag for k in group)) / len(group)
+        for group in members
+    ]
+    return members, centres
+
+
+def _towards_neighbours(xy: np.ndarray, reach: float) -> list[complex]:
+    """Per person at ``xy`` ((N, 2), m, N >= 2), the unit direction (complex) to the mean position of the others
+    within ``reach`` (m), or to the nearest other (lowest index among the equally near) when nobody is, or when that
+    mean is the person's own position; 1 when everyone stands on one spot. Distances within ``TIE`` count as
+    equal."""
+    offsets = xy[None, :, :] - xy[:, None, :]  # [a, b]: from a to b
+    distance2 = np.einsum("abk,abk->ab", offsets, offsets)
+    np.fill_diagonal(distance2, np.inf)
+    within = distance2 <= reach * reach * (1.0 + TIE)
+    counts = within.sum(axis=1)
+    towards = np.einsum("ab,abk->ak", within, offsets) / np.maximum(counts, 1)[:, None]
+    apart = np.where(distance2 > 0, distance2, np.inf)  # the others, those on the person's own spot left out
+    nearest = apart.min(axis=1)
+    scale = np.sqrt(np.where(np.isfinite(nearest), nearest, 1.0))
+    lost = (counts == 0) | (np.hypot(towards[:, 0], towards[:, 1]) <= TIE * scale)
+    for a in np.flatnonzero(lost).tolist():
+        if math.isfinite(nearest[a]):
+            b = int(np.flatnonzero(apart[a] <= nearest[a] * (1.0 + TIE))[0])
+            towards[a] = offsets[a, b]
+        else:  # everyone on this person's spot
+            towards[a] = (1.0, 0.0)
+    return [complex(x, y) / math.hypot(x, y) for x, y in towards.tolist()]
 
 
 def _gcff_groups(

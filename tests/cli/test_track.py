@@ -307,3 +307,17 @@ def test_an_id_given_twice_names_both_people_and_a_default_id(tmp_path, capsys):
         "its id)",
         "sid track: line 2: people[0] and people[2] have one id, 4",
     ]
+
+
+def test_people_without_facings_make_conversations_with_positions_only_groups(tmp_path, capsys):
+    # A LiDAR leg tracker's detections: positions only. Three people standing 1 m apart, a fourth 4 m away.
+    people = [{"x": 2.0, "y": 0.5}, {"x": 2.0, "y": -0.5}, {"x": 2.9, "y": 0.0}, {"x": 6.0, "y": 3.0}]
+    source = write_lines(tmp_path / "in.jsonl", [{"timestamp": k / FPS, "people": people} for k in range(20)])
+    code, out, _ = run_sid(["track", str(source), "--positions-only-reach", "1"], capsys)
+    by_position = {(p["x"], p["y"]): p["id"] for p in out[-1]["people"]}
+    [group] = out[-1]["groups"]
+    assert code == 0 and group["kind"] == "conversation"
+    assert sorted(group["members"]) == sorted(by_position[(p["x"], p["y"])] for p in people[:3])
+    assert group["interest_point"] == pytest.approx([2.3, 0.0])
+    code, out, _ = run_sid(["track", str(source)], capsys)
+    assert code == 0 and out[-1]["groups"] == []  # off by default

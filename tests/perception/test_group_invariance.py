@@ -15,13 +15,14 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from sid.experiments.fformation import load_dataset
+from sid.experiments.fformation import load_dataset, without_facings
 from sid.perception.groups import GroupParams, detect_groups, facing_step
 from sid.perception.people import Person
 from tests.conftest import shared_path
 
 DEFAULTS = GroupParams()
 METHODS = ("ospace", "gcff", "rays", "paper")
+POSITIONS_ONLY = GroupParams(positions_only_reach=1.0)  # as docs/groups.md turns it on for a detector of positions
 
 
 def moved(people: Sequence[Person], angle: float, dx: float, dy: float, order: Sequence[int]) -> list[Person]:
@@ -40,9 +41,11 @@ def moved(people: Sequence[Person], angle: float, dx: float, dy: float, order: S
     return [turned[k] for k in order]
 
 
-def member_sets(people: Sequence[Person], method: str = DEFAULTS.method) -> set[tuple[int, ...]]:
-    """The groups of the detector ``method`` (default parameters otherwise), as sorted member ids."""
-    return {tuple(sorted(g.members)) for g in detect_groups(people, GroupParams(method=method))}
+def member_sets(people: Sequence[Person], method: str | GroupParams = DEFAULTS.method) -> set[tuple[int, ...]]:
+    """The groups of the detector ``method`` (default parameters otherwise) or of the parameters given, as sorted
+    member ids."""
+    params = method if isinstance(method, GroupParams) else GroupParams(method=method)
+    return {tuple(sorted(g.members)) for g in detect_groups(people, params)}
 
 
 @st.composite
@@ -81,6 +84,40 @@ def test_a_rigid_motion_and_a_permutation_leave_the_groups_as_they_are(
     order = list(range(len(people)))
     rng.shuffle(order)
     assert member_sets(moved(people, angle, dx, dy, order)) == member_sets(people)
+
+
+@settings(max_examples=150)
+@given(
+    scenes(),
+    st.floats(0.0, 1.0),
+    st.floats(-math.pi, math.pi, allow_nan=False),
+    st.floats(-1000.0, 1000.0, allow_nan=False),
+    st.floats(-1000.0, 1000.0, allow_nan=False),
+    st.randoms(use_true_random=False),
+)
+def test_groups_from_positions_alone_do_not_follow_the_motion_or_the_order(
+    people: list[Person], unknown: float, angle: float, dx: float, dy: float, rng: random.Random
+) -> None:
+    # A share of the facings (all of them for a detector of positions only) taken away, positions-only groups on.
+    people = [
+        Person(p.id, p.x, p.y, None if rng.random() < unknown else p.theta, p.orientation_quality) for p in people
+    ]
+    order = list(range(len(people)))
+    rng.shuffle(order)
+    assert member_sets(moved(people, angle, dx, dy, order), POSITIONS_ONLY) == member_sets(people, POSITIONS_ONLY)
+
+
+def test_people_on_one_spot_or_at_their_neighbours_mean_keep_their_groups_under_motions() -> None:
+    # The direction a person without facing proposes towards falls back to the nearest other when the mean of the
+    # others within reach is the person's own spot (the middle of a line) or everyone stands on one spot.
+    line = [Person(1, -0.5, 0.0, None), Person(2, 0.0, 0.0, None), Person(3, 0.5, 0.0, None)]
+    stack = [Person(k, 0.0, 0.0, None) for k in range(4)]
+    for people in (line, stack, [*line, Person(4, 0.0, 0.0, None)]):
+        reference = member_sets(people, POSITIONS_ONLY)
+        assert reference  # close enough to be a group
+        for angle, dx, dy in ((math.radians(37), 1000.0, -700.0), (math.pi / 2, 0.0, 0.0), (-2.0, 5.0, 0.3)):
+            order = list(reversed(range(len(people))))
+            assert member_sets(moved(people, angle, dx, dy, order), POSITIONS_ONLY) == reference
 
 
 @pytest.mark.parametrize("method", METHODS)
@@ -155,6 +192,22 @@ def test_every_real_frame_keeps_its_groups_under_motions_and_permutations(name: 
         for angle, dx, dy in ((math.radians(37), 1000.0, -700.0), (math.pi / 2, 0.0, 0.0), (-2.0, 5.0, 0.3)):
             rng.shuffle(order)
             if member_sets(moved(frame.people, angle, dx, dy, order), method) != reference:
+                changed += 1
+                break
+    assert changed == 0
+
+
+@pytest.mark.parametrize("name", ["Synth", "CoffeeBreak", "CocktailParty", "GDet"])
+def test_every_real_frame_without_facings_keeps_its_groups_from_positions_under_motions(name: str) -> None:
+    frames = without_facings(load_dataset(shared_path("data", "fformation", name), 0.01), 1.0)
+    rng = random.Random(0)
+    changed = 0
+    for frame in frames:
+        reference = member_sets(frame.people, POSITIONS_ONLY)
+        order = list(range(len(frame.people)))
+        for angle, dx, dy in ((math.radians(37), 1000.0, -700.0), (-2.0, 5.0, 0.3)):
+            rng.shuffle(order)
+            if member_sets(moved(frame.people, angle, dx, dy, order), POSITIONS_ONLY) != reference:
                 changed += 1
                 break
     assert changed == 0

@@ -247,7 +247,51 @@ def test_a_member_whose_line_to_the_centre_passes_through_another_is_refused():
 def test_a_person_with_unknown_facing_on_the_circle_joins_but_two_such_people_are_no_group():
     people = [*circle(3, 0.8, start_deg=90), Person(7, 0.0, -0.8, None)]
     assert [g.members for g in detect_groups(people)] == [(0, 1, 2, 7)]
-    assert detect_groups([Person(1, 0.0, 0.0, None), Person(2, 0.8, 0.0, None)]) == []
+    assert detect_groups([Person(1, 0.0, 0.0, None), Person(2, 0.8, 0.0, None)]) == []  # positions only: off
+
+
+POSITIONS_ONLY = GroupParams(positions_only_reach=1.0)
+
+
+def test_groups_from_positions_alone_for_a_detector_without_facings():
+    # A LiDAR leg tracker's people: no facing. Three standing on a 0.55 m circle and a pair 0.9 m apart make two
+    # groups, centred on their members' mean; someone 3 m from everyone stays alone.
+    trio = [Person(1, 2.0, 0.5, None), Person(2, 2.0, -0.5, None), Person(3, 2.9, 0.0, None)]
+    pair = [Person(4, 6.0, 3.0, None), Person(5, 6.9, 3.0, None)]
+    alone = Person(6, 4.0, 6.0, None)
+    groups = detect_groups([*trio, *pair, alone], POSITIONS_ONLY)
+    assert [g.members for g in groups] == [(1, 2, 3), (4, 5)]
+    assert groups[0].interest_point == pytest.approx((2.3, 0.0))
+    assert groups[1].interest_point == pytest.approx((6.45, 3.0)) and groups[1].spread == pytest.approx(0.45)
+    assert detect_groups([*trio, *pair, alone]) == []  # off by default
+    # Beyond the reach, a pair opens on one member's proposal 0.7 m (the largest radius) towards the other, whom it
+    # costs (d - 1.4)^2, under the alone price 0.8 up to d = 1.4 + sqrt(0.8) = 2.29 m.
+    assert len(detect_groups([Person(1, 0.0, 0.0, None), Person(2, 2.2, 0.0, None)], POSITIONS_ONLY)) == 1
+    assert detect_groups([Person(1, 0.0, 0.0, None), Person(2, 2.4, 0.0, None)], POSITIONS_ONLY) == []
+
+
+def test_positions_only_leave_the_groups_of_facings_as_they_are():
+    # A conversation with facings, a person without facing on its circle (joins it), and two people without
+    # facing standing together elsewhere: grouped by their positions once the search has left them alone.
+    people = [*circle(3, 0.8, start_deg=90), Person(7, 0.0, -0.8, None)]
+    elsewhere = [Person(8, 5.0, 0.0, None), Person(9, 5.0, 0.8, None)]
+    assert [g.members for g in detect_groups([*people, *elsewhere], POSITIONS_ONLY)] == [(0, 1, 2, 7), (8, 9)]
+    assert [g.members for g in detect_groups([*people, *elsewhere])] == [(0, 1, 2, 7)]
+
+
+def test_a_wide_ring_of_people_without_facings_is_one_group():
+    # Twelve on a 1.6 m circle (a reception's), no facings: arcs joined into one ring, as with facings.
+    ring = [Person(p.id, p.x, p.y, None) for p in circle(12, 1.6)]
+    assert [g.members for g in detect_groups(ring, POSITIONS_ONLY)] == [tuple(range(12))]
+
+
+@pytest.mark.parametrize(
+    ("field", "value"),
+    [("positions_only_reach", -1.0), ("positions_only_radius_max", 0.1), ("positions_only_alone_price", 0.0)],
+)
+def test_bad_positions_only_fields_are_named(field, value):
+    with pytest.raises(ValueError, match=f"groups: {field} "):
+        GroupParams(**{field: value})
 
 
 def test_a_doubtful_facing_counts_less():
