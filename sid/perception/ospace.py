@@ -330,8 +330,11 @@ def _blocked(
     length2 = sx**2 + sy**2
     dot = rx * sx + ry * sy
     cross = rx * sy - ry * sx
-    # A person is never between themselves and the centre: dot = 0. Someone on the boundary (within TIE) is not.
-    inside = (dot > TIE * length2) & (dot < (1.0 - TIE) * length2)
+    # A person is never between themselves and the centre: dot = 0. Someone on the boundary is not: within TIE of
+    # the segment's length along it, or TIE metres where the segment is shorter than a metre (a centre nanometres
+    # from the person, where the rounding of a turned scene is no longer small against TIE times its length).
+    margin = TIE * np.maximum(length2, np.sqrt(length2))  # TIE x length x max(length, 1 m), m^2
+    inside = (dot > margin) & (dot < length2 - margin)
     between = inside & (cross**2 < (1.0 - TIE) * body_radius**2 * length2) & listed[row]
     return np.logical_or.reduce(between, axis=1)
 
@@ -606,7 +609,8 @@ class _SmallScene:
         length2 = ox * ox + oy * oy
         body2 = self.model.body_radius**2
         bound = (length2 + body2) * (1.0 + _SLACK)
-        inner, outer, wide = TIE * length2, (1.0 - TIE) * length2, (1.0 - TIE) * body2 * length2
+        margin = TIE * max(length2, math.sqrt(length2))  # as in ``_blocked``
+        inner, outer, wide = margin, length2 - margin, (1.0 - TIE) * body2 * length2
         for distance2, rx, ry, b in self._neighbours_of(j):
             if distance2 >= bound:
                 return False

@@ -159,6 +159,19 @@ def test_a_centre_on_a_member_does_not_turn_its_facing_by_rounding_noise() -> No
     assert member_sets(moved(people, 0.0, 0.0, 1.0, order)) == member_sets(people)
 
 
+def test_a_centre_nanometres_from_a_member_is_not_blocked_by_rounding_noise() -> None:
+    # Found by hypothesis in CI: a stack of people on one spot (a pair of known facings there proposes its centre on
+    # it), one of known facing 6e-8 m from it and one 0.0625 m to the side. The side person stands square to the
+    # 6e-8 m line from that member to the centre; turned by 1 rad, rounding put its projection 1e-19 m^2 inside,
+    # above TIE times the squared length (4e-24), blocked the member and changed the groups.
+    people = [Person(k, 0.0, 0.0, None, 1.0) for k in range(7, 59, 3) if k not in (7, 16, 19, 43, 58)]
+    people += [Person(7, 0.0, 0.0, 0.0, 1.0), Person(43, 0.0, 0.0, 0.0, 1.0), Person(16, 0.0, 0.0625, None, 1.0)]
+    people += [Person(19, 2.0**-24, 0.0, 0.0, 1.0), Person(58, 1.0, 0.0, None, 1.0)]
+    reference = member_sets(people)
+    for angle in (1.0, 0.5, 2.0):
+        assert member_sets(moved(people, angle, 0.0, 0.0, list(range(len(people))))) == reference
+
+
 def test_exact_ties_on_a_grid_do_not_follow_the_input_order() -> None:
     # Two face-to-face pairs side by side on a grid, all the same distance apart: the pairs tie with the two
     # side-by-side pairs by symmetry; the answer must not depend on who comes first.
