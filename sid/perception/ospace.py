@@ -431,7 +431,9 @@ def _turned(
     rho = np.sqrt(ox**2 + oy**2)
     along, across = ox * fx + oy * fy, fx * oy - fy * ox  # across > 0: the centre lies counter-clockwise
     off = rho > TIE  # the centre off the person: there is a direction to turn to
-    inside = (along >= rho * cos_slack) & off
+    # A full cone (slack pi: no facing known, cos exactly -1) holds every direction, the one straight behind too,
+    # which rounding may put a hair outside along >= -rho.
+    inside = ((along >= rho * cos_slack) | (cos_slack <= -1.0)) & off
     side = np.where(across > TIE * rho, 1.0, np.where(across < -TIE * rho, -1.0, 0.0)) * off
     edge_x = np.where(side == 0, fx, fx * cos_slack - side * fy * sin_slack)
     edge_y = np.where(side == 0, fy, fy * cos_slack + side * fx * sin_slack)
@@ -750,7 +752,7 @@ def _turned_small(
     along, across = ox * fx + oy * fy, fx * oy - fy * ox
     if rho <= TIE:  # the centre on the person: no direction to turn to
         return fx, fy
-    if along >= rho * cos_slack:
+    if along >= rho * cos_slack or cos_slack <= -1.0:  # inside the cone, or a full cone (as in ``_turned``)
         return ox / rho, oy / rho
     side = 1.0 if across > TIE * rho else -1.0 if across < -TIE * rho else 0.0
     if side == 0:
