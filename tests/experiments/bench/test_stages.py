@@ -82,6 +82,17 @@ def test_quick_run_writes_documented_fields(tmp_path, capsys):
     assert "| group/2 |" in capsys.readouterr().out
 
 
+def test_groups_from_positions_alone_are_timed_beside_the_default_on_the_scene_without_facings(tmp_path):
+    rc = main(["bench", "--quick", "--only", "group_positions_only/20", "--out", str(tmp_path / "bench")])
+    assert rc == 0
+    stages = json.loads((tmp_path / "bench" / "bench.json").read_text())["stages"]
+    assert set(stages) == {"group/20", "group_positions_only/20"}
+    stage = stages["group_positions_only/20"]
+    _check_stage(stage)
+    # Five circles of four, 2.4 m apart: positions alone find each, as the facings do.
+    assert stage["ratio_to"] == "group/20" and stage["groups"] == 5 and stage["circles_found"] == 5
+
+
 def test_compare_prints_change_per_stage(tmp_path, capsys):
     old = tmp_path / "old.json"
     old.write_text(json.dumps({

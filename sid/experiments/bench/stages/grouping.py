@@ -1,5 +1,5 @@
-"""``group*/N`` and ``dbscan*/N``: the group detector's methods, the authors' approach and DBSCAN on
-``grouping_scene(N)``, one native thread each."""
+"""``group*/N`` and ``dbscan*/N``: the group detector's methods, groups from positions alone, the authors' approach
+and DBSCAN on ``grouping_scene(N)``, one native thread each."""
 
 from __future__ import annotations
 
@@ -23,13 +23,23 @@ from sid.perception.people import Person
 if TYPE_CHECKING:
     from sid.perception.group import Group
 
-__all__ = ["DBSCAN_SIZES", "GROUPING_THREADS", "GROUP_SIZES", "PAPER_GROUP_MAX", "grouping_benchmarks"]
+__all__ = [
+    "DBSCAN_SIZES",
+    "GROUPING_THREADS",
+    "GROUP_SIZES",
+    "PAPER_GROUP_MAX",
+    "POSITIONS_ONLY_REACH",
+    "grouping_benchmarks",
+]
 
 GROUP_SIZES = (2, 3, 4, 6, 20, 100)
 # The ray methods above this many people: the authors' approach and sid's `paper` method prune one crowd member by
 # member (minutes at 100 people), so their rows stop here.
 PAPER_GROUP_MAX = 20
 DBSCAN_SIZES = (4, 20)
+POSITIONS_ONLY_REACH = 1.0
+"""``GroupParams.positions_only_reach`` of the ``group_positions_only/N`` rows: the value docs/groups.md sets for a
+detector of positions only."""
 
 # The grouping stages run with native thread pools (OpenMP, BLAS) limited to one thread: the work is tiny, and
 # scikit-learn's OpenMP pool (DBSCAN's brute-force neighbour search on small inputs) is many times slower while
@@ -50,13 +60,23 @@ def _member_sets(groups: Iterable[Group | BaselineGroup]) -> set[tuple[int, ...]
 
 
 def _bench_group(n: int, method: str | None = None) -> Callable[[Context], Records]:
-    """``group/N``: the default detector; ``group_METHOD/N``: another method, with its ratio to the default."""
+    """``group/N``: the default detector; ``group_METHOD/N``: another method, with its ratio to the default;
+    ``group_positions_only/N``: the default's scene without facings, groups from positions alone turned on
+    (``POSITIONS_ONLY``)."""
 
     def run(ctx: Context) -> Records:
+        from dataclasses import replace
+
         from sid.perception.groups import GroupParams, detect_groups
 
         people = grouping_scene(n)
-        params = GroupParams() if method is None else GroupParams(method=method)
+        if method is None:
+            params = GroupParams()
+        elif method == "positions_only":
+            params = GroupParams(positions_only_reach=POSITIONS_ONLY_REACH)
+            people = [replace(p, theta=None) for p in people]
+        else:
+            params = GroupParams(method=method)
         stats = _measure_one_thread(lambda: detect_groups(people, params), ctx.settings)
         found = detect_groups(people, params)
         name = f"group/{n}" if method is None else f"group_{method}/{n}"
@@ -154,6 +174,7 @@ _COMPARED_METHODS = (
     ("gcff", "method gcff (graph cuts, the literature's reference)", max(GROUP_SIZES)),
     ("rays", "method rays", max(GROUP_SIZES)),
     ("paper", "method paper (Algorithm 1)", PAPER_GROUP_MAX),
+    ("positions_only", "the scene without facings, groups from positions alone", max(GROUP_SIZES)),
 )
 
 
