@@ -335,15 +335,14 @@ def _positions_only(
     left = [k for k, f in enumerate(facing) if f != f and k not in grouped]
     if len(left) < 2:
         return [], []
-    xy = np.array([(positions[k].real, positions[k].imag) for k in left])
-    toward = _towards_neighbours(xy, params.positions_only_reach)
+    placed = [positions[k] for k in left]
+    toward = _towards_neighbours(np.array([(p.real, p.imag) for p in placed]), params.positions_only_reach)
     cone = [math.pi] * len(left)  # any direction: only standing on the circle costs
-    model = params.positions_only_model
-    found = find_ospaces([positions[k] for k in left], toward, [1.0] * len(left), model, cone)
+    found = find_ospaces(placed, toward, [1.0] * len(left), params.positions_only_model, cone)
     joined, _ = joined_rings(
         [ospace.members.tolist() for ospace in found],
         [ospace.centre for ospace in found],
-        [positions[k] for k in left],
+        placed,
         toward,
         math.pi,
         params.ring_model,
