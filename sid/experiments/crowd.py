@@ -37,6 +37,7 @@ import scipy.sparse.csgraph
 from sid.checks import check_limit
 from sid.experiments.fformation import format_threshold, frame_matches
 from sid.experiments.gmitre import LinkCounts, gmitre_counts
+from sid.experiments.progress import Progress
 from sid.experiments.synthetic_tracking import as_truth_ids, identify, merged_mot_scores, require_motmetrics
 from sid.experiments.trajectories import ReplaySettings, TrajectoryError, TrajectorySet, replay, replay_length
 from sid.experiments.workers import map_in_workers
@@ -52,7 +53,6 @@ __all__ = [
     "DEFAULT_GRID",
     "EVALUATION_PASSES",
     "MOT_PART_IDS",
-    "Progress",
     "TrackLog",
     "cross_validate",
     "evaluate_crowd",
@@ -63,9 +63,6 @@ __all__ = [
     "score_groups",
     "score_people",
 ]
-
-Progress = Callable[[int, int, str], None]
-"""progress(done, total, what) after each frame (``sid.experiments.progress.ProgressBar``)."""
 
 DEFAULT_GRID: dict[str, dict[str, tuple[float, ...]]] = {
     "tracker": {

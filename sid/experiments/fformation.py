@@ -37,7 +37,8 @@ import scipy.io
 from sid.checks import YAW_LIMIT_RAD, check_limit, check_number
 from sid.documents import InputWarning, plural, special_file
 from sid.errors import SidError
-from sid.experiments.workers import Progress, map_in_workers
+from sid.experiments.progress import Progress
+from sid.experiments.workers import map_in_workers
 from sid.perception.gcff import GCFFParams
 from sid.perception.groups import GroupParams, detect_groups
 from sid.perception.people import Person

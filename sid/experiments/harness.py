@@ -41,6 +41,7 @@ from planner.problem import (
 )
 from sid.checks import repeated
 from sid.experiments.path_metrics import result_metrics
+from sid.experiments.progress import Progress
 from sid.perception.group import Group
 from sid.perception.groups import detect_groups
 from sid.scenario.build import build_costmap, planning_problem
@@ -50,8 +51,7 @@ __all__ = [
     "Comparison",
     "LABELS",
     "MODES",
-    "MatrixProgress",
-    "Progress",
+    "RunProgress",
     "Run",
     "Task",
     "compare_with_without",
@@ -274,7 +274,7 @@ class Comparison:
         return {mode: run.metrics for mode, run in self.runs.items()}
 
 
-Progress = Callable[[str, Run | None], None]
+RunProgress = Callable[[str, Run | None], None]
 """progress(mode, run): called with None before a mode is planned and with its run after."""
 
 
@@ -286,7 +286,7 @@ def compare_with_without(
     max_iterations: int | None = None,
     modes: Sequence[str] = tuple(MODES),
     reference: bool = False,
-    progress: Progress | None = None,
+    progress: RunProgress | None = None,
 ) -> Comparison:
     """Plan the task in each of ``modes`` with the same planner, budget and OMPL seed, and measure each path.
 
@@ -318,10 +318,6 @@ def compare_with_without(
     return Comparison(task, runs)
 
 
-MatrixProgress = Callable[[int, int, str], None]
-"""progress(done, total, what): called before each plan and once at the end."""
-
-
 def run_matrix(
     tasks: Sequence[Task],
     planners: Sequence[str],
@@ -329,13 +325,14 @@ def run_matrix(
     time_limits: Sequence[float] = (0.5,),
     modes: Sequence[str] = tuple(MODES),
     max_iterations: int | None = None,
-    progress: MatrixProgress | None = None,
+    progress: Progress | None = None,
 ) -> list[Run]:
     """Every planner (grid: once, it is deterministic; the others with OMPL seeds 1..``runs``) for every time limit
     and task, in each mode, with cost ratios to the grid reference. The runs are told apart by scenario name and
     planner: a planner given twice, or two tasks whose scenarios share a name, are refused (ValueError), since their
     runs would be pooled into one row. Every task's grid references are planned first, so an impossible task raises
-    ``planner.problem.PlanningError`` naming its scenario before any run."""
+    ``planner.problem.PlanningError`` naming its scenario before any run. ``progress`` is called before each plan and
+    once at the end."""
     names = [resolve_planner(p) for p in planners]
     if runs < 1:
         raise ValueError(f"runs must be at least 1, got {runs}")

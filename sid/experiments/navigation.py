@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import copy
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -35,6 +35,7 @@ from planner.problem import DEFAULT_COST_WEIGHT, PlanningError
 from sid.checks import check_number, check_whole, repeated
 from sid.experiments.demo import DEMO_SCENARIO
 from sid.experiments.harness import Comparison, compare_with_without, prepare
+from sid.experiments.progress import Progress
 from sid.scenario.loader import Scenario, scenario_from_dict
 from sid.synthetic.layouts import LAYOUTS
 
@@ -50,7 +51,6 @@ __all__ = [
     "NavSettings",
     "NavTask",
     "NavigationResult",
-    "Progress",
     "RUN_KEYS",
     "navigation_tasks",
     "run_navigation",
@@ -206,9 +206,6 @@ class NavigationResult:
     runs: list[dict] = field(default_factory=list)
     impossible: dict[str, str] = field(default_factory=dict)
     example: Comparison | None = None
-
-
-Progress = Callable[[int, int, str], None]
 
 
 def run_navigation(

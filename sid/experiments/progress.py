@@ -5,20 +5,18 @@ from __future__ import annotations
 import atexit
 import sys
 import time
-from typing import TextIO
+from collections.abc import Callable
+from typing import TYPE_CHECKING, TextIO
 
-from rich.console import Console
-from rich.progress import (
-    BarColumn,
-    MofNCompleteColumn,
-    Progress,
-    TaskID,
-    TextColumn,
-    TimeElapsedColumn,
-    TimeRemainingColumn,
-)
+if TYPE_CHECKING:  # rich is imported when a bar is first drawn: ~55 ms that a run off a terminal never needs
+    from rich.progress import Progress as RichProgress
+    from rich.progress import TaskID
 
-__all__ = ["LINE_STEPS", "REDRAW_S", "ProgressBar"]
+__all__ = ["LINE_STEPS", "REDRAW_S", "Progress", "ProgressBar"]
+
+Progress = Callable[[int, int, str], None]
+"""A progress callback, ``progress(done, total, what)``: ``done`` of ``total`` items finished, ``what`` the current
+one; the experiments call it as they go, ``ProgressBar`` is one."""
 
 LINE_STEPS = 10
 """Off a terminal: one line per tenth of the work."""
@@ -39,8 +37,8 @@ class ProgressBar:
         self.label = label
         self.stream = stream if stream is not None else sys.stderr
         self.start = time.monotonic()
-        self._bar: Progress | None = None
-        self._task = TaskID(0)
+        self._bar: RichProgress | None = None
+        self._task: TaskID | None = None
         self._drawn = -REDRAW_S  # on a terminal: when the bar was last drawn
         self._next_line = 0  # off a terminal: the tenth whose line comes next
         self._last = (0, 0)  # the last call's done and total (a new total with more done: the same work, re-estimated)
@@ -59,7 +57,11 @@ class ProgressBar:
 
     def _draw(self, done: int, total: int, what: str) -> None:
         if self._bar is None:
-            self._bar = Progress(
+            from rich.console import Console
+            from rich.progress import BarColumn, MofNCompleteColumn, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+            from rich.progress import Progress as RichProgress
+
+            self._bar = RichProgress(
                 TextColumn(self.label),
                 BarColumn(),
                 MofNCompleteColumn(),
@@ -75,6 +77,7 @@ class ProgressBar:
             self._task = self._bar.add_task(self.label, total=total, completed=done, what=what)
             self._bar.start()
             atexit.register(self._bar.stop)  # a run that stops early still gives the terminal its cursor back
+        assert self._task is not None  # added with the bar
         self._bar.update(self._task, completed=done, total=total, what=what)
         now = time.monotonic()
         if done >= total or now - self._drawn >= REDRAW_S:

@@ -30,7 +30,7 @@ Protocol:
 from __future__ import annotations
 
 import importlib.util
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -44,6 +44,7 @@ from costmap.plugins import CostmapParams, layered_costmap
 from sid.checks import check_number, check_whole, repeated
 from sid.distribution import MissingDependencyError, install_hint
 from sid.experiments.fformation import LabelledFrame, format_threshold, score
+from sid.experiments.progress import Progress
 from sid.perception.frame import Frame
 from sid.perception.keypoints import PoseDetection
 from sid.perception.mount import CameraMount
@@ -58,7 +59,6 @@ from sid.tracking.view import ViewCone
 __all__ = [
     "MOT_METRICS",
     "MissingDependencyError",
-    "Progress",
     "TrackingEvalSettings",
     "as_truth_ids",
     "evaluate_tracking",
@@ -68,9 +68,6 @@ __all__ = [
     "mot_scores",
     "require_motmetrics",
 ]
-
-Progress = Callable[[int, int, str], None]
-"""progress(done, total, what) after each frame (``sid.experiments.progress.ProgressBar``)."""
 
 
 @dataclass(frozen=True)

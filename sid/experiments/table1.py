@@ -25,13 +25,14 @@ next to the RMSEs, together with the mean error (bias) of each quantity.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
 from sid.checks import check_number, check_whole, repeated
 from sid.experiments.fformation import most_shared
+from sid.experiments.progress import Progress
 from sid.experiments.synthetic_tracking import identify
 from sid.perception.group import Group
 from sid.perception.groups import GroupParams
@@ -48,7 +49,6 @@ __all__ = [
     "ErrorLog",
     "METRICS",
     "PAPER_TABLE1",
-    "Progress",
     "Table1Result",
     "Table1Settings",
     "UNITS",
@@ -225,9 +225,6 @@ def best_group(groups: Sequence[Group], matches: dict[int, int], members: Sequen
     mapped = [frozenset(matches.get(m, -1 - n) for n, m in enumerate(g.members)) for g in groups]
     k = most_shared(mapped, frozenset(members))
     return (None, 0) if k is None else (groups[k], len(mapped[k] & frozenset(members)))
-
-
-Progress = Callable[[int, int, str], None]
 
 
 @dataclass

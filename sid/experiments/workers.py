@@ -19,11 +19,9 @@ from typing import Any, TypeVar
 
 from sid.checks import Limits, check_whole, limits, use_limits
 from sid.cpu import keep_freed_memory
+from sid.experiments.progress import Progress
 
-__all__ = ["Progress", "map_in_workers"]
-
-Progress = Callable[[int, int, str], None]
-"""progress(done, total, what) (``sid.experiments.progress.ProgressBar``)."""
+__all__ = ["map_in_workers"]
 
 _Shared = TypeVar("_Shared")
 _Item = TypeVar("_Item")

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Callable
 from dataclasses import asdict
 from pathlib import Path
 
@@ -18,16 +17,14 @@ import cv2
 import numpy as np
 
 from sid.documents import InputWarning
+from sid.experiments.progress import Progress
 from sid.experiments.reproduce import write_json
 from sid.experiments.simulate.loop import Observer, RunOptions, StepView, simulate
 from sid.experiments.simulate.metrics import run_metrics
 from sid.experiments.simulate.video import VideoWriter, frame_picture
 from sid.experiments.simulate.world import SimWorld
 
-__all__ = ["StepProgress", "options_record", "run_record", "write_run"]
-
-StepProgress = Callable[[int, int, str], None]
-"""progress(step, steps at the time limit, what); at the end progress(steps run, steps run, reason)."""
+__all__ = ["options_record", "run_record", "write_run"]
 
 
 def options_record(options: RunOptions) -> dict:
@@ -53,12 +50,13 @@ def write_run(
     options: RunOptions,
     out_dir: Path | None,
     gif: bool = False,
-    progress: StepProgress | None = None,
+    progress: Progress | None = None,
     still_s: float | None = None,
 ) -> dict:
     """Run once; with ``out_dir``, write ``run.json`` and ``run.mp4`` (and ``run.gif``; with ``still_s``, ``run.png``:
     the picture of the first step at or after ``still_s`` seconds, or of the last step, with an InputWarning when the
-    run ended before ``still_s``) there. Returns the record."""
+    run ended before ``still_s``) there. Returns the record. ``progress(step, steps at the time limit, what)`` after
+    each step, and ``progress(steps run, steps run, reason)`` at the end (the goal may be reached early)."""
     settings = world.settings
     total = int(math.ceil(settings.time_limit_s * settings.rate_hz))
     driven: list[tuple[float, float]] = []

@@ -15,7 +15,7 @@ import json
 import os
 import statistics
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -24,14 +24,13 @@ from sid.checks import Limits, check_whole, limits, repeated, use_limits
 from sid.cpu import keep_freed_memory
 from sid.distribution import MissingDependencyError, install_hint
 from sid.experiments.harness import summarise
+from sid.experiments.progress import Progress
 from sid.experiments.simulate.loop import RunOptions
 from sid.experiments.simulate.run import run_record
 from sid.experiments.simulate.scenes import load_scene
 from sid.experiments.workers import map_in_workers
 
-__all__ = ["Job", "Progress", "run_job", "run_sweep", "sweep_jobs", "sweep_summary"]
-
-Progress = Callable[[int, int, str], None]
+__all__ = ["Job", "run_job", "run_sweep", "sweep_jobs", "sweep_summary"]
 
 
 @dataclass(frozen=True)
