@@ -306,7 +306,9 @@ def _relative_speed(
     now = history[-1].timestamp if history else None
     filled = np.zeros(len(i), dtype=bool)
     for old in history:
-        if now is None or now - old.timestamp < params.walk_window / 2 - TIME_TOLERANCE or filled.all():
+        span = 0.0 if now is None else now - old.timestamp
+        # span 0: the current frame (a window under TIME_TOLERANCE reaches it), which gives no displacement rate.
+        if span <= 0 or span < params.walk_window / 2 - TIME_TOLERANCE or filled.all():
             break
         if not len(old.ids):
             continue
@@ -317,7 +319,7 @@ def _relative_speed(
             continue
         then = old.positions[rows]
         moved = (position[i] - position[j]) - (then[i] - then[j])
-        relative = np.sqrt(moved[:, 0] ** 2 + moved[:, 1] ** 2) / (now - old.timestamp)
+        relative = np.sqrt(moved[:, 0] ** 2 + moved[:, 1] ** 2) / span
         speed = np.where(both, relative, speed)
         filled |= both
     return speed

@@ -186,6 +186,18 @@ def test_walkers_moving_together_are_a_group_through_noisy_velocity_estimates() 
     assert all(groups == [(1, 2)] for groups in found[20:])  # once the window is filled (1 s of history)
 
 
+@pytest.mark.parametrize("window", [0.0, 1e-7, 0.1])
+def test_a_walk_window_of_no_length_judges_walkers_by_their_velocities(window: float) -> None:
+    # With no window to look back over (0, or shorter than the trackers' time tolerance), only the current frame is
+    # in it: it gives no displacement rate (0 / 0 s), so the velocities decide, as for a pair with too little history.
+    tracker = GroupTracker(GroupTrackerParams(walk_window=window))
+    for k in range(30):
+        x = 1.0 + 1.0 * k * DT
+        people = [_person(1, x, 0.3, 0.0, (1.0, 0.0)), _person(2, x, -0.3, 0.0, (1.0, 0.0))]
+        groups = tracker.update(people, k * DT)
+    assert [(g.kind, g.members) for g in groups] == [("walking", (1, 2))]
+
+
 def test_walkers_who_drift_apart_are_no_group_even_when_their_velocities_look_alike() -> None:
     # Each frame's velocities are equal but the positions spread at 0.6 m/s: the displacement over the window counts.
     tracker = GroupTracker(GroupTrackerParams(walk_window=2.0, walk_distance=3.0, walk_velocity_difference=0.4))
