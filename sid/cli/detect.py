@@ -30,12 +30,12 @@ from sid.cli.common import (
     positive_int,
     signals_deferred,
 )
+from sid.cli.grouping import add_group_params, add_params_file_option, group_params_from, params_file_from
 from sid.distribution import MissingDependencyError, install_hint
 from sid.documents import plural, write_atomically
 from sid.perception.camera import Calibration
 from sid.perception.frame import Frame
 from sid.perception.group import Group
-from sid.perception.groups import GROUP_METHODS, GroupParams
 from sid.perception.lifting import LiftParams
 from sid.perception.mount import CameraMount
 from sid.perception.overlay import draw_detections
@@ -121,13 +121,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "tracks with stable ids, velocities and standing / walking states (the default, except for a source of "
         "one frame, where there is nothing to track; docs/tracking.md)",
     )
-    parser.add_argument(
-        "--group-method",
-        choices=GROUP_METHODS,
-        default=GroupParams.method,
-        help=f"group detector: one of {', '.join(GROUP_METHODS)} (default: {GroupParams.method}; 'paper' is the "
-        "paper's Algorithm 1); docs/groups.md",
-    )
+    add_params_file_option(parser, tracking=True)
+    add_group_params(parser)
     parser.set_defaults(func=run)
 
 
@@ -297,6 +292,8 @@ def run(args: argparse.Namespace) -> int:
         except OutputFolderError as exc:
             return fail("sid detect", exc)
     try:
+        params = params_file_from(args)  # before the model loads and the camera opens, as every check of the options
+        group_params = group_params_from(args, params.groups)
         lift = LiftParams() if args.keypoint_threshold is None else LiftParams(min_score=args.keypoint_threshold)
         mount = CameraMount(args.camera_height, args.camera_tilt)
         pose = pose_model(
@@ -306,7 +303,7 @@ def run(args: argparse.Namespace) -> int:
         single = isinstance(source, Sized) and len(source) == 1
         tracking = not (args.no_tracking or single)
         # With tracking the groups come from the group tracker, so the frame's own grouping would be thrown away.
-        pipeline = Pipeline(pose, mount, lift, GroupParams(method=args.group_method), group=not tracking)
+        pipeline = Pipeline(pose, mount, lift, group_params, group=not tracking)
     except MissingDependencyError as exc:  # --provider openvino without it
         return fail("sid detect", exc)
     except (SourceError, PoseModelError, ValueError, OSError) as exc:
@@ -330,7 +327,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"detect: frame {index}: skipped, {reason}", file=sys.stderr)
 
     interrupted = 0  # the exit code of the signal that stopped the run
-    stream = PeopleStream(pipeline) if tracking else None
+    stream = PeopleStream(pipeline, params.tracking) if tracking else None
     totals: list[float] = []
     started = time.perf_counter()
     try:

@@ -19,7 +19,7 @@ from typing import Any, TextIO
 
 from sid.checks import check_limit
 from sid.cli.common import fail, process_json_lines, refuse_unknown_fields, run_json_lines
-from sid.cli.grouping import add_json_lines_command, group_params_from
+from sid.cli.grouping import add_json_lines_command, group_params_from, params_file_from
 from sid.cli.person_json import parse_person
 from sid.documents import is_number, summary
 from sid.perception.group import group_json
@@ -39,7 +39,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     try:
-        params = group_params_from(args)
+        params = group_params_from(args, params_file_from(args).groups)
     except ValueError as exc:
         return fail("sid groups", exc)
     return run_json_lines(

@@ -19,8 +19,8 @@ beyond two turns (in degrees by mistake), a timestamp not after the last good li
 reported on stderr with its line number and skipped, or ends the run with --strict (exit 2); everything written
 before it stays written. A line more than the tracker's timeout (1.5 s) after the last good one ends every track, and
 a note on stderr says so, once for such lines in a row (timestamps in milli- or nanoseconds make every line one).
-The people and group trackers run with their defaults; the group detector that finds conversations among the tracks
-takes the options below.
+The trackers take their parameters from a parameters file (--params, its tracking block; their defaults without one),
+the group detector that finds conversations among the tracks from the options below, then the file's groups block.
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ from typing import Any, TextIO
 
 from sid.checks import check_limit, repeated
 from sid.cli.common import fail, process_json_lines, refuse_unknown_fields, run_json_lines
-from sid.cli.grouping import add_json_lines_command, group_params_from
+from sid.cli.grouping import add_json_lines_command, group_params_from, params_file_from
 from sid.cli.person_json import parse_person
 from sid.documents import is_number, summary
 from sid.perception.people import Person
@@ -49,7 +49,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     try:
-        session = TrackingSession(group_params=group_params_from(args))
+        params = params_file_from(args)
+        session = TrackingSession(params.tracking, group_params_from(args, params.groups))
     except ValueError as exc:
         return fail("sid track", exc)
     return run_json_lines(

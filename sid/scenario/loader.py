@@ -47,6 +47,7 @@ __all__ = [
     "TOP_LEVEL",
     "layers_from_dict",
     "load_scenario",
+    "params_from_dict",
     "read_scenario_file",
     "scenario_from_dict",
 ]
@@ -161,7 +162,7 @@ def _xy(value: Any, name: str) -> tuple[float, float]:
 def _mapping(value: Any, name: str, known: AbstractSet[str], required: AbstractSet[str] = frozenset()) -> dict:
     if not isinstance(value, dict):
         raise _fail(name, "a mapping", value)
-    unknown = sorted(set(value) - known)
+    unknown = sorted(str(key) for key in set(value) - known)  # str: YAML reads `1:` as a number key
     if unknown:
         raise ScenarioError(f"{name}.{unknown[0]}: unknown field; known fields: {', '.join(sorted(known))}")
     missing = sorted(required - set(value))
@@ -176,14 +177,18 @@ def _list(value: Any, name: str) -> list:
     return value
 
 
-def _params(value: Any, name: str, cls: type) -> Any:
-    """A parameter dataclass from a mapping of its fields, typed by the defaults (bool, int, float or str)."""
+def params_from_dict(value: Any, name: str, cls: type) -> Any:
+    """A parameter dataclass ``cls`` from a mapping (the block ``name`` of a file) of some of its fields, typed by
+    the defaults (bool, int, float or str; a field whose default is itself such a dataclass is a block of its own,
+    ``tracking.tracker``); the others keep their defaults. ScenarioError naming the field."""
     defaults = {f.name: getattr(cls(), f.name) for f in dataclasses.fields(cls)}
     data = _mapping(value, name, set(defaults))
     kwargs: dict[str, Any] = {}
     for key, raw in data.items():
         default, key_name = defaults[key], f"{name}.{key}"
-        if isinstance(default, bool):
+        if dataclasses.is_dataclass(default):
+            kwargs[key] = params_from_dict(raw, key_name, type(default))
+        elif isinstance(default, bool):
             if not isinstance(raw, bool):
                 raise _fail(key_name, "true or false", raw)
             kwargs[key] = raw
@@ -198,7 +203,7 @@ def _params(value: Any, name: str, cls: type) -> Any:
     try:
         return cls(**kwargs)
     except ValueError as exc:  # "groups: method must be ...": the dataclass's own name gives way to the block's path
-        reason = re.sub(r"^\w+: ", "", str(exc), count=1)
+        reason = re.sub(r"^[a-z]+(?: [a-z]+)?: ", "", str(exc), count=1)  # "groups: ", "group tracker: "
         raise ScenarioError(f"{name}: {reason}") from exc
 
 
@@ -249,14 +254,16 @@ def layers_from_dict(
             raise ScenarioError(f"{field_name}.plugin: unknown plugin {summary(plugin)}; known plugins: {known}")
         declared[key] = plugin
     plugins = _plugins(listed, where, declared)
-    sections = {k: _params(v, f"{where}.{k}", _SECTION_TYPES[k]) for k, v in data.items() if k in _SECTION_TYPES}
+    sections = {
+        k: params_from_dict(v, f"{where}.{k}", _SECTION_TYPES[k]) for k, v in data.items() if k in _SECTION_TYPES
+    }
     instances = {}
     for key, plugin in declared.items():
         own = {k: v for k, v in data[key].items() if k != "plugin"}
         kind = SECTIONS.get(plugin)
         if kind is None and own:
             raise ScenarioError(f"{where}.{key}: the {plugin} plugin takes no parameters, got {', '.join(own)}")
-        params = None if kind is None else _params(own, f"{where}.{key}", _SECTION_TYPES[kind])
+        params = None if kind is None else params_from_dict(own, f"{where}.{key}", _SECTION_TYPES[kind])
         instances[key] = LayerInstance(plugin, params)
     try:
         layers = CostmapParams(plugins=plugins, instances=instances, **sections)
@@ -627,7 +634,7 @@ def scenario_from_dict(data: Any, base_dir: Path | None = None, default_name: st
         people=people,
         lidar=lidar,
         static_map=static_map,
-        group_params=_params(data.get("groups", {}), "groups", GroupParams),
+        group_params=params_from_dict(data.get("groups", {}), "groups", GroupParams),
         layers=layers,
         walks=walks,
         conversations=conversations,

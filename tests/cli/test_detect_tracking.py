@@ -121,3 +121,27 @@ def test_session_options_without_a_model_are_refused_not_ignored(capsys) -> None
         assert f"detect: {option[0]}: an option of the pose model's session, and there is no --model" in (
             capsys.readouterr().err
         )
+
+
+def test_a_parameters_file_sets_the_trackers_and_the_group_detector(tmp_path, capsys) -> None:
+    params = tmp_path / "robot.yaml"
+    params.write_text("tracking:\n  tracker:\n    confirm_hits: 1\ngroups:\n  group_price: 100.0\n")
+    arguments = ["--source", "synthetic:S1", "--frames", "14", "--no-keypoints", "--params", str(params)]
+    assert main(["detect", *arguments]) == 0
+    records = _lines(capsys.readouterr().out)
+    assert all(len(r["people"]) == 2 for r in records)  # confirmed at the first detection (the default: the third)
+    assert all(r["groups"] == [] for r in records)  # a group priced above two people alone is never worth it
+    assert main(["detect", *arguments, "--group-price", "0.8"]) == 0  # the option wins over the file
+    assert _lines(capsys.readouterr().out)[-1]["groups"] != []
+
+
+def test_a_bad_parameters_file_stops_detect_before_the_source_opens(tmp_path, capsys) -> None:
+    params = tmp_path / "robot.yaml"
+    params.write_text("tracking:\n  tracker:\n    timeout: -1\n")
+    assert main(["detect", "--source", "synthetic:S1", "--params", str(params)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert (
+        captured.err
+        == f"detect: {params}: tracking.tracker: timeout must be a finite number of seconds >= 0, got -1.0\n"
+    )

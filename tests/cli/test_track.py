@@ -321,3 +321,28 @@ def test_people_without_facings_make_conversations_with_positions_only_groups(tm
     assert group["interest_point"] == pytest.approx([2.3, 0.0])
     code, out, _ = run_sid(["track", str(source)], capsys)
     assert code == 0 and out[-1]["groups"] == []  # off by default
+
+
+def test_a_parameters_file_sets_the_trackers_and_the_group_detector_and_options_win_over_it(tmp_path, capsys):
+    # The same LiDAR-like scene: with the file, tracks confirmed at their first detection and groups from positions.
+    people = [{"x": 2.0, "y": 0.5}, {"x": 2.0, "y": -0.5}, {"x": 2.9, "y": 0.0}, {"x": 6.0, "y": 3.0}]
+    source = write_lines(tmp_path / "in.jsonl", [{"timestamp": k / FPS, "people": people} for k in range(20)])
+    params = tmp_path / "leg_detector.yaml"
+    params.write_text("groups:\n  positions_only_reach: 1.0\ntracking:\n  tracker:\n    confirm_hits: 1\n")
+    code, out, _ = run_sid(["track", str(source)], capsys)
+    assert code == 0 and out[0]["people"] == [] and out[-1]["groups"] == []  # the defaults
+    code, out, _ = run_sid(["track", str(source), "--params", str(params)], capsys)
+    assert code == 0 and len(out[0]["people"]) == 4 and len(out[-1]["groups"]) == 1
+    code, out, _ = run_sid(["track", str(source), "--params", str(params), "--positions-only-reach", "0"], capsys)
+    assert code == 0 and len(out[0]["people"]) == 4 and out[-1]["groups"] == []
+
+
+def test_a_bad_parameters_file_is_one_line_naming_the_file_and_the_field(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(sys, "stdin", io.StringIO(""))
+    params = tmp_path / "p.yaml"
+    params.write_text("tracking:\n  tracker:\n    timeout: soon\n")
+    code, out, err = run_sid(["track", "-", "--params", str(params)], capsys)
+    assert code == 2 and out == []
+    assert err == [f'sid track: {params}: tracking.tracker.timeout: expected a finite number, got "soon"']
+    code, out, err = run_sid(["groups", "-", "--params", str(tmp_path / "nowhere.yaml")], capsys)
+    assert code == 2 and out == [] and len(err) == 1 and "nowhere.yaml: cannot read parameters file" in err[0]
