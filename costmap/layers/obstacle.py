@@ -102,6 +102,11 @@ def _trace_lines(spec: GridSpec, c0: np.ndarray, delta: np.ndarray, n: int) -> t
     return rows.astype(np.int64) * spec.width + cols, keep
 
 
+_BEYOND_HIT = 1e-6
+"""Metres a hit is taken along its beam before its cell is found: a hit on a surface that lies on a cell border (a
+wall at y = 0.8 m on 0.05 m cells) computes as 0.7999... from one side, and would mark the free cell before the wall
+instead of the wall's cell (``known_map`` puts a border in the cell above or to the right, the cell a beam from below
+enters). Far below any sensor's resolution, and far above the rounding of origin + range x direction (~1e-14 m)."""
 _PAIRS_PER_CHUNK = 2**20
 """``_marks_near`` tests at most this many (mark, person) pairs at once (a few MB of float64)."""
 
@@ -246,13 +251,14 @@ class ObstacleLayer(Layer):
             raise ValueError(f"scan: sensor at ({origin[0]:.2f}, {origin[1]:.2f}) is outside the costmap")
         r = scan.valid_ranges()
         dirs = scan.directions
-        clear_to = np.where(np.isinf(r), p.raytrace_max_range if p.clear_on_no_return else np.nan, r)
+        beyond = r + _BEYOND_HIT  # where the beam's cells end: the hit's, the surface's far side
+        clear_to = np.where(np.isinf(r), p.raytrace_max_range if p.clear_on_no_return else np.nan, beyond)
         clearing = np.isfinite(clear_to)
         clear_len = np.minimum(clear_to[clearing], p.raytrace_max_range)
         ends = origin + dirs[clearing] * clear_len[:, None]
         with np.errstate(invalid="ignore"):
             marking = np.isfinite(r) & (r >= p.obstacle_min_range) & (r <= p.obstacle_max_range)
-        hit_xy = origin + dirs[marking] * r[marking, None]
+        hit_xy = origin + dirs[marking] * beyond[marking, None]
         hits = self.spec.world_to_cell(hit_xy)
         hits = hits[self.spec.in_bounds(hits)]
         traced, everything = self._beams.update(origin, ends)

@@ -11,6 +11,7 @@ from costmap.layers.obstacle import SCAN, ObstacleLayer, ObstacleParams, trace_c
 from costmap.layers.social import PEOPLE
 from costmap.scan import LaserScan
 from sid.perception.people import Person
+from sid.scenario.known_map import obstacle_mask
 from sid.scenario.lidar import simulate_scan
 from sid.scenario.obstacles import SegmentObstacle
 from tests.costmap.scenes import WALLS
@@ -86,7 +87,7 @@ def test_lidar_layer_writes_what_clearing_every_beam_then_marking_would(seed):
         window = layer.update(LayerInputs({PEOPLE: people, SCAN: scan}), None)
         r = scan.valid_ranges()  # no return (inf): cleared to the 10 m raytrace range, not marked
         origin = np.array(pose[:2])
-        clear_to = np.where(np.isinf(r), 10.0, r)
+        clear_to = np.where(np.isinf(r), 10.0, r + 1e-6)  # a hit's cell: 1 um along the beam (the surface's side)
         ends = origin + scan.directions * clear_to[:, None]
         hits = SPEC.world_to_cell(ends[np.isfinite(r)])
         hits = hits[SPEC.in_bounds(hits)]
@@ -147,3 +148,21 @@ def test_the_lidar_layer_clears_people_marks_by_its_own_parameter():
         assert layer.update(no_scan, None) == (None if radius == 0 else mark)  # the window of what changed
     with pytest.raises(ValueError, match="people_clear_radius"):
         ObstacleLayer(SPEC, people_clear_radius=-1.0)
+
+
+@pytest.mark.parametrize("y", [0.8, 0.35, -0.35])
+def test_a_wall_on_a_cell_border_is_marked_in_the_cell_the_static_layer_puts_it_in(y: float) -> None:
+    # A wall along y on 0.05 m cells lies on a border: the known map puts it in the cell above, the one a beam from
+    # below enters. Computed hits came out at 0.7999... for about half the beams and marked the free cell before it,
+    # walling off a corridor the map leaves open. Seen from below (the sensor under the wall) every hit is the
+    # wall's cell; from above, the cell beyond the surface, never one on the sensor's side of the wall.
+    spec = GridSpec.from_size(0.05, (0.0, -1.0), (10.0, 2.0))
+    wall = SegmentObstacle(((0.0, y), (10.0, y)))
+    static = obstacle_mask([wall], spec)
+    wall_rows = np.unique(np.nonzero(static)[0])
+    for sensor_y in (y - 0.15, y + 0.15):
+        layer = ObstacleLayer(spec)
+        layer.apply_scan(simulate_scan((5.0, sensor_y, 0.0), [wall], [], beams=720, range_max=10.0))
+        rows = np.unique(np.nonzero(layer.costs == LETHAL)[0])
+        below = sensor_y < y
+        assert rows.tolist() == (wall_rows.tolist() if below else [wall_rows[0] - 1])
