@@ -61,6 +61,8 @@ def grid_search(field: CostField) -> np.ndarray:
     chain = [g]
     while chain[-1] != s:
         chain.append(previous[chain[-1]])
+    if len(chain) == 1:  # start and goal in one cell: the straight line between them stays inside it
+        return np.array([problem.start, problem.goal], dtype=float)
     flat = np.flatnonzero(node.ravel() >= 0)[np.array(chain[::-1])]
     path = spec.cell_to_world(np.stack(np.unravel_index(flat, node.shape), axis=1))
     path[0], path[-1] = problem.start, problem.goal

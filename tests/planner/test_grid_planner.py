@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from costmap.grid import LETHAL, Costmap2D, GridSpec
+from planner.facade import plan
 from planner.grid_planner import grid_graph
 from planner.problem import CostField, PlanningProblem
 
@@ -69,3 +70,19 @@ def test_no_diagonal_step_squeezes_between_two_blocked_cells():
     assert node[4, 4] >= 0 and node[5, 5] >= 0
     joined = {tuple(sorted((int(a), int(b)))) for a, b in zip(graph.row, graph.col, strict=True)}
     assert tuple(sorted((int(node[4, 4]), int(node[5, 5])))) not in joined
+
+
+@pytest.mark.parametrize(
+    ("start", "goal"), [((1.0, 1.0), (1.04, 1.04)), ((0.51, 0.51), (0.99, 0.99)), ((1.0, 1.0), (1.0, 1.0))]
+)
+def test_start_and_goal_in_one_cell_give_the_line_between_them(start, goal):
+    # The cheapest chain of cells is that one cell; its single point used to be overwritten by the goal, so the path
+    # lost its start and read 0 m however far apart the two were (0.68 m on 0.5 m cells).
+    for resolution in (0.05, 0.5):
+        spec = GridSpec.from_size(resolution, (0.0, 0.0), (5.0, 5.0))
+        problem = PlanningProblem(Costmap2D(spec, np.zeros(spec.shape, np.uint8)), start, goal, 0.25)
+        if (spec.world_to_cell(np.array([start]))[0] != spec.world_to_cell(np.array([goal]))[0]).any():
+            continue
+        result = plan(problem, "grid")
+        np.testing.assert_array_equal(result.path, [start, goal])
+        assert result.success and result.length_m == pytest.approx(math.dist(start, goal))
