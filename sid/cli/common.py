@@ -280,8 +280,10 @@ def process_json_lines(
     """Write ``handle(value)`` on ``out`` as one JSON line, flushed, for each non-blank line of ``lines``
     (``read_json_lines``). A line that cannot be read, or that ``handle`` refuses (ValueError), is reported on ``err``
     as ``COMMAND: line N: problem`` and skipped, or, with ``strict``, ends the run: exit code 2 (bad input); a note
-    ``handle`` makes on a good line as ``COMMAND: line N: note: text``. Returns the exit code."""
-    skipped = 0
+    ``handle`` makes on a good line as ``COMMAND: line N: note: text``. Returns the exit code: 2 also when lines were
+    read and none was good (nothing written: input of another kind, which a script must not take for an empty
+    result), 0 otherwise (an empty input too)."""
+    skipped = written = 0
     for number, value, problem in read_json_lines(lines):
         if problem is None:
             try:
@@ -296,9 +298,11 @@ def process_json_lines(
             continue
         out.write(json.dumps(record) + "\n")
         out.flush()
+        written += 1
     if skipped:
-        print(f"{command}: skipped {plural(skipped, 'malformed line')}", file=err, flush=True)
-    return 0
+        none = ", and no line was good" if not written else ""
+        print(f"{command}: skipped {plural(skipped, 'malformed line')}{none}", file=err, flush=True)
+    return ExitCode.USAGE if skipped and not written else 0
 
 
 def _note(command: str, number: int, err: TextIO, text: str) -> None:

@@ -159,7 +159,7 @@ def test_too_many_people_in_a_line_are_refused_by_the_people_limit(tmp_path, cap
     monkeypatch.setenv("SID_LIMITS", "people=2")
     source = write_lines(tmp_path / "in.jsonl", [{"timestamp": 0, "people": [{"x": k, "y": 0} for k in range(3)]}])
     code, out, err = run_sid(["track", str(source)], capsys)
-    assert code == 0 and out == []
+    assert code == 2 and out == []  # no line was good
     assert err[0] == (
         "sid track: line 1: people: 3 people is more than the limit of 2 people (people; raise it with "
         "SID_LIMITS=people=N)"
@@ -301,7 +301,7 @@ def test_an_id_given_twice_names_both_people_and_a_default_id(tmp_path, capsys):
         },
     ]
     code, out, err = run_sid(["track", str(write_lines(tmp_path / "in.jsonl", lines))], capsys)
-    assert code == 0 and out == []
+    assert code == 2 and out == []  # no line was good
     assert err[:2] == [
         "sid track: line 1: people[0] and people[1] have one id, 1 (people[1] has no 'id': its index in the list is "
         "its id)",
@@ -346,3 +346,16 @@ def test_a_bad_parameters_file_is_one_line_naming_the_file_and_the_field(tmp_pat
     assert err == [f'sid track: {params}: tracking.tracker.timeout: expected a finite number, got "soon"']
     code, out, err = run_sid(["groups", "-", "--params", str(tmp_path / "nowhere.yaml")], capsys)
     assert code == 2 and out == [] and len(err) == 1 and "nowhere.yaml: cannot read parameters file" in err[0]
+
+
+def test_input_of_which_no_line_is_good_exits_2_and_one_good_line_is_enough(tmp_path, capsys):
+    # sid detect's lines (a "frame" field) are not sid track's: every line refused, nothing written. A script must
+    # not read that as an empty result (exit 0 until then); an input with one good line among bad ones exits 0.
+    bad = {"frame": 0, "timestamp": 0.0, "people": []}
+    code, out, err = run_sid(["track", str(write_lines(tmp_path / "bad.jsonl", [bad, bad]))], capsys)
+    assert code == 2 and out == [] and err[-1] == "sid track: skipped 2 malformed lines, and no line was good"
+    good = {"timestamp": 1.0, "people": []}
+    code, out, err = run_sid(["track", str(write_lines(tmp_path / "mixed.jsonl", [bad, good]))], capsys)
+    assert code == 0 and len(out) == 1 and err[-1] == "sid track: skipped 1 malformed line"
+    code, out, err = run_sid(["groups", str(write_lines(tmp_path / "empty.jsonl", []))], capsys)
+    assert (code, out, err) == (0, [], [])
