@@ -36,6 +36,7 @@ from sid.cli.person_json import parse_person
 from sid.documents import is_number, summary
 from sid.perception.people import Person
 from sid.tracking import TrackingSession
+from sid.tracking.assignment import load_solver
 
 __all__ = ["LINE_FIELDS", "PERSON_FIELDS", "add_parser", "process", "run"]
 
@@ -53,6 +54,7 @@ def run(args: argparse.Namespace) -> int:
         session = TrackingSession(params.tracking, group_params_from(args, params.groups))
     except ValueError as exc:
         return fail("sid track", exc)
+    load_solver()  # now: lines may come live from a detector, and its first crowded one should not wait for an import
     return run_json_lines(
         "sid track", args.file, lambda lines, out, err: process(lines, out, err, session, args.strict)
     )
