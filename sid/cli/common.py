@@ -113,9 +113,11 @@ def check_output_folder(path: str | Path, option: str = "--out") -> Path:
     """``path`` as a Path when it is a folder sid can write in, or can be created as one; creates nothing.
 
     Commands call this before any work, so a run is not spent and then lost on the write. Raises
-    OutputFolderError ``"--out PATH: reason"``: the path is a file, a parent of it is a file, or the nearest
-    existing folder cannot be written (permissions, a read-only file system).
+    OutputFolderError ``"--out PATH: reason"``: the path is empty or blank, a file, a parent of it is a file, or the
+    nearest existing folder cannot be written (permissions, a read-only file system).
     """
+    if not str(path).strip():  # an unset variable in a script ($OUT): the working folder is not what was meant
+        raise OutputFolderError(f"{option} {path!r}: an empty path; give a folder (. for the working folder)")
     folder = existing = Path(path)
     try:
         if "\0" in str(path):
@@ -637,4 +639,6 @@ def pose_model(model: Path | None, source: str | None, **load: Any) -> PoseFn:
         return TruthPose()
     from sid.sources import SourceError
 
-    raise SourceError("a real source needs a pose model: --model FILE.onnx (see docs/models.md)")
+    scene = source is not None and Path(source).suffix.lower() in (".json", ".yaml", ".yml")
+    hint = f"; for a synthetic camera in the scene file, --source synthetic:{source}" if scene else ""
+    raise SourceError(f"a real source needs a pose model: --model FILE.onnx (see docs/models.md){hint}")

@@ -87,7 +87,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--frames", type=positive_int, help=f"stop after this many frames (default: all; synthetic: {SYNTHETIC_FRAMES})"
     )
-    parser.add_argument("--out", type=Path, help="also write detections.jsonl, overlay and top-view PNGs here")
+    parser.add_argument("--out", metavar="DIR", help="also write detections.jsonl, overlay and top-view PNGs here")
     parser.add_argument(
         "--align",
         choices=("none", "sid", "librealsense"),
@@ -288,7 +288,7 @@ def _tracked_json(record: dict, tracked: SessionUpdate) -> dict:
 def run(args: argparse.Namespace) -> int:
     if args.out is not None:
         try:
-            check_output_folder(args.out)  # before the model loads and the camera opens
+            args.out = check_output_folder(args.out)  # before the model loads and the camera opens
         except OutputFolderError as exc:
             return fail("sid detect", exc)
     try:

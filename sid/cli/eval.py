@@ -340,10 +340,10 @@ def _warn_about_data(name: str, frames: list[LabelledFrame], scale: float) -> No
 
 
 def _dataset_name(folder: str, taken: dict) -> str:
-    """The folder's name, made unique among the datasets already named."""
+    """The folder's name, made unique among the datasets already named and apart from the scores' "pooled"."""
     base = Path(folder).resolve().name or str(folder)
     name, k = base, 2
-    while name in taken:
+    while name in taken or name == "pooled":
         name, k = f"{base}-{k}", k + 1
     return name
 

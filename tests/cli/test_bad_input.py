@@ -53,6 +53,18 @@ def test_out_that_is_a_file_is_refused_before_any_work(command, tmp_path, capsys
     assert blocker.read_text() == "keep me"
 
 
+@pytest.mark.parametrize("command", COMMANDS)
+@pytest.mark.parametrize("empty", ["", " "])
+def test_an_empty_out_is_refused_rather_than_taken_for_the_working_folder(
+    command, empty, tmp_path, capsys, monkeypatch
+):
+    # An unset variable in a script (--out "$OUT") wrote into the working folder, and sid detect cleared its files.
+    monkeypatch.chdir(tmp_path)
+    assert main([*COMMANDS[command], "--out", empty]) == 2
+    assert one_line_error(capsys, command).endswith(": an empty path; give a folder (. for the working folder)")
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize("command", ["plan", "detect", "bench"])
 def test_out_below_a_file_is_refused(command, tmp_path, capsys):
     blocker = tmp_path / "results.txt"

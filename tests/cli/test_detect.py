@@ -18,7 +18,7 @@ from sid.perception.frame import Frame
 from sid.perception.pipeline import Pipeline
 from sid.sources.synthetic import SyntheticSource
 from sid.synthetic.pose import TruthPose
-from tests.conftest import realsense, shared_path
+from tests.conftest import REPO_ROOT, realsense, shared_path
 
 
 def test_pipeline_finds_the_s1_pair_where_the_truth_puts_it():
@@ -347,3 +347,10 @@ def test_one_rule_gives_the_pose_function_of_detect_and_ros(tmp_path, capsys):
     pytest.importorskip("rclpy", reason="rclpy is not installed")
     assert main(["ros"]) == ExitCode.USAGE
     assert capsys.readouterr().err.strip().removeprefix("sid ros: ") == detect_message
+
+
+def test_a_scene_file_as_source_without_a_model_points_to_the_synthetic_source(capsys):
+    scene = str(REPO_ROOT / "examples" / "conversation.json")
+    assert main(["detect", "--source", scene]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("detect: a real source needs a pose model") and f"--source synthetic:{scene}" in err

@@ -185,6 +185,18 @@ def test_eval_fformation_prints_json_and_a_table(tmp_path, capsys):
     assert out[1].split() == ["Tiny", "3/4", "3", "1.000", "0.667", "0.800"]
 
 
+def test_a_dataset_named_pooled_keeps_its_scores_apart_from_the_pooled_ones(tmp_path, capsys):
+    # A folder named "pooled" took the key of the scores over every set, and its own row was lost (exit 0).
+    truth = {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]}
+    folders = [
+        str(write_sequence(tmp_path / name, tiny_frames()[:k], truth)) for name, k in (("pooled", 3), ("Tiny", 2))
+    ]
+    code, out, _ = run_sid(["eval", "fformation", *folders, "--scale", "0.01"], capsys)
+    scores = json.loads("\n".join(out))["scores"]
+    assert code == 0 and list(scores) == ["pooled-2", "Tiny", "pooled"]
+    assert [scores[name]["2/3"]["frames"] for name in scores] == [3, 2, 5]
+
+
 def test_eval_fformation_tables_keep_their_columns_for_a_long_dataset_name(tmp_path, capsys):
     # The name column was 16 characters wide: a longer folder name pushed its row's numbers out of their columns.
     truth = {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]}
