@@ -4,13 +4,14 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from collections.abc import Sequence
 
 from costmap.mapfile import MapFileError
 from planner.facade import DEFAULT_PLANNER, DEFAULT_SOFT_LIMIT_S, MAX_SEED, PLANNERS
-from planner.problem import DEFAULT_COST_WEIGHT, PlanningError
-from sid.cli.common import add_output_option, positive_seconds
+from planner.problem import DEFAULT_COST_WEIGHT, MAX_COST_WEIGHT, PlanningError
+from sid.cli.common import add_output_option, positive_int, positive_seconds
 from sid.experiments.harness import zone_warnings
 from sid.perception.group import Group
 from sid.scenario.loader import Scenario, ScenarioError
@@ -76,7 +77,7 @@ def add_planning_options(
     )
     parser.add_argument(
         "--iterations",
-        type=int,
+        type=positive_int,
         default=iterations,
         metavar="K",
         help="cap on the planner's iterations; with --seed, a run that stops on the cap repeats exactly (default: "
@@ -84,11 +85,22 @@ def add_planning_options(
     )
     parser.add_argument(
         "--cost-weight",
-        type=float,
+        type=_cost_weight,
         default=DEFAULT_COST_WEIGHT,
         metavar="W",
         help="w in cost = integral of (1 + w c/252) ds (default: %(default)s; 0 = shortest path)",
     )
+
+
+def _cost_weight(text: str) -> float:
+    """argparse type of ``--cost-weight``: a number in [0, MAX_COST_WEIGHT], refused before anything is printed."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not 0 <= value <= MAX_COST_WEIGHT:  # NaN too
+        raise argparse.ArgumentTypeError(f"expected a number from 0 to {MAX_COST_WEIGHT:g}, got {text!r}")
+    return value
 
 
 def warn_zones(command: str, scenario: Scenario, groups: Sequence[Group]) -> None:

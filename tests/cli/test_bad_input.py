@@ -217,3 +217,21 @@ def test_bench_help_documents_sid_shared():
         [sys.executable, "-m", "sid", "bench", "--help"], capture_output=True, text=True, cwd=REPO_ROOT, check=True
     ).stdout
     assert "$SID_SHARED" in " ".join(out.split())
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "message"),
+    [
+        ("--cost-weight", "-1", "argument --cost-weight: expected a number from 0 to 1000, got '-1'"),
+        ("--cost-weight", "nan", "argument --cost-weight: expected a number from 0 to 1000, got 'nan'"),
+        ("--iterations", "0", "argument --iterations: expected a whole number >= 1, got '0'"),
+    ],
+)
+def test_planning_options_are_refused_before_anything_is_planned_or_printed(option, value, message, capsys):
+    # They were refused by the planner, after "planning ... with bitstar" was printed, in the planner's own words.
+    with pytest.raises(SystemExit) as stop:
+        main(["plan", SCENARIO, option, value])
+    captured = capsys.readouterr()
+    assert (
+        stop.value.code == 2 and captured.out == "" and captured.err.splitlines()[-1] == f"sid plan: error: {message}"
+    )
