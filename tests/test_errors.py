@@ -51,3 +51,15 @@ def test_the_packages_define_errors() -> None:
 @pytest.mark.parametrize("error", ERRORS, ids=lambda e: f"{e.__module__}.{e.__name__}")
 def test_every_error_derives_from_the_one_base(error: type[Exception]) -> None:
     assert issubclass(error, SidError)
+
+
+# Deliberately without a built-in base: the base itself; stdout failing is not one of a command's own files (not an
+# OSError, sid.cli.common); a recorded frame missing a stream is turned into a FrameReadError inside the source.
+_WITHOUT_BUILTIN = {"SidError", "StandardOutputError", "IncompleteFrame"}
+
+
+@pytest.mark.parametrize("error", ERRORS, ids=lambda e: f"{e.__module__}.{e.__name__}")
+def test_every_error_also_derives_from_the_builtin_error_it_stands_for(error: type[Exception]) -> None:
+    # The README's promise: `except ValueError` still catches bad input (a pose model file that cannot be used did not).
+    builtin = [b for b in error.__mro__ if b.__module__ == "builtins" and b not in (Exception, BaseException, object)]
+    assert bool(builtin) != (error.__name__ in _WITHOUT_BUILTIN)

@@ -46,7 +46,7 @@ _ORT_DTYPES: dict[str, np.dtype] = {
 }
 
 
-class PoseModelError(SidError):
+class PoseModelError(SidError, ValueError):
     """A pose model file that cannot be used: missing, not ONNX, or with a signature no contract matches."""
 
 
