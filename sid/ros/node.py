@@ -68,8 +68,8 @@ class SocialCostmapNode:
         self.node: Node = rclpy.create_node(NODE_NAME)
         self.params = p = read_params(self.node)
         self.pose = pose
-        pipeline = Pipeline(pose, p.mount, group=False)
-        self.stream = SocialStream(pipeline, p.grid, p.layers)
+        pipeline = Pipeline(pose, p.mount, group_params=p.groups, group=False)  # the group tracker groups the tracks
+        self.stream = SocialStream(pipeline, p.grid, p.layers, params=p.tracking)
         self.fixed_robot = False
         """Whether frames are placed with the robot fixed at the origin (pose_source auto, no pose arrived yet)."""
         self.frames = 0

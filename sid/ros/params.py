@@ -4,22 +4,28 @@
 The fixed parameters are the ``PARAMETERS`` table; tests check the shipped parameters YAML against it. The costmap's
 layers are named as Nav2's costmap_2d names them: ``costmap.plugins`` lists layer instances, a name that is not a
 plugin's gets ``costmap.NAME.plugin``, and every instance its plugin's parameters as ``costmap.NAME.FIELD``; they are
-declared once the list is read. Importing this module imports no ROS; ``read_params`` needs an rclpy node.
+declared once the list is read. The group detector's and the trackers' parameters are their records' fields, named as
+in a parameters file (``sid.scenario.params_file``): ``groups.FIELD``, ``tracking.tracker.FIELD``,
+``tracking.groups.FIELD`` and ``tracking.FIELD``. Importing this module imports no ROS; ``read_params`` needs an rclpy
+node.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, fields, is_dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 from costmap.grid import GridSpec
 from costmap.plugins import PLUGINS, SECTIONS, CostmapParams
 from sid.checks import check_number, check_numbers
+from sid.perception.groups import GroupParams
 from sid.perception.mount import CameraMount
 from sid.perception.robot_pose import BASE_FRAME, MAP_FRAME
 from sid.scenario.loader import layers_from_dict
+from sid.scenario.params_file import ParamsFile, params_file_from_dict
 from sid.sources.rosbag2 import COLOR_TOPIC, DEPTH_TOPIC
+from sid.tracking.session import TrackingParams
 
 if TYPE_CHECKING:
     from rclpy.node import Node
@@ -53,7 +59,8 @@ class NodeParams:
     """Every parameter of the node (ROS name = field name with ``__`` read as ``.``; metres, radians, seconds).
 
     ``layers``: the costmap's layer instances, from ``costmap.plugins`` and ``costmap.NAME.*`` (see the module
-    docstring), each of a plugin in ``NODE_PLUGINS``.
+    docstring), each of a plugin in ``NODE_PLUGINS``. ``groups``, ``tracking``: the group detector's and the
+    trackers' parameters, from ``groups.*`` and ``tracking.*``.
     """
 
     color_topic: str = COLOR_TOPIC
@@ -77,6 +84,8 @@ class NodeParams:
     costmap__origin_x: float = -10.0
     costmap__origin_y: float = -10.0
     layers: CostmapParams = field(default_factory=lambda: CostmapParams(plugins=DEFAULT_LAYERS))
+    groups: GroupParams = field(default_factory=GroupParams)
+    tracking: TrackingParams = field(default_factory=TrackingParams)
     costmap_topic: str = "/social_costmap"
     filter_info_topic: str = "/social_costmap_filter_info"
     markers_topic: str = "/social_markers"
@@ -157,12 +166,17 @@ def ros_name(field: str) -> str:
     return LAYERS_PARAMETER if field == "layers" else field.replace("__", ".")
 
 
+_RECORDS = tuple(f.name for f in fields(ParamsFile))
+"""The NodeParams fields that are records of their own (``groups``, ``tracking``), one parameter per field of theirs."""
+
 PARAMETERS: tuple[tuple[str, object, str], ...] = tuple(
     (ros_name(f.name), list(DEFAULT_LAYERS) if f.name == "layers" else f.default, DESCRIPTIONS[f.name])
     for f in fields(NodeParams)
+    if f.name not in _RECORDS
 )
 """(ROS name, default, description) of every fixed parameter, in declaration order (``costmap.plugins`` with the
-names of the default layers; the instances' own parameters are declared by ``read_params``)."""
+names of the default layers; the instances' own parameters, and the group detector's and the trackers', are declared
+by ``read_params``)."""
 
 
 def _typed(name: str, value: Any, default: object) -> Any:
@@ -258,19 +272,45 @@ def _section_parameters(node: Node, name: str, plugin: str, use: str = "") -> di
     return values
 
 
+_RECORD_DESCRIPTIONS = {
+    "groups": "the group detector (sid.perception.groups.GroupParams; docs/groups.md)",
+    "tracking": "the trackers' session: what counts as a jump of the robot pose (sid.tracking.session.TrackingParams)",
+    "tracking.tracker": "the people tracker (sid.tracking.tracker.TrackerParams; docs/tracking.md)",
+    "tracking.groups": "the group tracker (sid.tracking.groups.GroupTrackerParams; docs/tracking.md)",
+}
+
+
+def _record_parameters(node: Node, name: str, record: Any) -> dict[str, Any]:
+    """Declare and read ``NAME.FIELD`` for each field of ``record`` (a parameters dataclass, its values the defaults;
+    a field that is itself one, ``NAME.FIELD.*``), as the block ``name`` of a parameters file."""
+    values: dict[str, Any] = {}
+    for f in fields(record):
+        value = getattr(record, f.name)
+        if is_dataclass(value):
+            values[f.name] = _record_parameters(node, f"{name}.{f.name}", value)
+        else:
+            description = f"{f.name} of {_RECORD_DESCRIPTIONS[name]}"
+            values[f.name] = _declare(node, f"{name}.{f.name}", value, description)
+    return values
+
+
 def read_params(node: Node) -> NodeParams:
     """Declare every parameter of the node on ``node`` (an ``rclpy.node.Node``), each with its description, and read
     them: the fixed ones (``PARAMETERS``), then the layer instances ``costmap.plugins`` lists, Nav2-style (see the
-    module docstring), built by the scenario loader's ``layers_from_dict``. A bad value (of the wrong type, out of
-    range, an invalid topic name or frame id) raises ValueError naming the parameter."""
+    module docstring), built by the scenario loader's ``layers_from_dict``, and the group detector's and the trackers'
+    (``groups.*``, ``tracking.*``), checked as a parameters file's. A bad value (of the wrong type, out of range, an
+    invalid topic name or frame id) raises ValueError naming the parameter."""
     values = {name: _declare(node, name, default, description) for name, default, description in PARAMETERS}
     names = values.pop(LAYERS_PARAMETER)
     fixed = {
         f.name: _typed(ros_name(f.name), values[ros_name(f.name)], f.default)
         for f in fields(NodeParams)
-        if f.name != "layers"
+        if f.name != "layers" and f.name not in _RECORDS
     }
-    params = NodeParams(**fixed)
+    records = params_file_from_dict(
+        {name: _record_parameters(node, name, getattr(ParamsFile(), name)) for name in _RECORDS}
+    )
+    params = NodeParams(**fixed, groups=records.groups, tracking=records.tracking)
     _check_names(node, params)
     listed = names if isinstance(names, list) and all(isinstance(n, str) for n in names) else []
     mapping = {"plugins": names, **_layer_parameters(node, listed)}

@@ -18,8 +18,12 @@ from costmap.layers.inflation import InflationParams
 from costmap.layers.social import PEOPLE
 from costmap.layers.tracked import TRACKS, TrackedPeopleLayer, TrackedPeopleParams
 from costmap.plugins import CostmapParams, LayerInstance, layered_costmap
+from sid.perception.groups import GroupParams
 from sid.ros.params import NODE_NAME, NodeParams, read_params
 from sid.tracking import TrackedPerson, Tracks
+from sid.tracking.groups import GroupTrackerParams
+from sid.tracking.session import TrackingParams
+from sid.tracking.tracker import TrackerParams
 
 rclpy = pytest.importorskip("rclpy", reason="rclpy is not installed (pip install 'sid-social[ros]' or source ROS 2)")
 
@@ -173,3 +177,54 @@ def test_an_integer_for_a_real_parameter_and_a_relative_topic_are_read() -> None
         params = read_params(node)
     assert params.costmap__width == 30.0 and isinstance(params.costmap__width, float)
     assert params.costmap_topic == "social_costmap"  # ROS resolves it in the node's namespace
+
+
+def test_the_group_detector_and_the_trackers_take_their_fields_as_parameters(tmp_path: Path) -> None:
+    # As a parameters file names them (sid.scenario.params_file): groups.FIELD, tracking.tracker.FIELD, ...
+    path = tmp_path / "params.yaml"
+    document = {"groups": {"positions_only_reach": 1.0}, "tracking": {"tracker": {"timeout": 2}, "max_turn_rate": 2.0}}
+    path.write_text(yaml.safe_dump({NODE_NAME: {"ros__parameters": document}}))
+    with ros_node("--params-file", str(path), "-p", "tracking.groups.walk_distance:=1.2") as node:
+        params = read_params(node)
+        assert "group tracker" in node.describe_parameter("tracking.groups.walk_distance").description
+        assert node.get_parameter("groups.method").value == "ospace"  # every field declared, with its default
+    assert params.groups == GroupParams(positions_only_reach=1.0)
+    assert params.tracking == TrackingParams(
+        tracker=TrackerParams(timeout=2.0), groups=GroupTrackerParams(walk_distance=1.2), max_turn_rate=2.0
+    )
+    with ros_node() as node:
+        assert read_params(node) == NodeParams()
+
+
+@pytest.mark.parametrize(
+    ("ros_args", "message"),
+    [
+        (["-p", "groups.method:=dbscan"], r"^groups: method must be one of ospace, gcff, rays, paper"),
+        (["-p", "groups.alone_price:=0.0"], r"^groups: alone_price must be a finite number of square metres"),
+        (
+            ["-p", "tracking.tracker.timeout:=soon"],
+            r'^tracking\.tracker\.timeout: expected a finite number, got "soon"',
+        ),
+        (["-p", "tracking.tracker.confirm_hits:=1.5"], r"^tracking\.tracker\.confirm_hits: expected an integer >= 0"),
+        (["-p", "tracking.groups.walk_window:=-1.0"], r"^tracking\.groups: walk_window must be a finite number"),
+    ],
+)
+def test_a_bad_group_detector_or_tracker_parameter_is_refused_naming_it(ros_args: list[str], message: str) -> None:
+    with ros_node(*ros_args) as node, pytest.raises(ValueError, match=message):
+        read_params(node)
+
+
+def test_the_node_runs_its_trackers_and_group_detector_with_their_parameters() -> None:
+    from sid.ros.node import SocialCostmapNode
+
+    args = ["-p", "pose_source:=none", "-p", "tracking.tracker.confirm_hits:=1", "-p", "groups.group_price:=0.5"]
+    rclpy.init(args=["sid", "--ros-args", *args])
+    try:
+        node = SocialCostmapNode(lambda frame: [], camera_topics=False)
+        try:
+            tracking = node.stream.people.tracking
+            assert tracking.people.params.confirm_hits == 1 and tracking.groups.group_params.group_price == 0.5
+        finally:
+            node.node.destroy_node()
+    finally:
+        rclpy.shutdown()
