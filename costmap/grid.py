@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike
 from sid.checks import check_limit, check_number, check_numbers, check_whole
 
 __all__ = [
+    "BORDER_TOLERANCE",
     "Costmap2D",
     "FREE_SPACE",
     "GridSpec",
@@ -134,6 +135,12 @@ def nonzero_cells(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return rows, cols
 
 
+BORDER_TOLERANCE = 1e-6
+"""Cells: a point this near below a cell border counts as on it, so in the cell above / to the right. (y - origin) /
+resolution rounds a border point to 91.99999999999999 for 4.6 m on 0.05 m cells (and differently for another
+origin), which put a box at y = 4.6 m into the row below it. Above the rounding of any coordinate within
+``MAX_ORIGIN`` (4e-8 cells at 0.05 m) and far below a cell."""
+
 MAX_ORIGIN = 1e7
 """The farthest (m, along x or y) a map's origin may lie from the world's: 10 000 km holds any UTM coordinate, and
 float64 still resolves nanometres there; far beyond, a person's offset into the map is lost to rounding
@@ -178,10 +185,11 @@ class GridSpec:
         return (self.width * self.resolution, self.height * self.resolution)
 
     def world_to_cell(self, xy: np.ndarray) -> np.ndarray:
-        """World points (N, 2) -> integer cells (N, 2) as (row, col); may lie outside the grid."""
+        """World points (N, 2) -> integer cells (N, 2) as (row, col); may lie outside the grid. A point on a cell
+        border is in the cell above / to the right, however the division rounds it (``BORDER_TOLERANCE``)."""
         xy = np.asarray(xy, dtype=float).reshape(-1, 2)
-        col = np.floor((xy[:, 0] - self.origin_x) / self.resolution).astype(np.int64)
-        row = np.floor((xy[:, 1] - self.origin_y) / self.resolution).astype(np.int64)
+        col = np.floor((xy[:, 0] - self.origin_x) / self.resolution + BORDER_TOLERANCE).astype(np.int64)
+        row = np.floor((xy[:, 1] - self.origin_y) / self.resolution + BORDER_TOLERANCE).astype(np.int64)
         return np.stack([row, col], axis=1)
 
     def cell_to_world(self, cells: np.ndarray) -> np.ndarray:
@@ -199,7 +207,7 @@ class GridSpec:
     def contains(self, xy: np.ndarray) -> np.ndarray:
         """Boolean (N,) for world points (N, 2) inside the grid (False for any point far or not finite: compared as
         floats, never cast to a cell)."""
-        m = self.world_to_map(xy)  # (col, row), cell k covering [k, k + 1)
+        m = self.world_to_map(xy) + BORDER_TOLERANCE  # (col, row), cell k covering [k, k + 1), as world_to_cell
         return (m[:, 0] >= 0) & (m[:, 0] < self.width) & (m[:, 1] >= 0) & (m[:, 1] < self.height)
 
     @property
@@ -223,12 +231,12 @@ class GridSpec:
         Scalar float64 arithmetic, the same as ``world_to_cell``'s (boxes are per person, per frame: numpy's call
         overhead would dominate)."""
         (x0, y0), (x1, y1) = xy_min, xy_max
-        res, ox, oy = self.resolution, self.origin_x, self.origin_y
+        res, ox, oy, tol = self.resolution, self.origin_x, self.origin_y, BORDER_TOLERANCE
         try:  # clipped to the grid here: one Window built (a window per person and group per frame)
-            col0 = max(math.floor((float(x0) - ox) / res), 0)
-            col1 = min(math.floor((float(x1) - ox) / res) + 1, self.width)
-            row0 = max(math.floor((float(y0) - oy) / res), 0)
-            row1 = min(math.floor((float(y1) - oy) / res) + 1, self.height)
+            col0 = max(math.floor((float(x0) - ox) / res + tol), 0)
+            col1 = min(math.floor((float(x1) - ox) / res + tol) + 1, self.width)
+            row0 = max(math.floor((float(y0) - oy) / res + tol), 0)
+            row1 = min(math.floor((float(y1) - oy) / res + tol) + 1, self.height)
         except (ValueError, OverflowError):  # nan or inf
             return None
         return Window(row0, row1, col0, col1) if row0 < row1 and col0 < col1 else None

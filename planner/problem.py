@@ -33,7 +33,7 @@ from typing import TypeVar
 import numpy as np
 from scipy import ndimage
 
-from costmap.grid import INSCRIBED, LETHAL, MAX_NON_OBSTACLE, NO_INFORMATION, Costmap2D
+from costmap.grid import BORDER_TOLERANCE, INSCRIBED, LETHAL, MAX_NON_OBSTACLE, NO_INFORMATION, Costmap2D
 from costmap.layers.inflation import squared_distance_to_lethal_cells
 from sid.checks import check_number
 from sid.errors import SidError
@@ -169,7 +169,8 @@ class CostField:
         self.weight = np.where(self.free, problem.cost_weight * graded / MAX_NON_OBSTACLE, 0.0)
         # Scalar lookups use grids padded by one row and column (copies of the last ones), so a point on the map's
         # upper edge needs no clamping. Every lookup finds a point's cell as ``GridSpec.world_to_cell`` does,
-        # floor((x - origin) / resolution), so that a point on a cell border lands in the same cell everywhere.
+        # floor((x - origin) / resolution + BORDER_TOLERANCE), so that a point on a cell border lands in the same cell
+        # everywhere.
         self._stride = self._w + 1
         self._weight_padded = np.pad(self.weight, ((0, 1), (0, 1)), mode="edge")
         self._plannable_flat: list[bool] = np.pad(self.plannable, ((0, 1), (0, 1)), mode="edge").ravel().tolist()
@@ -188,8 +189,9 @@ class CostField:
     # ---- scalar lookups (OMPL callbacks) -------------------------------------------------------------------------
     def is_plannable(self, x: float, y: float) -> bool:
         """Whether a robot centre at world (x, y), inside the map, may be used by a planner."""
-        res = self.resolution
-        return self._plannable_flat[math.floor((y - self._oy) / res) * self._stride + math.floor((x - self._ox) / res)]
+        res, tol = self.resolution, BORDER_TOLERANCE
+        row, col = math.floor((y - self._oy) / res + tol), math.floor((x - self._ox) / res + tol)
+        return self._plannable_flat[row * self._stride + col]
 
     def segment_cost(self, x0: float, y0: float, x1: float, y1: float) -> float:
         """J of the straight segment (x0, y0) -> (x1, y1) (metres of weighted length), both ends inside the map."""
@@ -197,19 +199,19 @@ class CostField:
         length = math.hypot(dx, dy)
         n = int(self._pieces(length))
         # Midpoint i at t = (i + 0.5) / n, to a cell of the padded grids as ``GridSpec.world_to_cell`` does.
-        res, ox, oy = self.resolution, self._ox, self._oy
+        res, ox, oy, tol = self.resolution, self._ox, self._oy, BORDER_TOLERANCE
         if n > _LOOP_MAX:  # numpy's fixed overhead pays off on long segments
             ts = np.arange(0.5, n) / n  # (i + 0.5) / n
             # Offsets >= 0 inside the map: truncation is the floor.
-            rows = ((y0 + ts * dy - oy) / res).astype(np.intp)
-            cols = ((x0 + ts * dx - ox) / res).astype(np.intp)
+            rows = ((y0 + ts * dy - oy) / res + tol).astype(np.intp)
+            cols = ((x0 + ts * dx - ox) / res + tol).astype(np.intp)
             total = float(self._weight_padded[rows, cols].sum())
         else:
             weight, stride, floor = self._weight_flat, self._stride, math.floor
             total = 0.0
             for i in range(n):
                 t = (i + 0.5) / n
-                total += weight[floor((y0 + t * dy - oy) / res) * stride + floor((x0 + t * dx - ox) / res)]
+                total += weight[floor((y0 + t * dy - oy) / res + tol) * stride + floor((x0 + t * dx - ox) / res + tol)]
         return length * (1.0 + total / n)
 
     # ---- vectorised lookups (planners' post-processing, validation, metrics) -------------------------------------
@@ -270,6 +272,7 @@ class CostField:
         xy += p[:, None, :]
         xy -= self._origin[:, :, None]
         xy /= self.resolution
+        xy += BORDER_TOLERANCE
         size = self._size
         # The samples run monotonically from one end (row 0) to the other (row K - 1): both inside, all inside.
         ends = xy[:, :: width - 1]

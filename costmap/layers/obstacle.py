@@ -102,11 +102,12 @@ def _trace_lines(spec: GridSpec, c0: np.ndarray, delta: np.ndarray, n: int) -> t
     return rows.astype(np.int64) * spec.width + cols, keep
 
 
-_BEYOND_HIT = 1e-6
-"""Metres a hit is taken along its beam before its cell is found: a hit on a surface that lies on a cell border (a
+_BEYOND_HIT = 1e-4
+"""Cells a hit is taken along its beam before its cell is found: a hit on a surface that lies on a cell border (a
 wall at y = 0.8 m on 0.05 m cells) computes as 0.7999... from one side, and would mark the free cell before the wall
 instead of the wall's cell (``known_map`` puts a border in the cell above or to the right, the cell a beam from below
-enters). Far below any sensor's resolution, and far above the rounding of origin + range x direction (~1e-14 m)."""
+enters). Far below any sensor's resolution, far above the rounding of origin + range x direction, and above
+``costmap.grid.BORDER_TOLERANCE``, so that a beam from above marks the cell below the border."""
 _PAIRS_PER_CHUNK = 2**20
 """``_marks_near`` tests at most this many (mark, person) pairs at once (a few MB of float64)."""
 
@@ -251,7 +252,7 @@ class ObstacleLayer(Layer):
             raise ValueError(f"scan: sensor at ({origin[0]:.2f}, {origin[1]:.2f}) is outside the costmap")
         r = scan.valid_ranges()
         dirs = scan.directions
-        beyond = r + _BEYOND_HIT  # where the beam's cells end: the hit's, the surface's far side
+        beyond = r + _BEYOND_HIT * self.spec.resolution  # where the beam's cells end: the surface's far side
         clear_to = np.where(np.isinf(r), p.raytrace_max_range if p.clear_on_no_return else np.nan, beyond)
         clearing = np.isfinite(clear_to)
         clear_len = np.minimum(clear_to[clearing], p.raytrace_max_range)

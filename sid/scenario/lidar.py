@@ -10,7 +10,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from costmap.grid import LETHAL, Costmap2D
+from costmap.grid import BORDER_TOLERANCE, LETHAL, Costmap2D
 from costmap.scan import LaserScan
 from sid.checks import check_number
 from sid.perception.people import Person
@@ -78,7 +78,7 @@ def _grid_ranges(origin: np.ndarray, dirs: np.ndarray, grid: Costmap2D, range_ma
     spec = grid.spec
     step = spec.resolution / 2
     t = np.arange(1, int(np.ceil(range_max / step)) + 1) * step
-    m = spec.world_to_map(origin[None])[0]
+    m = spec.world_to_map(origin[None])[0] + BORDER_TOLERANCE  # cells as GridSpec.world_to_cell finds them
     cols = np.floor(m[0] + dirs[:, :1] * (t / spec.resolution)).astype(np.int64)
     rows = np.floor(m[1] + dirs[:, 1:] * (t / spec.resolution)).astype(np.int64)
     inside = (rows >= 0) & (rows < spec.height) & (cols >= 0) & (cols < spec.width)

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from costmap.grid import LETHAL, NO_INFORMATION, Costmap2D, GridSpec, Window, disjoint, union
+from costmap.grid import BORDER_TOLERANCE, LETHAL, NO_INFORMATION, Costmap2D, GridSpec, Window, disjoint, union
 
 SPEC = GridSpec.from_size(0.05, (-1.0, -4.0), (10.0, 8.0))
 
@@ -26,8 +26,8 @@ def test_world_cell_round_trip_lands_within_half_a_cell(x, y):
     cell = SPEC.world_to_cell([[x, y]])
     assert SPEC.in_bounds(cell).all()
     centre = SPEC.cell_to_world(cell)[0]
-    assert abs(centre[0] - x) <= SPEC.resolution / 2 + 1e-9
-    assert abs(centre[1] - y) <= SPEC.resolution / 2 + 1e-9
+    reach = SPEC.resolution * (0.5 + BORDER_TOLERANCE) + 1e-9  # a point just below a border: in the cell above
+    assert abs(centre[0] - x) <= reach and abs(centre[1] - y) <= reach
 
 
 def test_row_zero_is_lowest_y():
@@ -109,8 +109,8 @@ def test_a_world_box_covers_the_cells_it_overlaps_clipped_to_the_grid():
     rng = np.random.default_rng(0)
     for x0, y0, w, h in rng.uniform([-3.0, -6.0, -0.5, -0.5], [11.0, 6.0, 4.0, 4.0], (2000, 4)):
         for box in ((x0, y0, x0 + w, y0 + h), (round(x0, 2), round(y0, 2), round(x0 + w, 1), round(y0 + h, 1))):
-            col0, col1 = math.floor((box[0] + 2.0) / 0.05), math.floor((box[2] + 2.0) / 0.05) + 1
-            row0, row1 = math.floor((box[1] + 5.0) / 0.05), math.floor((box[3] + 5.0) / 0.05) + 1
+            col0, col1 = (math.floor((box[k] + 2.0) / 0.05 + BORDER_TOLERANCE) + k // 2 for k in (0, 2))
+            row0, row1 = (math.floor((box[k] + 5.0) / 0.05 + BORDER_TOLERANCE) + k // 2 for k in (1, 3))
             assert spec.window(box[:2], box[2:]) == Window(row0, row1, col0, col1).clipped(spec)
     for box in ((np.nan, 0.0, 1.0, 1.0), (0.0, 0.0, np.inf, 1.0), (-np.inf, 0.0, 1.0, 1.0), (20.0, 0.0, 21.0, 1.0)):
         assert spec.window(box[:2], box[2:]) is None
@@ -129,3 +129,18 @@ def test_windows_union_grow_and_clip():
     costs = np.zeros(SPEC.shape)
     costs[Window(1, 3, 4, 7).slices] = 1
     assert costs.sum() == 6
+
+
+@pytest.mark.parametrize("origin", [(0.0, 0.0), (1000.0, -500.0), (-12345.65, 7890.1), (1e6, -1e6)])
+def test_a_point_on_a_cell_border_is_in_the_cell_above_whatever_the_origin(origin):
+    # 4.6 / 0.05 divides to 91.99999999999999: the box of a scene at y = 4.6 m started a row low, and the same scene
+    # moved with its origin gave other cells (a helper's probe: 324 cells of a costmap).
+    spec = GridSpec.from_size(0.05, origin, (10.0, 10.0))
+    borders = np.array([[k * 0.05, k * 0.05] for k in range(201)]) + origin
+    cells = spec.world_to_cell(borders)
+    assert (cells == np.arange(201)[:, None]).all()
+    inner = spec.world_to_cell(borders[1:] - 1e-7)  # a tenth of a micrometre below: the cell below
+    assert (inner == np.arange(200)[:, None]).all()
+    assert spec.contains(borders[:200]).all() and not spec.contains(borders[200:]).any()
+    window = spec.window((origin[0] + 2.0, origin[1] + 4.6), (origin[0] + 3.0, origin[1] + 5.0))
+    assert window == Window(92, 101, 40, 61)

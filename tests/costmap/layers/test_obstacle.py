@@ -87,7 +87,7 @@ def test_lidar_layer_writes_what_clearing_every_beam_then_marking_would(seed):
         window = layer.update(LayerInputs({PEOPLE: people, SCAN: scan}), None)
         r = scan.valid_ranges()  # no return (inf): cleared to the 10 m raytrace range, not marked
         origin = np.array(pose[:2])
-        clear_to = np.where(np.isinf(r), 10.0, r + 1e-6)  # a hit's cell: 1 um along the beam (the surface's side)
+        clear_to = np.where(np.isinf(r), 10.0, r + 1e-4 * SPEC.resolution)  # a hit's cell: 1e-4 cells along its beam
         ends = origin + scan.directions * clear_to[:, None]
         hits = SPEC.world_to_cell(ends[np.isfinite(r)])
         hits = hits[SPEC.in_bounds(hits)]
