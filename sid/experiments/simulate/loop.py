@@ -4,8 +4,9 @@ collision or the time limit.
 Per step of ``1 / rate_hz`` seconds, at time t (map frame, metres, radians, seconds):
 
 1. the people move to their scripted poses at t (``SimWorld.people_at``); a robot disc overlapping an obstacle or a
-   person's body (``lidar.body_radius``) is a collision and ends the run (also when a walker, who never avoids the
-   robot, walks into it while it stands still; the reason says so); the robot within ``goal_tolerance_m`` of the goal
+   person's body (``lidar.body_radius``) at any moment of the step that ends at t (robot and people moving straight
+   over it) is a collision and ends the run (also when a walker, who never avoids the robot, walks into it while it
+   stands still; the reason says so); the robot within ``goal_tolerance_m`` of the goal
    ends it with success; t past ``time_limit_s`` ends it without;
 2. the 2D LiDAR scans from the robot's pose (``sid.scenario.lidar.simulate_scan``: obstacles and people); with the
    social layer the camera sees the people (``sid.experiments.simulate.perception``) and the group detector groups
@@ -303,6 +304,7 @@ def simulate(
     state = RobotState(*scenario.robot.start)
     follower = FollowerParams(max_speed=limits.max_speed, max_turn_rate=limits.max_turn_rate)
     k = 0
+    before: tuple[tuple[float, float], list[Person]] | None = None  # the robot and the people one step earlier
     while True:
         t = k * dt
         people = world.people_at(t)
@@ -310,7 +312,7 @@ def simulate(
         trace.trajectory.append((t, state.x, state.y, state.yaw))
         trace.truth.append((people, truth_groups))
         trace.time_s = t
-        hit = collision((state.x, state.y), limits.radius, obstacles, people, lidar.body_radius)
+        hit = collision((state.x, state.y), limits.radius, obstacles, people, lidar.body_radius, before)
         if hit is not None:
             trace.collisions, trace.reason = 1, _collision_reason(hit, t, k, state, scenario.walks)
             break
@@ -341,6 +343,7 @@ def simulate(
                     t, state, people, seen.people, seen.groups, scan, sensing.costmap.master, planner.path, seen.image
                 )
             )
+        before = ((state.x, state.y), people)
         state = step(state, linear, angular, dt, limits)
         k += 1
     trace.plans, trace.replans, trace.planning_time_s = planner.plans, planner.replans, planner.time_s

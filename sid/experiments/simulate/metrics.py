@@ -4,8 +4,11 @@ each step (the groups ``sid.perception.groups.detect_groups`` finds on the exact
 
 Each step's segment (from the robot's position at t to its position at t + dt) is measured with
 ``sid.experiments.path_metrics`` against the people and groups of time t: length inside any group's interaction zone
-(``ospace_intrusion_m``, summed), whether it crosses the segment between two members (``crosses_group``), and its
-distance to every person's centre (``min_person_distance_m``: the smallest over the run). ``personal_space_fraction``
+(``ospace_intrusion_m``, summed) and whether it crosses the segment between two members (``crosses_group``). The
+distance to every person's centre (``min_person_distance_m``: the smallest over the run) is the closest approach
+over the step, the robot and each person moving straight from where they were at t to where they are at t + dt
+(``sid.experiments.simulate.world.closest_approach``, as the collision check): against the people of time t alone a
+walker crossing the robot's segment read nearer than they ever were. ``personal_space_fraction``
 means what it means for a planned path (``path_metrics``): the share of samples at most ``SAMPLE_SPACING_M`` apart
 along the driven path (every vertex included) closer than ``PERSONAL_DISTANCE_M`` to someone, each sample measured
 against the people of its step; steps spent standing still add no path and no samples. Map frame, metres, seconds.
@@ -30,6 +33,7 @@ from sid.experiments.path_metrics import (
     path_length,
 )
 from sid.experiments.simulate.loop import RunTrace
+from sid.experiments.simulate.world import closest_approach
 
 __all__ = ["run_metrics"]
 
@@ -45,7 +49,11 @@ def run_metrics(trace: RunTrace, straight_m: float) -> dict:
     for i, (people, groups) in enumerate(trace.truth):
         segment = xy[i : i + 2]
         positions = np.array([(p.x, p.y) for p in people], dtype=float).reshape(-1, 2)
-        nearest = min(nearest, min_distance_to_points(segment, positions))
+        if len(segment) == 2 and people:  # the trajectory and trace.truth run in step: the next step's people
+            (x0, y0), (x1, y1) = segment.tolist()
+            nearest = min(nearest, float(closest_approach((x0, y0), (x1, y1), people, trace.truth[i + 1][0]).min()))
+        else:
+            nearest = min(nearest, min_distance_to_points(segment, positions))
         if len(segment) == 1:  # the final position: the path's last vertex
             points = segment
         elif path_length(segment) > 0:  # the segment's samples but its end, the next segment's start

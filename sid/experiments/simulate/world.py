@@ -45,6 +45,7 @@ __all__ = [
     "SIM_FIELDS",
     "SimSettings",
     "SimWorld",
+    "closest_approach",
     "collision",
     "jittered",
     "load_world",
@@ -218,12 +219,43 @@ def obstacle_geometry(obstacles: list[Obstacle], walls: Costmap2D | None = None)
 
 
 def collision(
-    xy: tuple[float, float], radius: float, obstacles: Any, people: list[Person], body_radius: float
+    xy: tuple[float, float],
+    radius: float,
+    obstacles: Any,
+    people: list[Person],
+    body_radius: float,
+    before: tuple[tuple[float, float], list[Person]] | None = None,
 ) -> str | None:
-    """What the robot's disc (centre ``xy``, ``radius``) overlaps: "obstacle", "person N", or None."""
-    if obstacles is not None and obstacles.distance(Point(xy)) < radius:
+    """What the robot's disc (centre ``xy``, ``radius``) overlaps: "obstacle", "person N", or None. With ``before``
+    (the robot's centre and the people one step earlier), over the whole step: the robot and each person moving
+    straight from there (``closest_approach``), so that a walker who crosses the robot between two steps (a low
+    ``rate_hz``) is not missed."""
+    if before is None:
+        reach: Any = Point(xy)
+        gaps = {p.id: math.hypot(p.x - xy[0], p.y - xy[1]) for p in people}
+    else:
+        start, earlier = before
+        reach = LineString([start, xy]) if start != xy else Point(xy)
+        gaps = dict(zip((p.id for p in people), closest_approach(start, xy, earlier, people).tolist(), strict=True))
+    if obstacles is not None and obstacles.distance(reach) < radius:
         return "obstacle"
     for p in people:
-        if math.hypot(p.x - xy[0], p.y - xy[1]) < radius + body_radius:
+        if gaps[p.id] < radius + body_radius:
             return f"person {p.id}"
     return None
+
+
+def closest_approach(
+    start: tuple[float, float], end: tuple[float, float], earlier: list[Person], people: list[Person]
+) -> np.ndarray:
+    """(N,) the least distance (m) between the robot, moving straight from ``start`` to ``end`` over a step, and each
+    of ``people``, moving straight from where ``earlier`` (the same ids, one step before) had them; a person not in
+    ``earlier`` is taken as standing. Relative motion is linear, so the least distance has a closed form."""
+    then = {p.id: (p.x, p.y) for p in earlier}
+    now = np.array([(p.x, p.y) for p in people], dtype=float).reshape(-1, 2)
+    before = np.array([then.get(p.id, (p.x, p.y)) for p in people], dtype=float).reshape(-1, 2)
+    r0 = before - np.asarray(start, dtype=float)  # person from robot, at the step's start and end
+    dr = now - np.asarray(end, dtype=float) - r0
+    moved = np.einsum("ij,ij->i", dr, dr)
+    s = np.clip(-np.einsum("ij,ij->i", r0, dr) / np.where(moved > 0, moved, 1.0), 0.0, 1.0)
+    return np.hypot(*(r0 + s[:, None] * dr).T)

@@ -209,3 +209,34 @@ def test_a_start_grazing_an_inflated_wall_escapes_in_a_second_planner_call_that_
     assert result is not None and result.success
     assert tuple(result.path[0]) == start and tuple(result.path[1]) != start  # the path leads out from the escape
     assert planner.plans == 2 and "no path: start" in planner.message
+
+
+def _ambush(start_time: float) -> dict:
+    """At 1 Hz: a walker comes out from behind a box at 1.5 m/s across the robot's straight way (0.5 m/s along y = 0),
+    and at whole seconds stands 0.75 m to one side of it and then the other."""
+    return {
+        "name": "ambush",
+        "map": {"resolution": 0.05, "origin": [-1.0, -4.0], "size": [12.0, 8.0]},
+        "obstacles": [{"type": "box", "min": [2.5, -4.0], "max": [3.5, -0.8]}],
+        "people": [{"id": 1, "x": 4.0, "y": -3.0, "theta": 1.5708, "path": [[4.0, 3.5]], "speed": 1.5,
+                    "start_time": start_time}],
+        "robot": {"start": [0.0, 0.0, 0.0], "goal": [10.0, 0.0, 0.0], "radius": 0.25},
+        "simulation": {"rate_hz": 1.0, "time_limit_s": 40.0},
+    }  # fmt: skip
+
+
+def test_a_walker_crossing_the_robot_between_two_steps_is_a_collision():
+    # Checked at the steps alone, the walker stood 0.75 m from the robot at t = 7 s and t = 8 s, and the run reached
+    # its goal; in between they were 0.24 m apart, under the 0.45 m of the two bodies.
+    trace = simulate(world_from_dict(_ambush(5.5)), EXACT)
+    assert not trace.success and trace.collisions == 1 and trace.reason.startswith("collision with person 1 at t = 8")
+    assert run_metrics(trace, 10.0)["min_person_distance_m"] == pytest.approx(0.237, abs=0.001)
+
+
+def test_the_closest_approach_is_over_the_step_not_against_where_the_people_were_at_its_start():
+    # Half a second earlier the walker passes in front of the robot: 0.495 m at the closest (a walker moving straight
+    # between the steps' positions); the segment against the walker's position at each step's start read 0.388 m.
+    world = world_from_dict(_ambush(5.0) | {"simulation": {"rate_hz": 2.0, "time_limit_s": 40.0}})
+    trace = simulate(world, EXACT)
+    assert trace.success and trace.collisions == 0
+    assert run_metrics(trace, 10.0)["min_person_distance_m"] == pytest.approx(0.4947, abs=0.001)

@@ -9,7 +9,7 @@ from costmap.grid import GridSpec
 from costmap.mapfile import write_map
 from costmap.occupancy import OCC_OCCUPIED, OccupancyGrid
 from sid.documents import InputWarning
-from sid.experiments.simulate.world import collision, obstacle_geometry, world_from_dict
+from sid.experiments.simulate.world import closest_approach, collision, obstacle_geometry, world_from_dict
 from sid.perception.people import Person
 from sid.scenario.loader import BoxObstacle, ScenarioError, SegmentObstacle
 from tests.experiments.simulate.tiny import PAIR, TINY, tiny_world
@@ -128,3 +128,19 @@ def test_collision_with_obstacles_and_people():
     assert collision((1.6, 0.0), 0.25, walls, people, 0.2) == "person 3"
     assert collision((1.5, 0.0), 0.25, walls, people, 0.2) is None
     assert collision((0.0, 0.0), 0.25, None, [], 0.2) is None
+
+
+def test_the_closest_approach_of_two_straight_motions_is_the_least_distance_between_them():
+    # Robot from (0, 0) to (1, 0); person 1 from (0.5, -1) to (0.5, 1): they meet at (0.5, 0) half-way through.
+    # Person 2 walks alongside, 0.3 m to the left; person 3 was not there a step before (taken as standing).
+    earlier = [Person(1, 0.5, -1.0, None), Person(2, 0.0, 0.3, None)]
+    people = [Person(1, 0.5, 1.0, None), Person(2, 1.0, 0.3, None), Person(3, 2.0, 0.0, None)]
+    gaps = closest_approach((0.0, 0.0), (1.0, 0.0), earlier, people)
+    assert gaps == pytest.approx([0.0, 0.3, 1.0])
+    rng = np.random.default_rng(0)
+    for _ in range(200):  # against sampling the step finely
+        a0, a1, b0, b1 = rng.uniform(-2, 2, (4, 2))
+        exact = closest_approach(tuple(a0), tuple(a1), [Person(1, *b0, None)], [Person(1, *b1, None)])[0]
+        s = np.linspace(0, 1, 20001)[:, None]
+        sampled = np.hypot(*((b0 + s * (b1 - b0)) - (a0 + s * (a1 - a0))).T).min()
+        assert exact == pytest.approx(sampled, abs=1e-6) and exact <= sampled + 1e-12
