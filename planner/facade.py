@@ -135,9 +135,16 @@ def check_endpoints(field: CostField) -> None:
     labels = free_regions(field)
     (sr, sc), (gr, gc) = cells
     if labels[sr, sc] != labels[gr, gc]:
+        free, _ = ndimage.label(field.free)  # free cells, without the planner's margin of one cell
+        margin = (
+            f"; only by the planners' margin of one cell ({spec.resolution:g} m) beyond the robot's radius: a finer "
+            "costmap resolution narrows it"
+            if free[sr, sc] == free[gr, gc]
+            else ""
+        )
         raise WalledOffError(
             "no path: the start and the goal lie in separate free regions of the costmap (walled off from each "
-            f"other for a robot of radius {problem.robot_radius:.2f} m)"
+            f"other for a robot of radius {problem.robot_radius:.2f} m{margin})"
         )
 
 

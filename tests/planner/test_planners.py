@@ -578,3 +578,21 @@ def test_the_clearance_test_is_the_exact_euclidean_distance_of_cell_centres(radi
     field = CostField(PlanningProblem(Costmap2D(spec, costs), (0.0, 3.0), (1.0, 4.0), radius))
     clearance = ndimage.distance_transform_edt(~lethal) * spec.resolution
     np.testing.assert_array_equal(field.free, clearance > radius)
+
+
+def test_a_gap_closed_only_by_the_planners_one_cell_margin_is_named_as_such():
+    # A 1 m door for a 0.5 m robot on 0.2 m cells: two free cells through it, none plannable (the planners keep one
+    # cell more than the radius); the refusal said the robot could not get through, with no word of the margin.
+    spec = GridSpec.from_size(0.2, (0.0, 0.0), (8.0, 6.0))
+    costs = np.zeros(spec.shape, np.uint8)
+    costs[:13, 20:22] = LETHAL  # walls x 4.0-4.4 m, y 0-2.6 m and 3.4-6 m: the door y 2.6-3.4 m
+    costs[17:, 20:22] = LETHAL
+    problem = PlanningProblem(Costmap2D(spec, costs), (1.0, 3.0), (7.0, 3.0), 0.25)
+    field = CostField(problem)
+    assert field.free[14:16, 20:22].all() and not field.plannable[:, 20:22].any()
+    with pytest.raises(WalledOffError, match=r"only by the planners' margin of one cell \(0.2 m\) beyond the robot"):
+        plan(problem, "grid")
+    costs[17:, 20:22] = 0  # open: the message of a true wall says nothing of the margin
+    costs[:, 20:22] = LETHAL
+    with pytest.raises(WalledOffError, match=r"for a robot of radius 0.25 m\)$"):
+        plan(PlanningProblem(Costmap2D(spec, costs), (1.0, 3.0), (7.0, 3.0), 0.25), "grid")
