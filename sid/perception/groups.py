@@ -105,8 +105,8 @@ class GroupParams:
       (the nearest other when nobody is that close), and pairs this close proposing their midpoint. Off by default:
       on the pedestrian sets, strangers waiting side by side become groups (docs/groups.md, "Positions only"); 1.0
       chosen by cross-validation on the F-formation benchmarks with every facing removed.
-    positions_only_radius_max: largest o-space radius (m) of a group from positions alone. 0.7, chosen with
-      positions_only_reach.
+    positions_only_radius_max: largest o-space radius (m) of a group from positions alone (the smallest is
+      radius_min, or this when radius_min is larger). 0.7, chosen with positions_only_reach.
     positions_only_alone_price: price (m^2) of a person without a facing left alone, for groups from positions
       alone (the group price is group_price). 0.8, chosen with positions_only_reach.
     body_radius: a member's line to the centre must pass farther than this (m) from everyone else (the o-space is
@@ -246,11 +246,18 @@ class GroupParams:
     @cached_property
     def positions_only_model(self) -> OSpaceModel:
         """``ospace_model`` for the people without a facing left alone, grouped by their positions only."""
-        names = {"pair_reach": "reach", "radius_max": "radius_max", "alone_price": "alone_price"}
+        # ospace_model checked the fields it shares; radius_min can only fail here as min(radius_min, radius_max)
+        names = {
+            "pair_reach": "reach",
+            "radius_min": "radius_max",
+            "radius_max": "radius_max",
+            "alone_price": "alone_price",
+        }
         try:
             return replace(
                 self.ospace_model,
                 pair_reach=self.positions_only_reach,
+                radius_min=min(self.radius_min, self.positions_only_radius_max),  # a radius_min above it: one radius
                 radius_max=self.positions_only_radius_max,
                 alone_price=self.positions_only_alone_price,
             )

@@ -287,7 +287,7 @@ def test_a_wide_ring_of_people_without_facings_is_one_group():
 
 @pytest.mark.parametrize(
     ("field", "value"),
-    [("positions_only_reach", -1.0), ("positions_only_radius_max", 0.1), ("positions_only_alone_price", 0.0)],
+    [("positions_only_reach", -1.0), ("positions_only_radius_max", 0.0), ("positions_only_alone_price", 0.0)],
 )
 def test_bad_positions_only_fields_are_named(field, value):
     with pytest.raises(ValueError, match=f"groups: {field} "):
@@ -463,3 +463,12 @@ def test_facings_parallel_to_a_denormal_raise_no_overflow_warning(method, tiny):
         groups = detect_groups(people, params)
     parallel = detect_groups([*people[:1], replace(people[1], theta=0.0), *people[2:]], params)
     assert [g.members for g in groups] == [g.members for g in parallel]
+
+
+def test_a_smallest_radius_above_the_positions_only_largest_is_accepted_off_and_on() -> None:
+    # radius_min 0.75 m was refused as "positions_only_radius_max must be ... in [0.75, 1000]", a field not set, with
+    # positions-only groups off (the default); on, their circles are 0.7 m, the one radius left.
+    people = [Person(1, 0.0, 0.75, None), Person(2, 0.0, -0.75, None)]
+    assert GroupParams(radius_min=0.75).positions_only_model.radius_min == 0.7
+    found = detect_groups(people, GroupParams(radius_min=0.75, positions_only_reach=1.6))
+    assert [g.members for g in found] == [(1, 2)]
