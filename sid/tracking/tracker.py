@@ -155,8 +155,10 @@ class PeopleTracker:
         self._hits[rows] += 1
         self._last_hit[rows] = timestamp
         self._unseen[rows] = 0.0
+        # Two detections confirm when they are confirm_time apart: the last one's time, not this frame's (a track
+        # missed now, 0.2 s after its first hit at 10 Hz, was confirmed by the miss that should end it).
         self._confirmed |= (self._hits >= p.confirm_hits) | (
-            (self._hits >= 2) & (timestamp - self._first_hit >= p.confirm_time - TIME_TOLERANCE)
+            (self._hits >= 2) & (self._last_hit - self._first_hit >= p.confirm_time - TIME_TOLERANCE)
         )
         self._detection[:] = -1
         self._detection[rows] = cols

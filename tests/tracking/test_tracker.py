@@ -310,6 +310,17 @@ def test_a_slow_detector_confirms_a_track_after_two_detections_confirm_time_apar
     assert reported == [k + 1 >= hits_to_confirm for k in range(4)]
 
 
+@pytest.mark.parametrize("rate", [10.0, 15.0, 5.0])
+def test_a_miss_after_two_detections_ends_the_tentative_track_whatever_the_rate(rate: float) -> None:
+    # At 10 Hz the miss came 0.2 s after the first detection, and the rule "two detections confirm_time apart" read
+    # the miss's time: the track was confirmed by the frame that should end it, and clutter became ghost people.
+    tracker = PeopleTracker(TrackerParams(confirm_hits=3, confirm_time=0.2))
+    reported = [tracker.update([Person(0, 2.0, 0.0)] if k in (0, 1) else [], k / rate) for k in range(12)]
+    confirmed_at_two = 1 / rate >= 0.2  # 5 Hz: the two detections themselves are 0.2 s apart
+    assert [bool(r) for r in reported[:2]] == [False, confirmed_at_two]
+    assert all(not r for r in reported[2:]) or confirmed_at_two
+
+
 def _walker_ids(frames: list[tuple[float, list[Person], dict[int, tuple[float, float]]]], view=None) -> dict[int, set]:
     """The track ids that showed each walker (key: walker, value: the ids of the track nearest to where the walker
     was detected, when within 0.3 m), over ``frames`` of (time s, detections, walker -> true position of those
