@@ -114,7 +114,7 @@ class PeopleTracker:
         self._last_hit = np.zeros(0)
         self._unseen = np.zeros(0)  # seconds undetected since the last hit while the camera could see the track
         self._first_hit = np.zeros(0)
-        self._facing = np.zeros((0, 2))  # unit vectors, NaN while unknown
+        self._facing = np.zeros((0, 2))  # exponential averages of unit facing vectors (length <= 1), NaN: unknown
         self._facing_time = np.zeros(0)  # timestamp (s) of the last measured facing, NaN while unknown
         self._quality = np.zeros(0)  # the facing's orientation quality in [0, 1], averaged as it; NaN while unknown
         self._detection = np.zeros(0, dtype=np.intp)  # index of this frame's matched detection, -1: none
@@ -203,9 +203,10 @@ class PeopleTracker:
         return gated_assignment(distance, allowed)
 
     def _smooth_facing(self, rows: np.ndarray, measured: np.ndarray, quality: np.ndarray, timestamp: float) -> None:
-        """Average facings (K, 2) unit vectors (NaN: none) measured at ``timestamp`` (s) into the tracks ``rows`` on
-        the unit circle, each weighted by the time since its track's last measured facing; their orientation
-        qualities (K,) (NaN: none) likewise."""
+        """Average facings (K, 2) unit vectors (NaN: none) measured at ``timestamp`` (s) into the tracks ``rows``
+        (exponentially, time constant ``facing_tau``: each weighted by the time since its track's last measured
+        facing; the average's direction is the track's facing); their orientation qualities (K,) (NaN: none)
+        likewise."""
         tau = self.params.facing_tau
         old, old_quality = self._facing[rows], self._quality[rows]
         weight = 1.0 - np.exp(-(timestamp - self._facing_time[rows]) / tau) if tau > 0 else np.ones(len(rows))
@@ -218,8 +219,10 @@ class PeopleTracker:
         norm = np.sqrt(mixed[:, 0] ** 2 + mixed[:, 1] ** 2)
         flat = ~(norm > 1e-9)  # exactly opposite facings average to nothing: take the new one
         mixed[flat], mixed_quality[flat] = measured[flat], quality[flat]
-        norm[flat] = 1.0
-        self._facing[rows] = mixed / norm[:, None]
+        # Not renormalised: renormalised each frame, a facing turned exactly round (a detector's front/back flip)
+        # left (1 - 2w) times the old one, which kept the old direction for ever (7.8 s at 10 Hz with a little
+        # noise); the average itself shrinks and turns over within tau ln 2 whatever the rate.
+        self._facing[rows] = mixed
         self._quality[rows] = mixed_quality
         self._facing_time[rows[~np.isnan(measured[:, 0])]] = timestamp
 

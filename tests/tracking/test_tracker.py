@@ -321,6 +321,26 @@ def test_a_miss_after_two_detections_ends_the_tentative_track_whatever_the_rate(
     assert all(not r for r in reported[2:]) or confirmed_at_two
 
 
+@pytest.mark.parametrize("rate", [10.0, 30.0])
+@pytest.mark.parametrize("turn", [math.pi, math.radians(170)])
+def test_a_person_turning_round_is_followed_within_the_facing_time_constant(rate: float, turn: float) -> None:
+    # Renormalised every frame, the average of a facing and its exact reverse kept the old direction: a person who
+    # turned round (or a detector's front/back flip) still faced the old way 7.8 s later at 10 Hz.
+    tracker = PeopleTracker(TrackerParams(facing_tau=0.3))
+    frames = [(k / rate, 0.0 if k / rate < 2.0 else turn) for k in range(int(4 * rate))]
+    settled = None
+    for t, theta in frames:
+        (track,) = tracker.update([Person(0, 2.0, 0.0, theta)], t) or [None]
+        if (
+            t >= 2.0
+            and track is not None
+            and settled is None
+            and abs(math.remainder(track.theta - turn, math.tau)) < 0.5
+        ):
+            settled = t - 2.0
+    assert settled is not None and settled <= 0.3 * math.log(2) + 1 / rate  # tau ln 2, to the next frame
+
+
 def _walker_ids(frames: list[tuple[float, list[Person], dict[int, tuple[float, float]]]], view=None) -> dict[int, set]:
     """The track ids that showed each walker (key: walker, value: the ids of the track nearest to where the walker
     was detected, when within 0.3 m), over ``frames`` of (time s, detections, walker -> true position of those
