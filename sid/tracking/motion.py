@@ -29,11 +29,12 @@ class MotionStates:
     def __len__(self) -> int:
         return len(self.position)
 
-    def predict(self, dt: float, q: float) -> None:
-        """Advance every track by ``dt`` seconds at constant velocity, growing the covariance by the process noise."""
+    def predict(self, dt: float, q: float, hold: np.ndarray | None = None) -> None:
+        """Advance every track by ``dt`` seconds at constant velocity, growing the covariance by the process noise;
+        the tracks ``hold`` (N,) bool marks keep their position (the covariance grows all the same)."""
         if not len(self.position):
             return  # nothing to advance; dt may be any gap then (a Python float's dt**3 overflows past ~1e102 s)
-        self.position += self.velocity * dt
+        self.position += self.velocity * (dt if hold is None else np.where(hold, 0.0, dt)[:, None])
         c = self.covariance  # in place, pp first: each line reads the columns after it before they change
         c[:, 0] += 2 * dt * c[:, 1] + dt * dt * c[:, 2] + q * dt**3 / 3
         c[:, 1] += dt * c[:, 2] + q * dt * dt / 2

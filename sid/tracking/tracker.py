@@ -145,7 +145,10 @@ class PeopleTracker:
         # Tracks undetected for longer than out_of_view_timeout expire below whatever their prediction says: dropped
         # first, so that the prediction never spans more than that (a gap of 1e308 s would overflow it).
         self._keep(timestamp - self._last_hit <= p.out_of_view_timeout + TIME_TOLERANCE)
-        self._motion.predict(dt, q)
+        # A standing track out of the camera's view holds its place: its velocity is noise about zero, and a group
+        # that left the view drifted 0.5 m in the 4 s its tracks coast (a probe's drive_past_group). In view, a miss
+        # is the detector's, and the track coasts on as before.
+        self._motion.predict(dt, q, hold=~self._walking & (self._detection < 0) & ~self._in_view)
         self._in_view = np.ones(len(self._ids), dtype=bool) if view is None else view.contains(self._motion.position)
         self._unseen += np.where(self._in_view & ~_behind(view, self._motion.position, positions), dt, 0.0)
         self._keep(~self._expired())

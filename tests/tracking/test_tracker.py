@@ -415,3 +415,22 @@ def test_a_track_missed_for_exactly_its_timeouts_lives_whatever_the_clocks_offse
             tracker.update([Person(0, 2.0, 0.0)], t)
         alive = [bool(tracker.update([], t, view)) for t in times[5:]]
         assert alive == [True] * steps + [False], (params, alive)
+
+
+def test_a_standing_track_out_of_view_holds_its_place_while_a_walking_one_coasts_on() -> None:
+    # A camera looking +x from the origin (87 degrees, 6 m); both people seen for 2 s at 15 Hz, then the view turns
+    # away (a robot driving past). The standing person's velocity is noise about zero: coasting on it for the 4 s a
+    # track outlives its person out of view moved a group 0.5 m (a probe's drive_past_group).
+    tracker = PeopleTracker()
+    rng = np.random.default_rng(1)
+    ahead, away = ViewCone(0.0, 0.0, 0.0, math.radians(87), 6.0), ViewCone(0.0, 0.0, math.pi, math.radians(87), 6.0)
+    for k in range(60):
+        t = k / 15
+        standing = Person(1, 3.0 + rng.normal(0, 0.05), 1.0 + rng.normal(0, 0.05), math.pi)
+        walking = Person(2, 1.0 + 1.2 * t + rng.normal(0, 0.05), -1.0, 0.0)
+        tracks = tracker.update([standing, walking] if t < 2.0 else [], t, ahead if t < 2.0 else away)
+        if k == 29:
+            held = {p.id: (p.x, p.y, p.state) for p in tracks}
+    final = {p.id: (p.x, p.y, p.state) for p in tracks}
+    assert held[1][2] == "standing" and final[1][:2] == pytest.approx(held[1][:2], abs=0.02)
+    assert held[2][2] == "walking" and final[2][0] > held[2][0] + 1.0  # 1.2 m/s for 1.9 s
