@@ -39,7 +39,9 @@ from sid.experiments.fformation import (
     load_dataset_in_metres,
     missing_members,
     parse_threshold,
+    repeated_members,
     score_all,
+    shifted_ids,
     unit_warning,
     with_facing_noise,
     without_facings,
@@ -332,9 +334,24 @@ def _warn_about_data(name: str, frames: list[LabelledFrame], scale: float) -> No
         )
     missing, total = missing_members(frames)
     if missing:
+        shift = shifted_ids(frames)
+        why = (
+            f"every member would be there with its id {shift:+d}: ids counted from {1 - shift if shift > 0 else 1} in "
+            f"the ground truth and from {1 if shift > 0 else 0} in the features?"
+            if shift
+            else "annotation slips if few; if many, the groups use other ids than the features"
+        )
         print(
             f"sid eval fformation: warning: {name}: {missing} of the {total} ground-truth group members are not among "
-            "their frame's people (annotation slips if few; if many, the groups use other ids than the features)",
+            f"their frame's people ({why})",
+            file=sys.stderr,
+        )
+    repeated, frames_with = repeated_members(frames)
+    if repeated:
+        print(
+            f"sid eval fformation: warning: {name}: {plural(repeated, 'ground-truth member')} listed in two or more "
+            f"groups of one frame (in {plural(frames_with, 'frame')}): nobody stands in two F-formations; another "
+            "encoding of the groups (padding, ids)?",
             file=sys.stderr,
         )
 

@@ -22,6 +22,7 @@ over its frames, and F1 = 2PR / (P + R).
 
 from __future__ import annotations
 
+import collections
 import dataclasses
 import itertools
 import math
@@ -49,6 +50,7 @@ __all__ = [
     "GROUP_ERRORS",
     "Fold",
     "LabelledFrame",
+    "PLAUSIBLE_MEMBER_M",
     "PLAUSIBLE_NEIGHBOUR_M",
     "Score",
     "UNIT_SCALES",
@@ -69,6 +71,9 @@ __all__ = [
     "load_dataset_in_metres",
     "load_sequence",
     "load_settings_gc",
+    "median_member_distance",
+    "repeated_members",
+    "shifted_ids",
     "median_neighbour_distance",
     "missing_members",
     "most_shared",
@@ -307,14 +312,26 @@ PLAUSIBLE_NEIGHBOUR_M = (0.1, 5.0)
 """The range (m) of the median distance from a person to their nearest neighbour in scenes of people talking: bodies
 keep them more than 0.1 m apart, conversation within 5 m. A median outside it means the positions, as scaled, are
 not metres (the Verona sets store centimetres: ``scale=0.01``)."""
+PLAUSIBLE_MEMBER_M = (0.3, 2.0)
+"""The range (m) of the median distance from a ground-truth group member to the nearest fellow member: people in a
+conversation stand 0.4-1.5 m from the nearest other (0.60-0.91 m on the four Verona sets). Narrower than a decade, so
+one unit at most fits it, and people standing alone do not pull it (in a set of mostly loners the median gap of
+everyone fitted centimetres and millimetres alike)."""
 UNIT_SCALES: dict[str, float] = {"metres": 1.0, "centimetres": 0.01, "millimetres": 0.001}
 """The units a dataset's positions are likely in, with the ``scale`` that turns them into metres."""
 
 
 def fitting_unit(frames: Sequence[LabelledFrame], scale: float = 1.0) -> tuple[str, float] | None:
     """The unit of ``UNIT_SCALES`` (name, scale to metres) in which the positions of ``frames``, loaded with
-    ``scale``, look like people's (``PLAUSIBLE_NEIGHBOUR_M``), nearest to it first; None when none does or no frame
-    holds two people."""
+    ``scale``, look like people's: the one in which the ground-truth groups' members stand as conversations do
+    (``PLAUSIBLE_MEMBER_M``), else by everyone's nearest neighbour (``PLAUSIBLE_NEIGHBOUR_M``), nearest to it
+    first; None when none does or no frame holds two people."""
+    member = median_member_distance(frames)
+    if member:
+        low, high = PLAUSIBLE_MEMBER_M
+        fit = [(unit, fit) for unit, fit in UNIT_SCALES.items() if low <= member / scale * fit <= high]
+        if fit:
+            return fit[0]
     gap = median_neighbour_distance(frames)
     if not gap:  # None, or 0: most people share their position with another, which no scale mends
         return None
@@ -328,8 +345,20 @@ def unit_warning(frames: Sequence[LabelledFrame], scale: float) -> str | None:
     """Why the positions of ``frames``, loaded with ``scale``, are implausible as metres, with the scale that fits
     them best (``fitting_unit``); None when they look like metres (``PLAUSIBLE_NEIGHBOUR_M``) or no frame holds two
     people."""
-    gap = median_neighbour_distance(frames)
+    gap, member = median_neighbour_distance(frames), median_member_distance(frames)
     low, high = PLAUSIBLE_NEIGHBOUR_M
+    if member and not PLAUSIBLE_MEMBER_M[0] <= member <= PLAUSIBLE_MEMBER_M[1]:
+        low, high = PLAUSIBLE_MEMBER_M
+        fit = fitting_unit(frames, scale)
+        hint = (
+            f"the file's units look like {fit[0]}, scale {fit[1]:g}"
+            if fit and fit[1] != scale
+            else "check the file's units (pixels of a top view?)"
+        )
+        return (
+            f"scaled by {scale:g}, the median distance from a ground-truth group member to the nearest fellow member "
+            f"is {member:.3g} m, implausible for a conversation (expected {low:g}-{high:g} m); {hint}"
+        )
     if gap is None or low <= gap <= high:
         return None
     hint = "check the file's units"
@@ -378,6 +407,49 @@ def missing_members(frames: Sequence[LabelledFrame]) -> tuple[int, int]:
             total += len(group)
             missing += len(group - ids)
     return missing, total
+
+
+def repeated_members(frames: Sequence[LabelledFrame]) -> tuple[int, int]:
+    """(ground-truth members listed in two or more groups of their frame, frames with any): nobody stands in two
+    F-formations at once, so these are an encoding the reader took otherwise (padding, another id scheme)."""
+    repeated = frames_with = 0
+    for frame in frames:
+        counts = collections.Counter(i for group in frame.truth for i in group)
+        twice = [i for i, n in counts.items() if n > 1]
+        repeated += len(twice)
+        frames_with += bool(twice)
+    return repeated, frames_with
+
+
+def shifted_ids(frames: Sequence[LabelledFrame]) -> int | None:
+    """The shift (+1 or -1) that, added to every ground-truth member id, puts every member among their frame's
+    people when the ids as given leave some out: ids counted from 0 in one file and from 1 in the other; else None."""
+    missing, _ = missing_members(frames)
+    if not missing:
+        return None
+    for shift in (1, -1):
+        if all(i + shift in {p.id for p in f.people} for f in frames for group in f.truth for i in group):
+            return shift
+    return None
+
+
+def median_member_distance(frames: Sequence[LabelledFrame]) -> float | None:
+    """Median over the ground-truth groups' members present in their frame of the distance to the nearest fellow
+    member (input units); None when no group has two members present, or more than a twentieth of the members are
+    not among their frame's people (the groups then use other ids, and the people they name are not the members)."""
+    missing, total = missing_members(frames)
+    if missing > 0.05 * total:
+        return None
+    distances: list[float] = []
+    for frame in frames:
+        where = {p.id: (p.x, p.y) for p in frame.people}
+        for group in frame.truth:
+            xy = np.array([where[i] for i in sorted(group) if i in where], dtype=float).reshape(-1, 2)
+            if len(xy) >= 2:
+                gaps = np.hypot(*(xy[:, None, :] - xy[None, :, :]).transpose(2, 0, 1))
+                np.fill_diagonal(gaps, np.inf)
+                distances.extend(gaps.min(axis=1).tolist())
+    return float(np.median(distances)) if distances else None
 
 
 def median_neighbour_distance(frames: Sequence[LabelledFrame]) -> float | None:
@@ -777,14 +849,18 @@ def _people(cell: np.ndarray, scale: float, degrees: bool, where: str) -> tuple[
 
 def _groups(cell: object, where: str, present: set[int]) -> list[frozenset[int]]:
     """Member-id sets from a GTgroups cell: a cell array of id arrays (possibly nested), an id vector, a matrix of
-    one group per row (shorter groups padded with NaN, or with 0 when nobody ``present`` has id 0), or empty."""
+    one group per row (shorter groups padded with NaN, or with 0: any 0 when nobody ``present`` has id 0, the 0s that
+    end rows when 0 is in more than one row, as nobody stands in two groups), or empty."""
     if isinstance(cell, np.ndarray) and cell.dtype == object:
         return [g for item in cell.ravel() for g in _groups(item, where, present)]
     ids = _real(cell, f"{where}: a group must list real ids")
     if ids.size == 0:
         return []
     if ids.ndim == 2 and min(ids.shape) > 1:  # MATLAB's [1 2; 3 4], two groups of two; [1 2 0; 3 4 5]: padded
-        padding = np.isnan(ids) | ((ids == 0) & (0 not in present))
+        zero = ids == 0
+        ending = np.flip(np.logical_and.accumulate(np.flip(zero | np.isnan(ids), axis=1), axis=1), axis=1) & zero
+        rows_with_zero = int(zero.any(axis=1).sum())  # ids from 0: [0 2 9; 3 8 0] is (0, 2, 9) and (3, 8)
+        padding = np.isnan(ids) | (zero & (0 not in present)) | (ending & (rows_with_zero > 1))
         return [g for row, pad in zip(ids, padding, strict=True) for g in _groups(row[~pad], where, present)]
     if not np.all(np.isfinite(ids)) or not np.array_equal(ids, np.round(ids)):
         raise ValueError(f"fformation: {where}: group member ids must be finite whole numbers, got {ids.ravel()[:10]}")

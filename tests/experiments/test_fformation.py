@@ -17,6 +17,7 @@ from sid.experiments.fformation import (
     YawUnitError,
     cross_validate,
     evaluate,
+    fitting_unit,
     format_threshold,
     frame_precision_recall,
     group_errors,
@@ -24,11 +25,14 @@ from sid.experiments.fformation import (
     load_dataset_any_yaw,
     load_dataset_in_metres,
     load_sequence,
+    median_member_distance,
     median_neighbour_distance,
     missing_members,
     most_shared,
     parse_threshold,
+    repeated_members,
     score,
+    shifted_ids,
     unit_warning,
     with_facing_noise,
     without_facings,
@@ -578,3 +582,59 @@ def test_the_detected_group_sharing_most_members_fewest_strangers_on_ties_is_cho
     assert most_shared([frozenset({1, 2, 9}), frozenset({1, 2}), frozenset({3})], true) == 1
     assert most_shared([frozenset({1, 5}), frozenset({2, 6})], frozenset({1, 2})) == 0  # the first of equals
     assert most_shared([frozenset({7, 8})], true) == 0 and most_shared([], true) is None
+
+
+def _circles(groups: list[int], loners: int, unit: float) -> tuple[np.ndarray, list[list[int]]]:
+    """One frame: groups of the given sizes on 0.7 m circles facing their centres, 6 m apart, and people standing
+    alone 4 m from anyone, in units of ``unit`` metres (0.01: centimetres); the rows and the true groups."""
+    rows, truth, k = [], [], 1
+    for g, size in enumerate(groups):
+        members = []
+        for j in range(size):
+            a = 2 * math.pi * j / size
+            rows.append([k, (6.0 * g + 0.7 * math.cos(a)) / unit, 0.7 * math.sin(a) / unit, a + math.pi])
+            members, k = [*members, k], k + 1
+        truth.append(members)
+    for j in range(loners):
+        rows.append([k, 4.0 * j / unit, 20.0 / unit, 0.0])
+        k += 1
+    return np.array(rows), truth
+
+
+def test_the_unit_comes_from_the_annotated_groups_spacing_when_most_people_stand_alone(tmp_path):
+    # Everyone's median gap (4 m between the loners) fits centimetres and millimetres alike; the members' (1.4 m,
+    # 1.21 m in a triangle) fits centimetres only. Read as millimetres every group was lost (F1 0).
+    rows, truth = _circles([2, 2, 3], 9, 0.01)
+    frames = load_sequence(write_sequence(tmp_path / "Sparse", [rows], {1: truth}))
+    assert fitting_unit(frames) == ("centimetres", 0.01)
+    assert median_member_distance(frames) == pytest.approx(140.0)  # the pairs, 1.4 m apart, and the trio, 1.21 m
+
+
+def test_a_unit_that_puts_group_members_implausibly_close_is_named(tmp_path):
+    # A top view at 20 pixels per metre read as centimetres: everyone's gaps look like people's, the members' do not.
+    rows, truth = _circles([2, 3], 2, 0.05)
+    frames = load_sequence(write_sequence(tmp_path / "Pixels", [rows], {1: truth}), scale=0.01)
+    assert "ground-truth group member to the nearest fellow member is 0.242 m, implausible" in str(
+        unit_warning(frames, 0.01)
+    )
+
+
+def test_ground_truth_ids_shifted_by_one_and_members_in_two_groups_are_found(tmp_path):
+    rows, truth = _circles([2, 3], 0, 0.01)
+    rows[:, 0] -= 1  # features count from 0, the ground truth from 1
+    frames = load_sequence(write_sequence(tmp_path / "Shifted", [rows], {1: truth}), scale=0.01)
+    assert shifted_ids(frames) == -1 and repeated_members(frames) == (0, 0)
+    twice = [replace(frames[0], truth=[frozenset({0, 1}), frozenset({1, 2, 3})])]
+    assert shifted_ids(twice) is None and repeated_members(twice) == (1, 1)
+
+
+def test_a_matrix_of_groups_padded_with_0_whose_ids_start_at_0_keeps_person_0_in_one_group(tmp_path):
+    # [0 2 9; 3 8 0]: 0 is in two rows, and nobody stands in two groups, so the 0 that ends a row is padding.
+    rows = np.array([[i, 100.0 * i, 0.0, 0.0] for i in range(10)])
+    folder = tmp_path / "Padded"
+    folder.mkdir()
+    scipy.io.savemat(folder / "features.mat", {"features": cells([rows]), "timestamp": np.array([[1]])})
+    groups = cells([np.array([[0, 2, 9], [3, 8, 0]], dtype=float)])
+    scipy.io.savemat(folder / "groundtruth.mat", {"GTgroups": groups, "GTtimestamp": np.array([[1]])})
+    (frame,) = load_sequence(folder)
+    assert sorted(map(sorted, frame.truth)) == [[0, 2, 9], [3, 8]]
