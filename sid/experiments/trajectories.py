@@ -153,6 +153,8 @@ def load_trajectory_set(folder: str | Path, interval: float | None = None) -> Tr
     if interval is None:
         interval, note = _read_interval(frames, ids, position, velocity, step)
         notes += [note] if note else []
+    note = _position_note(frames, ids, position, step, interval)
+    notes += [note] if note else []
     times = (frames[starts] - frames[0]) / step * interval
     groups, group_notes = _read_groups(groups_file, set(ids.tolist()))
     ids, aliases, note = _split_returns(frames, ids, step, interval)
@@ -218,6 +220,25 @@ def _frame_step(frames: np.ndarray, ids: np.ndarray) -> int:
     return int(steps[np.argmax(counts)]) if len(steps) else 1
 
 
+def _position_note(frames: np.ndarray, ids: np.ndarray, position: np.ndarray, step: int, interval: float) -> str:
+    """A note when the people move between annotation steps faster than people walk as metres (the median of one-step
+    moves over ``interval`` beyond ``WALKING_SPEED_MAX``: 1.2-1.5 m/s in the public sets): positions in pixels or
+    centimetres, which the tracker's gates in metres cannot follow; else ""."""
+    order = np.lexsort((frames, ids))
+    f, i, p = frames[order], ids[order], position[order]
+    one_step = (i[1:] == i[:-1]) & (f[1:] - f[:-1] == step)
+    if one_step.sum() < 5:
+        return ""
+    speed = float(np.median(np.hypot(*(p[1:] - p[:-1])[one_step].T))) / interval
+    if speed <= WALKING_SPEED_MAX:
+        return ""
+    return (
+        f"the people move a median {speed:.3g} per second between annotation steps, too fast for metres (people walk "
+        f"1-2 m/s): positions in another unit (pixels, centimetres)? The trackers take metres, and the scores mean "
+        "nothing until the positions are converted"
+    )
+
+
 def _read_interval(
     frames: np.ndarray, ids: np.ndarray, position: np.ndarray, velocity: np.ndarray, step: int
 ) -> tuple[float, str]:
@@ -232,7 +253,13 @@ def _read_interval(
     moving = one_step & (speed > 0.3)
     taken = f"{DEFAULT_INTERVAL} s taken (--interval sets it)"
     if not np.any(velocity):
-        return DEFAULT_INTERVAL, f"the velocities (v_x, v_y) are all 0: the time between annotation steps is {taken}"
+        pace = ""
+        if one_step.sum() >= 5:  # what the interval taken makes of the moves: a hint when it is far off
+            moves = float(np.median(np.hypot(*(p[1:] - p[:-1])[one_step].T)))
+            pace = f"; at that the people move a median {moves / DEFAULT_INTERVAL:.3g} m/s (people walk 1-2 m/s)"
+        return DEFAULT_INTERVAL, (
+            f"the velocities (v_x, v_y) are all 0: the time between annotation steps is {taken}{pace}"
+        )
     if moving.sum() < 5:
         return DEFAULT_INTERVAL, f"too few people walking to read the time between annotation steps: {taken}"
     walking = float(np.median(speed[moving]))

@@ -71,8 +71,18 @@ def test_velocities_that_cannot_give_the_time_between_steps_leave_it_at_0_4_s_sa
     )
     still = [(*row[:5], 0, 0, 0) for row in _walkers(frames=8)]
     assert load_trajectory_set(write_set(tmp_path / "zero", still, "1 2\n")).notes == (
-        "the velocities (v_x, v_y) are all 0: the time between annotation steps is 0.4 s taken (--interval sets it)",
+        "the velocities (v_x, v_y) are all 0: the time between annotation steps is 0.4 s taken (--interval sets it); "
+        "at that the people move a median 1 m/s (people walk 1-2 m/s)",
     )
+
+
+def test_positions_that_move_faster_than_people_walk_are_named_as_another_unit(tmp_path: Path) -> None:
+    # Pixels of a top view at 20 px/m: the trackers' gates in metres lost everyone (MOTA 0) without a word.
+    in_pixels = [(*row[:2], row[2] * 20, row[3], row[4] * 20, row[5] * 20, row[6], row[7] * 20) for row in _walkers(8)]
+    velocities, positions = load_trajectory_set(write_set(tmp_path / "px", in_pixels, "1 2\n")).notes
+    assert velocities.startswith("the people walking have a median annotated speed of 20, too fast for m/s")
+    assert positions.startswith("the people move a median 20 per second between annotation steps, too fast for metres")
+    assert load_trajectory_set(write_set(tmp_path / "m", _walkers(frames=8), "1 2\n")).notes == ()
 
 
 def test_lines_sharing_a_person_are_one_group_with_a_note(tmp_path: Path) -> None:
