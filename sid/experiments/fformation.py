@@ -159,10 +159,11 @@ def load_sequence(folder: str | Path, scale: float = 1.0, degrees: bool = False)
     _check_unique(timestamps, features_path, "timestamp")
     _check_unique(truth_timestamps, truth_path, "GTtimestamp")
     index = _frame_index(timestamps)
+    near = _nearest_frames(timestamps, truth_timestamps, index)
     frames, unmatched, widest = [], [], 4  # widest: the most columns of a scored frame's features
     for groups_cell, stamp in zip(truth_groups, truth_timestamps, strict=True):
         with np.errstate(over="ignore"):  # a stamp beyond single precision's range rounds to inf: no frame
-            k = index.get(float(stamp), index.get(float(np.float32(stamp))))
+            k = index.get(float(stamp), index.get(float(np.float32(stamp)), near.get(float(stamp))))
         if k is None:
             unmatched.append(stamp)
             continue
@@ -196,6 +197,30 @@ def load_sequence(folder: str | Path, scale: float = 1.0, degrees: bool = False)
             stacklevel=2,
         )
     return frames
+
+
+_NEAR_SHARE = 0.05
+"""A ground-truth timestamp within this share of the smallest gap between two frames' timestamps of one frame is that
+frame's, when every unmatched one is (``_nearest_frames``)."""
+
+
+def _nearest_frames(timestamps: np.ndarray, truth: np.ndarray, index: dict[float, int]) -> dict[float, int]:
+    """Ground-truth timestamp -> frame for the timestamps that match no frame exactly but lie within ``_NEAR_SHARE``
+    of the smallest gap between frames of one: the same clock written with fewer digits (k / 15 s against
+    round(k / 15, 3)). All or none: when one of them is not that near a frame, the clocks differ, and none is
+    taken (a near match there would be chance)."""
+    with np.errstate(over="ignore"):
+        loose = [float(t) for t in truth if float(t) not in index and float(np.float32(t)) not in index]
+    order = np.argsort(timestamps)
+    ordered = timestamps[order].astype(float)
+    if not loose or len(ordered) < 2 or not np.isfinite(ordered).all():
+        return {}
+    reach = _NEAR_SHARE * float(np.diff(ordered).min())
+    at = np.clip(np.searchsorted(ordered, loose), 1, len(ordered) - 1)
+    nearer = np.where(np.abs(ordered[at - 1] - loose) <= np.abs(ordered[at] - loose), at - 1, at)
+    if not (np.abs(ordered[nearer] - loose) <= reach).all():
+        return {}
+    return {t: int(order[k]) for t, k in zip(loose, nearer.tolist(), strict=True)}
 
 
 def _check_unique(stamps: np.ndarray, path: Path, name: str) -> None:

@@ -638,3 +638,21 @@ def test_a_matrix_of_groups_padded_with_0_whose_ids_start_at_0_keeps_person_0_in
     scipy.io.savemat(folder / "groundtruth.mat", {"GTgroups": groups, "GTtimestamp": np.array([[1]])})
     (frame,) = load_sequence(folder)
     assert sorted(map(sorted, frame.truth)) == [[0, 2, 9], [3, 8]]
+
+
+def test_ground_truth_timestamps_written_with_fewer_digits_find_their_frames_and_other_clocks_do_not(tmp_path):
+    # Frames at k / 15 s, the ground truth at round(k / 15, 3) as a text export writes it: 13 of 20 were dropped.
+    frame = tiny_frames()[0]
+    stamps = np.arange(20) / 15
+    folder = tmp_path / "Rounded"
+    folder.mkdir()
+    scipy.io.savemat(folder / "features.mat", {"features": cells([frame] * 20), "timestamp": stamps[None, :]})
+    truth = cells([cells([np.array([[1, 2]], dtype=np.uint8)])] * 20)
+    scipy.io.savemat(folder / "groundtruth.mat", {"GTgroups": truth, "GTtimestamp": np.round(stamps, 3)[None, :]})
+    assert [f.timestamp for f in load_sequence(folder)] == pytest.approx(stamps.tolist())
+    # Another clock: one stamp half a frame away means none is taken near (a near match would be chance).
+    shifted = np.round(stamps, 3)
+    shifted[5] += 1 / 30
+    scipy.io.savemat(folder / "groundtruth.mat", {"GTgroups": truth, "GTtimestamp": shifted[None, :]})
+    with pytest.warns(InputWarning, match="13 ground-truth frames of 20 without a frame"):
+        assert len(load_sequence(folder)) == 7
