@@ -15,9 +15,11 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from shapely.geometry import Polygon
 
 from costmap.export import keepout_mask
 from costmap.grid import Costmap2D
+from costmap.layers.social import SocialParams, group_zone_polygon
 from sid.perception.group import group_json
 from sid.tracking.records import TrackedGroup, TrackedPerson
 
@@ -103,9 +105,12 @@ class MarkerFields:
     text: str = ""
 
 
-def scene_markers(people: list[TrackedPerson], groups: list[TrackedGroup]) -> list[MarkerFields]:
+def scene_markers(
+    people: list[TrackedPerson], groups: list[TrackedGroup], margin: float = SocialParams.group_margin
+) -> list[MarkerFields]:
     """Markers for RViz: per person a body cylinder, a facing arrow (when the facing is known) and its id; per
-    conversation its zone outline and id. The node clears old markers first (DELETEALL), so ids are the tracks'."""
+    conversation the outline of its interaction zone as the costmap paints it (``group_zone_polygon`` with the social
+    layer's ``group_margin``, m) and its id. The node clears old markers first (DELETEALL), so ids are the tracks'."""
     markers = []
     for p in people:
         color = PERSON_COLORS[p.state]
@@ -122,10 +127,13 @@ def scene_markers(people: list[TrackedPerson], groups: list[TrackedGroup]) -> li
                 "people_ids", p.id, "text_view_facing", p.x, p.y, height + 0.2, 0.0, (0, 0, 0.25), color, (), f"{p.id}"
             )
         )
+    by_id = {p.id: p.as_person() for p in people}
     for g in groups:
-        zone = np.asarray(g.zone, dtype=float).reshape(-1, 2)
-        if len(zone) >= 2:
-            outline = tuple((float(x), float(y)) for x, y in np.vstack([zone, zone[:1]]))
+        # The detector's o-space polygon is a point for a face-to-face pair (no outline was drawn) and a few
+        # millimetres across for a trio; the zone the mask paints is its hull with the members, grown by the margin.
+        zone = group_zone_polygon(g.as_group(), by_id, margin) if g.kind == "conversation" else None
+        if isinstance(zone, Polygon):  # margin 0 and members on a line: a line of no area, no outline
+            outline = tuple((float(x), float(y)) for x, y in zone.exterior.coords)
             markers.append(
                 MarkerFields("group_zones", g.id, "line_strip", 0.0, 0.0, 0.0, 0.0, (0.05, 0, 0), GROUP_COLOR, outline)
             )

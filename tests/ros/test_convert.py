@@ -7,9 +7,11 @@ import math
 
 import numpy as np
 import pytest
+from shapely.geometry import Polygon
 
 from costmap.export import filter_mask_cost, keepout_mask
 from costmap.grid import Costmap2D, GridSpec
+from costmap.layers.social import group_zone_polygon
 from costmap.occupancy import occupancy_to_cost
 from sid.ros.convert import grid_fields, groups_document, quaternion_from_yaw, scene_markers, yaw_from_quaternion
 from sid.tracking.records import MotionState, TrackedGroup, TrackedPerson
@@ -75,8 +77,13 @@ def test_markers_and_groups_document() -> None:
     assert kinds[("people", 3)].kind == "cylinder" and kinds[("people", 3)].z == pytest.approx(0.85)
     assert kinds[("facing", 2)].yaw == pytest.approx(math.pi)
     assert ("facing", 3) not in kinds  # unknown facing: no arrow
+    # The zone the mask paints: the hull of the o-space polygon and the members, grown by the social margin (0.3 m).
     outline = kinds[("group_zones", 7)].points
-    assert outline[0] == outline[-1] == (1.4, 0.4) and len(outline) == 4
+    expected = group_zone_polygon(group.as_group(), {p.id: p.as_person() for p in people}, 0.3)
+    assert outline[0] == outline[-1] and Polygon(outline).symmetric_difference(expected).area < 1e-9
+    assert Polygon(outline).area > 1.0 * 0.6 + math.pi * 0.3**2  # at least the stadium round the two members
+    pair = TrackedGroup(8, "conversation", (1, 2), (1.5, 0.5), np.array([[1.5, 0.5]]), 0.0, 0.5, (0.0, 0.0), 0.0)
+    assert ("group_zones", 8) in {(m.namespace, m.id) for m in scene_markers(people, [pair])}  # a point: none before
     assert kinds[("group_ids", 7)].text == "group 7: 1, 2"
     document = json.loads(json.dumps(groups_document(12.5, "map", people, [group])))
     assert document["frame_id"] == "map" and document["stamp"] == 12.5
