@@ -336,7 +336,7 @@ def _warn_about_data(name: str, frames: list[LabelledFrame], scale: float) -> No
     if missing:
         shift = shifted_ids(frames)
         why = (
-            f"every member would be there with its id {shift:+d}: ids counted from {1 - shift if shift > 0 else 1} in "
+            f"every member would be there with its id {shift:+d}: ids counted from {0 if shift > 0 else 1} in "
             f"the ground truth and from {1 if shift > 0 else 0} in the features?"
             if shift
             else "annotation slips if few; if many, the groups use other ids than the features"

@@ -452,8 +452,9 @@ def shifted_ids(frames: Sequence[LabelledFrame]) -> int | None:
     missing, _ = missing_members(frames)
     if not missing:
         return None
+    present = [({p.id for p in f.people}, f.truth) for f in frames]
     for shift in (1, -1):
-        if all(i + shift in {p.id for p in f.people} for f in frames for group in f.truth for i in group):
+        if all(i + shift in ids for ids, truth in present for group in truth for i in group):
             return shift
     return None
 
@@ -465,29 +466,29 @@ def median_member_distance(frames: Sequence[LabelledFrame]) -> float | None:
     missing, total = missing_members(frames)
     if missing > 0.05 * total:
         return None
-    distances: list[float] = []
+    points = []
     for frame in frames:
         where = {p.id: (p.x, p.y) for p in frame.people}
-        for group in frame.truth:
-            xy = np.array([where[i] for i in sorted(group) if i in where], dtype=float).reshape(-1, 2)
-            if len(xy) >= 2:
-                gaps = np.hypot(*(xy[:, None, :] - xy[None, :, :]).transpose(2, 0, 1))
-                np.fill_diagonal(gaps, np.inf)
-                distances.extend(gaps.min(axis=1).tolist())
-    return float(np.median(distances)) if distances else None
+        points += [[where[i] for i in sorted(group) if i in where] for group in frame.truth]
+    return _median_nearest_other(points)
 
 
 def median_neighbour_distance(frames: Sequence[LabelledFrame]) -> float | None:
     """Median over people of the distance to their nearest neighbour in the same frame (input units); None when no
     frame holds two people."""
+    return _median_nearest_other([[(p.x, p.y) for p in frame.people] for frame in frames])
+
+
+def _median_nearest_other(point_sets: Sequence[Sequence[tuple[float, float]]]) -> float | None:
+    """Median over the points of every set of two or more of the distance to the nearest other point of its set;
+    None when no set has two points."""
     distances: list[float] = []
-    for frame in frames:
-        xy = np.array([(p.x, p.y) for p in frame.people], dtype=float).reshape(-1, 2)
-        if len(xy) < 2:
-            continue
-        gaps = np.hypot(*(xy[:, None, :] - xy[None, :, :]).transpose(2, 0, 1))
-        np.fill_diagonal(gaps, np.inf)
-        distances.extend(gaps.min(axis=1).tolist())
+    for points in point_sets:
+        xy = np.array(points, dtype=float).reshape(-1, 2)
+        if len(xy) >= 2:
+            gaps = np.hypot(*(xy[:, None, :] - xy[None, :, :]).transpose(2, 0, 1))
+            np.fill_diagonal(gaps, np.inf)
+            distances.extend(gaps.min(axis=1).tolist())
     return float(np.median(distances)) if distances else None
 
 
