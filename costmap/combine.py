@@ -22,6 +22,7 @@ import cv2
 import numpy as np
 
 from costmap.grid import FREE_SPACE, INSCRIBED, NO_INFORMATION
+from sid.errors import InputError
 
 __all__ = [
     "COMBINE",
@@ -112,12 +113,12 @@ COMBINE: dict[str, Callable[[np.ndarray, np.ndarray], None]] = {
 def check_method(method: str) -> None:
     """Raise ValueError unless ``method`` is one of the combination methods above."""
     if method not in COMBINE:
-        raise ValueError(f"unknown combination method {method!r}; use one of {sorted(COMBINE)}")
+        raise InputError(f"unknown combination method {method!r}; use one of {sorted(COMBINE)}")
 
 
 def combine(master: np.ndarray, layer: np.ndarray, method: CombinationMethod = "max") -> None:
     """Write ``layer`` into ``master`` (same shape, uint8) with one of the combination methods above."""
     if master.shape != layer.shape:
-        raise ValueError(f"combine: layer shape {layer.shape} differs from the master's {master.shape}")
+        raise InputError(f"combine: layer shape {layer.shape} differs from the master's {master.shape}")
     check_method(method)
     COMBINE[method](master, layer)

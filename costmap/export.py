@@ -24,6 +24,7 @@ from costmap.npz import save_npz
 from costmap.occupancy import OCC_OCCUPIED, OCC_UNKNOWN, OccupancyGrid, cost_to_occupancy, costmap_to_occupancy
 from costmap.render import Outline, RobotTask, render_costmap
 from costmap.rosbag import write_occupancy_mcap
+from sid.errors import InputError
 
 __all__ = ["NAMES", "export_costmap", "filter_mask_cost", "keepout_mask"]
 
@@ -46,7 +47,7 @@ def export_costmap(
     """
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
-        raise ValueError(f"{out}: exists and is not a directory")
+        raise InputError(f"{out}: exists and is not a directory")
     out.mkdir(parents=True, exist_ok=True)
     for name in NAMES:
         (out / name).unlink(missing_ok=True)
@@ -78,6 +79,6 @@ def filter_mask_cost(data: np.ndarray) -> np.ndarray:
     -1 -> 255 (no information: the filter leaves that cell alone)."""
     values = np.asarray(data)
     if values.dtype != np.int8 or np.any((values < OCC_UNKNOWN) | (values > OCC_OCCUPIED)):
-        raise ValueError("filter mask: values must be int8 in -1..100")
+        raise InputError("filter mask: values must be int8 in -1..100")
     costs = np.floor(values.astype(np.float64) * LETHAL / OCC_OCCUPIED + 0.5).astype(np.int16)
     return np.where(values == OCC_UNKNOWN, NO_INFORMATION, costs).astype(np.uint8)

@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from sid.checks import check_limit, check_number, check_numbers, check_whole
+from sid.errors import InputError
 
 __all__ = [
     "BORDER_TOLERANCE",
@@ -282,7 +283,7 @@ class Costmap2D:
     def __post_init__(self) -> None:
         self.costs = np.asarray(self.costs)
         if self.costs.dtype != np.uint8 or self.costs.shape != self.spec.shape:
-            raise ValueError(
+            raise InputError(
                 f"costmap: costs must be uint8 of shape {self.spec.shape}, got {self.costs.dtype} {self.costs.shape}"
             )
 

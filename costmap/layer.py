@@ -23,6 +23,7 @@ import numpy as np
 
 from costmap.combine import CombinationMethod, check_method, combine
 from costmap.grid import FREE_SPACE, GridSpec, Window, union
+from sid.errors import InputError, InputTypeError
 
 __all__ = ["Input", "Layer", "LayerInputs", "RepaintedLayer"]
 
@@ -59,9 +60,9 @@ class LayerInputs(Mapping[Input[Any], Any]):
         names: dict[str, Input[Any]] = {}
         for key, value in (values or {}).items():
             if not isinstance(key, Input):
-                raise TypeError(f"layer inputs are keyed by Input, got {type(key).__name__}")
+                raise InputTypeError(f"layer inputs are keyed by Input, got {type(key).__name__}")
             if names.setdefault(key.name, key) is not key:
-                raise ValueError(f"two different inputs are named {key.name!r}")
+                raise InputError(f"two different inputs are named {key.name!r}")
             checked[key] = value if key.check is None else key.check(value)
         self._values = checked
 

@@ -10,6 +10,7 @@ import numpy as np
 
 from costmap.grid import FREE_SPACE, Costmap2D, GridSpec, Window, disjoint, union
 from costmap.layer import Input, Layer, LayerInputs
+from sid.errors import InputError
 
 __all__ = ["LayeredCostmap"]
 
@@ -27,10 +28,10 @@ class LayeredCostmap:
     def __init__(self, spec: GridSpec, layers: Sequence[Layer], default_value: int = FREE_SPACE) -> None:
         names = [layer.name for layer in layers]
         if len(set(names)) != len(names):
-            raise ValueError(f"costmap layers need distinct names, got {names}")
+            raise InputError(f"costmap layers need distinct names, got {names}")
         for layer in layers:
             if layer.spec != spec:
-                raise ValueError(f"layer {layer.name!r}: its grid {layer.spec} differs from the costmap's {spec}")
+                raise InputError(f"layer {layer.name!r}: its grid {layer.spec} differs from the costmap's {spec}")
         self.spec = spec
         self.layers = list(layers)
         self.default_value = int(default_value)
@@ -61,7 +62,7 @@ class LayeredCostmap:
         read = {key.name: key for key in self.reads}
         strangers = [key.name for key in inputs if read.get(key.name, key) is not key]
         if strangers:
-            raise ValueError(f"inputs {strangers}: not the keys of these names that the layers read")
+            raise InputError(f"inputs {strangers}: not the keys of these names that the layers read")
         for layer in self.layers:
             changed = layer.update_windows(inputs, self._pending)
             self._pending = disjoint([*self._pending, *changed])

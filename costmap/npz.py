@@ -10,6 +10,7 @@ import numpy as np
 
 from costmap.grid import Costmap2D, GridSpec
 from costmap.layered import LayeredCostmap
+from sid.errors import InputError
 
 __all__ = ["SavedCostmap", "load_npz", "save_npz"]
 
@@ -51,27 +52,27 @@ def load_npz(path: str | Path) -> SavedCostmap:
     try:
         archive = np.load(path, allow_pickle=False)
     except (OSError, ValueError, zipfile.BadZipFile) as exc:
-        raise ValueError(f"{path}: cannot read costmap archive ({exc})") from exc
+        raise InputError(f"{path}: cannot read costmap archive ({exc})") from exc
     with archive:
         missing = [k for k in ("costmap", "layer_names", "resolution", "origin") if k not in archive]
         if missing:
-            raise ValueError(f"{path}: not a costmap archive, missing '{missing[0]}'")
+            raise InputError(f"{path}: not a costmap archive, missing '{missing[0]}'")
         costs = archive["costmap"]
         origin = archive["origin"]
         if costs.ndim != 2 or origin.shape != (2,):
-            raise ValueError(f"{path}: 'costmap' must be 2-D and 'origin' [x, y]")
+            raise InputError(f"{path}: 'costmap' must be 2-D and 'origin' [x, y]")
         rows, cols = costs.shape
         try:
             spec = GridSpec(float(archive["resolution"]), float(origin[0]), float(origin[1]), cols, rows)
             master = Costmap2D(spec, costs)
         except (TypeError, ValueError) as exc:
-            raise ValueError(f"{path}: {exc}") from exc
+            raise InputError(f"{path}: {exc}") from exc
         layers = {}
         for name in archive["layer_names"].tolist():
             key = f"layer_{name}"
             grid = archive.get(key)
             if grid is None or grid.shape != spec.shape or grid.dtype != np.uint8:
                 found = "missing" if grid is None else f"{grid.dtype} {grid.shape}"
-                raise ValueError(f"{path}: layer '{name}' must be uint8 of shape {spec.shape}, got {found}")
+                raise InputError(f"{path}: layer '{name}' must be uint8 of shape {spec.shape}, got {found}")
             layers[name] = grid
     return SavedCostmap(master, layers)

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from costmap.grid import FREE_SPACE, INSCRIBED, LETHAL, NO_INFORMATION, Costmap2D, GridSpec
+from sid.errors import InputError
 
 __all__ = [
     "COST_TO_OCCUPANCY",
@@ -59,7 +60,7 @@ class OccupancyGrid:
     def __post_init__(self) -> None:
         self.data = np.asarray(self.data)
         if self.data.dtype != np.int8 or self.data.shape != self.spec.shape:
-            raise ValueError(
+            raise InputError(
                 f"occupancy grid: data must be int8 of shape {self.spec.shape}, got {self.data.dtype} {self.data.shape}"
             )
 
@@ -79,7 +80,7 @@ def cost_to_occupancy(costs: np.ndarray) -> np.ndarray:
     """uint8 Nav2 costs -> int8 OccupancyGrid values (Nav2's costmap publisher table)."""
     costs = np.asarray(costs)
     if costs.dtype != np.uint8:
-        raise ValueError(f"cost_to_occupancy: costs must be uint8, got {costs.dtype}")
+        raise InputError(f"cost_to_occupancy: costs must be uint8, got {costs.dtype}")
     return COST_TO_OCCUPANCY[costs]
 
 

@@ -28,6 +28,7 @@ from costmap.layers.social import SocialLayer, SocialParams
 from costmap.layers.static import StaticLayer
 from costmap.layers.tracked import TrackedPeopleLayer, TrackedPeopleParams
 from costmap.occupancy import OccupancyGrid
+from sid.errors import InputError
 
 __all__ = [
     "CostmapParams",
@@ -66,17 +67,17 @@ class CostmapParams:
     def __post_init__(self) -> None:
         object.__setattr__(self, "plugins", tuple(self.plugins))
         if len(set(self.plugins)) != len(self.plugins):
-            raise ValueError(f"plugins: a layer is listed twice in {list(self.plugins)}")
+            raise InputError(f"plugins: a layer is listed twice in {list(self.plugins)}")
         object.__setattr__(self, "instances", dict(self.instances))
         for name, instance in self.instances.items():
             if not isinstance(instance, LayerInstance):
-                raise ValueError(f"instances: {name} must be a LayerInstance, got {type(instance).__name__}")
+                raise InputError(f"instances: {name} must be a LayerInstance, got {type(instance).__name__}")
             section = SECTIONS.get(instance.plugin)
             wanted = None if section is None else type(getattr(self, section))
             known = instance.plugin in PLUGINS  # another plugin (``layered_costmap``'s ``plugins``) takes any params
             if known and instance.params is not None and not isinstance(instance.params, wanted or type(None)):
                 expected = "None (it takes no parameters)" if wanted is None else f"{wanted.__name__} or None"
-                raise ValueError(
+                raise InputError(
                     f"instances: {name}'s params must be {expected} for the {instance.plugin} plugin, got "
                     f"{type(instance.params).__name__}"
                 )
@@ -91,7 +92,7 @@ class CostmapParams:
         values = {layer: getattr(self.layer_params(layer), name) for layer in self.named(plugin)}
         if len(set(values.values())) > 1:
             given = ", ".join(f"{layer} {value}" for layer, value in values.items())
-            raise ValueError(
+            raise InputError(
                 f"plugins: the {plugin} layers disagree on {name} ({given}); it sets the whole costmap, so give them "
                 "the same value"
             )
@@ -189,7 +190,7 @@ def layered_costmap(
     params = params or CostmapParams()
     unknown = [name for name in params.plugins if params.plugin(name) not in plugins]
     if unknown:
-        raise ValueError(f"plugins: unknown layer {params.plugin(unknown[0])!r}; known layers: {', '.join(plugins)}")
+        raise InputError(f"plugins: unknown layer {params.plugin(unknown[0])!r}; known layers: {', '.join(plugins)}")
     context = LayerContext(spec, params, float(robot_radius), float(body_radius), static_map)
     layers = []
     for name in params.plugins:

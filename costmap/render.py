@@ -26,6 +26,7 @@ from costmap.layered import LayeredCostmap
 from costmap.layers.obstacle import SCAN as SCAN_INPUT  # SCAN is the scan's colour here
 from costmap.layers.social import GROUPS, PEOPLE, SocialLayer, SocialParams, group_zone_polygon
 from costmap.scan import LaserScan
+from sid.errors import InputError
 from sid.labels import place_labels
 from sid.perception.group import Group
 from sid.perception.people import Person
@@ -520,7 +521,7 @@ def render_costmap(
     spec = costmap.spec
     scale = default_scale(spec) if scale is None else int(scale)
     if scale < 1:
-        raise ValueError(f"render scale must be >= 1 pixel per cell, got {scale}")
+        raise InputError(f"render scale must be >= 1 pixel per cell, got {scale}")
     people, groups = list(people or []), list(groups or [])
     body_radius = 0.2 if body_radius is None else body_radius
     radius = max(3, int(round(body_radius * scale / spec.resolution)))

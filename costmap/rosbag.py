@@ -23,6 +23,7 @@ from rosbags.typesys.stores.ros2_humble import nav_msgs__msg__OccupancyGrid as O
 
 from costmap.grid import GridSpec
 from costmap.occupancy import OccupancyGrid
+from sid.errors import InputError, InputTypeError
 
 __all__ = ["DISTROS", "MSGTYPE", "read_occupancy_grids", "write_occupancy_mcap"]
 
@@ -74,11 +75,11 @@ def write_occupancy_mcap(
     """
     path = Path(path)
     if path.suffix != ".mcap":
-        raise ValueError(f"{path}: an MCAP file name must end in .mcap")
+        raise InputError(f"{path}: an MCAP file name must end in .mcap")
     if path.exists():
-        raise ValueError(f"{path}: already exists; the writer does not overwrite bags")
+        raise InputError(f"{path}: already exists; the writer does not overwrite bags")
     if distro not in DISTROS:
-        raise ValueError(f"unknown ROS 2 distro {distro!r}; use one of {sorted(DISTROS)}")
+        raise InputError(f"unknown ROS 2 distro {distro!r}; use one of {sorted(DISTROS)}")
     typestore = get_typestore(DISTROS[distro])
     path.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=path.parent) as tmp:
@@ -101,7 +102,7 @@ def read_occupancy_grids(path: str | Path) -> dict[str, list[OccupancyGrid]]:
     """Every OccupancyGrid in a bag (an .mcap file or a rosbag2 folder), by topic, in time order."""
     path = Path(path)
     if not path.exists():
-        raise ValueError(f"{path}: no such bag")
+        raise InputError(f"{path}: no such bag")
     out: dict[str, list[OccupancyGrid]] = {}
     typestore = get_typestore(Stores.ROS2_HUMBLE)
     with Reader(path) as reader:
@@ -109,13 +110,13 @@ def read_occupancy_grids(path: str | Path) -> dict[str, list[OccupancyGrid]]:
         for connection, _, raw in reader.messages(connections=connections):
             msg = typestore.deserialize_cdr(raw, MSGTYPE)
             if not isinstance(msg, OccupancyGridMsg):  # the Humble store builds this class for MSGTYPE
-                raise TypeError(f"{path}: {MSGTYPE} deserialized as {type(msg).__name__}")
+                raise InputTypeError(f"{path}: {MSGTYPE} deserialized as {type(msg).__name__}")
             grids = out.setdefault(connection.topic, [])
             where = f"{path}: {connection.topic}, message {len(grids) + 1}"
             try:
                 grids.append(_grid(msg))
             except ValueError as exc:
-                raise ValueError(f"{where}: {exc}") from exc
+                raise InputError(f"{where}: {exc}") from exc
     return out
 
 
@@ -128,7 +129,7 @@ def _grid(msg: OccupancyGridMsg) -> OccupancyGrid:
         _float32_decimal(info.resolution), info.origin.position.x, info.origin.position.y, info.width, info.height
     )
     if len(msg.data) != spec.width * spec.height:
-        raise ValueError(
+        raise InputError(
             f"data holds {len(msg.data)} cells, not width x height = {spec.width} x {spec.height} = "
             f"{spec.width * spec.height}"
         )

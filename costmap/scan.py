@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sid.checks import check_number, check_numbers
+from sid.errors import InputError
 
 __all__ = ["LaserScan"]
 
@@ -34,15 +35,15 @@ class LaserScan:
     def __post_init__(self) -> None:
         ranges = np.asarray(self.ranges, dtype=float)
         if ranges.ndim != 1 or ranges.size == 0:
-            raise ValueError(f"scan.ranges must be a non-empty 1-D array, got shape {ranges.shape}")
+            raise InputError(f"scan.ranges must be a non-empty 1-D array, got shape {ranges.shape}")
         object.__setattr__(self, "ranges", ranges)
         pose = tuple(float(v) for v in self.pose)
         if len(pose) != 3 or not np.isfinite(pose).all():
-            raise ValueError(f"scan.pose must be a finite (x, y, yaw), got {self.pose}")
+            raise InputError(f"scan.pose must be a finite (x, y, yaw), got {self.pose}")
         object.__setattr__(self, "pose", pose)
         check_numbers("scan", self, ("angle_min", "angle_increment"), unit="radians")
         if self.angle_increment == 0:
-            raise ValueError("scan: angle_increment must not be 0")
+            raise InputError("scan: angle_increment must not be 0")
         check_number("scan", "range_min", self.range_min, low=0, unit="metres")
         check_number("scan", "range_max", self.range_max, low=self.range_min, low_open=True, unit="metres")
 

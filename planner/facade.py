@@ -23,6 +23,7 @@ from planner.ompl_planners import OMPL_PLANNERS, seed_ompl, solve_ompl
 from planner.problem import CostField, EndpointCollisionError, PlanningError, PlanningProblem, WalledOffError
 from planner.smoothing import smooth
 from planner.validity import check_path
+from sid.errors import InputError
 
 __all__ = [
     "DEFAULT_PLANNER",
@@ -85,9 +86,9 @@ def resolve_planner(name: str) -> str:
     """The registry name for ``name`` (case-insensitive), or a ValueError listing the choices."""
     key = name.strip().lower().replace("-", "_")
     if key in UNAVAILABLE:
-        raise ValueError(UNAVAILABLE[key])
+        raise InputError(UNAVAILABLE[key])
     if key not in PLANNERS:
-        raise ValueError(f"unknown planner {name!r}; choose one of: {', '.join(PLANNERS)}")
+        raise InputError(f"unknown planner {name!r}; choose one of: {', '.join(PLANNERS)}")
     return key
 
 
@@ -171,17 +172,17 @@ def plan(
     """
     name = resolve_planner(planner)
     if not (math.isfinite(time_limit) and time_limit > 0):
-        raise ValueError(f"time_limit must be a positive number of seconds, got {time_limit}")
+        raise InputError(f"time_limit must be a positive number of seconds, got {time_limit}")
     if max_iterations is not None and max_iterations < 1:
-        raise ValueError(f"max_iterations must be at least 1, got {max_iterations}")
+        raise InputError(f"max_iterations must be at least 1, got {max_iterations}")
     for option, value in (("settle", settle), ("soft_limit", soft_limit)):
         if value is not None and not (math.isfinite(value) and value > 0):
-            raise ValueError(f"{option} must be a positive number of seconds or None, got {value}")
+            raise InputError(f"{option} must be a positive number of seconds or None, got {value}")
     t0 = time.perf_counter()
     if name != "grid":
         seed = secrets.randbelow(2**31 - 1) + 1 if seed is None else int(seed)
         if not 1 <= seed <= MAX_SEED:
-            raise ValueError(f"seed must be a whole number from 1 to {MAX_SEED} (OMPL ignores 0), got {seed}")
+            raise InputError(f"seed must be a whole number from 1 to {MAX_SEED} (OMPL ignores 0), got {seed}")
         seed_ompl(seed)
     else:
         seed = None

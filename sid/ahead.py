@@ -16,6 +16,8 @@ import threading
 from collections.abc import Iterable, Iterator
 from typing import TypeVar, cast
 
+from sid.errors import InputError
+
 __all__ = ["T", "run_ahead"]
 
 T = TypeVar("T")
@@ -32,7 +34,7 @@ def run_ahead(items: Iterable[T], depth: int = 1) -> Iterator[T]:
     after the item it is making and closes ``items`` if it is a generator.
     """
     if depth < 1:
-        raise ValueError(f"run_ahead: depth must be at least 1, got {depth}")
+        raise InputError(f"run_ahead: depth must be at least 1, got {depth}")
     return _ahead(items, depth)
 
 

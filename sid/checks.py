@@ -16,7 +16,7 @@ from collections.abc import Hashable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any, TypeVar
 
-from sid.errors import SidError
+from sid.errors import InputError, SidError
 
 __all__ = [
     "LIMITS_ENV",
@@ -127,15 +127,15 @@ def limits_from_environment() -> Limits:
     for item in text.split(","):
         name, _, value = (part.strip() for part in item.partition("="))
         if name not in names:
-            raise ValueError(f"${LIMITS_ENV}: unknown limit {name!r} in {text!r}; known limits: {', '.join(names)}")
+            raise InputError(f"${LIMITS_ENV}: unknown limit {name!r} in {text!r}; known limits: {', '.join(names)}")
         if name in values:  # as a key given twice in a file: which one was meant?
-            raise ValueError(f"${LIMITS_ENV}: {name} is given twice in {text!r}")
+            raise InputError(f"${LIMITS_ENV}: {name} is given twice in {text!r}")
         try:
             number = float(value)
         except ValueError:
             number = math.nan
         if not (math.isfinite(number) and number >= 1 and number == int(number)):
-            raise ValueError(f"${LIMITS_ENV}: {name} must be a whole number >= 1, got {value!r}")
+            raise InputError(f"${LIMITS_ENV}: {name} must be a whole number >= 1, got {value!r}")
         values[name] = int(number)
     return Limits(**values)
 
@@ -151,7 +151,7 @@ def check_number(
     high_open: bool = False,
     allow_inf: bool = False,
     unit: str = "",
-    error: type[Exception] = ValueError,
+    error: type[Exception] = InputError,
 ) -> None:
     """Raise ``error`` unless ``value`` is a finite real number (``is_real``: not a bool, a string or bytes) within
     [low, high] (bounds optional).
@@ -182,7 +182,7 @@ def check_whole(
     *,
     low: int | None = None,
     high: int | None = None,
-    error: type[Exception] = ValueError,
+    error: type[Exception] = InputError,
 ) -> int:
     """``value`` as an int; raise ``error`` unless it is a whole number (an integer, or a real number without a
     fraction; not a bool, not a string) within [low, high] (bounds optional). NaN and infinities get the same
@@ -203,7 +203,7 @@ def check_whole(
     return int(number)
 
 
-def check_yaw(owner: str, name: str, value: float, error: type[Exception] = ValueError) -> None:
+def check_yaw(owner: str, name: str, value: float, error: type[Exception] = InputError) -> None:
     """Raise ``error`` unless ``value`` is a yaw within two turns of 0 (``YAW_LIMIT_RAD``): 90 or 180 is a facing in
     degrees, which read as radians points anywhere. ``value`` is a finite number already."""
     if abs(value) > YAW_LIMIT_RAD:

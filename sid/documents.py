@@ -18,6 +18,8 @@ from typing import Any, TypeGuard
 
 import yaml
 
+from sid.errors import InputError
+
 __all__ = [
     "IMAGE_FORMATS",
     "ImageHeader",
@@ -49,22 +51,22 @@ def load_document(path: str | Path, kind: str = "file") -> Any:
     path = Path(path)
     special = special_file(path)
     if special:
-        raise ValueError(f"{path}: cannot read {kind}: {special}")
+        raise InputError(f"{path}: cannot read {kind}: {special}")
     try:
         raw = path.read_bytes()
     except OSError as exc:
-        raise ValueError(f"{path}: cannot read {kind} ({exc.strerror or exc})") from None
+        raise InputError(f"{path}: cannot read {kind} ({exc.strerror or exc})") from None
     text = decode_text(raw, f"{path}: cannot read {kind}")
     is_json = path.suffix.lower() == ".json"
     try:
         return json.loads(text, object_pairs_hook=unique_keys) if is_json else yaml.load(text, _UniqueKeyLoader)
     except RecursionError:
-        raise ValueError(f"{path}: cannot read {kind}: nested too deeply") from None
+        raise InputError(f"{path}: cannot read {kind}: nested too deeply") from None
     except (json.JSONDecodeError, yaml.YAMLError, ValueError, TypeError, OverflowError) as exc:
         # Besides syntax errors, YAML's constructors raise ValueError for values such as `2001-02-30` or `!!int 0xZZ`.
         # PyYAML's messages span lines and name "<unicode string>": made one line here.
         reason = " ".join(str(exc).split()).replace(' in "<unicode string>",', " at")
-        raise ValueError(f"{path}: not valid {'JSON' if is_json else 'YAML'} ({reason})") from None
+        raise InputError(f"{path}: not valid {'JSON' if is_json else 'YAML'} ({reason})") from None
 
 
 _SPECIAL_FILES = (
@@ -98,7 +100,7 @@ def unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
     result: dict[str, Any] = {}
     for key, value in pairs:
         if key in result:
-            raise ValueError(f"duplicate key {key!r}")
+            raise InputError(f"duplicate key {key!r}")
         result[key] = value
     return result
 
@@ -189,7 +191,7 @@ def decode_text(raw: bytes, what: str) -> str:
         return raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         line = raw.count(b"\n", 0, exc.start) + 1
-        raise ValueError(
+        raise InputError(
             f"{what}: byte 0x{raw[exc.start]:02x} at offset {exc.start} (line {line}) is not UTF-8 text"
         ) from None
 
@@ -244,10 +246,10 @@ def read_image_header(path: str | Path, what: str) -> ImageHeader:
                 offset = int(tiles[0][2]) if len(tiles) == 1 else 0
                 return ImageHeader(name, image.size[0], image.size[1], offset)
     except OSError as exc:  # missing, unreadable, or truncated within its header
-        raise ValueError(f"cannot read {what} {path} ({str(exc.strerror or exc)[:120]})") from None
+        raise InputError(f"cannot read {what} {path} ({str(exc.strerror or exc)[:120]})") from None
     except (SyntaxError, ValueError, EOFError, struct.error) as exc:  # a header the format's parser refuses
-        raise ValueError(f"cannot read {what} {path}: bad header ({str(exc)[:120]})") from None
-    raise ValueError(
+        raise InputError(f"cannot read {what} {path}: bad header ({str(exc)[:120]})") from None
+    raise InputError(
         f"cannot read {what} {path}: not a PNG, JPEG, PGM/PPM, BMP or TIFF image (the formats whose size sid reads "
         "before decoding)"
     )

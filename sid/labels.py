@@ -11,6 +11,8 @@ from collections.abc import Sequence
 import cv2
 import numpy as np
 
+from sid.errors import InputError
+
 __all__ = ["place_labels"]
 
 
@@ -33,7 +35,7 @@ def place_labels(
     """
     height, width = shape
     if avoid is not None and avoid.shape != (height, width):
-        raise ValueError(f"place_labels: avoid mask of shape {avoid.shape} for an image of {(height, width)}")
+        raise InputError(f"place_labels: avoid mask of shape {avoid.shape} for an image of {(height, width)}")
     drawn = None if avoid is None else cv2.integral(avoid.astype(np.uint8))  # (h + 1, w + 1) running sums
     placed: list[tuple[int, int, int, int]] = []
     corners = []

@@ -24,6 +24,7 @@ from costmap.layers.social import GROUPS, PEOPLE
 from costmap.layers.tracked import TRACKS
 from costmap.plugins import CostmapParams, layered_costmap
 from costmap.scan import LaserScan
+from sid.errors import InputError
 from sid.perception.frame import Frame
 from sid.perception.pipeline import FrameResult, Pipeline
 from sid.perception.robot_pose import RobotPose
@@ -82,7 +83,7 @@ class SocialStream:
         if isinstance(costmap, GridSpec):
             costmap = layered_costmap(costmap, costmap_params or CostmapParams(plugins=STREAM_PLUGINS))
         elif costmap_params is not None:
-            raise ValueError("stream: costmap_params only apply when the costmap is built from a GridSpec")
+            raise InputError("stream: costmap_params only apply when the costmap is built from a GridSpec")
         self.costmap = costmap
         self.people = PeopleStream(pipeline, params)
         load_solver()  # now, not on the first ambiguous frame: a robot should not pause mid-run for an import

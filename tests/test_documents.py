@@ -9,6 +9,7 @@ import stat
 import pytest
 
 from sid.documents import load_document
+from sid.errors import InputError
 
 
 @pytest.mark.parametrize(("name", "text"), [("a.json", '{"x": 1}'), ("a.yaml", "x: 1"), ("a.scenario", "x: 1")])
@@ -79,7 +80,7 @@ def test_bytes_that_are_not_utf8_name_the_file_and_the_byte(tmp_path, kind, suff
         r"\(line \d\) is not UTF-8 text",
     ) as error:
         load_document(path, "map YAML")
-    assert type(error.value) is ValueError  # not UnicodeDecodeError, whose message names no file
+    assert type(error.value) is InputError  # not UnicodeDecodeError, whose message names no file
 
 
 @pytest.mark.parametrize(("name", "text"), [("deep.json", "[" * 100_000 + "]" * 100_000),

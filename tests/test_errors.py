@@ -1,7 +1,9 @@
-"""One error base: every exception class sid, costmap and planner define derives from ``sid.errors.SidError``."""
+"""One error base: every exception class sid, costmap and planner define derives from ``sid.errors.SidError``, and
+none of them raises a bare built-in ValueError or TypeError."""
 
 from __future__ import annotations
 
+import ast
 import importlib
 import inspect
 import pkgutil
@@ -12,6 +14,7 @@ import costmap
 import planner
 import sid
 from sid.errors import SidError
+from tests.conftest import REPO_ROOT
 
 
 def _modules() -> list[str]:
@@ -63,3 +66,23 @@ def test_every_error_also_derives_from_the_builtin_error_it_stands_for(error: ty
     # The README's promise: `except ValueError` still catches bad input (a pose model file that cannot be used did not).
     builtin = [b for b in error.__mro__ if b.__module__ == "builtins" and b not in (Exception, BaseException, object)]
     assert bool(builtin) != (error.__name__ in _WITHOUT_BUILTIN)
+
+
+def _bare_raises() -> list[str]:
+    """``path:line`` of each ``raise ValueError(...)`` / ``raise TypeError(...)`` in the three packages."""
+    found = []
+    for package in ("sid", "costmap", "planner"):
+        for path in sorted((REPO_ROOT / package).rglob("*.py")):
+            for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+                raised = node.exc.func if isinstance(node, ast.Raise) and isinstance(node.exc, ast.Call) else None
+                if isinstance(raised, ast.Name) and raised.id in {"ValueError", "TypeError"}:
+                    found.append(f"{path.relative_to(REPO_ROOT)}:{node.lineno}")
+    return found
+
+
+def test_no_input_check_raises_a_bare_builtin_error() -> None:
+    # The README's promise, ``except SidError`` catches every error sid means to say: 13 input checks (colour and
+    # depth dtypes, duplicate ids, GroupParams, CameraMount, ...) raised plain ValueError or TypeError.
+    assert _bare_raises() == []
+    with pytest.raises(SidError, match="groups: eps must be a positive number"):
+        sid.GroupParams(eps=-1.0)

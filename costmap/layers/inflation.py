@@ -26,6 +26,7 @@ import numpy as np
 from costmap.grid import FREE_SPACE, INSCRIBED, LETHAL, MAX_NON_OBSTACLE, GridSpec, Window, nonzero_cells
 from costmap.layer import Layer, LayerInputs
 from sid.checks import check_number
+from sid.errors import InputError
 
 __all__ = [
     "InflationLayer",
@@ -59,7 +60,7 @@ def check_reach(spec: GridSpec, inflation_radius: float, field: str) -> None:
     than the map, and the cost table grows with the square of the radius in cells."""
     diagonal = math.hypot(*spec.size_m)
     if inflation_radius > diagonal:
-        raise ValueError(
+        raise InputError(
             f"{field}: {inflation_radius:g} m is more than the map's diagonal ({diagonal:g} m), the farthest any cost "
             "can spread; use at most that"
         )

@@ -32,6 +32,7 @@ from costmap.layer import Input, Layer, LayerInputs
 from costmap.layers.social import PEOPLE
 from costmap.scan import LaserScan
 from sid.checks import check_number, check_numbers
+from sid.errors import InputError
 
 __all__ = ["SCAN", "ObstacleLayer", "ObstacleParams", "trace_cells"]
 
@@ -249,7 +250,7 @@ class ObstacleLayer(Layer):
         p = self.params
         origin = np.asarray(scan.pose[:2])
         if self.spec.window(scan.pose[:2], scan.pose[:2]) is None:  # its cell is outside (scalar: cheaper here)
-            raise ValueError(f"scan: sensor at ({origin[0]:.2f}, {origin[1]:.2f}) is outside the costmap")
+            raise InputError(f"scan: sensor at ({origin[0]:.2f}, {origin[1]:.2f}) is outside the costmap")
         r = scan.valid_ranges()
         dirs = scan.directions
         beyond = r + _BEYOND_HIT * self.spec.resolution  # where the beam's cells end: the surface's far side

@@ -36,6 +36,7 @@ from costmap.combine import CombinationMethod
 from costmap.grid import FREE_SPACE, LETHAL, MAX_NON_OBSTACLE, GridSpec, Window, disjoint
 from costmap.layer import Input, LayerInputs, RepaintedLayer
 from sid.checks import check_number, check_numbers
+from sid.errors import InputError
 from sid.perception.group import Group
 from sid.perception.people import Person
 
@@ -64,7 +65,7 @@ def _people(people: Sequence[Person]) -> tuple[Person, ...]:
     for p in people:
         check_numbers(f"person {p.id}", p, ("x", "y") if p.theta is None else ("x", "y", "theta"))
         if p.id in seen:
-            raise ValueError(f"person id {p.id} appears twice")
+            raise InputError(f"person id {p.id} appears twice")
         seen.add(p.id)
     return people
 
@@ -120,16 +121,16 @@ def zone_hull(group: Group, people: Sequence[Person] | Mapping[int, Person]) -> 
     by_id = _people_by_id(people)
     missing = [m for m in group.members if m not in by_id]
     if missing:
-        raise ValueError(f"group {group.members}: members {missing} are not among the people given")
+        raise InputError(f"group {group.members}: members {missing} are not among the people given")
     zone = np.asarray(group.zone, dtype=float)
     if zone.ndim != 2 or zone.shape[1] != 2:
-        raise ValueError(f"group {group.members}: zone must be (K, 2) vertices (x, y), got shape {zone.shape}")
+        raise InputError(f"group {group.members}: zone must be (K, 2) vertices (x, y), got shape {zone.shape}")
     if not group.members and not len(zone):
-        raise ValueError(f"group {group.members}: no member and no zone vertex, so no zone to draw")
+        raise InputError(f"group {group.members}: no member and no zone vertex, so no zone to draw")
     members = np.array([(by_id[m].x, by_id[m].y) for m in group.members], dtype=float).reshape(-1, 2)
     points = np.vstack([members, zone])
     if not np.isfinite(points).all():
-        raise ValueError(f"group {group.members}: non-finite member position or zone vertex")
+        raise InputError(f"group {group.members}: non-finite member position or zone vertex")
     return cast(MultiPoint, shapely.multipoints(points)).convex_hull  # from the array: no point object per vertex
 
 
@@ -296,7 +297,7 @@ def paint_people(
     calls per batch instead of per person: on a person's window their fixed cost is a good part of the work
     (docs/parameters.md, "Personal space at the defaults")."""
     if sigma_fronts is not None and len(sigma_fronts) != len(people):
-        raise ValueError(f"social: {len(sigma_fronts)} sigma_fronts for {len(people)} people")
+        raise InputError(f"social: {len(sigma_fronts)} sigma_fronts for {len(people)} people")
     windows: list[Window | None] = []
     todo: list[tuple[Person, Window, list[float]]] = []  # (person, window, the 27 coefficients)
     for k, person in enumerate(people):

@@ -27,7 +27,7 @@ from typing import IO, TYPE_CHECKING, Any, TextIO, cast
 
 from sid.distribution import MissingDependencyError
 from sid.documents import TEMPORARY_PREFIX, plural, special_file, unique_keys
-from sid.errors import SidError
+from sid.errors import InputError, SidError
 
 if TYPE_CHECKING:  # the pipeline and the sources are imported only by the commands that read frames
     from sid.perception.pipeline import PoseFn
@@ -121,7 +121,7 @@ def check_output_folder(path: str | Path, option: str = "--out") -> Path:
     folder = existing = Path(path)
     try:
         if "\0" in str(path):
-            raise ValueError("embedded null byte")
+            raise InputError("embedded null byte")
         while not existing.exists() and existing != existing.parent:
             existing = existing.parent  # the nearest existing ancestor: the folder is created in it
     except (OSError, ValueError) as exc:  # a name too long, a parent that cannot be searched
@@ -355,7 +355,7 @@ def read_json_lines(lines: Iterable[str | bytes]) -> Iterator[tuple[int, Any, st
 
 
 def _reject_constant(name: str) -> float:
-    raise ValueError(f"{name} is not a number")
+    raise InputError(f"{name} is not a number")
 
 
 def refuse_unknown_fields(data: dict[str, Any], known: tuple[str, ...], prefix: str = "") -> None:
@@ -363,7 +363,7 @@ def refuse_unknown_fields(data: dict[str, Any], known: tuple[str, ...], prefix: 
     one (a misspelt ``thta`` would otherwise be read as an unknown facing)."""
     unknown = [key for key in data if key not in known]
     if unknown:
-        raise ValueError(f"{prefix}unknown field {unknown[0]!r} (the fields are {', '.join(known)})")
+        raise InputError(f"{prefix}unknown field {unknown[0]!r} (the fields are {', '.join(known)})")
 
 
 class StandardOutputError(SidError):
@@ -632,7 +632,7 @@ def pose_model(model: Path | None, source: str | None, **load: Any) -> PoseFn:
         options = {"threads": "--threads", "providers": "--provider", "contract": "--contract"}
         given = [options.get(name, name) for name, value in load.items() if value not in (None, "auto")]
         if given:  # they set up a model's session: without a model they would be ignored in silence
-            raise ValueError(
+            raise InputError(
                 f"{', '.join(given)}: an option of the pose model's session, and there is no --model (the synthetic "
                 "source's true poses stand in for one); give --model to run a model"
             )

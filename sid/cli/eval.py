@@ -25,6 +25,7 @@ from sid.cli.eval_crowd import add_crowd_parser
 from sid.cli.grouping import add_group_params, group_params_from
 from sid.distribution import MissingDependencyError
 from sid.documents import plural
+from sid.errors import InputError
 from sid.experiments.fformation import (
     DEFAULT_GRID,
     DEFAULT_THRESHOLDS,
@@ -199,15 +200,15 @@ def run(args: argparse.Namespace) -> int:
     try:
         params = group_params_from(args)
         if len(args.scale) not in (1, len(args.dirs)):
-            raise ValueError(f"--scale takes one value or one per DIR ({len(args.dirs)}), got {len(args.scale)}")
+            raise InputError(f"--scale takes one value or one per DIR ({len(args.dirs)}), got {len(args.scale)}")
         scales = args.scale * len(args.dirs) if len(args.scale) == 1 else args.scale
         if args.workers is not None and not (args.grid or args.cross_validate):
-            raise ValueError("--workers spreads a cross-validation's grid points: give --cross-validate or --grid too")
+            raise InputError("--workers spreads a cross-validation's grid points: give --cross-validate or --grid too")
         if args.pictures_max is not None and args.pictures is None:
-            raise ValueError("--pictures-max caps --pictures: give --pictures DIR too")
+            raise InputError("--pictures-max caps --pictures: give --pictures DIR too")
         if args.pictures is not None:
             if args.grid or args.cross_validate:
-                raise ValueError(
+                raise InputError(
                     "--pictures draws one detector's groups: it takes no --grid or --cross-validate (draw the "
                     "chosen parameters' errors with them set, e.g. --alone-price 0.5)"
                 )
@@ -233,9 +234,9 @@ def run(args: argparse.Namespace) -> int:
                 datasets[name] = with_facing_noise(datasets[name], math.radians(args.facing_noise))
         grid = args.grid or ([(k, list(v)) for k, v in DEFAULT_GRID.items()] if args.cross_validate else None)
         if grid and args.gcff_settings:
-            raise ValueError("--gcff-settings scores GCFF's own settings: it takes no --grid or --cross-validate")
+            raise InputError("--gcff-settings scores GCFF's own settings: it takes no --grid or --cross-validate")
         if grid and args.errors:
-            raise ValueError("--errors counts one detector's groups: it takes no --grid or --cross-validate")
+            raise InputError("--errors counts one detector's groups: it takes no --grid or --cross-validate")
         if grid:
             from sid.experiments.progress import ProgressBar
 

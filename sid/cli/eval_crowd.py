@@ -16,6 +16,7 @@ from typing import Any
 
 from sid.cli.common import fail, name_width, plain_text, positive_int, whole_number
 from sid.distribution import MissingDependencyError
+from sid.errors import InputError
 from sid.experiments.crowd import DEFAULT_GRID, CrowdSettings, cross_validate, evaluate_crowd
 from sid.experiments.trajectories import ReplaySettings, TrajectoryError, TrajectorySet, load_trajectory_set
 from sid.tracking.view import ViewCone
@@ -84,7 +85,7 @@ def run_crowd(args: argparse.Namespace) -> int:
 
     try:
         if args.workers is not None and not args.cross_validate:
-            raise ValueError("--workers spreads the cross-validation's grid points: give --cross-validate too")
+            raise InputError("--workers spreads the cross-validation's grid points: give --cross-validate too")
         view = None
         if args.view is not None:
             x, y, yaw = args.view

@@ -22,6 +22,7 @@ from sid.cli.common import fail, process_json_lines, refuse_unknown_fields, run_
 from sid.cli.grouping import add_json_lines_command, group_params_from, params_file_from
 from sid.cli.person_json import parse_person
 from sid.documents import is_number, summary
+from sid.errors import InputError
 from sid.perception.group import group_json
 from sid.perception.groups import GroupParams, detect_groups
 
@@ -66,14 +67,14 @@ def _groups_line(data: Any, params: GroupParams) -> dict[str, Any]:
 
 def _parse_frame(data: Any) -> dict[str, Any]:
     if not isinstance(data, dict):
-        raise ValueError("expected a JSON object with 'frame' and 'people'")
+        raise InputError("expected a JSON object with 'frame' and 'people'")
     refuse_unknown_fields(data, LINE_FIELDS)
     if "people" not in data:
-        raise ValueError("missing 'people'")
+        raise InputError("missing 'people'")
     if not isinstance(data["people"], list):
-        raise ValueError("'people' must be a list")
+        raise InputError("'people' must be a list")
     check_limit("people", len(data["people"]), "people", "people")  # before any work on them (sid.checks.Limits)
     frame = data.get("frame")  # a label, echoed back: it must stay valid JSON (1e400 would come back as Infinity)
     if not (frame is None or isinstance(frame, str) or is_number(frame)):
-        raise ValueError(f"'frame' must be a finite number or a string, got {summary(frame)}")
+        raise InputError(f"'frame' must be a finite number or a string, got {summary(frame)}")
     return {"frame": frame, "people": [parse_person(p, k, PERSON_FIELDS) for k, p in enumerate(data["people"])]}

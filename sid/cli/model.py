@@ -20,6 +20,7 @@ from sid.cli.common import (
     whole_number,
 )
 from sid.distribution import MissingDependencyError
+from sid.errors import InputError
 from sid.perception.frame import Frame
 from sid.perception.pose.contracts import PoseModelError
 from sid.perception.pose.quantize import FLOAT_LAYERS
@@ -142,7 +143,7 @@ def _frames(args: argparse.Namespace, command: str) -> Iterator[tuple[str, Frame
 def _open_all(args: argparse.Namespace, command: str) -> list[tuple[str, Frame]]:
     frames = list(_frames(args, command))
     if not frames:
-        raise ValueError(f"no frames in {' '.join(args.sources)}")
+        raise InputError(f"no frames in {' '.join(args.sources)}")
     return frames
 
 

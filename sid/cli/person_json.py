@@ -7,6 +7,7 @@ from typing import Any
 from sid.checks import check_yaw
 from sid.cli.common import refuse_unknown_fields
 from sid.documents import is_number, summary
+from sid.errors import InputError
 from sid.perception.people import Person
 
 __all__ = ["parse_person"]
@@ -19,23 +20,23 @@ def parse_person(data: Any, index: int, fields: tuple[str, ...], *, id_default: 
     ``index``. ValueError naming the entry and the key."""
     where = f"people[{index}]"
     if not isinstance(data, dict):
-        raise ValueError(f"{where} must be an object with {', '.join(fields)}")
+        raise InputError(f"{where} must be an object with {', '.join(fields)}")
     refuse_unknown_fields(data, fields, f"{where}: ")
     if "id" not in data and not id_default:
-        raise ValueError(f"{where} is missing 'id'")
+        raise InputError(f"{where} is missing 'id'")
     person_id = data.get("id", index)
     if isinstance(person_id, bool) or not isinstance(person_id, int):
-        raise ValueError(f"{where}: id must be an integer, got {summary(person_id)}")
+        raise InputError(f"{where}: id must be an integer, got {summary(person_id)}")
     where = f"{where} (id {person_id})"
     for key in ("x", "y"):
         if key not in data:
-            raise ValueError(f"{where} is missing {key!r}")
+            raise InputError(f"{where} is missing {key!r}")
         if not is_number(data[key]):
-            raise ValueError(f"{where}: {key} must be a finite number of metres, got {summary(data[key])}")
+            raise InputError(f"{where}: {key} must be a finite number of metres, got {summary(data[key])}")
     theta = data.get("theta")
     if theta is not None:
         if not is_number(theta):
-            raise ValueError(
+            raise InputError(
                 f"{where}: theta must be a finite number of radians, or null when unknown, got {summary(theta)}"
             )
         check_yaw(where, "theta", theta)
@@ -43,5 +44,5 @@ def parse_person(data: Any, index: int, fields: tuple[str, ...], *, id_default: 
     if quality is None:  # a given facing is taken at full quality unless the line says otherwise
         quality = 0.0 if theta is None else 1.0
     elif not (is_number(quality) and 0.0 <= quality <= 1.0):
-        raise ValueError(f"{where}: orientation_quality must be a number in [0, 1], got {summary(quality)}")
+        raise InputError(f"{where}: orientation_quality must be a number in [0, 1], got {summary(quality)}")
     return Person(person_id, float(data["x"]), float(data["y"]), None if theta is None else float(theta), quality)

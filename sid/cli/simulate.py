@@ -23,6 +23,7 @@ from sid.cli.common import (
 from sid.cli.planning import INPUT_ERRORS, add_planner_option, warn_zones
 from sid.distribution import MissingDependencyError
 from sid.documents import plural, special_file
+from sid.errors import InputError
 from sid.experiments.progress import ProgressBar
 from sid.experiments.simulate.loop import PERCEPTIONS, RunOptions
 from sid.experiments.simulate.scenes import SCENE_ORDER, load_scene, scene_list
@@ -137,7 +138,7 @@ def run(args: argparse.Namespace) -> int:
         options = _options(args)
         if args.model is not None:
             if not Path(args.model).is_file():
-                raise ValueError(f"--model {args.model}: {special_file(args.model) or 'no such file'}")
+                raise InputError(f"--model {args.model}: {special_file(args.model) or 'no such file'}")
             from sid.perception.pose.session import quiet_load_warnings
 
             quiet_load_warnings()

@@ -34,6 +34,7 @@ from sid.cli.common import fail, process_json_lines, refuse_unknown_fields, run_
 from sid.cli.grouping import add_json_lines_command, group_params_from, params_file_from
 from sid.cli.person_json import parse_person
 from sid.documents import is_number, summary
+from sid.errors import InputError
 from sid.perception.people import Person
 from sid.tracking import TrackingSession
 from sid.tracking.assignment import load_solver
@@ -107,16 +108,16 @@ def _track_line(data: Any, session: TrackingSession, gaps: _Gaps, note: Callable
 def _parse_line(data: Any) -> tuple[int | float, list[Person]]:
     """The timestamp (s, as given) and people of a line."""
     if not isinstance(data, dict):
-        raise ValueError("expected a JSON object with 'timestamp' and 'people'")
+        raise InputError("expected a JSON object with 'timestamp' and 'people'")
     refuse_unknown_fields(data, LINE_FIELDS)
     for key in LINE_FIELDS:
         if key not in data:
-            raise ValueError(f"missing {key!r}")
+            raise InputError(f"missing {key!r}")
     timestamp = data["timestamp"]
     if not is_number(timestamp):
-        raise ValueError(f"'timestamp' must be a finite number of seconds, got {summary(timestamp)}")
+        raise InputError(f"'timestamp' must be a finite number of seconds, got {summary(timestamp)}")
     if not isinstance(data["people"], list):
-        raise ValueError("'people' must be a list")
+        raise InputError("'people' must be a list")
     check_limit("people", len(data["people"]), "people", "people")  # before any work on them (sid.checks.Limits)
     people = [parse_person(person, k, PERSON_FIELDS, id_default=True) for k, person in enumerate(data["people"])]
     ids = [person.id for person in people]
@@ -125,5 +126,5 @@ def _parse_line(data: Any) -> tuple[int | float, list[Person]]:
         first, second = [k for k, person_id in enumerate(ids) if person_id == twice][:2]
         defaults = [f"people[{k}]" for k in (first, second) if "id" not in data["people"][k]]
         why = f" ({defaults[0]} has no 'id': its index in the list is its id)" if defaults else ""
-        raise ValueError(f"people[{first}] and people[{second}] have one id, {twice}{why}")
+        raise InputError(f"people[{first}] and people[{second}] have one id, {twice}{why}")
     return timestamp, people

@@ -37,7 +37,7 @@ import scipy.io
 
 from sid.checks import YAW_LIMIT_RAD, check_limit, check_number
 from sid.documents import InputWarning, plural, special_file
-from sid.errors import SidError
+from sid.errors import InputError, SidError
 from sid.experiments.progress import Progress
 from sid.experiments.workers import map_in_workers
 from sid.perception.gcff import GCFFParams
@@ -149,11 +149,11 @@ def load_sequence(folder: str | Path, scale: float = 1.0, degrees: bool = False)
     truth_groups = _cells(truth["GTgroups"], truth_path, "GTgroups")
     truth_timestamps = _numbers(truth["GTtimestamp"], truth_path, "GTtimestamp")
     if len(frames_people) != len(timestamps):
-        raise ValueError(
+        raise InputError(
             f"fformation: {features_path}: {len(frames_people)} feature frames but {len(timestamps)} timestamps"
         )
     if len(truth_groups) != len(truth_timestamps):
-        raise ValueError(
+        raise InputError(
             f"fformation: {truth_path}: {len(truth_groups)} GTgroups frames but {len(truth_timestamps)} GTtimestamps"
         )
     _check_unique(timestamps, features_path, "timestamp")
@@ -175,7 +175,7 @@ def load_sequence(folder: str | Path, scale: float = 1.0, degrees: bool = False)
         groups = [g for g in _groups(groups_cell, where_truth, {p.id for p in people}) if len(g) > 1]
         frames.append(LabelledFrame(folder.name, float(timestamps[k]), people, groups, unplaced))
     if unmatched and not frames:  # nothing matches: other clocks or units, not a slip
-        raise ValueError(
+        raise InputError(
             f"fformation: {truth_path}: GTtimestamp {unmatched[0]} has no frame in {features_path.name}"
             + (f" (nor do the other {len(unmatched) - 1})" if len(unmatched) > 1 else "")
         )
@@ -227,7 +227,7 @@ def _check_unique(stamps: np.ndarray, path: Path, name: str) -> None:
     values, counts = np.unique(stamps, return_counts=True)
     if (counts > 1).any():
         repeated = ", ".join(f"{v:g}" for v in values[counts > 1][:5])
-        raise ValueError(f"fformation: {path}: {name} repeats {repeated}: each frame needs its own timestamp")
+        raise InputError(f"fformation: {path}: {name} repeats {repeated}: each frame needs its own timestamp")
 
 
 def _frame_index(timestamps: np.ndarray) -> dict[float, int]:
@@ -277,18 +277,18 @@ def sequence_folders(folder: str | Path) -> list[Path]:
     down)."""
     folder = Path(folder)
     if not folder.is_dir():
-        raise ValueError(f"fformation: {folder} is not a folder")
+        raise InputError(f"fformation: {folder} is not a folder")
     if (folder / "features.mat").exists():
         return [folder]
     sequences = sorted(p.parent for p in folder.glob("*/features.mat"))
     deeper = sorted({p.parent.parent.name for p in folder.glob("*/*/features.mat")})
     if deeper:  # a folder of datasets: pooling its one-sequence datasets, and leaving the others out, is no score
         datasets = sorted({s.name for s in sequences} | set(deeper))
-        raise ValueError(
+        raise InputError(
             f"fformation: {folder} holds datasets, not one ({', '.join(datasets)}): give each dataset's folder"
         )
     if not sequences:
-        raise ValueError(f"fformation: no features.mat in {folder} or its sub-folders")
+        raise InputError(f"fformation: no features.mat in {folder} or its sub-folders")
     return sequences
 
 
@@ -320,7 +320,7 @@ def load_dataset(folder: str | Path, scale: float = 1.0, degrees: bool = False) 
         )
     frames = [frame for sequence in sequences for frame in load_sequence(sequence, scale, degrees)]
     if not frames:
-        raise ValueError(f"fformation: {folder} has no frame with ground truth (GTtimestamp is empty)")
+        raise InputError(f"fformation: {folder} has no frame with ground truth (GTtimestamp is empty)")
     return frames
 
 
@@ -528,9 +528,9 @@ def frame_precision_recall(
 def score(frames: Sequence[LabelledFrame], detections: Sequence[Sequence[Iterable[int]]], threshold: float) -> Score:
     """Mean precision and recall over ``frames`` of the detected groups (member ids, one list per frame), and F1."""
     if not frames:
-        raise ValueError("fformation: no frames to score")
+        raise InputError("fformation: no frames to score")
     if len(detections) != len(frames):
-        raise ValueError(f"fformation: {len(detections)} detection lists for {len(frames)} frames")
+        raise InputError(f"fformation: {len(detections)} detection lists for {len(frames)} frames")
     pairs = [frame_precision_recall(found, f.truth, threshold) for f, found in zip(frames, detections, strict=True)]
     precision = float(np.mean([p for p, _ in pairs]))
     recall = float(np.mean([r for _, r in pairs]))
@@ -575,7 +575,7 @@ def group_errors(frames: Sequence[LabelledFrame], detections: Sequence[Sequence[
     (``lacking``), two or more of them and others (``mixed``), or no detected group holds two of them (``missed``).
     Also ``false_groups``: detected groups of two or more that hold two members of no true group."""
     if len(detections) != len(frames):
-        raise ValueError(f"fformation: {len(detections)} detection lists for {len(frames)} frames")
+        raise InputError(f"fformation: {len(detections)} detection lists for {len(frames)} frames")
     counts = dict.fromkeys((*GROUP_ERRORS, "false_groups"), 0)
     for frame, found in zip(frames, detections, strict=True):
         groups = [frozenset(g) for g in found if len(frozenset(g)) > 1]
@@ -664,12 +664,12 @@ def cross_validate(
     Needs at least two datasets; raises ValueError for an unknown field or an empty grid.
     """
     if len(datasets) < 2:
-        raise ValueError("fformation: cross-validation needs at least two datasets")
+        raise InputError("fformation: cross-validation needs at least two datasets")
     base = base or GroupParams()
     numeric = {f.name for f in dataclasses.fields(GroupParams) if f.name != "method"}
     unknown = sorted(set(grid) - numeric)
     if unknown or not grid or not all(grid.values()):
-        raise ValueError(f"fformation: the grid needs values for numeric fields of GroupParams, got {dict(grid)}")
+        raise InputError(f"fformation: the grid needs values for numeric fields of GroupParams, got {dict(grid)}")
     names = list(grid)
     points = list(itertools.product(*(grid[n] for n in names)))
     params = []
@@ -714,7 +714,7 @@ def _check_threshold(threshold: float) -> None:
     """Raise ValueError unless the tolerance ``threshold`` lies in (1/2, 1], where the protocol is defined (at 1/2
     or below one detected group could find two true groups)."""
     if not 0.5 < threshold <= 1:
-        raise ValueError(f"threshold {threshold:g} must lie in (1/2, 1], e.g. 2/3 or 1")
+        raise InputError(f"threshold {threshold:g} must lie in (1/2, 1], e.g. 2/3 or 1")
 
 
 def parse_threshold(text: str) -> float:
@@ -726,7 +726,7 @@ def parse_threshold(text: str) -> float:
         else:
             value = float(text)
     except (ValueError, ZeroDivisionError):
-        raise ValueError(f"threshold {text!r} is not a number or fraction such as 2/3") from None
+        raise InputError(f"threshold {text!r} is not a number or fraction such as 2/3") from None
     _check_threshold(value)
     return value
 
@@ -748,7 +748,7 @@ def load_settings_gc(folder: str | Path, base: GCFFParams | None = None, scale: 
     for name in ("stride", "mdl"):
         array = _real(data[name], f"{path}: {name} must be a number")
         if array.size != 1 or not math.isfinite(float(array.ravel()[0])):
-            raise ValueError(f"fformation: {path}: {name} must be one finite number, got {array.ravel()[:4]}")
+            raise InputError(f"fformation: {path}: {name} must be one finite number, got {array.ravel()[:4]}")
         values[name] = float(array.ravel()[0])
     check_number("fformation", "scale", scale, low=0, low_open=True)
     unit = {0.01: "cm", 0.001: "mm", 1.0: "m"}.get(scale, f"x {scale:g} m")
@@ -757,7 +757,7 @@ def load_settings_gc(folder: str | Path, base: GCFFParams | None = None, scale: 
         return dataclasses.replace(base or GCFFParams(), stride=stride, mdl=mdl)
     except ValueError as exc:
         reason = str(exc).removeprefix("gcff: ")
-        raise ValueError(
+        raise InputError(
             f"fformation: {path}: {reason} (from {values['stride']:g} {unit}, {values['mdl']:g} {unit}^2)"
         ) from None
 
@@ -766,19 +766,19 @@ def _load_mat(path: Path, keys: tuple[str, ...]) -> dict:
     if not path.exists():
         others = sorted(p.name for p in path.parent.glob("*") if p.suffix.lower() == ".mat" and p.is_file())
         beside = f" (the folder holds {', '.join(others[:5])}{', ...' if len(others) > 5 else ''})" if others else ""
-        raise ValueError(f"fformation: {path} is missing{beside}")
+        raise InputError(f"fformation: {path} is missing{beside}")
     special = special_file(path)
     if special:
-        raise ValueError(f"fformation: cannot read {path}: {special}")
+        raise InputError(f"fformation: cannot read {path}: {special}")
     try:
         data = scipy.io.loadmat(str(path))
     except NotImplementedError:  # scipy's answer to a v7.3 file, which is HDF5 inside
-        raise ValueError(
+        raise InputError(
             f"fformation: cannot read {path}: it is a MATLAB v7.3 (HDF5) file; save it again in MATLAB with "
             "save(FILE, ..., '-v7')"
         ) from None
     except Exception as exc:  # scipy raises ValueError, TypeError, MatReadError... for non-MAT input
-        raise ValueError(f"fformation: cannot read {path} as a MATLAB file ({exc})") from None
+        raise InputError(f"fformation: cannot read {path} as a MATLAB file ({exc})") from None
     missing = [k for k in keys if k not in data]
     # The variables as the fields of one struct (MATLAB's save(FILE, 'S') of a struct S holding them).
     holders = [v for k, v in data.items() if not k.startswith("__") and set(missing) <= set(_fields(v))]
@@ -787,7 +787,7 @@ def _load_mat(path: Path, keys: tuple[str, ...]) -> dict:
         missing = []
     if missing:
         present = sorted(k for k in data if not k.startswith("__"))
-        raise ValueError(f"fformation: {path} lacks the variable(s) {missing} (it holds {present})")
+        raise InputError(f"fformation: {path} lacks the variable(s) {missing} (it holds {present})")
     return data
 
 
@@ -802,7 +802,7 @@ def _cells(value: np.ndarray, path: Path, name: str) -> list:
     if not isinstance(value, np.ndarray) or value.dtype != object:
         names = getattr(getattr(value, "dtype", None), "names", None)
         got = f"a struct array (fields {', '.join(names)})" if names else getattr(value, "dtype", type(value))
-        raise ValueError(f"fformation: {path}: {name} must be a cell array, got {got}")
+        raise InputError(f"fformation: {path}: {name} must be a cell array, got {got}")
     return list(value.ravel())
 
 
@@ -812,16 +812,16 @@ def _real(value: object, problem: str) -> np.ndarray:
     try:
         array = np.asarray(value)
         if np.iscomplexobj(array):
-            raise ValueError("complex")
+            raise InputError("complex")
         return np.asarray(array, dtype=float)
     except (TypeError, ValueError):
-        raise ValueError(f"fformation: {problem}") from None
+        raise InputError(f"fformation: {problem}") from None
 
 
 def _numbers(value: np.ndarray, path: Path, name: str) -> np.ndarray:
     numbers = _real(value, f"{path}: {name} must be real numbers").ravel()
     if not np.all(np.isfinite(numbers)):
-        raise ValueError(f"fformation: {path}: {name} holds non-finite values")
+        raise InputError(f"fformation: {path}: {name} holds non-finite values")
     return numbers
 
 
@@ -831,26 +831,26 @@ def _people(cell: np.ndarray, scale: float, degrees: bool, where: str) -> tuple[
     if rows.size == 0:
         return [], 0
     if rows.ndim != 2 or rows.shape[1] < 4:
-        raise ValueError(f"fformation: {where}: features must be N x 4 [id, x, y, theta], got shape {rows.shape}")
+        raise InputError(f"fformation: {where}: features must be N x 4 [id, x, y, theta], got shape {rows.shape}")
     check_limit(f"fformation: {where}: features", len(rows), "people", "people")  # as sid groups, before grouping
     if not np.all(np.isfinite(rows[:, 0])):
-        raise ValueError(f"fformation: {where}: non-finite person id")
+        raise InputError(f"fformation: {where}: non-finite person id")
     ids = rows[:, 0]
     if not np.array_equal(ids, np.round(ids)):
-        raise ValueError(
+        raise InputError(
             f"fformation: {where}: ids (first column) must be whole numbers, got {ids[ids != np.round(ids)][0]:g} "
             "(a transposed array? features are N x 4 [id, x, y, theta], one row per person)"
         )
     values, counts = np.unique(ids, return_counts=True)
     if (counts > 1).any():
-        raise ValueError(f"fformation: {where}: person id {values[counts > 1][0]:g} appears more than once")
+        raise InputError(f"fformation: {where}: person id {values[counts > 1][0]:g} appears more than once")
     placed = np.isfinite(rows[:, 1:3]).all(axis=1)  # a person without a position (a lost track) is left out
     unplaced = int(len(rows) - placed.sum())
     rows = rows[placed]
     yaw = np.radians(rows[:, 3]) if degrees else rows[:, 3]
     reach = float(np.abs(yaw[np.isfinite(yaw)]).max(initial=0.0))
     if reach > YAW_LIMIT_RAD and degrees:  # read as degrees already: no unit makes it an angle
-        raise ValueError(
+        raise InputError(
             f"fformation: {where}: theta reaches {math.degrees(reach):g} degrees, beyond two turns (720): neither "
             "radians nor degrees"
         )
@@ -864,7 +864,7 @@ def _people(cell: np.ndarray, scale: float, degrees: bool, where: str) -> tuple[
     overflow = ~np.isfinite(xy).all(axis=1)
     if overflow.any():
         x, y = rows[overflow][0, 1:3].tolist()
-        raise ValueError(f"fformation: {where}: position ({x:g}, {y:g}) scaled by {scale:g} overflows to infinity")
+        raise InputError(f"fformation: {where}: position ({x:g}, {y:g}) scaled by {scale:g} overflows to infinity")
     # An annotated facing is taken at full quality (1), a missing one is unknown (None, quality 0).
     people = [
         Person(int(i), x, y, *((theta, 1.0) if math.isfinite(theta) else (None, 0.0)))
@@ -889,5 +889,5 @@ def _groups(cell: object, where: str, present: set[int]) -> list[frozenset[int]]
         padding = np.isnan(ids) | (zero & (0 not in present)) | (ending & (rows_with_zero > 1))
         return [g for row, pad in zip(ids, padding, strict=True) for g in _groups(row[~pad], where, present)]
     if not np.all(np.isfinite(ids)) or not np.array_equal(ids, np.round(ids)):
-        raise ValueError(f"fformation: {where}: group member ids must be finite whole numbers, got {ids.ravel()[:10]}")
+        raise InputError(f"fformation: {where}: group member ids must be finite whole numbers, got {ids.ravel()[:10]}")
     return [frozenset(int(i) for i in ids.ravel().tolist())]

@@ -12,6 +12,8 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass
 
+from sid.errors import InputError
+
 __all__ = ["LinkCounts", "gmitre_counts"]
 
 
@@ -67,7 +69,7 @@ def _partition(groups: Iterable[Iterable[int]], side: str) -> list[frozenset[int
     seen: set[int] = set()
     for c in classes:
         if seen & c:
-            raise ValueError(f"gmitre: person {min(seen & c)} is in two {side} groups")
+            raise InputError(f"gmitre: person {min(seen & c)} is in two {side} groups")
         seen |= c
     return [c for c in classes if c]
 

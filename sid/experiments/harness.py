@@ -40,6 +40,7 @@ from planner.problem import (
     WalledOffError,
 )
 from sid.checks import repeated
+from sid.errors import InputError
 from sid.experiments.path_metrics import result_metrics
 from sid.experiments.progress import Progress
 from sid.perception.group import Group
@@ -335,13 +336,13 @@ def run_matrix(
     once at the end."""
     names = [resolve_planner(p) for p in planners]
     if runs < 1:
-        raise ValueError(f"runs must be at least 1, got {runs}")
+        raise InputError(f"runs must be at least 1, got {runs}")
     twice = repeated(names)
     if twice is not None:
-        raise ValueError(f"planner {twice} is given twice: its runs would be counted twice")
+        raise InputError(f"planner {twice} is given twice: its runs would be counted twice")
     twice = repeated([task.scenario.name for task in tasks])
     if twice is not None:
-        raise ValueError(
+        raise InputError(
             f"two scenarios are named {twice!r}: their runs would be pooled into one row; give each its own 'name'"
         )
     for task in tasks:  # an impossible task stops the matrix here, named, before any run is spent

@@ -33,6 +33,7 @@ import numpy as np
 from planner.facade import DEFAULT_PLANNER, resolve_planner
 from planner.problem import DEFAULT_COST_WEIGHT, PlanningError
 from sid.checks import check_number, check_whole, repeated
+from sid.errors import InputError
 from sid.experiments.demo import DEMO_SCENARIO
 from sid.experiments.harness import Comparison, compare_with_without, prepare
 from sid.experiments.progress import Progress
@@ -108,9 +109,9 @@ class NavTask:
 def task_scenario(layout_name: str, seed: int, direction: str = "forward", base_seed: int = 0) -> Scenario:
     """The scenario of one task (see the module docstring for how it is drawn)."""
     if layout_name not in NAV_LAYOUTS:
-        raise ValueError(f"unknown navigation layout {layout_name!r}; known: {', '.join(NAV_LAYOUTS)}")
+        raise InputError(f"unknown navigation layout {layout_name!r}; known: {', '.join(NAV_LAYOUTS)}")
     if direction not in DIRECTIONS:
-        raise ValueError(f"direction must be one of {DIRECTIONS}, got {direction!r}")
+        raise InputError(f"direction must be one of {DIRECTIONS}, got {direction!r}")
     spec = NAV_LAYOUTS[layout_name]
     rng = np.random.default_rng([base_seed, list(NAV_LAYOUTS).index(layout_name), seed])
     centre = np.array([GROUP_CENTRE_X, rng.uniform(-CENTRE_LATERAL_M, CENTRE_LATERAL_M)])
@@ -161,14 +162,14 @@ class NavSettings:
 
     def __post_init__(self) -> None:
         if not self.planners:
-            raise ValueError("navigation: give at least one planner")
+            raise InputError("navigation: give at least one planner")
         # resolve_planner raises ValueError naming an unknown planner
         twice = repeated([resolve_planner(name) for name in self.planners])
         if twice is not None:  # as run_matrix: its plans would be counted twice in the report
-            raise ValueError(f"navigation: planner {twice} is given twice: its runs would be counted twice")
+            raise InputError(f"navigation: planner {twice} is given twice: its runs would be counted twice")
         check_number("navigation", "time limit", self.time_limit, low=0, low_open=True, unit="seconds")
         if self.max_iterations is not None and self.max_iterations < 1:
-            raise ValueError(f"navigation: iteration cap must be >= 1, got {self.max_iterations}")
+            raise InputError(f"navigation: iteration cap must be >= 1, got {self.max_iterations}")
 
 
 # The fields of a run kept in the report: the task's labels, then ``Run.record`` keys.

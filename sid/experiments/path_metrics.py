@@ -25,6 +25,7 @@ from shapely.ops import unary_union
 from costmap.grid import LETHAL, MAX_NON_OBSTACLE, NO_INFORMATION, Costmap2D
 from costmap.layers.social import group_zone_polygon
 from planner.validity import interpolate
+from sid.errors import InputError
 from sid.perception.group import Group
 from sid.perception.people import Person
 
@@ -126,7 +127,7 @@ def path_metrics(
     """
     path = np.asarray(path, dtype=float).reshape(-1, 2)
     if len(path) == 0 or not np.isfinite(path).all():
-        raise ValueError("path_metrics needs a non-empty path of finite (x, y) points")
+        raise InputError("path_metrics needs a non-empty path of finite (x, y) points")
     length = path_length(path)
     straight = float(np.hypot(*(path[-1] - path[0])))
     positions = np.array([(p.x, p.y) for p in people], dtype=float).reshape(-1, 2)

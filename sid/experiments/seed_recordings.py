@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from sid.documents import special_file
+from sid.errors import InputError
 from sid.perception.group import Group
 from sid.perception.groups import GroupParams, detect_groups
 from sid.perception.people import Person
@@ -116,16 +117,16 @@ def load_recording(path: str | Path) -> list[LoggedFrame]:
     path = Path(path)
     special = special_file(path)
     if special:
-        raise ValueError(f"cannot read {path}: {special}")
+        raise InputError(f"cannot read {path}: {special}")
     try:
         with path.open(newline="", encoding="utf-8") as handle:
             reader = csv.DictReader(handle)
             missing = [c for c in COLUMNS if c not in (reader.fieldnames or [])]
             if missing:
-                raise ValueError(f"{path}: missing column(s) {missing}")
+                raise InputError(f"{path}: missing column(s) {missing}")
             return _frames(path.name, reader)
     except OSError as exc:
-        raise ValueError(f"cannot read {path}: {exc.strerror}") from None
+        raise InputError(f"cannot read {path}: {exc.strerror}") from None
 
 
 def _frames(source: str, rows: Iterable[dict[str, str]]) -> list[LoggedFrame]:
@@ -135,9 +136,9 @@ def _frames(source: str, rows: Iterable[dict[str, str]]) -> list[LoggedFrame]:
         try:
             values = {c: float(row[c]) for c in COLUMNS}
         except (TypeError, ValueError):
-            raise ValueError(f"{source} line {line}: non-numeric value in {row}") from None
+            raise InputError(f"{source} line {line}: non-numeric value in {row}") from None
         if not all(math.isfinite(v) for v in values.values()):
-            raise ValueError(f"{source} line {line}: non-finite value in {row}")
+            raise InputError(f"{source} line {line}: non-finite value in {row}")
         message = (values["Timestamp"], values["Runtime"])
         group, person = int(values["Group Index"]), int(values["Person Index"])
         centre = (values["Centroid X"], values["Centroid Y"])
@@ -166,7 +167,7 @@ def load_recordings(folder: str | Path) -> list[LoggedFrame]:
     """All frames of the ``*.csv`` files in ``folder``, file by file in name order."""
     paths = sorted(Path(folder).glob("*.csv"))
     if not paths:
-        raise ValueError(f"no .csv recordings in {folder}")
+        raise InputError(f"no .csv recordings in {folder}")
     return [frame for path in paths for frame in load_recording(path)]
 
 

@@ -43,6 +43,7 @@ from costmap.layers.social import GROUPS, PEOPLE
 from costmap.plugins import CostmapParams, layered_costmap
 from sid.checks import check_number, check_whole, repeated
 from sid.distribution import MissingDependencyError, install_hint
+from sid.errors import InputError
 from sid.experiments.fformation import LabelledFrame, format_threshold, score
 from sid.experiments.progress import Progress
 from sid.perception.frame import Frame
@@ -100,10 +101,10 @@ class TrackingEvalSettings:
                 check_whole("tracking evaluation", name, value, low=low)
         unknown = [name for name in self.sequences if name not in SEQUENCES]
         if unknown or not self.sequences:
-            raise ValueError(f"tracking evaluation: unknown sequences {unknown}; known: {', '.join(SEQUENCES)}")
+            raise InputError(f"tracking evaluation: unknown sequences {unknown}; known: {', '.join(SEQUENCES)}")
         twice = repeated(list(self.sequences))
         if twice is not None:  # "overall" would count its frames twice
-            raise ValueError(f"tracking evaluation: sequence {twice} is given twice")
+            raise InputError(f"tracking evaluation: sequence {twice} is given twice")
 
 
 @dataclass

@@ -31,6 +31,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from sid.checks import check_number, check_whole, repeated
+from sid.errors import InputError
 from sid.experiments.fformation import most_shared
 from sid.experiments.progress import Progress
 from sid.experiments.synthetic_tracking import identify
@@ -95,13 +96,13 @@ class Table1Settings:
     def __post_init__(self) -> None:
         unknown = [s for s in self.scenarios if s.upper() not in LAYOUTS]
         if unknown or not self.scenarios:
-            raise ValueError(f"table1: unknown scenario(s) {unknown or '(none given)'}; known: {', '.join(LAYOUTS)}")
+            raise InputError(f"table1: unknown scenario(s) {unknown or '(none given)'}; known: {', '.join(LAYOUTS)}")
         twice = repeated([s.upper() for s in self.scenarios])
         if twice is not None:  # its frames would be pooled twice into the one row
-            raise ValueError(f"table1: scenario {twice} is given twice")
+            raise InputError(f"table1: scenario {twice} is given twice")
         check_whole("table1", "frames", self.frames, low=1)
         if not 1 <= self.variations <= len(VARIATIONS):
-            raise ValueError(f"table1: variations must be 1..{len(VARIATIONS)}, got {self.variations}")
+            raise InputError(f"table1: variations must be 1..{len(VARIATIONS)}, got {self.variations}")
         check_number("table1", "match_radius", self.match_radius, low=0, low_open=True, unit="metres")
 
     def describe(self) -> dict:

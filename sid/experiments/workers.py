@@ -19,6 +19,7 @@ from typing import Any, TypeVar
 
 from sid.checks import Limits, check_whole, limits, use_limits
 from sid.cpu import keep_freed_memory
+from sid.errors import InputError
 from sid.experiments.progress import Progress
 
 __all__ = ["map_in_workers"]
@@ -82,7 +83,7 @@ def map_in_workers(
     path = getattr(main, "__file__", None)
     if getattr(main, "__spec__", None) is None and path and not os.path.isfile(path):
         # spawn runs the main program's file again in each worker; "<stdin>" (python - <<EOF) is none: they all fail
-        raise ValueError(
+        raise InputError(
             f"tasks: worker processes cannot start from a program that is not a file ({path}): run it from a file, "
             "or with one worker"
         )

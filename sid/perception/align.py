@@ -46,6 +46,7 @@ from typing import Literal
 import cv2
 import numpy as np
 
+from sid.errors import InputError
 from sid.perception.camera import Calibration, Intrinsics, pixel_rays
 
 __all__ = [
@@ -85,23 +86,23 @@ _WINDOW_STEPS = 3
 def _validate_depth(depth_m: np.ndarray, intr: Intrinsics, what: str) -> np.ndarray:
     depth_m = np.asarray(depth_m)
     if depth_m.ndim != 2:
-        raise ValueError(f"{what}: depth must be a 2-D image, got shape {depth_m.shape}")
+        raise InputError(f"{what}: depth must be a 2-D image, got shape {depth_m.shape}")
     if depth_m.shape != (intr.height, intr.width):
-        raise ValueError(
+        raise InputError(
             f"{what}: depth image is {depth_m.shape[1]}x{depth_m.shape[0]} but the calibration says "
             f"{intr.width}x{intr.height}"
         )
     if depth_m.dtype.kind != "f":  # floating (np.issubdtype costs more than the lookups it guards)
-        raise ValueError(f"{what}: depth must be float metres, got dtype {depth_m.dtype} (multiply by depth_scale)")
+        raise InputError(f"{what}: depth must be float metres, got dtype {depth_m.dtype} (multiply by depth_scale)")
     return depth_m
 
 
 def _check_options(mode: SplatMode, value: StoredValue) -> None:
     """ValueError naming an unknown splat ``mode`` or stored ``value``."""
     if mode not in ("rectangle", "point"):
-        raise ValueError(f"unknown splat mode {mode!r}; use 'rectangle' or 'point'")
+        raise InputError(f"unknown splat mode {mode!r}; use 'rectangle' or 'point'")
     if value not in ("z", "depth"):
-        raise ValueError(f"unknown stored value {value!r}; use 'z' or 'depth'")
+        raise InputError(f"unknown stored value {value!r}; use 'z' or 'depth'")
 
 
 def _reduce_patches(values: np.ndarray, method: PatchMethod, min_support: int = _MIN_SUPPORT) -> np.ndarray:
@@ -120,7 +121,7 @@ def _reduce_patches(values: np.ndarray, method: PatchMethod, min_support: int = 
     if method == "min":
         return np.where(count > 0, ordered[:, 0], np.nan)
     if method not in ("nearest", "median"):
-        raise ValueError(f"unknown patch method {method!r}; use 'nearest', 'min' or 'median'")
+        raise InputError(f"unknown patch method {method!r}; use 'nearest', 'min' or 'median'")
     # The indices of the two middle readings of each row, (2, N) (a row without readings reads cell -1, which the
     # last line replaces).
     middle = (count - _LOW_HIGH) // 2
@@ -170,12 +171,12 @@ def _patch_offsets(patch: int) -> tuple[np.ndarray, np.ndarray]:
 
 def _check_pixels(pixels: np.ndarray, patch: int) -> np.ndarray:
     if isinstance(patch, bool) or not isinstance(patch, (int, np.integer)) or patch < 1 or patch % 2 == 0:
-        raise ValueError(f"patch must be a positive odd integer (pixels), got {patch!r}")
+        raise InputError(f"patch must be a positive odd integer (pixels), got {patch!r}")
     pixels = np.asarray(pixels, dtype=float)
     if pixels.size == 0:
         return pixels.reshape(0, 2)
     if pixels.ndim != 2 or pixels.shape[1] != 2:
-        raise ValueError(f"pixels must be an (N, 2) array of (u, v) colour pixels, got shape {pixels.shape}")
+        raise InputError(f"pixels must be an (N, 2) array of (u, v) colour pixels, got shape {pixels.shape}")
     return pixels
 
 
@@ -291,7 +292,7 @@ class Aligner:
 
     def __init__(self, calib: Calibration, mode: SplatMode = "rectangle", value: StoredValue = "z") -> None:
         if calib.depth is None:
-            raise ValueError("Aligner: the calibration has no depth intrinsics (depth already registered to colour)")
+            raise InputError("Aligner: the calibration has no depth intrinsics (depth already registered to colour)")
         _check_options(mode, value)
         self.calib, self.mode, self.value = calib, mode, value
         kd, kc = calib.depth, calib.color
@@ -482,10 +483,10 @@ def depth_at_color_pixels(
     the exact search.
     """
     if search not in ("exact", "window"):
-        raise ValueError(f"unknown depth search {search!r}; use 'exact' or 'window'")
+        raise InputError(f"unknown depth search {search!r}; use 'exact' or 'window'")
     _check_options(mode, value)
     if not (0 < depth_min < depth_max and math.isfinite(depth_max)):
-        raise ValueError(f"need 0 < depth_min < depth_max < inf, got {depth_min}, {depth_max}")
+        raise InputError(f"need 0 < depth_min < depth_max < inf, got {depth_min}, {depth_max}")
     pixels = _check_pixels(pixels, patch)
     if calib.depth is None:
         depth_m = _validate_depth(depth_m, calib.color, "depth_at_color_pixels")

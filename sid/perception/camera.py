@@ -20,6 +20,7 @@ import numpy as np
 
 from sid.checks import check_limit, check_number, check_numbers
 from sid.documents import InputWarning, is_number, load_document, summary
+from sid.errors import InputError
 
 __all__ = [
     "Calibration",
@@ -67,12 +68,12 @@ class Intrinsics:
 
     def __post_init__(self) -> None:
         if self.width <= 0 or self.height <= 0:
-            raise ValueError(f"intrinsics: image size must be positive, got {self.width}x{self.height}")
+            raise InputError(f"intrinsics: image size must be positive, got {self.width}x{self.height}")
         detail = f"{self.width} x {self.height} = "  # every frame of this camera is decoded at this size
         check_limit("intrinsics: image", self.width * self.height, "image_pixels", "pixels", detail)
         check_numbers("intrinsics", self, ("fx", "fy", "cx", "cy"), unit="pixels")
         if self.fx <= 0 or self.fy <= 0:
-            raise ValueError(f"intrinsics: focal lengths must be positive, got fx={self.fx}, fy={self.fy}")
+            raise InputError(f"intrinsics: focal lengths must be positive, got fx={self.fx}, fy={self.fy}")
         # A real camera's optical axis meets its own image, and its field of view spans half a degree to 178 degrees.
         check_number("intrinsics", "cx", self.cx, low=0, high=self.width, unit="pixels")
         check_number("intrinsics", "cy", self.cy, low=0, high=self.height, unit="pixels")
@@ -122,17 +123,17 @@ class Intrinsics:
         A missing or mistyped field is a ValueError naming ``where`` (e.g. ``color``), the field and its value.
         """
         if not isinstance(data, dict):
-            raise ValueError(f"{where}: expected an object with width, height, fx, fy, cx, cy, got {summary(data)}")
+            raise InputError(f"{where}: expected an object with width, height, fx, fy, cx, cy, got {summary(data)}")
         width, height = (_pixel_count(data, key, where) for key in ("width", "height"))
         fx, fy = (_number(data, key, where, low=0, low_open=True, unit="pixels") for key in ("fx", "fy"))
         cx = _number(data, "cx" if "cx" in data or "ppx" not in data else "ppx", where, unit="pixels")
         cy = _number(data, "cy" if "cy" in data or "ppy" not in data else "ppy", where, unit="pixels")
         model = data.get("model", "none")
         if not isinstance(model, str):
-            raise ValueError(f"{where}: model must be a distortion model name, got {summary(model)}")
+            raise InputError(f"{where}: model must be a distortion model name, got {summary(model)}")
         coeffs = data.get("coeffs", [0.0] * 5)
         if not (isinstance(coeffs, list) and all(is_number(c) for c in coeffs)):
-            raise ValueError(f"{where}: coeffs must be a list of numbers, got {summary(coeffs)}")
+            raise InputError(f"{where}: coeffs must be a list of numbers, got {summary(coeffs)}")
         return cls(width, height, fx, fy, cx, cy, model, tuple(float(c) for c in coeffs))
 
     def to_dict(self) -> dict[str, Any]:
@@ -159,11 +160,11 @@ class Extrinsics:
         rotation = np.asarray(self.rotation, dtype=float).reshape(3, 3)
         translation = np.asarray(self.translation, dtype=float).reshape(3)
         if not (np.all(np.isfinite(rotation)) and np.all(np.isfinite(translation))):
-            raise ValueError("extrinsics: rotation and translation must be finite")
+            raise InputError("extrinsics: rotation and translation must be finite")
         if not np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-5):
-            raise ValueError("extrinsics: rotation is not orthonormal")
+            raise InputError("extrinsics: rotation is not orthonormal")
         if np.linalg.det(rotation) < 0:  # orthonormal, but a reflection: it would mirror the depth points
-            raise ValueError("extrinsics: rotation has determinant -1, a mirror rather than a rotation")
+            raise InputError("extrinsics: rotation has determinant -1, a mirror rather than a rotation")
         object.__setattr__(self, "rotation", rotation)
         object.__setattr__(self, "translation", translation)
 
@@ -183,13 +184,13 @@ class Extrinsics:
         A missing or mistyped field is a ValueError naming ``where`` (e.g. ``depth_to_color``), the field and its value.
         """
         if not isinstance(data, dict):
-            raise ValueError(f"{where}: expected an object with rotation and translation, got {summary(data)}")
+            raise InputError(f"{where}: expected an object with rotation and translation, got {summary(data)}")
         rotation = _numbers(data, "rotation", where, 9, "a 3x3 row-major matrix of numbers")
         translation = _numbers(data, "translation", where, 3, "[x, y, z] in metres")
         try:
             return cls(rotation, translation)
         except ValueError as exc:  # e.g. a rotation that is not one
-            raise ValueError(f"{where}: {str(exc).removeprefix('extrinsics: ')}") from None
+            raise InputError(f"{where}: {str(exc).removeprefix('extrinsics: ')}") from None
 
     def to_dict(self) -> dict[str, Any]:
         return {"rotation": self.rotation.tolist(), "translation": self.translation.tolist()}
@@ -214,14 +215,14 @@ class Calibration:
         extrinsics = self.depth_to_color
         identity = np.array_equal(extrinsics.rotation, np.eye(3)) and not extrinsics.translation.any()
         if self.depth is None and not identity:
-            raise ValueError(
+            raise InputError(
                 "depth_to_color is not the identity but there are no depth intrinsics: without them the depth "
                 "image is taken as registered to colour and the transform would be ignored; give the depth section "
                 "(or drop depth_to_color if the depth image is registered)"
             )
         baseline = float(np.linalg.norm(extrinsics.translation))
         if baseline > MAX_BASELINE:
-            raise ValueError(
+            raise InputError(
                 f"depth_to_color: translation {baseline:g} m is more than {MAX_BASELINE:g} m; the two sensors of an "
                 "RGB-D camera sit centimetres apart (metres expected, not millimetres)"
             )
@@ -243,7 +244,7 @@ class Calibration:
         path = Path(path)
         data = load_document(path, "calibration JSON")  # names the file itself
         if not isinstance(data, dict):
-            raise ValueError(f"calibration {path}: expected a JSON object, got {summary(data)}")
+            raise InputError(f"calibration {path}: expected a JSON object, got {summary(data)}")
         depth_scale = _depth_scale(data, f"calibration {path}")
         if "color" in data:
             extrinsics = data.get("depth_to_color")
@@ -269,10 +270,10 @@ class Calibration:
                 )
             else:
                 if data.get("depth_aligned_to_color") is False:
-                    raise ValueError("depth is not aligned to colour; give color, depth and depth_to_color sections")
+                    raise InputError("depth is not aligned to colour; give color, depth and depth_to_color sections")
                 calibration = cls(Intrinsics.from_dict(data), depth_scale=depth_scale)
         except ValueError as exc:
-            raise ValueError(f"calibration {path}: {exc}") from None
+            raise InputError(f"calibration {path}: {exc}") from None
         for name, intrinsics in (("color", calibration.color), ("depth", calibration.depth)):
             if intrinsics is not None:
                 warn_distortion(intrinsics, f"calibration {path}: {name}" if "color" in data else f"calibration {path}")
@@ -331,10 +332,10 @@ def _number(data: dict[str, Any], key: str, where: str, **bounds: Any) -> float:
     """``data[key]`` as a float: ValueError ``"where: key ..."`` when it is missing, not a number or out of bounds
     (``bounds`` as in ``sid.checks.check_number``)."""
     if key not in data:
-        raise ValueError(f"{where}: missing field {key!r}")
+        raise InputError(f"{where}: missing field {key!r}")
     value = data[key]
     if not is_number(value):
-        raise ValueError(f"{where}: {key} must be a number, got {summary(value)}")
+        raise InputError(f"{where}: {key} must be a number, got {summary(value)}")
     check_number(where, key, value, **bounds)
     return float(value)
 
@@ -343,18 +344,18 @@ def _pixel_count(data: dict[str, Any], key: str, where: str) -> int:
     """``data[key]`` as a whole number of pixels in [1, MAX_IMAGE_SIDE] (image width or height)."""
     value = _number(data, key, where, low=1, high=MAX_IMAGE_SIDE, unit="pixels")
     if not value.is_integer():
-        raise ValueError(f"{where}: {key} must be a whole number of pixels, got {summary(data[key])}")
+        raise InputError(f"{where}: {key} must be a whole number of pixels, got {summary(data[key])}")
     return int(value)
 
 
 def _numbers(data: dict[str, Any], key: str, where: str, count: int, rule: str) -> np.ndarray:
     """``data[key]``, a list of ``count`` numbers or of lists of numbers (rows), flattened."""
     if key not in data:
-        raise ValueError(f"{where}: missing field {key!r}")
+        raise InputError(f"{where}: missing field {key!r}")
     value = data[key]
     flat = [x for row in value for x in (row if isinstance(row, list) else [row])] if isinstance(value, list) else None
     if flat is None or len(flat) != count or not all(is_number(x) for x in flat):
-        raise ValueError(f"{where}: {key} must be {rule}, got {summary(value)}")
+        raise InputError(f"{where}: {key} must be {rule}, got {summary(value)}")
     return np.array(flat, dtype=float)
 
 

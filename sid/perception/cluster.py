@@ -25,6 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from sid.checks import check_number, check_whole
+from sid.errors import InputError
 
 __all__ = ["SMALL_N_MAX", "dbscan_labels"]
 
@@ -40,12 +41,12 @@ def dbscan_labels(points: np.ndarray, eps: float, min_samples: int) -> np.ndarra
     """
     points = np.asarray(points, dtype=float)
     if points.ndim != 2:
-        raise ValueError(f"dbscan: points must be an (N, D) array, got shape {points.shape}")
+        raise InputError(f"dbscan: points must be an (N, D) array, got shape {points.shape}")
     check_number("dbscan", "eps", eps, low=0, low_open=True)
     check_whole("dbscan", "min_samples", min_samples, low=1)
     if not np.all(np.isfinite(points)):
         bad = int(np.flatnonzero(~np.all(np.isfinite(points), axis=1))[0])
-        raise ValueError(f"dbscan: point {bad} is not finite: {points[bad].tolist()}")
+        raise InputError(f"dbscan: point {bad} is not finite: {points[bad].tolist()}")
     n = len(points)
     if n == 0:
         return np.empty(0, dtype=np.intp)

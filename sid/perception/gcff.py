@@ -67,6 +67,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sid.checks import MAX_LENGTH, check_limit, check_number, check_whole
+from sid.errors import InputError, InputTypeError
 
 __all__ = ["GCFF_ORDERS", "GCFFParams", "gcff_labels"]
 
@@ -121,7 +122,7 @@ class GCFFParams:
         check_number("gcff", "visibility_unit", self.visibility_unit, low=0, unit="square metres")
         check_whole("gcff", "max_rounds", self.max_rounds, low=1)
         if self.order not in GCFF_ORDERS:
-            raise ValueError(f"gcff: order must be one of {', '.join(GCFF_ORDERS)}, got {self.order!r}")
+            raise InputError(f"gcff: order must be one of {', '.join(GCFF_ORDERS)}, got {self.order!r}")
 
 
 def gcff_labels(positions: np.ndarray, yaw: np.ndarray, params: GCFFParams | None = None) -> np.ndarray:
@@ -136,7 +137,7 @@ def gcff_labels(positions: np.ndarray, yaw: np.ndarray, params: GCFFParams | Non
     """
     params = params if params is not None else GCFFParams()
     if not isinstance(params, GCFFParams):
-        raise TypeError(f"gcff: params must be GCFFParams, got {type(params).__name__}")
+        raise InputTypeError(f"gcff: params must be GCFFParams, got {type(params).__name__}")
     xy, theta = _checked(positions, yaw)
     count = len(xy)
     if count == 0:
@@ -166,20 +167,20 @@ def _checked(positions: np.ndarray, yaw: np.ndarray) -> tuple[np.ndarray, np.nda
         xy = np.asarray(positions, dtype=float)
         theta = np.asarray(yaw, dtype=float)
     except (TypeError, ValueError):
-        raise ValueError("gcff: positions and yaw must be numeric arrays") from None
+        raise InputError("gcff: positions and yaw must be numeric arrays") from None
     if xy.size == 0 and theta.size == 0:
         return np.zeros((0, 2)), np.zeros(0)
     if xy.ndim != 2 or xy.shape[1] != 2:
-        raise ValueError(f"gcff: positions must be an (N, 2) array of x, y (m), got shape {xy.shape}")
+        raise InputError(f"gcff: positions must be an (N, 2) array of x, y (m), got shape {xy.shape}")
     if theta.ndim != 1 or len(theta) != len(xy):
-        raise ValueError(f"gcff: yaw must be an ({len(xy)},) array, one angle per position, got shape {theta.shape}")
+        raise InputError(f"gcff: yaw must be an ({len(xy)},) array, one angle per position, got shape {theta.shape}")
     check_limit("gcff: positions", len(xy), "people", "people")
     bad = np.flatnonzero(~np.isfinite(xy).all(axis=1))
     if len(bad):
-        raise ValueError(f"gcff: positions must be finite, row {bad[0]} is {xy[bad[0]].tolist()}")
+        raise InputError(f"gcff: positions must be finite, row {bad[0]} is {xy[bad[0]].tolist()}")
     bad = np.flatnonzero(np.isinf(theta))
     if len(bad):
-        raise ValueError(f"gcff: yaw must be finite or NaN (unknown facing), yaw[{bad[0]}] is {theta[bad[0]]}")
+        raise InputError(f"gcff: yaw must be finite or NaN (unknown facing), yaw[{bad[0]}] is {theta[bad[0]]}")
     return xy, theta
 
 

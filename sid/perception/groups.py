@@ -25,6 +25,7 @@ import numpy as np
 
 from sid.checks import MAX_COORDINATE, check_number, check_numbers, check_whole, is_real
 from sid.documents import summary
+from sid.errors import InputError
 from sid.perception.gcff import GCFFParams, gcff_labels
 from sid.perception.group import Group
 from sid.perception.ospace import TIE, OSpaceModel, find_ospaces
@@ -169,7 +170,7 @@ class GroupParams:
 
     def __post_init__(self) -> None:
         if self.method not in GROUP_METHODS:
-            raise ValueError(f"groups: method must be one of {', '.join(GROUP_METHODS)}, got {summary(self.method)}")
+            raise InputError(f"groups: method must be one of {', '.join(GROUP_METHODS)}, got {summary(self.method)}")
         self.ospace_model  # noqa: B018 - builds (and so checks) the o-space fields, once per record
         self.coarse_ospace_model  # noqa: B018 - and the coarse-facing field
         self.positions_only_model  # noqa: B018 - and the positions-only fields
@@ -193,7 +194,7 @@ class GroupParams:
         try:
             return GCFFParams(stride=self.gcff_stride, mdl=self.gcff_mdl)
         except ValueError as exc:
-            raise ValueError(str(exc).replace("gcff: ", "groups: gcff_", 1)) from None
+            raise InputError(str(exc).replace("gcff: ", "groups: gcff_", 1)) from None
 
     @cached_property
     def ospace_model(self) -> OSpaceModel:
@@ -219,7 +220,7 @@ class GroupParams:
             message = str(exc).replace("ospace: ", "groups: ", 1)
             for old, new in names.items():
                 message = message.replace(f"groups: {old} ", f"groups: {new} ", 1)
-            raise ValueError(message) from None
+            raise InputError(message) from None
 
     @cached_property
     def as_paper(self) -> GroupParams:
@@ -233,7 +234,7 @@ class GroupParams:
         try:
             return RingModel(self.ring_radius_max, self.ring_tolerance, self.ring_facing_tolerance)
         except ValueError as exc:
-            raise ValueError(str(exc).replace("rings: ", "groups: ring_", 1)) from None
+            raise InputError(str(exc).replace("rings: ", "groups: ring_", 1)) from None
 
     @cached_property
     def coarse_ospace_model(self) -> OSpaceModel:
@@ -241,7 +242,7 @@ class GroupParams:
         try:
             return replace(self.ospace_model, pair_reach=self.coarse_pair_reach)
         except ValueError as exc:
-            raise ValueError(str(exc).replace("ospace: pair_reach", "groups: coarse_pair_reach", 1)) from None
+            raise InputError(str(exc).replace("ospace: pair_reach", "groups: coarse_pair_reach", 1)) from None
 
     @cached_property
     def positions_only_model(self) -> OSpaceModel:
@@ -265,7 +266,7 @@ class GroupParams:
             message = str(exc)
             for old, new in names.items():
                 message = message.replace(f"ospace: {old} ", f"groups: positions_only_{new} ", 1)
-            raise ValueError(message.replace("ospace: ", "groups: ", 1)) from None
+            raise InputError(message.replace("ospace: ", "groups: ", 1)) from None
 
 
 def detect_groups(people: Sequence[Person], params: GroupParams = GroupParams()) -> list[Group]:
@@ -467,27 +468,27 @@ def _validated(people: list[Person]) -> tuple[list[int], list[complex], list[com
     ids = [p.id for p in people]
     for i in ids:  # before sorting by id, which would fail inside Python on a str or None
         if type(i) is not int and (isinstance(i, bool) or not isinstance(i, numbers.Integral)):
-            raise ValueError(f"groups: person id {i!r} is not a whole number")
+            raise InputError(f"groups: person id {i!r} is not a whole number")
     if len(set(ids)) != len(ids):
         duplicates = sorted({i for i in ids if ids.count(i) > 1})
-        raise ValueError(f"groups: person ids must be unique, repeated: {duplicates}")
+        raise InputError(f"groups: person ids must be unique, repeated: {duplicates}")
     positions = []
     facing = []
     for person in people:
         if not (is_real(person.x) and is_real(person.y)):
-            raise ValueError(
+            raise InputError(
                 f"groups: person {person.id} has a position that is not a pair of numbers: ({person.x!r}, {person.y!r})"
             )
         if not (math.isfinite(person.x) and math.isfinite(person.y)):
-            raise ValueError(f"groups: person {person.id} has a non-finite position ({person.x}, {person.y})")
+            raise InputError(f"groups: person {person.id} has a non-finite position ({person.x}, {person.y})")
         quality = person.orientation_quality
         if not (is_real(quality) and math.isfinite(quality)):
-            raise ValueError(
+            raise InputError(
                 f"groups: person {person.id} has orientation_quality {quality!r}: a finite number is needed (values "
                 "outside [0, 1] count as the nearer end)"
             )
         if max(abs(person.x), abs(person.y)) > MAX_COORDINATE:
-            raise ValueError(
+            raise InputError(
                 f"groups: person {person.id} at ({person.x}, {person.y}) is farther than {MAX_COORDINATE:g} m from "
                 "the frame's origin along x or y"
             )
@@ -495,11 +496,11 @@ def _validated(people: list[Person]) -> tuple[list[int], list[complex], list[com
         if person.theta is None:
             facing.append(_UNKNOWN_FACING)
         elif not is_real(person.theta):
-            raise ValueError(
+            raise InputError(
                 f"groups: person {person.id} has a theta that is not a number: {person.theta!r} (use None)"
             )
         elif not math.isfinite(person.theta):
-            raise ValueError(f"groups: person {person.id} has a non-finite theta {person.theta} (use None)")
+            raise InputError(f"groups: person {person.id} has a non-finite theta {person.theta} (use None)")
         else:
             facing.append(complex(math.cos(person.theta), math.sin(person.theta)))
     return ids, positions, facing

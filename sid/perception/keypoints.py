@@ -6,6 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sid.errors import InputError
+
 __all__ = ["COCO_KEYPOINTS", "KP", "NUM_KEYPOINTS", "PoseDetection", "SKELETON"]
 
 COCO_KEYPOINTS: tuple[str, ...] = (
@@ -49,5 +51,5 @@ def _exact(field: str, value: object, shape: tuple[int, ...]) -> np.ndarray:
     reshape would accept a (2, 17) array for (17, 2) and scramble it)."""
     array = np.asarray(value, dtype=float)
     if array.shape != shape:
-        raise ValueError(f"pose detection: {field} must have shape {shape}, got {array.shape}")
+        raise InputError(f"pose detection: {field} must have shape {shape}, got {array.shape}")
     return array

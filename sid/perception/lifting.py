@@ -44,6 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sid.checks import check_limit, check_number, check_numbers, check_whole
+from sid.errors import InputError
 from sid.perception.align import Search, depth_at_color_pixels
 from sid.perception.camera import Calibration, pixel_rays
 from sid.perception.keypoints import KP, NUM_KEYPOINTS, PoseDetection
@@ -141,13 +142,13 @@ class LiftParams:
         check_number("lift", "min_score", self.min_score, low=0, high=1)
         check_whole("lift", "min_keypoints", self.min_keypoints, low=1, high=NUM_KEYPOINTS)
         if check_whole("lift", "patch", self.patch, low=1) % 2 == 0:
-            raise ValueError(f"lift: patch must be a positive odd number of pixels, got {self.patch}")
+            raise InputError(f"lift: patch must be a positive odd number of pixels, got {self.patch}")
         if self.depth_search not in ("exact", "window"):
-            raise ValueError(f"lift: depth_search must be 'exact' or 'window', got {self.depth_search!r}")
+            raise InputError(f"lift: depth_search must be 'exact' or 'window', got {self.depth_search!r}")
         check_number("lift", "occluder_gap", self.occluder_gap, low=0, allow_inf=True, unit="metres")  # inf: off
         check_number("lift", "min_range", self.min_range, low=0, low_open=True, unit="metres")
         if self.min_range >= self.max_range:
-            raise ValueError(f"lift: min_range ({self.min_range} m) must be below max_range ({self.max_range} m)")
+            raise InputError(f"lift: min_range ({self.min_range} m) must be below max_range ({self.max_range} m)")
         metres = ("max_range", "depth_gate", "shoulder_separation", "hip_separation", "ear_separation")
         check_numbers("lift", self, metres, low=0, low_open=True, unit="metres")
         check_number("lift", "surface_offset", self.surface_offset, low=0, high=0.5, high_open=True, unit="metres")
@@ -172,7 +173,7 @@ def lift_people(
     are corrected from the body's surface to its joints (module docstring).
     """
     if ids is not None and len(ids) != len(detections):
-        raise ValueError(f"lift: {len(ids)} ids for {len(detections)} detections")
+        raise InputError(f"lift: {len(ids)} ids for {len(detections)} detections")
     if not detections:
         return []
     check_limit("lift: detections", len(detections), "detections", "detections")  # (P, P, 17) arrays below

@@ -31,6 +31,7 @@ import math
 
 import numpy as np
 
+from sid.errors import InputError
 from sid.perception.keypoints import KP, NUM_KEYPOINTS
 
 __all__ = [
@@ -97,11 +98,11 @@ def estimate_orientation(keypoints_world: np.ndarray, inferred: np.ndarray | Non
     """
     points = np.asarray(keypoints_world, dtype=float)
     if points.shape != (NUM_KEYPOINTS, 3):
-        raise ValueError(f"orientation: keypoints must be a ({NUM_KEYPOINTS}, 3) array, got shape {points.shape}")
+        raise InputError(f"orientation: keypoints must be a ({NUM_KEYPOINTS}, 3) array, got shape {points.shape}")
     if inferred is not None:
         inferred = np.asarray(inferred, dtype=bool)
         if inferred.shape != (NUM_KEYPOINTS,):
-            raise ValueError(f"orientation: inferred must be a ({NUM_KEYPOINTS},) mask, got shape {inferred.shape}")
+            raise InputError(f"orientation: inferred must be a ({NUM_KEYPOINTS},) mask, got shape {inferred.shape}")
     return _orientations(points[None], None if inferred is None else inferred[None])[0]
 
 
@@ -115,11 +116,11 @@ def estimate_orientations(
     """
     points = np.asarray(keypoints_world, dtype=float)
     if points.ndim != 3 or points.shape[1:] != (NUM_KEYPOINTS, 3):
-        raise ValueError(f"orientation: keypoints must be a (P, {NUM_KEYPOINTS}, 3) array, got shape {points.shape}")
+        raise InputError(f"orientation: keypoints must be a (P, {NUM_KEYPOINTS}, 3) array, got shape {points.shape}")
     if inferred is not None:
         inferred = np.asarray(inferred, dtype=bool)
         if inferred.shape != points.shape[:2]:
-            raise ValueError(f"orientation: inferred must be a {points.shape[:2]} mask, got shape {inferred.shape}")
+            raise InputError(f"orientation: inferred must be a {points.shape[:2]} mask, got shape {inferred.shape}")
     return _orientations(points, inferred)
 
 

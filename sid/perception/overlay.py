@@ -14,6 +14,7 @@ from collections.abc import Sequence
 import cv2
 import numpy as np
 
+from sid.errors import InputError
 from sid.labels import place_labels
 from sid.perception.keypoints import COCO_KEYPOINTS, LEFT_SHOULDER, RIGHT_SHOULDER, SKELETON, PoseDetection
 from sid.perception.people import Person
@@ -109,7 +110,7 @@ def draw_detections(
     """
     image = cv2.cvtColor(check_color_image(color_rgb), cv2.COLOR_RGB2BGR)
     if people is not None and len(people) != len(detections):
-        raise ValueError(f"overlay: {len(people)} people for {len(detections)} detections; they must match 1:1")
+        raise InputError(f"overlay: {len(people)} people for {len(detections)} detections; they must match 1:1")
     h, w = image.shape[:2]
     thick = max(1, round(min(h, w) / 240))
     font_scale = 0.3 * thick

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from sid.errors import InputError
 from sid.perception.keypoints import COCO_KEYPOINTS
 
 __all__ = ["skeleton_world"]
@@ -44,9 +45,9 @@ _BODY_FRACTIONS = np.array([_JOINT_FRACTIONS[name] for name in COCO_KEYPOINTS])
 def skeleton_world(x: float, y: float, theta: float, height: float = 1.7) -> np.ndarray:
     """(17, 3) world-frame COCO keypoints (metres) of an upright person standing at (x, y) facing yaw theta (rad)."""
     if not (np.isfinite(x) and np.isfinite(y) and np.isfinite(theta)):
-        raise ValueError(f"skeleton: position and yaw must be finite, got x={x}, y={y}, theta={theta}")
+        raise InputError(f"skeleton: position and yaw must be finite, got x={x}, y={y}, theta={theta}")
     if not (np.isfinite(height) and height > 0):
-        raise ValueError(f"skeleton: height must be positive (metres), got {height}")
+        raise InputError(f"skeleton: height must be positive (metres), got {height}")
     c, s = np.cos(theta), np.sin(theta)
     body = _BODY_FRACTIONS * height
     world = np.empty_like(body)

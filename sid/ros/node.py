@@ -32,6 +32,7 @@ from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
 
 from sid.documents import plural
+from sid.errors import InputError
 from sid.perception.camera import Intrinsics
 from sid.perception.frame import Frame
 from sid.perception.pipeline import Pipeline, PoseFn
@@ -136,7 +137,7 @@ class SocialCostmapNode:
                 import tf2_ros  # noqa: F401 - only whether it imports
             except ImportError:
                 if chosen == "tf":
-                    raise ValueError("pose_source 'tf' needs tf2_ros, which is not importable") from None
+                    raise InputError("pose_source 'tf' needs tf2_ros, which is not importable") from None
                 return "odom"
             return "tf"
         return chosen

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any
 from costmap.grid import GridSpec
 from costmap.plugins import PLUGINS, SECTIONS, CostmapParams
 from sid.checks import check_number, check_numbers
+from sid.errors import InputError
 from sid.perception.groups import GroupParams
 from sid.perception.mount import CameraMount
 from sid.perception.robot_pose import BASE_FRAME, MAP_FRAME
@@ -93,7 +94,7 @@ class NodeParams:
 
     def __post_init__(self) -> None:
         if self.pose_source not in POSE_SOURCES:
-            raise ValueError(f"pose_source must be one of {', '.join(POSE_SOURCES)}, got {self.pose_source!r}")
+            raise InputError(f"pose_source must be one of {', '.join(POSE_SOURCES)}, got {self.pose_source!r}")
         check_number("parameters", "depth_scale", self.depth_scale, low=0, low_open=True, unit="metres per unit")
         check_numbers("parameters", self, ("sync_tolerance", "transform_timeout"), low=0, unit="seconds")
         self.grid  # noqa: B018 - checks the costmap geometry now, with a message naming it
@@ -102,9 +103,9 @@ class NodeParams:
         for name in self.layers.plugins:
             plugin = self.layers.plugin(name)
             if name in taken:
-                raise ValueError(f"{LAYERS_PARAMETER}: costmap.{name} is a parameter already; name the layer otherwise")
+                raise InputError(f"{LAYERS_PARAMETER}: costmap.{name} is a parameter already; name the layer otherwise")
             if plugin not in NODE_PLUGINS:
-                raise ValueError(
+                raise InputError(
                     f"{LAYERS_PARAMETER}: {name} is a {plugin} layer, which the node cannot feed (it reads no map and "
                     f"no scan; Nav2's own costmaps keep those layers); the node's plugins: {', '.join(NODE_PLUGINS)}"
                 )
@@ -119,7 +120,7 @@ class NodeParams:
                 (self.costmap__width, self.costmap__height),
             )
         except ValueError as exc:
-            raise ValueError(f"costmap.*: {exc}") from None
+            raise InputError(f"costmap.*: {exc}") from None
 
     @property
     def mount(self) -> CameraMount:
@@ -185,10 +186,10 @@ def _typed(name: str, value: Any, default: object) -> Any:
     name)."""
     if isinstance(default, float):
         if isinstance(value, bool) or not isinstance(value, int | float):
-            raise ValueError(f"{name}: expected a number, got {value!r}")
+            raise InputError(f"{name}: expected a number, got {value!r}")
         return float(value)
     if not isinstance(value, str):
-        raise ValueError(f"{name}: expected a name (text), got {value!r}")
+        raise InputError(f"{name}: expected a name (text), got {value!r}")
     return value
 
 
@@ -210,12 +211,12 @@ def _check_names(node: Node, params: NodeParams) -> None:
                 node.resolve_topic_name(value)
             except rclpy_implementation.RCLError as exc:
                 reason = rcl_reason(exc, "failed to resolve name: ")
-                raise ValueError(f"{f.name}: {value!r} is not a valid topic name ({reason})") from None
+                raise InputError(f"{f.name}: {value!r} is not a valid topic name ({reason})") from None
         elif f.name.endswith("_frame"):
             if not value:
-                raise ValueError(f"{f.name}: a frame id must not be empty")
+                raise InputError(f"{f.name}: a frame id must not be empty")
             if value.startswith("/"):
-                raise ValueError(f"{f.name}: tf2 frame ids do not start with '/', got {value!r}")
+                raise InputError(f"{f.name}: tf2 frame ids do not start with '/', got {value!r}")
 
 
 def _declare(node: Node, name: str, default: object, description: str) -> Any:

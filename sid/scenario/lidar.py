@@ -13,6 +13,7 @@ import numpy as np
 from costmap.grid import BORDER_TOLERANCE, LETHAL, Costmap2D
 from costmap.scan import LaserScan
 from sid.checks import check_number
+from sid.errors import InputError
 from sid.perception.people import Person
 from sid.scenario.obstacles import BoxObstacle, CircleObstacle, Obstacle, SegmentObstacle
 
@@ -106,11 +107,11 @@ def simulate_scan(
     cells the beams hit too. Beams that hit nothing within ``range_max`` read ``inf``.
     """
     if beams < 1:
-        raise ValueError(f"lidar.beams must be >= 1, got {beams}")
+        raise InputError(f"lidar.beams must be >= 1, got {beams}")
     check_number("lidar", "range_max", range_max, low=0, low_open=True, unit="metres")
     pose_t = tuple(float(v) for v in pose)
     if len(pose_t) != 3 or not np.isfinite(pose_t).all():
-        raise ValueError(f"scan pose must be a finite (x, y, yaw), got {pose}")
+        raise InputError(f"scan pose must be a finite (x, y, yaw), got {pose}")
     increment = 2 * np.pi / beams
     scan = LaserScan(np.zeros(beams), -np.pi, increment, range_max, pose_t)
     origin, dirs = np.asarray(pose_t[:2]), scan.directions
@@ -120,7 +121,7 @@ def simulate_scan(
     circles += [((p.x, p.y), body_radius) for p in people]
     centres = np.array([c for c, _ in circles], dtype=float).reshape(-1, 2)
     if not np.isfinite(centres).all():
-        raise ValueError("simulate_scan: a circle obstacle or a person has a non-finite position")
+        raise InputError("simulate_scan: a circle obstacle or a person has a non-finite position")
     radii = np.array([r for _, r in circles], dtype=float)
 
     ranges = np.empty(beams)

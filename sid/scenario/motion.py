@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from itertools import pairwise
 
 from sid.checks import check_number, check_numbers
+from sid.errors import InputError
 
 __all__ = ["MotionState", "Trajectory"]
 
@@ -58,11 +59,11 @@ class Trajectory:
         previous = (self.x, self.y)
         for i, point in enumerate(self.path):
             if len(point) != 2:
-                raise ValueError(f"trajectory: path[{i}] must be an (x, y) pair, got {point}")
+                raise InputError(f"trajectory: path[{i}] must be an (x, y) pair, got {point}")
             check_number("trajectory", f"path[{i}][0]", point[0], unit="metres")
             check_number("trajectory", f"path[{i}][1]", point[1], unit="metres")
             if tuple(point) == previous:
-                raise ValueError(f"trajectory: path[{i}] {tuple(point)} repeats the point before it")
+                raise InputError(f"trajectory: path[{i}] {tuple(point)} repeats the point before it")
             previous = (point[0], point[1])
 
     @property

@@ -27,6 +27,7 @@ import cv2
 import numpy as np
 
 from sid.documents import image_cut_short, read_image_header, special_file
+from sid.errors import InputError
 from sid.perception.camera import Calibration
 from sid.perception.frame import Frame
 from sid.sources import FrameReadError, SourceError
@@ -49,7 +50,7 @@ class FolderSource:
         if not self.path.is_dir():
             raise SourceError(f"frame folder {self.path} does not exist or is not a directory")
         if not (np.isfinite(fps) and fps > 0):
-            raise ValueError(f"folder source: fps must be positive, got {fps}")
+            raise InputError(f"folder source: fps must be positive, got {fps}")
         self.fps = float(fps)
         self.calibration = calibration if calibration is not None else self._read_calibration()
         self.single = False  # the one-frame layout (DIR/color.png + DIR/depth.png); set by _find_pairs

@@ -22,6 +22,7 @@ import cv2
 import numpy as np
 import pyrealsense2 as rs
 
+from sid.errors import InputError
 from sid.perception.camera import Calibration, Extrinsics, Intrinsics
 
 __all__ = [
@@ -55,7 +56,7 @@ _TO_RGB = {
 def rs_intrinsics(intr: Intrinsics) -> rs.intrinsics:
     """Our intrinsics -> ``pyrealsense2.intrinsics`` (principal point ppx/ppy = cx/cy, same pixel convention)."""
     if intr.model not in _DISTORTIONS:
-        raise ValueError(f"intrinsics: distortion model {intr.model!r} has no librealsense equivalent")
+        raise InputError(f"intrinsics: distortion model {intr.model!r} has no librealsense equivalent")
     out = rs.intrinsics()
     out.width, out.height = intr.width, intr.height
     out.fx, out.fy, out.ppx, out.ppy = intr.fx, intr.fy, intr.cx, intr.cy
@@ -129,10 +130,10 @@ def read_frameset(frames: rs.composite_frame, align: rs.align | None = None) -> 
     depth_frame, color_frame = frames.get_depth_frame(), frames.get_color_frame()
     if not depth_frame or not color_frame:
         missing = " and ".join(name for name, f in (("depth", depth_frame), ("colour", color_frame)) if not f)
-        raise ValueError(f"frameset {frames.get_frame_number()} has no {missing} frame")
+        raise InputError(f"frameset {frames.get_frame_number()} has no {missing} frame")
     fmt = color_frame.get_profile().format()
     if fmt not in _TO_RGB:
-        raise ValueError(f"colour format {fmt} is not supported; record rgb8, bgr8, rgba8, bgra8 or yuyv")
+        raise InputError(f"colour format {fmt} is not supported; record rgb8, bgr8, rgba8, bgra8 or yuyv")
     color = np.asanyarray(color_frame.get_data())
     code = _TO_RGB[fmt]
     color = color.copy() if code is None else cv2.cvtColor(color, code)
@@ -154,7 +155,7 @@ def record_synthetic(
     ``rs.align`` can align it. librealsense 2.59 writes ROS 2 .db3 files and refuses other suffixes (ValueError).
     """
     if calib.depth is None:
-        raise ValueError("record_synthetic: the calibration needs depth intrinsics (unregistered depth)")
+        raise InputError("record_synthetic: the calibration needs depth intrinsics (unregistered depth)")
     path = Path(path)
     device = rs.software_device()
     depth_sensor, color_sensor = device.add_sensor("Depth"), device.add_sensor("Color")
@@ -169,7 +170,7 @@ def record_synthetic(
     try:
         recorder = rs.recorder(str(path), device)
     except RuntimeError as exc:
-        raise ValueError(f"cannot record to {path}: {exc}") from None
+        raise InputError(f"cannot record to {path}: {exc}") from None
     depth_sensor.open(depth_profile)
     color_sensor.open(color_profile)
     syncer = rs.syncer()
@@ -214,12 +215,12 @@ def _checked_pair(
     assert calib.depth is not None
     color, depth = np.ascontiguousarray(color), np.ascontiguousarray(depth)
     if color.shape != (calib.color.height, calib.color.width, 3) or color.dtype != np.uint8:
-        raise ValueError(
+        raise InputError(
             f"frame {number}: colour must be uint8 ({calib.color.height}, {calib.color.width}, 3), "
             f"got {color.dtype} {color.shape}"
         )
     if depth.shape != (calib.depth.height, calib.depth.width) or depth.dtype != np.uint16:
-        raise ValueError(
+        raise InputError(
             f"frame {number}: depth must be uint16 ({calib.depth.height}, {calib.depth.width}) in depth units, "
             f"got {depth.dtype} {depth.shape}"
         )

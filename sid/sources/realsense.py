@@ -35,7 +35,7 @@ from typing import Literal
 import numpy as np
 import pyrealsense2 as rs
 
-from sid.errors import SidError
+from sid.errors import InputError, SidError
 from sid.perception.align import Aligner
 from sid.perception.camera import Calibration, Extrinsics
 from sid.perception.frame import Frame
@@ -76,7 +76,7 @@ class RealSenseSource:
         max_failures: int = 3,
     ) -> None:
         if align not in ("sid", "librealsense", "none"):
-            raise ValueError(f"realsense source: align must be 'sid', 'librealsense' or 'none', got {align!r}")
+            raise InputError(f"realsense source: align must be 'sid', 'librealsense' or 'none', got {align!r}")
         self.path = Path(path) if path is not None else None
         self.align = align
         self.timeout_s = float(timeout_s)

@@ -17,6 +17,7 @@ import cv2
 import numpy as np
 
 from sid.checks import check_number
+from sid.errors import InputError
 from sid.perception.camera import Calibration, Intrinsics, warn_distortion
 from sid.perception.frame import Frame
 
@@ -59,7 +60,7 @@ def _pixels(msg: Any, dtype: str, channels: int) -> np.ndarray:
     row = width * channels * item.itemsize
     raw = np.frombuffer(msg.data, dtype=np.uint8)
     if height <= 0 or width <= 0 or step < row or raw.size < height * step:
-        raise ValueError(
+        raise InputError(
             f"image {width}x{height} {msg.encoding}: step {step} and {raw.size} bytes of data do not hold it"
         )
     rows = raw[: height * step].reshape(height, step)[:, :row]
@@ -72,7 +73,7 @@ def _pixels(msg: Any, dtype: str, channels: int) -> np.ndarray:
 def color_rgb(msg: Any) -> np.ndarray:
     """A colour Image -> (H, W, 3) uint8 RGB. ValueError names an encoding that is not a colour one."""
     if msg.encoding not in _COLOR:
-        raise ValueError(f"colour image encoding {msg.encoding!r} is not supported; use one of {', '.join(_COLOR)}")
+        raise InputError(f"colour image encoding {msg.encoding!r} is not supported; use one of {', '.join(_COLOR)}")
     channels, code = _COLOR[msg.encoding]
     pixels = _pixels(msg, "u1", channels)
     return pixels.copy() if code is None else cv2.cvtColor(pixels, code)
@@ -81,7 +82,7 @@ def color_rgb(msg: Any) -> np.ndarray:
 def depth_metres(msg: Any, depth_scale: float) -> np.ndarray:
     """A depth Image -> (H, W) float32 metres (0 = no reading). ``depth_scale``: metres per unit of 16UC1 depth."""
     if msg.encoding not in _DEPTH:
-        raise ValueError(
+        raise InputError(
             f"depth image encoding {msg.encoding!r} is not supported; use 16UC1 (depth units) or 32FC1 (m)"
         )
     dtype, metres = _DEPTH[msg.encoding]
@@ -100,7 +101,7 @@ def intrinsics_from_camera_info(msg: Any) -> Intrinsics:
     """
     k = [float(v) for v in msg.k]
     if len(k) != 9:
-        raise ValueError(f"camera_info: k must hold 9 numbers, got {len(k)}")
+        raise InputError(f"camera_info: k must hold 9 numbers, got {len(k)}")
     try:
         intrinsics = Intrinsics(
             int(msg.width),
@@ -113,7 +114,7 @@ def intrinsics_from_camera_info(msg: Any) -> Intrinsics:
             tuple(float(v) for v in msg.d),
         )
     except ValueError as exc:
-        raise ValueError(f"camera_info: {exc} (k = {k})") from None
+        raise InputError(f"camera_info: {exc} (k = {k})") from None
     warn_distortion(intrinsics, "camera_info")
     return intrinsics
 
@@ -130,7 +131,7 @@ def rgbd_frame(
     expected = (intrinsics.height, intrinsics.width)
     for name, image in (("colour", rgb), ("depth", metres)):
         if image.shape[:2] != expected:
-            raise ValueError(
+            raise InputError(
                 f"{name} image is {image.shape[1]}x{image.shape[0]}, camera_info says "
                 f"{intrinsics.width}x{intrinsics.height} (is the depth aligned to colour?)"
             )
@@ -170,7 +171,7 @@ class StampPairer(Generic[T]):
 
     def add(self, stream: str, stamp: float, item: T) -> tuple[Stamped[T], Stamped[T]] | None:
         if stream not in self.waiting:
-            raise ValueError(f"stamp pairing: stream must be 'color' or 'depth', got {stream!r}")
+            raise InputError(f"stamp pairing: stream must be 'color' or 'depth', got {stream!r}")
         if stream == "color" and (
             stamp == self.last_color_stamp or any(m.stamp == stamp for m in self.waiting["color"])
         ):

@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from sid.checks import check_whole
+from sid.errors import InputTypeError
 from sid.perception.frame import Frame
 from sid.scenario.loader import Scenario
 from sid.sources import SourceError
@@ -84,7 +85,7 @@ class SyntheticSource:
         elif isinstance(scene_or_spec, Scenario):
             self.scene = SyntheticSequence.from_scenario(scene_or_spec)
         else:
-            raise TypeError(
+            raise InputTypeError(
                 "synthetic source: expected a Scene, a SyntheticSequence, a spec string or a scenario, got "
                 f"{type(scene_or_spec).__name__}"
             )

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from sid.checks import check_number
+from sid.errors import InputError
 from sid.perception.keypoints import KP, NUM_KEYPOINTS
 from sid.synthetic.render import Capsule
 
@@ -58,7 +59,7 @@ def body_capsules(keypoints: np.ndarray, height: float = REFERENCE_HEIGHT) -> li
     """Solids of one person from their (17, 3) world-frame COCO keypoints; ``height`` (m) scales the radii."""
     keypoints = np.asarray(keypoints, dtype=float)
     if keypoints.shape != (NUM_KEYPOINTS, 3) or not np.all(np.isfinite(keypoints)):
-        raise ValueError(f"body: expected finite (17, 3) world keypoints, got shape {keypoints.shape}")
+        raise InputError(f"body: expected finite (17, 3) world keypoints, got shape {keypoints.shape}")
     check_number("body", "height", height, low=0, low_open=True, unit="metres")
     s = height / REFERENCE_HEIGHT
     frame = body_frame(keypoints)
@@ -89,5 +90,5 @@ def body_capsules(keypoints: np.ndarray, height: float = REFERENCE_HEIGHT) -> li
 def _unit(vector: np.ndarray, problem: str) -> np.ndarray:
     norm = float(np.linalg.norm(vector))
     if norm < 1e-6:
-        raise ValueError(f"body: cannot orient the body, {problem}")
+        raise InputError(f"body: cannot orient the body, {problem}")
     return vector / norm

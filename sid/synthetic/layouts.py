@@ -36,6 +36,7 @@ from typing import Any
 import numpy as np
 
 from sid.checks import check_numbers
+from sid.errors import InputError
 from sid.perception.mount import CameraMount
 from sid.synthetic.scene import Scene, ScenePerson
 
@@ -126,7 +127,7 @@ def layout(
     focus = centre - np.array([formation.focus_offset, 0.0])
     towards = focus - xy
     if np.any(np.hypot(towards[:, 0], towards[:, 1]) < 1e-6):
-        raise ValueError(
+        raise InputError(
             f"layout {name}: a person stands on the point everyone faces (focus_offset {formation.focus_offset})"
         )
     theta = np.arctan2(towards[:, 1], towards[:, 0]) + rng.normal(0.0, formation.jitter_theta, n)
@@ -150,7 +151,7 @@ def variations(name: str, **options: Any) -> list[Scene]:
     spec = _spec(name)
     own = sorted({"jitter_xy", "jitter_theta"} & set(options))
     if own:
-        raise ValueError(
+        raise InputError(
             f"variations of {name}: {', '.join(own)} are set by the jitter variations; use layout() instead"
         )
     options = dict(options)
@@ -174,5 +175,5 @@ def variations(name: str, **options: Any) -> list[Scene]:
 def _spec(name: str) -> LayoutSpec:
     spec = LAYOUTS.get(str(name).upper())
     if spec is None:
-        raise ValueError(f"unknown layout {name!r}; known layouts: {', '.join(LAYOUTS)}")
+        raise InputError(f"unknown layout {name!r}; known layouts: {', '.join(LAYOUTS)}")
     return spec

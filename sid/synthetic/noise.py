@@ -22,6 +22,7 @@ import cv2
 import numpy as np
 
 from sid.checks import check_number, check_numbers, check_whole
+from sid.errors import InputError
 
 __all__ = ["DepthNoise", "KeypointNoise", "visible_to_right_imager"]
 
@@ -62,7 +63,7 @@ class DepthNoise:
             check_number("depth noise", "focal_px", self.focal_px, low=0, low_open=True)
         check_whole("depth noise", "edge_width_px", self.edge_width_px, low=1)
         if self.max_range_m <= self.min_range_m:
-            raise ValueError("depth noise: max_range_m must exceed min_range_m")
+            raise InputError("depth noise: max_range_m must exceed min_range_m")
 
     @classmethod
     def exact(cls) -> DepthNoise:

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sid.errors import InputError
 from sid.perception.frame import Frame
 from sid.perception.keypoints import KP, NUM_KEYPOINTS, PoseDetection
 from sid.synthetic.sensor import FrameTruth
@@ -47,18 +48,18 @@ class TruthPose:
 
     def __post_init__(self) -> None:
         if not 0.0 <= self.score_hidden <= self.score_self_occluded <= self.score_observed <= 1.0:
-            raise ValueError(
+            raise InputError(
                 "truth pose: need 0 <= score_hidden <= score_self_occluded <= score_observed <= 1, got "
                 f"{self.score_hidden}, {self.score_self_occluded}, {self.score_observed}"
             )
         if self.min_observed < 1:
-            raise ValueError(f"truth pose: min_observed must be >= 1, got {self.min_observed}")
+            raise InputError(f"truth pose: min_observed must be >= 1, got {self.min_observed}")
 
     def __call__(self, frame: Frame) -> list[PoseDetection]:
         """People of ``frame.truth`` as pose detections (colour-image pixels), in the truth's order."""
         truth = getattr(frame, "truth", None)
         if not isinstance(truth, FrameTruth):
-            raise ValueError(
+            raise InputError(
                 "truth pose: the frame carries no synthetic ground truth (frame.truth); TruthPose only works on "
                 "frames from sid.sources.synthetic - use a real pose model for other sources"
             )

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sid.checks import check_number
+from sid.errors import InputError
 from sid.perception.camera import Extrinsics, Intrinsics, pixel_rays
 
 __all__ = ["Background", "Capsule", "LABEL_GROUND", "LABEL_NONE", "LABEL_WALL", "RayCaster", "Rendering"]
@@ -48,11 +49,11 @@ class Capsule:
         centre = np.asarray(self.centre, dtype=float).reshape(3)
         axes = np.asarray(self.axes, dtype=float).reshape(3, 3)
         if not (np.all(np.isfinite(centre)) and np.all(np.isfinite(axes)) and np.isfinite(self.half_length)):
-            raise ValueError("capsule: centre, axes and half_length must be finite")
+            raise InputError("capsule: centre, axes and half_length must be finite")
         if abs(np.linalg.det(axes)) < 1e-12:
-            raise ValueError("capsule: axes are degenerate (zero semi-axis)")
+            raise InputError("capsule: axes are degenerate (zero semi-axis)")
         if self.half_length < 0:
-            raise ValueError(f"capsule: half_length must be >= 0, got {self.half_length}")
+            raise InputError(f"capsule: half_length must be >= 0, got {self.half_length}")
         object.__setattr__(self, "centre", centre)
         object.__setattr__(self, "axes", axes)
 
@@ -185,13 +186,13 @@ class RayCaster:
         do not move are cast once.
         """
         if base is not None and shading and base.shade is None:
-            raise ValueError("render: shading over a base rendering needs a base made with shading=True")
+            raise InputError("render: shading over a base rendering needs a base made with shading=True")
         depth = (self._bg_depth if base is None else base.depth).copy()
         depth[depth == 0] = np.inf
         label = (self._bg_label if base is None else base.label).copy()
         labels = range(len(bodies)) if labels is None else labels
         if len(labels) != len(bodies):
-            raise ValueError(f"render: {len(labels)} labels for {len(bodies)} bodies")
+            raise InputError(f"render: {len(labels)} labels for {len(bodies)} bodies")
         shapes = [
             (index, shape.transformed(self.world_to_camera))
             for index, body in zip(labels, bodies, strict=True)

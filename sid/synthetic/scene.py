@@ -18,6 +18,7 @@ import numpy as np
 
 from sid.checks import check_numbers, check_yaw
 from sid.documents import load_document
+from sid.errors import InputError
 from sid.perception.mount import CameraMount
 from sid.perception.people import Person
 
@@ -38,7 +39,7 @@ class ScenePerson:
         check_numbers(f"scene person {self.id}", self, ("x", "y", "theta", "height"))
         check_yaw(f"scene person {self.id}", "theta", self.theta)
         if not 0.5 <= self.height <= 2.5:
-            raise ValueError(f"scene person {self.id}: height {self.height} m is not a standing person (0.5-2.5 m)")
+            raise InputError(f"scene person {self.id}: height {self.height} m is not a standing person (0.5-2.5 m)")
 
     def as_person(self) -> Person:
         """The ``sid.perception.people.Person`` record (exact position and facing, orientation quality 1)."""
@@ -62,26 +63,26 @@ class Scene:
     def __post_init__(self) -> None:
         ids = [p.id for p in self.people]
         if len(set(ids)) != len(ids):
-            raise ValueError(f"scene {self.name}: person ids must be unique, got {ids}")
+            raise InputError(f"scene {self.name}: person ids must be unique, got {ids}")
         for group in self.groups:
             missing = set(group) - set(ids)
             if missing:
-                raise ValueError(f"scene {self.name}: group {group} names unknown people {sorted(missing)}")
+                raise InputError(f"scene {self.name}: group {group} names unknown people {sorted(missing)}")
             if len(group) < 2:
-                raise ValueError(f"scene {self.name}: a group needs at least two members, got {group}")
+                raise InputError(f"scene {self.name}: a group needs at least two members, got {group}")
         positions = np.array([[p.x, p.y] for p in self.people]).reshape(-1, 2)
         if len(positions) > 1:
             gaps = np.linalg.norm(positions[:, None] - positions[None], axis=-1) + np.eye(len(positions)) * 1e9
             if gaps.min() < 0.3:
                 i, j = np.unravel_index(np.argmin(gaps), gaps.shape)
-                raise ValueError(
+                raise InputError(
                     f"scene {self.name}: people {ids[i]} and {ids[j]} stand {gaps.min():.2f} m apart; bodies "
                     "would overlap (need >= 0.3 m)"
                 )
         if self.wall_distance is not None:
             too_far = [p.id for p in self.people if p.x > self.wall_distance - 0.3]
             if too_far:
-                raise ValueError(f"scene {self.name}: people {too_far} stand in or behind the wall")
+                raise InputError(f"scene {self.name}: people {too_far} stand in or behind the wall")
 
     @classmethod
     def from_file(cls, path: str | Path) -> Scene:
@@ -90,23 +91,23 @@ class Scene:
         try:
             data = load_document(path)
         except ValueError as exc:
-            raise ValueError(f"scene {exc}") from None
+            raise InputError(f"scene {exc}") from None
         try:
             return cls.from_dict(data, default_name=path.stem)
         except ValueError as exc:
-            raise ValueError(f"scene {path}: {exc}") from None
+            raise InputError(f"scene {path}: {exc}") from None
 
     @classmethod
     def from_dict(cls, data: Any, default_name: str = "scene") -> Scene:
         """Build a scene from the parsed file content (see the module docstring)."""
         if isinstance(data, dict) and "robot" in data:
-            raise ValueError("a costmap scenario file (it has a robot): read it with sid.synthetic.sequence")
+            raise InputError("a costmap scenario file (it has a robot): read it with sid.synthetic.sequence")
         if not isinstance(data, dict) or not isinstance(data.get("people"), list) or not data["people"]:
-            raise ValueError('expected an object with a non-empty "people" list')
+            raise InputError('expected an object with a non-empty "people" list')
         people = tuple(_person(entry, index) for index, entry in enumerate(data["people"]))
         camera = data.get("camera") or {}
         if not isinstance(camera, dict):
-            raise ValueError('"camera" must be an object with "height" and "tilt"')
+            raise InputError('"camera" must be an object with "height" and "tilt"')
         try:
             groups = tuple(tuple(int(i) for i in group) for group in data.get("groups") or ())
             mount = CameraMount(float(camera.get("height", 0.9)), float(camera.get("tilt", 0.0)))
@@ -115,7 +116,7 @@ class Scene:
                 str(data.get("name", default_name)), people, groups, mount, None if wall is None else float(wall)
             )
         except (TypeError, ValueError) as exc:
-            raise ValueError(str(exc)) from None
+            raise InputError(str(exc)) from None
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -129,10 +130,10 @@ class Scene:
 
 def _person(entry: Any, index: int) -> ScenePerson:
     if not isinstance(entry, dict):
-        raise ValueError(f"people[{index}] must be an object with x, y, theta")
+        raise InputError(f"people[{index}] must be an object with x, y, theta")
     theta = entry.get("theta", entry.get("yaw"))
     if theta is None or "x" not in entry or "y" not in entry:
-        raise ValueError(f"people[{index}] needs x, y and theta (or yaw), got keys {sorted(entry)}")
+        raise InputError(f"people[{index}] needs x, y and theta (or yaw), got keys {sorted(entry)}")
     try:
         return ScenePerson(
             int(entry.get("id", index)),
@@ -142,4 +143,4 @@ def _person(entry: Any, index: int) -> ScenePerson:
             float(entry.get("height", 1.70)),
         )
     except (TypeError, ValueError) as exc:
-        raise ValueError(f"people[{index}]: {exc}") from None
+        raise InputError(f"people[{index}]: {exc}") from None

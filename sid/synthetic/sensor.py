@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from sid.checks import check_number, check_numbers
+from sid.errors import InputError
 from sid.perception.camera import Calibration, Extrinsics, Intrinsics, project
 from sid.perception.frame import Frame
 from sid.perception.groups import GroupParams
@@ -227,7 +228,7 @@ class SyntheticCamera:
     ):
         if calibration is not None and registered is not None and registered != (calibration.depth is None):
             said = "registered" if calibration.depth is None else "not registered (it has depth intrinsics)"
-            raise ValueError(
+            raise InputError(
                 f"synthetic camera: registered={registered} contradicts the calibration, whose depth is {said}; "
                 "pass registered only without a calibration"
             )
@@ -236,7 +237,7 @@ class SyntheticCamera:
         self.keypoint_noise = keypoint_noise if keypoint_noise is not None else KeypointNoise()
         depth = self.calibration.depth
         if depth is not None and sensor_focal_px is not None and sensor_focal_px != depth.fx:
-            raise ValueError(
+            raise InputError(
                 f"synthetic camera: sensor_focal_px {sensor_focal_px} contradicts the calibration's depth fx "
                 f"{depth.fx}; sensor_focal_px is for registered depth only (unregistered depth uses its own fx)"
             )

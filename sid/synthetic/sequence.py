@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from sid.documents import load_document
+from sid.errors import InputError
 from sid.perception.mount import CameraMount
 from sid.perception.robot_pose import RobotPose
 from sid.scenario.loader import Scenario, ScenarioError, scenario_from_dict
@@ -83,17 +84,17 @@ class SyntheticSequence:
 
     def __post_init__(self) -> None:
         if not self.people:
-            raise ValueError(f"sequence {self.name}: no people to render")
+            raise InputError(f"sequence {self.name}: no people to render")
         ids = [p.id for p in self.people]
         if len(set(ids)) != len(ids):
-            raise ValueError(f"sequence {self.name}: person ids must be unique, got {ids}")
+            raise InputError(f"sequence {self.name}: person ids must be unique, got {ids}")
         unknown = [p.id for p in self.people if p.trajectory.yaw is None and not p.trajectory.path]
         if unknown:
-            raise ValueError(f"sequence {self.name}: people {unknown} have no facing direction (theta) and no path")
+            raise InputError(f"sequence {self.name}: people {unknown} have no facing direction (theta) and no path")
         for group in self.conversations:
             missing = set(group) - set(ids)
             if missing:
-                raise ValueError(f"sequence {self.name}: conversation {group} names unknown people {sorted(missing)}")
+                raise InputError(f"sequence {self.name}: conversation {group} names unknown people {sorted(missing)}")
 
     @classmethod
     def from_scenario(cls, scenario: Scenario, mount: CameraMount | None = None) -> SyntheticSequence:
@@ -102,7 +103,7 @@ class SyntheticSequence:
         try:
             return cls(scenario.name, people, scenario.robot.trajectory, scenario.conversations, mount or CameraMount())
         except ValueError as exc:
-            raise ValueError(f"scenario {exc}") from None
+            raise InputError(f"scenario {exc}") from None
 
     @property
     def duration(self) -> float:
@@ -129,7 +130,7 @@ class SyntheticSequence:
 def builtin_sequence(name: str) -> SyntheticSequence:
     """One of the built-in sequences (``SEQUENCES``) by name."""
     if name not in SEQUENCES:
-        raise ValueError(f"unknown built-in sequence {name!r}; known: {', '.join(SEQUENCES)}")
+        raise InputError(f"unknown built-in sequence {name!r}; known: {', '.join(SEQUENCES)}")
     scene = load_scene_file(SEQUENCES_DIR / f"{name}.yaml")
     assert isinstance(scene, SyntheticSequence)  # the shipped files are scenarios
     return scene
@@ -146,4 +147,4 @@ def load_scene_file(path: str | Path) -> Scene | SyntheticSequence:
     try:
         return SyntheticSequence.from_scenario(scenario_from_dict(data, path.parent, path.stem))
     except (ScenarioError, ValueError) as exc:
-        raise ValueError(f"{path}: {exc}") from None
+        raise InputError(f"{path}: {exc}") from None

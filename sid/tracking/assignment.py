@@ -20,6 +20,8 @@ from functools import cache
 
 import numpy as np
 
+from sid.errors import InputError
+
 __all__ = ["gated_assignment", "load_solver"]
 
 
@@ -31,7 +33,7 @@ def gated_assignment(cost: np.ndarray, allowed: np.ndarray) -> tuple[np.ndarray,
     cost, allowed = np.asarray(cost, dtype=float), np.asarray(allowed, dtype=bool)
     if cost.ndim != 2 or allowed.shape != cost.shape:
         shapes = f"{cost.shape} and {allowed.shape}"
-        raise ValueError(f"assignment: cost and allowed must be matrices of one shape, got {shapes}")
+        raise InputError(f"assignment: cost and allowed must be matrices of one shape, got {shapes}")
     pairs = _own_minima(np.where(allowed, cost, np.inf))
     if pairs is not None:
         return pairs

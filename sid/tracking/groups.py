@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from sid.checks import check_number, check_numbers, check_whole
+from sid.errors import InputError
 from sid.perception.groups import GroupParams, detect_groups
 from sid.tracking.assignment import gated_assignment
 from sid.tracking.records import TIME_TOLERANCE, GroupKind, TrackedGroup, TrackedPerson
@@ -84,7 +85,7 @@ class GroupTrackerParams:
             check_whole("group tracker", name, getattr(self, name), low=1)
         for name in ("confirm_hits", "walk_confirm_hits"):
             if getattr(self, name) > self.confirm_window:
-                raise ValueError(
+                raise InputError(
                     f"group tracker: {name} ({getattr(self, name)}) must not exceed confirm_window "
                     f"({self.confirm_window})"
                 )
@@ -153,7 +154,7 @@ class GroupTracker:
         check_time_order("group tracker: frame", timestamp, self._last_time)
         by_id = {p.id: p for p in people}
         if len(by_id) != len(people):
-            raise ValueError("group tracker: a track id appears twice in one frame")
+            raise InputError("group tracker: a track id appears twice in one frame")
         self._remember(people, timestamp)
         candidates = self._conversations(people) + _walking_groups(people, self._history, self.params)
         matched = self._match(candidates)

@@ -13,6 +13,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from sid.errors import InputError
 from sid.perception.group import Group, group_json
 from sid.perception.people import Person
 
@@ -136,8 +137,8 @@ class Tracks:
         object.__setattr__(self, "groups", tuple(self.groups))
         ids = {p.id for p in self.people}
         if len(ids) != len(self.people):
-            raise ValueError("tracks: a track id appears twice")
+            raise InputError("tracks: a track id appears twice")
         for group in self.groups:
             missing = sorted(set(group.members) - ids)
             if missing:
-                raise ValueError(f"tracks: group {group.id} has members {missing} that are not among the people")
+                raise InputError(f"tracks: group {group.id} has members {missing} that are not among the people")

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from sid.checks import check_number, check_numbers
+from sid.errors import InputError
 from sid.perception.camera import Calibration
 from sid.perception.mount import CameraMount
 from sid.perception.robot_pose import RobotPose
@@ -75,7 +76,7 @@ class ViewRegion:
     def __post_init__(self) -> None:
         polygon = np.asarray(self.polygon, dtype=float)
         if polygon.ndim != 2 or polygon.shape[1] != 2 or len(polygon) < 3 or not np.isfinite(polygon).all():
-            raise ValueError(f"view: a region needs 3 or more finite (x, y) corners, got shape {polygon.shape}")
+            raise InputError(f"view: a region needs 3 or more finite (x, y) corners, got shape {polygon.shape}")
         object.__setattr__(self, "polygon", polygon)
         import shapely.prepared  # here, not at start-up: an import a camera's view cone never needs
 
@@ -100,7 +101,7 @@ def scene_view(positions: np.ndarray, margin: float = 0.0) -> ViewRegion:
     points = shapely.MultiPoint(np.asarray(positions, dtype=float).reshape(-1, 2))
     hull = points.convex_hull.buffer(margin) if margin > 0 else points.convex_hull
     if not isinstance(hull, shapely.Polygon) or hull.is_empty:
-        raise ValueError("view: the positions span no area (fewer than three points not on one line)")
+        raise InputError("view: the positions span no area (fewer than three points not on one line)")
     return ViewRegion(np.array(hull.exterior.coords)[:-1])
 
 

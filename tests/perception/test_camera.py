@@ -10,6 +10,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from sid.documents import InputWarning
+from sid.errors import InputError
 from sid.perception.camera import Calibration, Extrinsics, Intrinsics, deproject, pixel_rays, project
 from sid.perception.mount import CameraMount
 
@@ -167,7 +168,7 @@ def test_mistyped_calibration_fields_name_the_file_field_and_value(tmp_path, dat
     path.write_text(json.dumps(data))
     with pytest.raises(ValueError) as error:
         Calibration.from_json(path)
-    assert type(error.value) is ValueError
+    assert type(error.value) is InputError  # sid's own, not a KeyError or a float() error
     assert str(error.value).startswith(f"calibration {path}: ") and message in str(error.value)
 
 

@@ -35,6 +35,7 @@ import numpy as np
 from shapely.geometry import LineString, MultiPoint, Point
 from sklearn.cluster import DBSCAN
 
+from sid.errors import InputError
 from sid.perception.people import Person
 
 __all__ = ["BaselineGroup", "BaselineParams", "baseline_groups"]
@@ -80,7 +81,7 @@ def baseline_groups(people: Sequence[Person], params: BaselineParams = BaselineP
     known = [p for p in people if p.theta is not None]
     for person in known:
         if not all(math.isfinite(v) for v in (person.x, person.y, _facing(person))):
-            raise ValueError(
+            raise InputError(
                 f"baseline: person {person.id} has a non-finite pose ({person.x}, {person.y}, {person.theta})"
             )
     if len(known) < 2:
@@ -99,7 +100,7 @@ def baseline_groups(people: Sequence[Person], params: BaselineParams = BaselineP
 def _facing(person: Person) -> float:
     """The facing (rad) of a person the baseline kept: people with theta None are left out before DBSCAN."""
     if person.theta is None:
-        raise ValueError(f"baseline: person {person.id} has no facing (theta None) to cast a ray along")
+        raise InputError(f"baseline: person {person.id} has no facing (theta None) to cast a ray along")
     return person.theta
 
 

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sid.errors import InputError
 from sid.experiments.trajectories import ReplayFrame, ReplaySettings, TrajectorySet, replay
 from sid.perception.people import Person
 
@@ -70,7 +71,7 @@ class CrowdReplay:
 
     def __init__(self, sets: Sequence[TrajectorySet], rate: float = 15.0, seed: int = 0) -> None:
         if not sets:
-            raise ValueError("bench: a crowd scene needs at least one trajectory set")
+            raise InputError("bench: a crowd scene needs at least one trajectory set")
         self.sets = tuple(sets)
         self.rate = float(rate)
         self.replays = [list(replay(s, ReplaySettings(rate=rate, seed=seed))) for s in self.sets]
@@ -81,7 +82,7 @@ class CrowdReplay:
     def scene(self, n: int, frames: int) -> CrowdScene:
         """``frames`` time steps with ``n`` or more people present in each; ValueError when the sets hold too few."""
         if n < 1 or frames < 1:
-            raise ValueError(f"bench: a crowd scene needs n >= 1 people and frames >= 1, got {n} and {frames}")
+            raise InputError(f"bench: a crowd scene needs n >= 1 people and frames >= 1, got {n} and {frames}")
         stretches = [(k, start) for k, r in enumerate(self.replays) for start in range(0, len(r) - frames + 1, frames)]
         counts = np.array([[len(f.truth_ids) for f in self._stretch(k, s, frames)] for k, s in stretches])
         counts = counts.reshape(len(stretches), frames)
@@ -91,7 +92,7 @@ class CrowdReplay:
             gain = np.minimum(n, total + counts).sum(axis=1)
             gain[chosen] = -1
             if not stretches or gain.max() <= np.minimum(n, total).sum():
-                raise ValueError(f"bench: the trajectory sets hold fewer than {n} people in some of {frames} frames")
+                raise InputError(f"bench: the trajectory sets hold fewer than {n} people in some of {frames} frames")
             chosen.append(int(np.argmax(gain)))
             total += counts[chosen[-1]]
         left_out = self._left_out([stretches[c] for c in chosen], frames, total, n)

@@ -28,6 +28,7 @@ from typing import Any
 
 from sid.cpu import physical_cores, usable_cpus
 from sid.documents import is_number, load_document, plural
+from sid.errors import InputError
 
 __all__ = [
     "COMPARED_SETTINGS",
@@ -122,14 +123,14 @@ def load_report(path: str | Path) -> dict[str, Any]:
     try:
         data = load_document(path, "bench report")
     except ValueError as exc:  # names the file: unreadable, or not valid JSON
-        raise ValueError(f"bench: {exc}") from None
+        raise InputError(f"bench: {exc}") from None
     stages = data.get("stages") if isinstance(data, dict) else None
     if not isinstance(stages, dict):
-        raise ValueError(f'bench: {path} is not a sid bench report (no "stages" object)')
+        raise InputError(f'bench: {path} is not a sid bench report (no "stages" object)')
     for name, stage in stages.items():
         median = stage.get("median_ms") if isinstance(stage, dict) else None
         if not is_number(median) or median <= 0:  # a ratio against 0, NaN or inf means nothing
-            raise ValueError(f'bench: {path}: stage {name!r} has no positive "median_ms", got {median!r}')
+            raise InputError(f'bench: {path}: stage {name!r} has no positive "median_ms", got {median!r}')
     return data
 
 

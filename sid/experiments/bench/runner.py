@@ -16,6 +16,8 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from sid.errors import InputError
+
 __all__ = ["FULL", "QUICK", "RunSettings", "Stats", "measure", "measure_parts"]
 
 
@@ -31,7 +33,7 @@ class RunSettings:
 
     def __post_init__(self) -> None:
         if self.warmup < 0 or self.min_runs < 1 or self.max_runs < self.min_runs or not self.budget_s > 0:
-            raise ValueError(
+            raise InputError(
                 f"bench: need warmup >= 0, 1 <= min_runs <= max_runs and budget_s > 0, got {self.warmup}, "
                 f"{self.min_runs}, {self.max_runs}, {self.budget_s}"
             )
@@ -55,7 +57,7 @@ class Stats:
     @classmethod
     def of(cls, samples_ms: list[float]) -> Stats:
         if not samples_ms:
-            raise ValueError("bench: no samples to summarise")
+            raise InputError("bench: no samples to summarise")
         return cls(statistics.median(samples_ms), min(samples_ms), max(samples_ms), len(samples_ms))
 
     def to_dict(self) -> dict[str, float | int]:
@@ -73,11 +75,11 @@ def measure_parts(fn: Callable[[], dict[str, float]], settings: RunSettings) -> 
         nonlocal names
         parts = fn()
         if not parts:
-            raise ValueError("bench: a timed call reported no parts")
+            raise InputError("bench: a timed call reported no parts")
         if names is None:
             names = list(parts)
         elif set(parts) != set(names):  # in any order: a stage may time its parts in turns
-            raise ValueError(f"bench: a timed call reported parts {list(parts)}, an earlier one {names}")
+            raise InputError(f"bench: a timed call reported parts {list(parts)}, an earlier one {names}")
         return parts
 
     for _ in range(settings.warmup):

@@ -9,6 +9,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from sid.errors import InputError
 from sid.experiments.bench.stages import Benchmark, Context
 
 __all__ = ["Progress", "SuiteResult", "run_suite", "select"]
@@ -32,11 +33,11 @@ def select(items: Sequence[Benchmark], only: str | None) -> list[Benchmark]:
         return list(items)
     patterns = [p.strip() for p in only.split(",") if p.strip()]
     if not patterns:
-        raise ValueError("bench: --only needs at least one stage name or pattern")
+        raise InputError("bench: --only needs at least one stage name or pattern")
     unmatched = [p for p in patterns if not any(_matches(b.name, p) for b in items)]
     if unmatched:
         names = ", ".join(b.name for b in items)
-        raise ValueError(f"bench: --only {', '.join(unmatched)} matches no benchmark; choose from: {names}")
+        raise InputError(f"bench: --only {', '.join(unmatched)} matches no benchmark; choose from: {names}")
     chosen = {b.name for b in items if any(_matches(b.name, p) for p in patterns)}
     chosen |= {need for b in items if b.name in chosen for need in b.needs}
     return [b for b in items if b.name in chosen]

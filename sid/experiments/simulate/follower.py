@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sid.checks import check_numbers
+from sid.errors import InputError
 
 __all__ = ["Command", "FollowerParams", "follow", "nearest_arc_length", "point_at", "remaining"]
 
@@ -47,7 +48,7 @@ class FollowerParams:
         check_numbers("follower", self, positive, low=0, low_open=True)
         check_numbers("follower", self, ("lookahead_time_s", "regulated_min_radius_m", "approach_distance_m"), low=0)
         if self.max_lookahead_m < self.min_lookahead_m:
-            raise ValueError(
+            raise InputError(
                 f"follower: max_lookahead_m ({self.max_lookahead_m}) is below min_lookahead_m ({self.min_lookahead_m})"
             )
 
@@ -93,7 +94,7 @@ def follow(
     """The command that follows ``path`` (N >= 1, world frame) from ``pose`` at current ``speed`` (m/s)."""
     path = np.asarray(path, dtype=float).reshape(-1, 2)
     if len(path) == 0 or not np.isfinite(path).all():
-        raise ValueError("follower: the path must hold at least one finite (x, y) point")
+        raise InputError("follower: the path must hold at least one finite (x, y) point")
     x, y, yaw = (float(v) for v in pose)
     s, _ = nearest_arc_length(path, (x, y))
     total = float(_arc_lengths(path)[-1])

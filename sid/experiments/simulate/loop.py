@@ -50,6 +50,7 @@ from planner.problem import (
     PlanningProblem,
 )
 from planner.validity import interpolate
+from sid.errors import InputError
 from sid.experiments.harness import people_in_the_way
 from sid.experiments.simulate.follower import FollowerParams, follow, remaining
 from sid.experiments.simulate.perception import (
@@ -96,9 +97,9 @@ class RunOptions:
     def __post_init__(self) -> None:
         resolve_planner(self.planner)
         if self.perception not in PERCEPTIONS:
-            raise ValueError(f"perception must be one of {', '.join(PERCEPTIONS)}, got {self.perception!r}")
+            raise InputError(f"perception must be one of {', '.join(PERCEPTIONS)}, got {self.perception!r}")
         if not (isinstance(self.seed, int) and 0 <= self.seed < 2**31):
-            raise ValueError(f"seed must be a whole number from 0 to {2**31 - 1}, got {self.seed!r}")
+            raise InputError(f"seed must be a whole number from 0 to {2**31 - 1}, got {self.seed!r}")
 
 
 @dataclass

@@ -6,6 +6,7 @@ from __future__ import annotations
 from importlib import resources
 from pathlib import Path
 
+from sid.errors import InputError
 from sid.experiments.simulate.world import SimWorld, load_world
 
 __all__ = ["SCENE_ORDER", "load_scene", "scene_list", "scene_path"]
@@ -17,7 +18,7 @@ SCENE_ORDER = ("paper", "pair", "circle4", "circle5", "wall", "walkers", "formin
 def scene_path(name: str) -> Path:
     """The file of the built-in scene ``name``; ValueError listing the scenes when there is none."""
     if name not in SCENE_ORDER:
-        raise ValueError(f"unknown built-in scene {name!r}; built-in scenes: {', '.join(SCENE_ORDER)}")
+        raise InputError(f"unknown built-in scene {name!r}; built-in scenes: {', '.join(SCENE_ORDER)}")
     return Path(str(resources.files("sid.experiments.simulate") / "scenes" / f"{name}.yaml"))
 
 
@@ -26,7 +27,7 @@ def load_scene(spec: str | Path) -> SimWorld:
     if str(spec) in SCENE_ORDER and not Path(spec).is_file():
         return load_world(scene_path(str(spec)))
     if not Path(spec).is_file():
-        raise ValueError(f"{spec}: neither a built-in scene ({', '.join(SCENE_ORDER)}) nor an existing file")
+        raise InputError(f"{spec}: neither a built-in scene ({', '.join(SCENE_ORDER)}) nor an existing file")
     return load_world(spec)
 
 

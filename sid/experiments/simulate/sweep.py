@@ -23,6 +23,7 @@ from typing import Any
 from sid.checks import Limits, check_whole, limits, repeated, use_limits
 from sid.cpu import keep_freed_memory
 from sid.distribution import MissingDependencyError, install_hint
+from sid.errors import InputError
 from sid.experiments.harness import summarise
 from sid.experiments.progress import Progress
 from sid.experiments.simulate.loop import RunOptions
@@ -53,7 +54,7 @@ def sweep_jobs(scenes: Sequence[str], seeds: int, options: RunOptions | None = N
         load_scene(scene)  # a bad scene fails here, before any run
     twice = repeated(list(scenes))
     if twice is not None:  # the summary would count its runs twice
-        raise ValueError(f"sweep: scene {twice} is given twice")
+        raise InputError(f"sweep: scene {twice} is given twice")
     return [
         Job(scene, replace(options, social=social, seed=seed))
         for scene in scenes
@@ -128,7 +129,7 @@ def run_sweep(
     """Run the jobs (in this process with ``workers`` 1, in ``workers`` processes, or on the Ray cluster at
     ``ray_address``: "local" starts one on this machine, "auto" joins a running head); records in job order."""
     if workers < 1:
-        raise ValueError(f"sweep: workers must be >= 1, got {workers}")
+        raise InputError(f"sweep: workers must be >= 1, got {workers}")
     if ray_address is not None:
         return _on_ray(jobs, ray_address, progress)
     if workers == 1:

@@ -13,6 +13,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from sid.errors import InputError
 from sid.perception.pose.base import Letterbox, PoseEstimator
 from sid.perception.pose.contracts import (
     CONTRACTS,
@@ -75,16 +76,16 @@ def load_pose_estimator(
     model = OnnxModel(path, threads=threads, providers=providers, spinning=spinning, load_warnings=load_warnings)
     name = detect_contract(model.signature, contract, source=str(model.path))
     if iou_threshold is not None and name != YOLO_POSE:
-        raise ValueError(f"pose: iou_threshold applies to yolo_pose models only, this one is {name}")
+        raise InputError(f"pose: iou_threshold applies to yolo_pose models only, this one is {name}")
     options: dict[str, Any] = {} if score_threshold is None else {"score_threshold": score_threshold}
     if name == MOVENET_MULTIPOSE:
         return MoveNetMultiPose(model, size=input_size, **options)
     if name == MOVENET_SINGLEPOSE:
         if isinstance(input_size, (str, tuple)):
-            raise ValueError(f"pose: a SinglePose input size is one side in pixels, got {input_size!r}")
+            raise InputError(f"pose: a SinglePose input size is one side in pixels, got {input_size!r}")
         return MoveNetSinglePose(model, size=input_size, **options)
     if isinstance(input_size, str):
-        raise ValueError(f"pose: a YOLO input size is a side or (height, width) in pixels, got {input_size!r}")
+        raise InputError(f"pose: a YOLO input size is a side or (height, width) in pixels, got {input_size!r}")
     if iou_threshold is not None:
         options["iou_threshold"] = iou_threshold
     return YoloPose(model, size=input_size, **options)

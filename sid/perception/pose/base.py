@@ -20,6 +20,7 @@ import numpy as np
 
 from sid.checks import LIMITS_ENV, amount, check_number, check_numbers, limits
 from sid.documents import InputWarning
+from sid.errors import InputError, InputTypeError
 from sid.perception.keypoints import PoseDetection
 
 __all__ = [
@@ -66,7 +67,7 @@ class Letterbox:
         check_number("letterbox", "scale", self.scale, low=0, low_open=True)
         check_numbers("letterbox", self, ("pad_x", "pad_y"), unit="pixels")
         if min(self.input_size) <= 0:
-            raise ValueError(f"letterbox: input size must be positive, got {self.input_size}")
+            raise InputError(f"letterbox: input size must be positive, got {self.input_size}")
 
     @classmethod
     def fit(cls, image_hw: Sequence[int], input_hw: Sequence[int]) -> Letterbox:
@@ -84,9 +85,9 @@ class Letterbox:
         in_h, in_w = _size(input_hw, "input")
         u0, v0, u1, v1 = np.asarray(box, dtype=float).reshape(4).tolist()
         if not all(map(math.isfinite, (u0, v0, u1, v1))) or u1 <= u0 or v1 <= v0:
-            raise ValueError(f"letterbox: box must be finite with u_max > u_min and v_max > v_min, got {box}")
+            raise InputError(f"letterbox: box must be finite with u_max > u_min and v_max > v_min, got {box}")
         if not expand > 0:
-            raise ValueError(f"letterbox: expand must be positive, got {expand}")
+            raise InputError(f"letterbox: expand must be positive, got {expand}")
         side = expand * max(u1 - u0, v1 - v0)
         scale = min(in_w, in_h) / side
         # Box centre in edge coordinates is (u + 0.5); it must land on the input's centre.
@@ -207,13 +208,13 @@ def most_detections(found: int) -> int:
 def check_color_image(color_rgb: np.ndarray) -> np.ndarray:
     """Validate a colour image: (H, W, 3) uint8 RGB, non-empty. Returns it as a C-contiguous array."""
     if not isinstance(color_rgb, np.ndarray):
-        raise TypeError(f"pose: colour image must be a numpy array, got {type(color_rgb).__name__}")
+        raise InputTypeError(f"pose: colour image must be a numpy array, got {type(color_rgb).__name__}")
     if color_rgb.ndim != 3 or color_rgb.shape[2] != 3:
-        raise ValueError(f"pose: colour image must have shape (H, W, 3) RGB, got {color_rgb.shape}")
+        raise InputError(f"pose: colour image must have shape (H, W, 3) RGB, got {color_rgb.shape}")
     if color_rgb.shape[0] == 0 or color_rgb.shape[1] == 0:
-        raise ValueError(f"pose: colour image is empty, shape {color_rgb.shape}")
+        raise InputError(f"pose: colour image is empty, shape {color_rgb.shape}")
     if color_rgb.dtype != np.uint8:
-        raise ValueError(f"pose: colour image must be uint8 (0-255), got {color_rgb.dtype}")
+        raise InputError(f"pose: colour image must be uint8 (0-255), got {color_rgb.dtype}")
     return np.ascontiguousarray(color_rgb)
 
 
@@ -223,11 +224,11 @@ def check_boxes(boxes: np.ndarray | Sequence[Sequence[float]]) -> np.ndarray:
     if boxes.size == 0:
         return boxes.reshape(0, 4)
     if boxes.ndim != 2 or boxes.shape[1] != 4:
-        raise ValueError(f"pose: boxes must have shape (N, 4) as (u_min, v_min, u_max, v_max), got {boxes.shape}")
+        raise InputError(f"pose: boxes must have shape (N, 4) as (u_min, v_min, u_max, v_max), got {boxes.shape}")
     if not np.all(np.isfinite(boxes)):
-        raise ValueError("pose: boxes contain NaN or infinite values")
+        raise InputError("pose: boxes contain NaN or infinite values")
     if np.any(boxes[:, 2] <= boxes[:, 0]) or np.any(boxes[:, 3] <= boxes[:, 1]):
-        raise ValueError("pose: every box needs u_max > u_min and v_max > v_min")
+        raise InputError("pose: every box needs u_max > u_min and v_max > v_min")
     return boxes
 
 
@@ -242,5 +243,5 @@ def clip_corners(corners: np.ndarray, image_hw: Sequence[int]) -> None:
 def _size(hw: Sequence[int], what: str) -> tuple[int, int]:
     h, w = (int(x) for x in hw)
     if h <= 0 or w <= 0:
-        raise ValueError(f"letterbox: {what} size must be positive, got {tuple(hw)}")
+        raise InputError(f"letterbox: {what} size must be positive, got {tuple(hw)}")
     return h, w

@@ -11,6 +11,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from sid.errors import InputError
 from sid.perception.keypoints import NUM_KEYPOINTS, PoseDetection
 from sid.perception.pose.base import (
     Letterbox,
@@ -66,15 +67,15 @@ def multipose_input_size(image_hw: Sequence[int], size: MultiPoseSize = MULTIPOS
     if size == "paper":
         return _ceil32(h * PAPER_WIDTH / w), PAPER_WIDTH
     if isinstance(size, str):
-        raise ValueError(f"movenet: input size must be an int, (height, width) or 'paper', got {size!r}")
+        raise InputError(f"movenet: input size must be an int, (height, width) or 'paper', got {size!r}")
     if isinstance(size, int):
         if size < 32 or size % 32:
-            raise ValueError(f"movenet: MultiPose long side must be a positive multiple of 32, got {size}")
+            raise InputError(f"movenet: MultiPose long side must be a positive multiple of 32, got {size}")
         scale = size / max(h, w)
         return _ceil32(h * scale), _ceil32(w * scale)
     in_h, in_w = (int(x) for x in size)
     if min(in_h, in_w) < 32 or in_h % 32 or in_w % 32:
-        raise ValueError(f"movenet: MultiPose input height and width must be multiples of 32, got {in_h}x{in_w}")
+        raise InputError(f"movenet: MultiPose input height and width must be multiples of 32, got {in_h}x{in_w}")
     return in_h, in_w
 
 
@@ -117,7 +118,7 @@ class MoveNetMultiPose:
         self._fixed = fixed_hw(model.signature.inputs[0].shape[1:3])
         requested = tuple(size) if isinstance(size, (list, tuple)) else size
         if self._fixed is not None and requested is not None and requested != self._fixed:
-            raise ValueError(f"movenet: this MultiPose model has a fixed input {self._fixed}, cannot use size {size!r}")
+            raise InputError(f"movenet: this MultiPose model has a fixed input {self._fixed}, cannot use size {size!r}")
         self.size = MULTIPOSE_LONG_SIDE if size is None else size
         if self._fixed is None:
             multipose_input_size((480, 640), self.size)  # validate now rather than on the first frame
@@ -187,17 +188,17 @@ class MoveNetSinglePose:
         self.crop_expand = float(crop_expand)
         self.crop_margin = float(crop_margin)
         if self.crop_margin < 0:
-            raise ValueError(f"movenet: crop_margin must be >= 0, got {crop_margin}")
+            raise InputError(f"movenet: crop_margin must be >= 0, got {crop_margin}")
         spec = model.signature.inputs[0]
         fixed = fixed_hw(spec.shape[1:3])
         if fixed is not None:
             if size is not None and (size, size) != fixed:
-                raise ValueError(f"movenet: this SinglePose model has a fixed input {fixed}, cannot use {size}")
+                raise InputError(f"movenet: this SinglePose model has a fixed input {fixed}, cannot use {size}")
             self._size = fixed
         else:
             side = 192 if size is None else int(size)
             if side < 32:
-                raise ValueError(f"movenet: SinglePose input size must be at least 32, got {side}")
+                raise InputError(f"movenet: SinglePose input size must be at least 32, got {side}")
             self._size = (side, side)
         self._dtype = spec.dtype
 

@@ -35,6 +35,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from sid.distribution import MissingDependencyError, install_hint
+from sid.errors import InputError
 from sid.perception.pose.contracts import YOLO_POSE, PoseModelError
 
 if TYPE_CHECKING:
@@ -284,14 +285,14 @@ def quantize_model(
     from sid.perception.pose import load_pose_estimator
 
     if isinstance(float_layers, bool) or not isinstance(float_layers, int) or float_layers < 0:
-        raise ValueError(f"float_layers must be a whole number >= 0, got {float_layers!r}")
+        raise InputError(f"float_layers must be a whole number >= 0, got {float_layers!r}")
     started = time.perf_counter()
     source, output = check_paths(source, output)
     estimator = load_pose_estimator(source, threads=1)
     input_name = estimator.model.signature.inputs[0].name
     tensors = [estimator.preprocess(image)[0] for image in _first(images, max_images)]
     if not tensors:
-        raise ValueError("no calibration image: the calibration source gave no frames")
+        raise InputError("no calibration image: the calibration source gave no frames")
     model = onnx.load(str(source))
     removed = simplify_graph(model)
     weighted = sum(node.op_type in WEIGHTED_OPS for node in model.graph.node)
@@ -364,11 +365,11 @@ def check_paths(source: str | Path, output: str | Path) -> tuple[Path, Path]:
     does not exist (checked before any work)."""
     source, output = Path(source), Path(output)
     if source.exists() and output.exists() and source.resolve() == output.resolve():
-        raise ValueError(f"the output {output} is the input model; write to another file")
+        raise InputError(f"the output {output} is the input model; write to another file")
     if output.is_dir():
-        raise ValueError(f"the output {output} is a folder; name a .onnx file")
+        raise InputError(f"the output {output} is a folder; name a .onnx file")
     if not output.parent.is_dir():
-        raise ValueError(f"cannot write {output}: the folder {output.parent} does not exist")
+        raise InputError(f"cannot write {output}: the folder {output.parent} does not exist")
     return source, output
 
 

@@ -37,6 +37,7 @@ import onnxruntime as ort
 from sid.cpu import physical_cores, usable_cpus
 from sid.distribution import MissingDependencyError, install_hint
 from sid.documents import special_file
+from sid.errors import InputError
 from sid.perception.pose.contracts import ModelSignature, PoseModelError, supported_contracts_text
 
 __all__ = [
@@ -102,13 +103,13 @@ def resolve_providers(providers: str | Sequence[str] | None = None) -> list[str]
                 missing = OPENVINO_MISSING.format(available=", ".join(available)) + _overwritten_hint()
                 raise MissingDependencyError(missing)
             return [OPENVINO_PROVIDER, CPU_PROVIDER]
-        raise ValueError(
+        raise InputError(
             f"pose: unknown provider {providers!r}: expected one of {', '.join(PROVIDER_CHOICES)} "
             "or a list of onnxruntime provider names"
         )
     names = list(providers)
     if not names or not all(isinstance(name, str) and name for name in names):
-        raise ValueError(f"pose: providers must be a non-empty list of onnxruntime provider names, got {providers!r}")
+        raise InputError(f"pose: providers must be a non-empty list of onnxruntime provider names, got {providers!r}")
     return names
 
 
@@ -152,12 +153,12 @@ def check_threads(threads: object) -> int | None:
     if threads is None:
         return None
     if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)):
-        raise ValueError(f"pose: threads must be a whole number >= 1, got {threads!r}")
+        raise InputError(f"pose: threads must be a whole number >= 1, got {threads!r}")
     if threads < 1:
-        raise ValueError(f"pose: threads must be >= 1, got {threads}")
+        raise InputError(f"pose: threads must be >= 1, got {threads}")
     cpus = len(usable_cpus())
     if threads > THREADS_PER_CPU * cpus:
-        raise ValueError(
+        raise InputError(
             f"pose: threads must be at most {THREADS_PER_CPU * cpus} ({THREADS_PER_CPU} per logical CPU this process "
             f"may use, {cpus}), got {threads}"
         )
@@ -217,7 +218,7 @@ class OnnxModel:
             ) from exc
         asked_openvino = isinstance(providers, str) and providers.strip().lower() == "openvino"
         if asked_openvino and self.provider != OPENVINO_PROVIDER:  # onnxruntime fell back to CPU silently
-            raise ValueError(
+            raise InputError(
                 f"pose: the openvino provider failed to start on {self.path}; onnxruntime fell back to "
                 f"{self.provider}; use --provider cpu (load_warnings=True shows onnxruntime's reason)"
             )

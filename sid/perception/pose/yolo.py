@@ -16,6 +16,7 @@ from collections.abc import Sequence
 import cv2
 import numpy as np
 
+from sid.errors import InputError
 from sid.perception.keypoints import NUM_KEYPOINTS, PoseDetection
 from sid.perception.pose.base import Letterbox, check_color_image, clip_corners, fit_letterbox, most_detections
 from sid.perception.pose.contracts import YOLO_POSE, PoseModelError, fixed_hw, yolo_layout
@@ -47,18 +48,18 @@ class YoloPose:
         self.score_threshold = float(score_threshold)
         self.iou_threshold = float(iou_threshold)
         if not 0.0 < self.iou_threshold <= 1.0:
-            raise ValueError(f"yolo: iou_threshold must be in (0, 1], got {iou_threshold}")
+            raise InputError(f"yolo: iou_threshold must be in (0, 1], got {iou_threshold}")
         spec = model.signature.inputs[0]
         self.layout = yolo_layout(spec)
         fixed = fixed_hw(spec.shape[2:4] if self.layout == "nchw" else spec.shape[1:3])
         if fixed is not None:
             if size is not None and tuple(np.broadcast_to(size, 2)) != fixed:
-                raise ValueError(f"yolo: this model has a fixed input {fixed}, cannot use size {size!r}")
+                raise InputError(f"yolo: this model has a fixed input {fixed}, cannot use size {size!r}")
             self._size = fixed
         else:
             h, w = (int(x) for x in np.broadcast_to(DEFAULT_SIZE if size is None else size, 2))
             if min(h, w) < 32 or h % 32 or w % 32:
-                raise ValueError(f"yolo: input height and width must be multiples of 32, got {h}x{w}")
+                raise InputError(f"yolo: input height and width must be multiples of 32, got {h}x{w}")
             self._size = (h, w)
         self._dtype = spec.dtype
         self._pixel_unit = 1.0 / np.array(self._size[::-1], dtype=float)  # input px -> [0, 1], for pixel exports

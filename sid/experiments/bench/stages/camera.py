@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from sid.errors import InputError
 from sid.experiments.bench.runner import measure
 from sid.experiments.bench.stages.core import (
     PAPER_LIFT_MS,
@@ -35,7 +36,7 @@ def _bench_align(mode: SplatMode) -> Callable[[Context], Records]:
         stats = measure(lambda: aligner(frame.depth), ctx.settings)
         kd, kc = frame.calibration.depth, frame.calibration.color
         if kd is None:  # unreachable: Aligner refuses a calibration without depth intrinsics
-            raise ValueError("bench: align needs depth intrinsics; the frame's depth is registered to colour")
+            raise InputError("bench: align needs depth intrinsics; the frame's depth is registered to colour")
         filled = float(np.count_nonzero(aligner(frame.depth)) / (kc.width * kc.height))
         size = f"{kd.width}x{kd.height} -> {kc.width}x{kc.height}"
         return {f"align/{mode}": record(stats, size=size, filled_fraction=round(filled, 3))}

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from sid.errors import InputError
 from sid.experiments.bench.runner import RunSettings, Stats
 
 __all__ = [
@@ -49,7 +50,7 @@ class Context:
 
     def __post_init__(self) -> None:
         if self.plan_runs < 1:
-            raise ValueError(f"bench: plan_runs must be at least 1, got {self.plan_runs}")
+            raise InputError(f"bench: plan_runs must be at least 1, got {self.plan_runs}")
 
     def cached(self, key: str, build: Callable[[], Any]) -> Any:
         """``build()`` once per run, shared by the benchmarks that need the same input."""

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from sid.errors import InputError
 from sid.experiments.bench.stages.core import (
     Context,
 )
@@ -34,7 +35,7 @@ def grouping_scene(n: int, seed: int = 0) -> list[Person]:
     in one point).
     """
     if n < 1:
-        raise ValueError(f"bench: a grouping scene needs at least one person, got {n}")
+        raise InputError(f"bench: a grouping scene needs at least one person, got {n}")
     sizes = [n] if n <= 6 else [4] * (n // 4) + ([n % 4] if n % 4 else [])
     radius = {1: 0.4, 2: 0.4, 3: 0.69, 4: 0.8, 5: 0.8, 6: 0.85}
     rng = np.random.default_rng(seed)
