@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -45,7 +46,7 @@ def _number(doc: dict, key: str, path: Path) -> float:
     return float(value)
 
 
-def _read_metadata(path: Path) -> dict:
+def _read_metadata(path: Path) -> dict[str, Any]:
     try:
         doc = load_document(path, "map YAML")
     except ValueError as exc:  # names the file: unreadable, or not valid YAML

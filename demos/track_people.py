@@ -29,5 +29,5 @@ for frame in source:
         print(f"  track {p.id}: ({p.x:5.2f}, {p.y:5.2f}) m, velocity ({p.vx:5.2f}, {p.vy:5.2f}) m/s, {p.state}")
     for g in update.groups:
         print(f"  group {g.id}: {g.kind}, members {list(g.members)}")
-    costs = update.costmap.master.costs  # the combined uint8 grid (Nav2 values), rows along map y
+    costs = update.costmap.costs  # the combined uint8 grid (Nav2 values), rows along map y
     print(f"  costmap: {int((costs > 0).sum())} of {costs.size} cells with a cost")

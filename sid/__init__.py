@@ -81,14 +81,16 @@ if TYPE_CHECKING:  # what type checkers see; ``as`` marks each as re-exported
     from sid.tracking.tracker import PeopleTracker as PeopleTracker
 
 
-def __getattr__(name: str) -> Any:
-    """Import a public name's module on first access (PEP 562) and keep the name here."""
-    module = _EXPORTS.get(name)
-    if module is None:
-        raise AttributeError(f"module 'sid' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
+if not TYPE_CHECKING:  # hidden from type checkers, which would read any misspelt ``sid.X`` as this function's Any
+
+    def __getattr__(name: str) -> Any:
+        """Import a public name's module on first access (PEP 562) and keep the name here."""
+        module = _EXPORTS.get(name)
+        if module is None:
+            raise AttributeError(f"module 'sid' has no attribute {name!r}")
+        value = getattr(importlib.import_module(module), name)
+        globals()[name] = value
+        return value
 
 
 def __dir__() -> list[str]:

@@ -31,6 +31,7 @@ __all__ = [
     "check_numbers",
     "check_whole",
     "check_yaw",
+    "check_yaws",
     "is_real",
     "limits",
     "limits_from_environment",
@@ -164,7 +165,8 @@ def check_number(
     ok = ok and (low is None or (number > low if low_open else number >= low))
     ok = ok and (high is None or (number < high if high_open else number <= high))
     if not ok:
-        raise error(f"{owner}: {name} must be {_rule(low, high, low_open, high_open, allow_inf, unit)}, got {value}")
+        shown = value if is_real(value) else repr(value)  # a string "0.8" must not read as the number 0.8
+        raise error(f"{owner}: {name} must be {_rule(low, high, low_open, high_open, allow_inf, unit)}, got {shown}")
 
 
 def is_real(value: object) -> bool:
@@ -208,6 +210,14 @@ def check_yaw(owner: str, name: str, value: float, error: type[Exception] = Inpu
     degrees, which read as radians points anywhere. ``value`` is a finite number already."""
     if abs(value) > YAW_LIMIT_RAD:
         raise error(f"{owner}: {name} {value:g} is beyond two turns (4 pi): radians expected, not degrees")
+
+
+def check_yaws(owner: str, record: object, names: Iterable[str], error: type[Exception] = InputError) -> None:
+    """``check_number`` then ``check_yaw`` on each attribute of ``record`` named in ``names`` (radians)."""
+    for name in names:
+        value = getattr(record, name)
+        check_number(owner, name, value, unit="radians", error=error)
+        check_yaw(owner, name, value, error)
 
 
 def check_numbers(owner: str, record: object, names: Iterable[str], **bounds: Any) -> None:

@@ -16,7 +16,7 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
-from costmap.grid import GridSpec
+from costmap.grid import Costmap2D, GridSpec
 from costmap.layer import LayerInputs
 from costmap.layered import LayeredCostmap
 from costmap.layers.obstacle import SCAN
@@ -45,7 +45,8 @@ class StreamUpdate:
     """The stream's state after one frame.
 
     frame_id: the frame of every position ("map" or "base_footprint"). timestamp: the frame's (s). people, groups:
-    confirmed tracks. costmap: the LayeredCostmap after the update (``costmap.master.costs``: the combined uint8 grid).
+    confirmed tracks. costmap: the combined grid after this frame (``costmap.costs``: uint8, Nav2 values), a copy that
+    later frames leave as it is (the stream's live LayeredCostmap is ``SocialStream.costmap``).
     result: the per-frame pipeline's raw result. timing_ms: per stage ("pose", "lift", "group" from the pipeline,
     then "track", "track_groups", "costmap", and "total"). reset: why the trackers were reset at this frame (None:
     they were not).
@@ -55,7 +56,7 @@ class StreamUpdate:
     timestamp: float
     people: list[TrackedPerson]
     groups: list[TrackedGroup]
-    costmap: LayeredCostmap
+    costmap: Costmap2D
     result: FrameResult
     timing_ms: dict[str, float]
     reset: str | None = None
@@ -110,7 +111,7 @@ class SocialStream:
             frame.timestamp,
             tracked.people,
             tracked.groups,
-            self.costmap,
+            self.costmap.master.copy(),
             result,
             timing,
             tracked.reset,

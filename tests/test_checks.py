@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-from sid.checks import YAW_LIMIT_RAD, check_number, check_numbers, check_whole, check_yaw, repeated
+from sid.checks import YAW_LIMIT_RAD, check_number, check_numbers, check_whole, check_yaw, check_yaws, repeated
 
 
 @pytest.mark.parametrize(
@@ -33,7 +33,8 @@ from sid.checks import YAW_LIMIT_RAD, check_number, check_numbers, check_whole, 
 def test_out_of_range_values_are_named_with_the_rule(value, bounds, rule):
     with pytest.raises(ValueError) as error:
         check_number("groups", "eps", value, **bounds)
-    assert str(error.value) == f"groups: eps must be {rule}, got {value}"
+    shown = repr(value) if isinstance(value, (str, bytes, np.ndarray)) else value  # quoted: not to read as a number
+    assert str(error.value) == f"groups: eps must be {rule}, got {shown}"
 
 
 @pytest.mark.parametrize(
@@ -126,6 +127,23 @@ def test_repeated_names_the_first_item_given_twice_in_order() -> None:
     assert repeated(["grid", "bitstar", "rrtstar"]) is None and repeated([]) is None
     assert repeated(["S2", "S1", "S2", "S1"]) == "S2"
     assert repeated(["a", "b", "b", "a"]) == "a"  # the first item in order that appears again, not the first repeat
+
+
+def test_a_string_is_quoted_so_that_it_does_not_read_as_a_number() -> None:
+    with pytest.raises(ValueError, match=r"^groups: radius_max must be a finite number of metres, got '0.8'$"):
+        check_number("groups", "radius_max", "0.8", unit="metres")  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match=r"got nan$"):
+        check_number("groups", "radius_max", math.nan, unit="metres")
+
+
+def test_yaws_of_a_record_are_numbers_within_two_turns() -> None:
+    from sid.perception.mount import CameraMount
+
+    check_yaws("mount", CameraMount(0.9, yaw=-2 * math.pi), ("yaw",))
+    with pytest.raises(ValueError, match=r"^camera mount: yaw 90 is beyond two turns \(4 pi\): radians expected"):
+        CameraMount(0.9, yaw=90.0)
+    with pytest.raises(ValueError, match=r"^camera mount: yaw must be a finite number of radians, got '1'$"):
+        CameraMount(0.9, yaw="1")  # type: ignore[arg-type]
 
 
 def test_a_yaw_beyond_two_turns_is_refused_as_degrees() -> None:

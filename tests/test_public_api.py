@@ -26,6 +26,20 @@ def test_unknown_names_raise_attribute_error():
         _ = sid.Nope
 
 
+def test_a_type_checker_sees_the_public_names_and_refuses_a_misspelt_one(tmp_path, monkeypatch):
+    """The lazy loader (module ``__getattr__``) is hidden from type checkers: else every ``sid.X`` would be Any."""
+    api = pytest.importorskip("mypy.api", reason="mypy (the test extra) is not installed")
+    user = tmp_path / "user.py"
+    user.write_text("import sid\n\nsid.Pipeline\nsid.Pipline\nreveal_type(sid.detect_groups)\n")
+    monkeypatch.setenv("MYPYPATH", str(REPO_ROOT))  # an editable install's import hook is invisible to mypy
+    report, _, _ = api.run(["--follow-imports=silent", "--no-incremental", "--python-version=3.10", str(user)])
+    lines = report.splitlines()
+    assert [line.split(":", 1)[1] for line in lines if ": error:" in line] == [
+        '4: error: Module has no attribute "Pipline"  [attr-defined]'
+    ]
+    assert any("def (people:" in line for line in lines), report
+
+
 def test_version_is_a_plain_string():
     assert isinstance(sid.__version__, str) and sid.__version__.count(".") == 2
 

@@ -70,7 +70,7 @@ def test_people_groups_and_costmap_follow_the_frames_in_the_map() -> None:
     assert all(p.state == "standing" for p in last.people)
     (group,) = last.groups
     assert group.kind == "conversation" and group.members == tuple(sorted(p.id for p in last.people))
-    master = last.costmap.master.costs
+    master = last.costmap.costs
     assert master[_cell(0.6, 3.0)] == LETHAL and master[_cell(1.0, 3.0)] >= 240
     assert last.result.frame_id == MAP_FRAME and len(last.result.people) == 2
     assert {"pose", "lift", "group", "track", "track_groups", "costmap", "total"} <= last.timing_ms.keys()
@@ -96,9 +96,11 @@ def test_a_frame_out_of_time_order_is_refused_and_changes_nothing() -> None:
     stream = SocialStream(ScriptedPipeline(_pair), SPEC)
     for k in range(4):
         before = stream.update(_frame(k))
-    for bad in (before.timestamp, before.timestamp - 1.0, math.nan):
+    for bad in (before.timestamp, before.timestamp - 1.0):
         with pytest.raises(TrackingError, match="timestamp"):
             stream.update(_frame(9, time=bad))
+    with pytest.raises(ValueError, match="frame: timestamp must be a finite number"):  # refused by the record itself
+        _frame(9, time=math.nan)
     after = stream.update(_frame(4))
     assert {p.id for p in after.people} == {p.id for p in before.people} and after.reset is None
 
@@ -147,15 +149,28 @@ def test_empty_frames_keep_the_tracks_for_a_while() -> None:
     update = stream.update(_frame(10))
     assert {p.id for p in update.people} == {p.id for p in before.people}
     assert not any(p.visible for p in update.people) and update.groups
-    assert update.costmap.master.costs[_cell(3.0, 0.4)] == LETHAL
+    assert update.costmap.costs[_cell(3.0, 0.4)] == LETHAL
+
+
+def test_an_update_keeps_its_own_costmap_when_later_frames_change_the_stream() -> None:
+    people: dict[str, list[Person]] = {"now": _pair(0.0)}
+    stream = SocialStream(ScriptedPipeline(lambda t: people["now"]), SPEC)
+    kept = [stream.update(_frame(k)) for k in range(10)][-1]
+    drawn = kept.costmap.costs.copy()
+    assert drawn[_cell(3.0, 0.4)] == LETHAL
+    people["now"] = []
+    for k in range(10, 60):  # 5 s without anyone: the tracks end and the live costmap empties
+        last = stream.update(_frame(k))
+    assert not last.people and last.costmap.costs[_cell(3.0, 0.4)] != LETHAL
+    np.testing.assert_array_equal(kept.costmap.costs, drawn)
 
 
 def test_a_ready_costmap_with_the_social_layer_draws_the_tracks() -> None:
     layered = layered_costmap(SPEC, CostmapParams(plugins=("social",)))
     stream = SocialStream(ScriptedPipeline(_pair), layered)
     for k in range(10):
-        update = stream.update(_frame(k))
-    assert update.costmap is layered and layered.master.costs[_cell(3.0, 0.0)] >= 240
+        stream.update(_frame(k))
+    assert stream.costmap is layered and layered.master.costs[_cell(3.0, 0.0)] >= 240
     with pytest.raises(ValueError, match="costmap_params only apply"):
         SocialStream(ScriptedPipeline(_pair), layered, CostmapParams())
 

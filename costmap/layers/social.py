@@ -35,7 +35,7 @@ from shapely.geometry.base import BaseGeometry
 from costmap.combine import CombinationMethod
 from costmap.grid import FREE_SPACE, LETHAL, MAX_NON_OBSTACLE, GridSpec, Window, disjoint
 from costmap.layer import Input, LayerInputs, RepaintedLayer
-from sid.checks import check_number, check_numbers
+from sid.checks import check_number, check_numbers, check_yaws
 from sid.errors import InputError
 from sid.perception.group import Group
 from sid.perception.people import Person
@@ -63,7 +63,9 @@ def _people(people: Sequence[Person]) -> tuple[Person, ...]:
     people = tuple(people)
     seen = set()
     for p in people:
-        check_numbers(f"person {p.id}", p, ("x", "y") if p.theta is None else ("x", "y", "theta"))
+        check_numbers(f"person {p.id}", p, ("x", "y"))
+        if p.theta is not None:
+            check_yaws(f"person {p.id}", p, ("theta",))
         if p.id in seen:
             raise InputError(f"person id {p.id} appears twice")
         seen.add(p.id)

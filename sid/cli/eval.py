@@ -10,6 +10,7 @@ import json
 import math
 import sys
 from pathlib import Path
+from typing import Any
 
 from sid.cli.common import (
     check_output_folder,
@@ -382,7 +383,7 @@ def _folds(folds: list[Fold], table: dict[tuple[float, ...], dict[str, float]]) 
 
 def _folds_json(
     folds: list[Fold], table: dict[tuple[float, ...], dict[str, float]], grid: list[tuple[str, list[float]]]
-) -> dict:
+) -> dict[str, Any]:
     names = [name for name, _ in grid]
     return {
         "folds": [dataclasses.asdict(fold) for fold in folds],

@@ -762,7 +762,7 @@ def load_settings_gc(folder: str | Path, base: GCFFParams | None = None, scale: 
         ) from None
 
 
-def _load_mat(path: Path, keys: tuple[str, ...]) -> dict:
+def _load_mat(path: Path, keys: tuple[str, ...]) -> dict[str, Any]:
     if not path.exists():
         others = sorted(p.name for p in path.parent.glob("*") if p.suffix.lower() == ".mat" and p.is_file())
         beside = f" (the folder holds {', '.join(others[:5])}{', ...' if len(others) > 5 else ''})" if others else ""

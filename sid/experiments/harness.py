@@ -247,7 +247,7 @@ class Run:
     def social_layer(self) -> bool:
         return MODES[self.mode]
 
-    def record(self) -> dict:
+    def record(self) -> dict[str, Any]:
         """The run as one flat JSON-ready dict: every metric, then the run's fields, then the task's labels (a
         label wins over a metric of the same name, e.g. a task's draw ``seed`` over the planner's seed)."""
         fields = {

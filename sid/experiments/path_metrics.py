@@ -16,7 +16,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from itertools import combinations
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from shapely.geometry import LineString, Point
@@ -119,7 +119,7 @@ def path_metrics(
     groups: Sequence[Group],
     costmap: Costmap2D | None = None,
     spacing: float = SAMPLE_SPACING_M,
-) -> dict:
+) -> dict[str, Any]:
     """Geometry and social metrics of a successful path (N >= 1, world frame).
 
     With ``costmap``: ``cost_integral`` = integral of c / 252 ds over the graded cost c (0..252; unknown counts as
@@ -177,7 +177,7 @@ FIXED_KEYS = (
 
 def result_metrics(
     result: PlanResult, people: Sequence[Person], groups: Sequence[Group], costmap: Costmap2D | None = None
-) -> dict:
+) -> dict[str, Any]:
     """The metrics of a plan: the planner's outcome plus ``path_metrics`` (JSON-ready; path metrics are None when
     the plan failed)."""
     outcome = {

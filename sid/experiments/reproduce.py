@@ -177,7 +177,7 @@ def _layout_row(name: str, rows: list[dict]) -> list[str]:
     ]
 
 
-def navigation_json(result: NavigationResult, seeds: int) -> dict:
+def navigation_json(result: NavigationResult, seeds: int) -> dict[str, Any]:
     """``navigation.json``: settings, layouts, the summaries by planner and by layout, failed tasks, every run."""
     settings = result.settings
     return {

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -36,7 +37,7 @@ def plan_scenario(
     return compare_with_without(prepare(scenario, cost_weight), planner, time_limit, seed, max_iterations, (mode,))
 
 
-def path_record(comparison: Comparison) -> dict:
+def path_record(comparison: Comparison) -> dict[str, Any]:
     """The JSON record of a one-run comparison: every metric at the top level, plus the waypoints (world frame)."""
     (run,) = comparison.runs.values()
     robot = comparison.task.scenario.robot

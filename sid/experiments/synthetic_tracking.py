@@ -131,7 +131,7 @@ def require_motmetrics() -> None:
         )
 
 
-def evaluate_tracking(settings: TrackingEvalSettings | None = None, progress: Progress | None = None) -> dict:
+def evaluate_tracking(settings: TrackingEvalSettings | None = None, progress: Progress | None = None) -> dict[str, Any]:
     """Every score of the module docstring: ``{"sequences": {name: {...}}, "overall": {...}, "flicker": {...},
     "settings": {...}}``."""
     require_motmetrics()  # fail before any rendering
@@ -354,7 +354,7 @@ def measure_flicker(settings: TrackingEvalSettings | None = None, progress: Prog
     for index, frame in enumerate(source):
         update = stream.update(frame)
         per_frame.update(LayerInputs({PEOPLE: update.result.people, GROUPS: update.result.groups}))
-        for name, grid in (("per_frame", per_frame.master.costs), ("tracked", update.costmap.master.costs)):
+        for name, grid in (("per_frame", per_frame.master.costs), ("tracked", update.costmap.costs)):
             grid = grid.astype(np.int16)
             if name in previous and index * 1.0 / settings.fps >= settings.settle_time:
                 changed[name].append(int(np.count_nonzero(np.abs(grid - previous[name]) > settings.flicker_threshold)))

@@ -27,6 +27,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -105,7 +106,7 @@ class Table1Settings:
             raise InputError(f"table1: variations must be 1..{len(VARIATIONS)}, got {self.variations}")
         check_number("table1", "match_radius", self.match_radius, low=0, low_open=True, unit="metres")
 
-    def describe(self) -> dict:
+    def describe(self) -> dict[str, Any]:
         """The settings as plain JSON (noise records spelled out)."""
         return {
             "scenarios": list(self.scenarios),
@@ -164,7 +165,7 @@ class ErrorLog:
             self.errors["IPX"].append(group.interest_point[0] - true_group.interest_point[0])
             self.errors["IPY"].append(group.interest_point[1] - true_group.interest_point[1])
 
-    def summary(self) -> dict:
+    def summary(self) -> dict[str, Any]:
         """RMSE, bias (mean error) and sample count per metric, and the detection counts and rates."""
         rmse, bias, samples = {}, {}, {}
         for name, values in self.errors.items():
@@ -271,7 +272,7 @@ def run_table1(settings: Table1Settings = Table1Settings(), progress: Progress |
     return result
 
 
-def table1_json(result: Table1Result) -> dict:
+def table1_json(result: Table1Result) -> dict[str, Any]:
     """``table1.json``: ``{"S1": {"IZA": .., ..., "HFD": .., "bias": .., "people": .., "group": ..}, ...}`` plus
     ``"paper"`` (the paper's values), ``"settings"`` and ``"by_variation"``."""
     return {

@@ -56,6 +56,7 @@ __all__ = [
     "SplatMode",
     "StoredValue",
     "align_depth_to_color",
+    "check_depth_image",
     "depth_at_color_pixels",
 ]
 
@@ -83,7 +84,9 @@ _CLASS_SAMPLE = 16
 _WINDOW_STEPS = 3
 
 
-def _validate_depth(depth_m: np.ndarray, intr: Intrinsics, what: str) -> np.ndarray:
+def check_depth_image(depth_m: np.ndarray, intr: Intrinsics, what: str) -> np.ndarray:
+    """``depth_m`` as an array after checking it is a 2-D float image (metres) of the size ``intr`` gives; ValueError
+    naming ``what`` (the caller) otherwise."""
     depth_m = np.asarray(depth_m)
     if depth_m.ndim != 2:
         raise InputError(f"{what}: depth must be a 2-D image, got shape {depth_m.shape}")
@@ -315,7 +318,7 @@ class Aligner:
     def __call__(self, depth_m: np.ndarray) -> np.ndarray:
         """Depth image (H_d, W_d) metres -> (H_c, W_c) float32 metres in the colour grid, 0 where nothing landed."""
         assert self.calib.depth is not None
-        depth_m = _validate_depth(depth_m, self.calib.depth, "align")
+        depth_m = check_depth_image(depth_m, self.calib.depth, "align")
         d = self._work[0]
         np.fmax(depth_m.reshape(-1), np.float32(0), out=d)  # NaN and negative -> 0 (no reading)
         out = self._points(d) if self._corners is None else self._rectangles(d)
@@ -432,7 +435,7 @@ def align_depth_to_color(
     float32 copy with NaN set to 0. For a stream, build one ``Aligner`` and call it per frame.
     """
     if calib.depth is None:
-        depth_m = _validate_depth(depth_m, calib.color, "align_depth_to_color")
+        depth_m = check_depth_image(depth_m, calib.color, "align_depth_to_color")
         return np.nan_to_num(depth_m.astype(np.float32), nan=0.0, posinf=0.0, neginf=0.0)
     return Aligner(calib, mode, value)(depth_m)
 
@@ -489,11 +492,11 @@ def depth_at_color_pixels(
         raise InputError(f"need 0 < depth_min < depth_max < inf, got {depth_min}, {depth_max}")
     pixels = _check_pixels(pixels, patch)
     if calib.depth is None:
-        depth_m = _validate_depth(depth_m, calib.color, "depth_at_color_pixels")
+        depth_m = check_depth_image(depth_m, calib.color, "depth_at_color_pixels")
         if len(pixels) == 0:
             return np.zeros(0)
         return _reduce_patches(_registered_patches(depth_m, pixels, patch, depth_min, depth_max), method)
-    depth_m = _validate_depth(depth_m, calib.depth, "depth_at_color_pixels")
+    depth_m = check_depth_image(depth_m, calib.depth, "depth_at_color_pixels")
     if len(pixels) == 0:
         return np.zeros(0)
     if search == "window":

@@ -23,7 +23,7 @@ from functools import cached_property
 
 import numpy as np
 
-from sid.checks import MAX_COORDINATE, check_number, check_numbers, check_whole, is_real
+from sid.checks import MAX_COORDINATE, check_number, check_numbers, check_whole, check_yaw, is_real
 from sid.documents import summary
 from sid.errors import InputError
 from sid.perception.gcff import GCFFParams, gcff_labels
@@ -502,5 +502,6 @@ def _validated(people: list[Person]) -> tuple[list[int], list[complex], list[com
         elif not math.isfinite(person.theta):
             raise InputError(f"groups: person {person.id} has a non-finite theta {person.theta} (use None)")
         else:
+            check_yaw(f"groups: person {person.id}", "theta", person.theta)
             facing.append(complex(math.cos(person.theta), math.sin(person.theta)))
     return ids, positions, facing

@@ -14,7 +14,7 @@ from functools import cached_property
 
 import numpy as np
 
-from sid.checks import check_number, check_numbers
+from sid.checks import check_number, check_numbers, check_yaws
 
 __all__ = ["CameraMount", "MAX_MOUNT_M"]
 
@@ -43,7 +43,7 @@ class CameraMount:
         half_turn = np.pi / 2
         check_number("camera mount", "tilt", self.tilt, low=-half_turn, high=half_turn, low_open=True, high_open=True)
         check_numbers("camera mount", self, ("x", "y"), low=-MAX_MOUNT_M, high=MAX_MOUNT_M, unit="metres")
-        check_number("camera mount", "yaw", self.yaw, unit="radians")
+        check_yaws("camera mount", self, ("yaw",))
 
     @property
     def rotation(self) -> np.ndarray:

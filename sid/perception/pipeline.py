@@ -58,7 +58,7 @@ class FrameResult:
     frame_id: str = BASE_FRAME
     robot_pose: RobotPose | None = None
 
-    def to_json(self, keypoints: bool = True) -> dict:
+    def to_json(self, keypoints: bool = True) -> dict[str, Any]:
         """The JSON-lines record of ``sid detect``."""
         pose = self.robot_pose
         return {
@@ -72,7 +72,7 @@ class FrameResult:
         }
 
 
-def _person_json(person: Person, keypoints: bool) -> dict:
+def _person_json(person: Person, keypoints: bool) -> dict[str, Any]:
     record: dict[str, Any] = {
         "id": int(person.id),
         "x": round(float(person.x), 4),

@@ -320,7 +320,7 @@ class SocialCostmapNode:
     def publish(self, update: StreamUpdate, stamp: Any) -> None:
         """The mask, the markers and the groups of one update, stamped ``stamp``."""
         frame_id = self.params.global_frame
-        self.costmap_pub.publish(messages.occupancy_grid(grid_fields(update.costmap.master, frame_id), stamp))
+        self.costmap_pub.publish(messages.occupancy_grid(grid_fields(update.costmap, frame_id), stamp))
         markers = scene_markers(update.people, update.groups, self.params.layers.social.group_margin)
         self.markers_pub.publish(messages.marker_array(markers, frame_id, stamp))
         seconds = stamp.sec + stamp.nanosec * 1e-9

@@ -342,12 +342,14 @@ def test_bad_people_are_rejected_naming_the_person(people, message, method):
 
 
 @pytest.mark.parametrize("method", ["ospace", "gcff", "rays", "paper"])
-def test_any_finite_yaw_is_an_angle(method):
-    # 1e308 - (-1e308) overflowed in facing_step (OverflowError from round(inf)); whole turns change nothing.
-    huge = [Person(1, 0.0, 0.0, 1e308, 1.0), Person(2, 1.0, 0.0, -1e308, 1.0)]
-    detect_groups(huge, GroupParams(method=method))
-    turned = [Person(1, 0.0, 0.0, 4 * math.tau, 1.0), Person(2, 0.8, 0.0, math.pi - 3 * math.tau, 1.0)]
+def test_a_yaw_within_two_turns_is_an_angle_and_one_beyond_is_refused_as_degrees(method):
+    # Whole turns change nothing; beyond two turns (90, 180: degrees) a facing read as radians points anywhere (it
+    # moved a pair's interest point from (0.6, 0.6) to (0.34, 0.55)), as sid groups and sid track refuse it.
+    turned = [Person(1, 0.0, 0.0, math.tau, 1.0), Person(2, 0.8, 0.0, math.pi - math.tau, 1.0)]
     assert [g.members for g in detect_groups(turned, GroupParams(method=method))] == [(1, 2)]
+    for huge in (180.0, 1e308):  # 1e308 - (-1e308) overflowed in facing_step once
+        with pytest.raises(ValueError, match=r"groups: person 2: theta .* is beyond two turns .*not degrees"):
+            detect_groups([Person(1, 0.0, 0.0, 0.0, 1.0), Person(2, 1.0, 0.0, huge, 1.0)], GroupParams(method=method))
     assert facing_step([0.0, math.pi / 2 + 10 * math.tau, -math.pi - 7 * math.tau]) == pytest.approx(math.pi / 2)
 
 

@@ -17,6 +17,7 @@ against the people of its step; steps spent standing still add no path and no sa
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from shapely.geometry import LineString
@@ -38,7 +39,7 @@ from sid.experiments.simulate.world import closest_approach
 __all__ = ["run_metrics"]
 
 
-def run_metrics(trace: RunTrace, straight_m: float) -> dict:
+def run_metrics(trace: RunTrace, straight_m: float) -> dict[str, Any]:
     """The run's record (JSON-ready): outcome, social metrics, replans, planning time and the trajectory.
 
     ``straight_m``: straight-line distance from start to goal (m), for ``length_ratio``.

@@ -12,6 +12,7 @@ import math
 import warnings
 from dataclasses import asdict
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -27,7 +28,7 @@ from sid.experiments.simulate.world import SimWorld
 __all__ = ["options_record", "run_record", "write_run"]
 
 
-def options_record(options: RunOptions) -> dict:
+def options_record(options: RunOptions) -> dict[str, Any]:
     """The options as JSON-ready fields (the model as a path string; ``social`` as the record's ``social_layer``)."""
     record = asdict(options)
     record.pop("social")  # the record's ``social_layer``
@@ -35,7 +36,9 @@ def options_record(options: RunOptions) -> dict:
     return record
 
 
-def run_record(world: SimWorld, options: RunOptions, observer: Observer | None = None, color: bool = False) -> dict:
+def run_record(
+    world: SimWorld, options: RunOptions, observer: Observer | None = None, color: bool = False
+) -> dict[str, Any]:
     """Simulate once and return the run's record (see the module docstring); ``color``: see ``simulate``."""
     trace = simulate(world, options, observer, color)
     (x0, y0, _), (x1, y1, _) = world.scenario.robot.start, world.scenario.robot.goal
@@ -52,7 +55,7 @@ def write_run(
     gif: bool = False,
     progress: Progress | None = None,
     still_s: float | None = None,
-) -> dict:
+) -> dict[str, Any]:
     """Run once; with ``out_dir``, write ``run.json`` and ``run.mp4`` (and ``run.gif``; with ``still_s``, ``run.png``:
     the picture of the first step at or after ``still_s`` seconds, or of the last step, with an InputWarning when the
     run ended before ``still_s``) there. Returns the record. ``progress(step, steps at the time limit, what)`` after

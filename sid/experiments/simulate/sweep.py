@@ -63,7 +63,7 @@ def sweep_jobs(scenes: Sequence[str], seeds: int, options: RunOptions | None = N
     ]
 
 
-def run_job(job: Job) -> dict:
+def run_job(job: Job) -> dict[str, Any]:
     """The record of one job (module docstring); what every executor runs."""
     record = run_record(load_scene(job.scene), job.options)
     trajectory = record.pop("trajectory")
@@ -72,7 +72,7 @@ def run_job(job: Job) -> dict:
     return record
 
 
-def _worker_job(job: Job, in_force: Limits) -> dict:
+def _worker_job(job: Job, in_force: Limits) -> dict[str, Any]:
     """``run_job`` on Ray, with the allocator set as the ``sid`` command sets it and the parent's limits in force
     (``sid.checks.use_limits``: a fresh interpreter starts with the defaults)."""
     keep_freed_memory()
@@ -80,7 +80,7 @@ def _worker_job(job: Job, in_force: Limits) -> dict:
         return run_job(job)
 
 
-def _job_task(_: None, job: Job) -> dict:
+def _job_task(_: None, job: Job) -> dict[str, Any]:
     return run_job(job)
 
 

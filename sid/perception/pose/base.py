@@ -205,16 +205,17 @@ def most_detections(found: int) -> int:
     return min(found, keep)
 
 
-def check_color_image(color_rgb: np.ndarray) -> np.ndarray:
-    """Validate a colour image: (H, W, 3) uint8 RGB, non-empty. Returns it as a C-contiguous array."""
+def check_color_image(color_rgb: np.ndarray, what: str = "pose") -> np.ndarray:
+    """Validate a colour image: (H, W, 3) uint8 RGB, non-empty. Returns it as a C-contiguous array. ``what`` names
+    the caller in the message."""
     if not isinstance(color_rgb, np.ndarray):
-        raise InputTypeError(f"pose: colour image must be a numpy array, got {type(color_rgb).__name__}")
+        raise InputTypeError(f"{what}: colour image must be a numpy array, got {type(color_rgb).__name__}")
     if color_rgb.ndim != 3 or color_rgb.shape[2] != 3:
-        raise InputError(f"pose: colour image must have shape (H, W, 3) RGB, got {color_rgb.shape}")
+        raise InputError(f"{what}: colour image must have shape (H, W, 3) RGB, got {color_rgb.shape}")
     if color_rgb.shape[0] == 0 or color_rgb.shape[1] == 0:
-        raise InputError(f"pose: colour image is empty, shape {color_rgb.shape}")
+        raise InputError(f"{what}: colour image is empty, shape {color_rgb.shape}")
     if color_rgb.dtype != np.uint8:
-        raise InputError(f"pose: colour image must be uint8 (0-255), got {color_rgb.dtype}")
+        raise InputError(f"{what}: colour image must be uint8 (0-255), got {color_rgb.dtype}")
     return np.ascontiguousarray(color_rgb)
 
 
