@@ -15,10 +15,12 @@ velocity in m/s; group members as track ids):
                  "area": a, "spread": d, "zone": [[x, y], ...], "velocity": [vx, vy]}],
      "timing_ms": {"track": ms, "track_groups": ms}}
 A malformed line (not UTF-8 JSON, a key given twice, an unknown field, a missing or non-finite number, a theta
-beyond two turns (in degrees by mistake), a timestamp not after the last good line's, two people with one id) is
-reported on stderr with its line number and skipped, or ends the run with --strict (exit 2); everything written
-before it stays written. A line more than the tracker's timeout (1.5 s) after the last good one ends every track, and
-a note on stderr says so, once for such lines in a row (timestamps in milli- or nanoseconds make every line one).
+beyond two turns (in degrees by mistake), a timestamp not after the last good line's but within 1 s before it, two
+people with one id) is reported on stderr with its line number and skipped, or ends the run with --strict (exit 2);
+everything written before it stays written. A line more than the tracker's timeout (1.5 s) after the last good one
+ends every track, and a note on stderr says so, once for such lines in a row (timestamps in milli- or nanoseconds make
+every line one); a line more than 1 s before it (a looped recording, or the line after one stamped in the future)
+starts the trackers over, with a note.
 The trackers take their parameters from a parameters file (--params, its tracking block; their defaults without one),
 the group detector that finds conversations among the tracks from the options below, then the file's groups block.
 """
@@ -26,6 +28,7 @@ the group detector that finds conversations among the tracks from the options be
 from __future__ import annotations
 
 import argparse
+import warnings
 from collections.abc import Callable, Iterable
 from typing import Any, TextIO
 
@@ -38,6 +41,7 @@ from sid.errors import InputError
 from sid.perception.people import Person
 from sid.tracking import TrackingSession
 from sid.tracking.assignment import load_solver
+from sid.tracking.tracker import TimeGapWarning
 
 __all__ = ["LINE_FIELDS", "PERSON_FIELDS", "add_parser", "process", "run"]
 
@@ -66,37 +70,26 @@ def process(
 ) -> int:
     """Track ``lines`` (text, or bytes decoded line by line) into ``session``, writing one JSON line per good line on
     ``out`` and each problem on ``err``; the exit code (2 when ``strict`` stopped at a bad line)."""
-    gaps = _Gaps()
     return process_json_lines(
-        "sid track", lines, out, err, lambda data, note: _track_line(data, session, gaps, note), strict=strict
+        "sid track", lines, out, err, lambda data, note: _track_line(data, session, note), strict=strict
     )
 
 
-class _Gaps:
-    """Whether the last good line came after a gap that ended every track: a run of such lines is noted once
-    (timestamps in milli- or nanoseconds make every line one)."""
-
-    def __init__(self) -> None:
-        self.in_a_row = False
-
-
-def _track_line(data: Any, session: TrackingSession, gaps: _Gaps, note: Callable[[str], None]) -> dict[str, Any]:
+def _track_line(data: Any, session: TrackingSession, note: Callable[[str], None]) -> dict[str, Any]:
     """The output line of one parsed input line, after ``session`` tracked its people (ValueError for a malformed
-    line, the session unchanged). A gap since the last line longer than the tracker's timeout ends every track (no
-    view: every track counts as seen): ``note`` says so, once per run of such lines, since timestamps in milli- or
-    nanoseconds do it at every line and nobody is ever reported."""
+    line, the session unchanged). What the trackers say of the line (a gap that ended every track, a jump back in
+    time that started them over) is a ``note`` on it."""
     timestamp, people = _parse_line(data)
-    last, alive = session.people.timestamp, len(session.people)
-    update = session.track(people, float(timestamp))
-    timeout = session.params.tracker.timeout
-    elapsed = 0.0 if last is None else timestamp - last  # s since the last good line (none before the first)
-    gap = elapsed > timeout
-    if gap and alive and not gaps.in_a_row:
-        note(
-            f"{elapsed:.3g} s after the last line, more than the tracker's timeout ({timeout:g} s): every "
-            "track ended (are the timestamps in seconds?); the lines right after it that do the same are not noted"
-        )
-    gaps.in_a_row = gap
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always", TimeGapWarning)
+        update = session.track(people, float(timestamp))
+    for warning in said:
+        if issubclass(warning.category, TimeGapWarning):
+            note(str(warning.message))
+        else:
+            warnings.warn(warning.message, warning.category, stacklevel=2)
+    if update.reset is not None:
+        note(f"{update.reset}: the trackers started over")
     return {
         "timestamp": timestamp,
         "people": [person.to_json() | {"detection": person.detection} for person in update.people],

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -45,7 +46,7 @@ from sid.tracking.coherent import CoherentMotion, CoherentMotionParams
 from sid.tracking.groups import GroupTracker, GroupTrackerParams
 from sid.tracking.records import TrackedPerson
 from sid.tracking.session import TrackingParams, TrackingSession
-from sid.tracking.tracker import TrackerParams
+from sid.tracking.tracker import TimeGapWarning, TrackerParams
 from sid.tracking.view import View, scene_view
 
 __all__ = [
@@ -120,7 +121,9 @@ def record_tracks(
     total = replay_length(trajectories, settings.replay.rate)
     view = replay_view(trajectories, settings.replay)
     for k, frame in enumerate(replay(trajectories, settings.replay)):
-        people = session.people.update(frame.detections, frame.timestamp, view)
+        with warnings.catch_warnings():  # the sets' annotations pause for seconds: gaps of the data, not of units
+            warnings.simplefilter("ignore", TimeGapWarning)
+            people = session.people.update(frame.detections, frame.timestamp, view)
         log.times.append(frame.timestamp)
         log.truth_ids.append(frame.truth_ids)
         log.truth_positions.append(frame.truth_positions)

@@ -3,9 +3,11 @@
 ``TrackingSession.update(result, view)`` feeds one ``FrameResult`` (``sid.perception.pipeline``) to the people
 tracker and its tracks to the group tracker. Resets (documented, not errors): both trackers forget everything,
 and ``SessionUpdate.reset`` says why, when the robot pose jumps (moves faster than ``max_robot_speed`` or turns
-faster than ``max_turn_rate``, plus a tolerance: a relocalisation puts every track in the wrong place) or when the
-frame the results are given in changes (a pose that appears or disappears). Errors (``TrackingError``, nothing
-changed): a result not after the last one in time, a non-finite timestamp or robot pose.
+faster than ``max_turn_rate``, plus a tolerance: a relocalisation puts every track in the wrong place), when the
+frame the results are given in changes (a pose that appears or disappears), or when time goes back more than
+``max_time_back`` (a looped recording, a clock reset, or the frame after one stamped in the future: refused for
+good, every later frame would be). Errors (``TrackingError``, nothing changed): a result not after the last one in
+time (but within ``max_time_back`` of it), a non-finite timestamp or robot pose.
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from sid.checks import check_numbers
+from sid.checks import check_numbers, is_real
 from sid.perception.groups import GroupParams
 from sid.perception.people import Person
 from sid.perception.pipeline import FrameResult
@@ -30,9 +32,10 @@ __all__ = ["SessionUpdate", "TrackingParams", "TrackingSession"]
 
 @dataclass(frozen=True)
 class TrackingParams:
-    """The two trackers' parameters, and what counts as a jump of the robot pose: it moves more than
+    """The two trackers' parameters, what counts as a jump of the robot pose: it moves more than
     ``max_robot_speed`` (m/s) x dt + ``jump_tolerance`` (m), or turns more than ``max_turn_rate`` (rad/s) x dt +
-    ``yaw_tolerance`` (rad), between consecutive frames dt seconds apart."""
+    ``yaw_tolerance`` (rad), between consecutive frames dt seconds apart, and of time: a frame more than
+    ``max_time_back`` (s) before the last one starts the trackers over (one less before it is refused)."""
 
     tracker: TrackerParams = field(default_factory=TrackerParams)
     groups: GroupTrackerParams = field(default_factory=GroupTrackerParams)
@@ -40,9 +43,10 @@ class TrackingParams:
     jump_tolerance: float = 0.3
     max_turn_rate: float = 3.0
     yaw_tolerance: float = 0.3
+    max_time_back: float = 1.0
 
     def __post_init__(self) -> None:
-        names = ("max_robot_speed", "jump_tolerance", "max_turn_rate", "yaw_tolerance")
+        names = ("max_robot_speed", "jump_tolerance", "max_turn_rate", "yaw_tolerance", "max_time_back")
         check_numbers("tracking", self, names, low=0)
 
 
@@ -74,8 +78,9 @@ class TrackingSession:
 
     def check(self, timestamp: float, pose: RobotPose | None, what: str = "frame") -> None:
         """Raise TrackingError unless ``timestamp`` (s) is finite and after the last one, and ``pose`` (None allowed)
-        a finite RobotPose; ``what`` names the input in the message."""
-        check_time_order(what, timestamp, None if self._last is None else self._last[0])
+        a finite RobotPose; ``what`` names the input in the message. A timestamp more than ``max_time_back`` before
+        the last one passes: it starts the trackers over."""
+        check_time_order(what, timestamp, None if self._last is None or self._rewinds(timestamp) else self._last[0])
         if pose is not None:
             if not isinstance(pose, RobotPose):
                 raise TrackingError(f"{what}: robot_pose must be a RobotPose, got {type(pose).__name__}")
@@ -85,7 +90,7 @@ class TrackingSession:
         """Track the people and groups of ``result``; ``view``: the camera's field of view in ``result.frame_id``
         (None: everything counts as in view)."""
         self.check(result.timestamp, result.robot_pose, f"frame {result.frame}")
-        reset = self._reset_reason(result)
+        reset = self._rewind_reason(result.timestamp) or self._reset_reason(result)
         if reset is not None:
             check_people(result.people)  # bad people refuse the frame before the reset forgets the tracks
             self.people.reset()
@@ -99,9 +104,24 @@ class TrackingSession:
         """Track detected ``people`` given in one fixed ground frame at ``timestamp`` (s), with no robot pose to
         check (``sid track``, ``sid eval crowd``). ``view``: where the detector looked (None: everywhere)."""
         self.check(timestamp, None)
+        reset = self._rewind_reason(timestamp)
+        if reset is not None:
+            check_people(people)  # bad people refuse the frame before the reset forgets the tracks
+            self.people.reset()
+            self.groups.reset()
         update = self._track(people, timestamp, view)  # a TrackingError here (bad people) changes nothing
         self._last = (timestamp, "ground", None)
+        update.reset = reset
         return update
+
+    def _rewinds(self, timestamp: float) -> bool:
+        """Whether ``timestamp`` (s) lies more than ``max_time_back`` before the last frame's."""
+        return self._last is not None and is_real(timestamp) and timestamp < self._last[0] - self.params.max_time_back
+
+    def _rewind_reason(self, timestamp: float) -> str | None:
+        if self._last is None or not self._rewinds(timestamp):
+            return None
+        return f"time went back {self._last[0] - timestamp:.3g} s"
 
     def _track(self, people: Sequence[Person], timestamp: float, view: View | None) -> SessionUpdate:
         t0 = time.perf_counter()

@@ -18,12 +18,14 @@ from __future__ import annotations
 
 import math
 import numbers
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from sid.checks import MAX_COORDINATE, check_number, check_numbers, check_whole, is_real
+from sid.checks import MAX_COORDINATE, YAW_LIMIT_RAD, check_number, check_numbers, check_whole, check_yaws, is_real
+from sid.documents import InputWarning
 from sid.errors import SidError
 from sid.perception.people import Person
 from sid.tracking.assignment import gated_assignment
@@ -31,7 +33,15 @@ from sid.tracking.motion import MotionStates
 from sid.tracking.records import TIME_TOLERANCE, TrackedPerson
 from sid.tracking.view import View, ViewCone
 
-__all__ = ["OCCLUDER_RADIUS", "PeopleTracker", "TrackerParams", "TrackingError", "check_people", "check_time_order"]
+__all__ = [
+    "OCCLUDER_RADIUS",
+    "PeopleTracker",
+    "TimeGapWarning",
+    "TrackerParams",
+    "TrackingError",
+    "check_people",
+    "check_time_order",
+]
 
 OCCLUDER_RADIUS = 0.2
 """A person's half-width (m) seen from above, to tell who is behind whom in the camera's view (``ViewCone.behind``)."""
@@ -39,6 +49,11 @@ OCCLUDER_RADIUS = 0.2
 
 class TrackingError(SidError, ValueError):
     """Input a tracker cannot use: a frame out of time order, a non-finite position, an id given twice."""
+
+
+class TimeGapWarning(InputWarning):
+    """Frames further apart than the tracker's timeout ended its tracks: said once for such frames in a row, since
+    timestamps in milli- or nanoseconds make every frame one and nobody is ever reported."""
 
 
 def check_time_order(what: str, timestamp: float, last: float | None) -> None:
@@ -58,14 +73,16 @@ class TrackerParams:
     measurement_sigma: noise of a detected position (m), per axis. acceleration_sigma: how hard people change
     velocity (m/s^2, white-noise acceleration). initial_speed_sigma: the velocity uncertainty of a new track (m/s).
     gate_sigmas, min_gate, max_gate: a detection may join a track when it lies within gate_sigmas standard
-    deviations of the prediction, bounded to [min_gate, max_gate] (m). confirm_hits: detections that confirm a
-    track; confirm_time: two detections in a row at least this far apart (s) confirm it too, so that a slow detector
-    (a few Hz) does not hold a person back for confirm_hits long frames. timeout: seconds a confirmed track
-    survives undetected while in the camera's view (not behind someone detected nearer to it); out_of_view_timeout:
-    seconds it survives undetected in all. walk_speed, stand_speed: speeds (m/s) above which a standing track walks
-    and below which a walking track stands (hysteresis). facing_tau: time constant (s) of the facing average.
-    heading_gate: a walking track faster than walk_speed, missed in the last frame, takes no detection facing more
-    than this (rad) away from its velocity.
+    deviations of the prediction, bounded to [min_gate, max_gate] (m); max_speed: the fastest a person is followed
+    (m/s): a new track (its velocity unknown) takes a detection up to max_speed x the time between the frames away
+    when that is more than max_gate (at frames more than max_gate / max_speed, 0.4 s, apart).
+    confirm_hits: detections that confirm a track; confirm_time: two detections in a row at least this far apart (s)
+    confirm it too, so that a slow detector (a few Hz) does not hold a person back for confirm_hits long frames.
+    timeout: seconds a confirmed track survives undetected while in the camera's view (not behind someone detected
+    nearer to it); out_of_view_timeout: seconds it survives undetected in all. walk_speed, stand_speed: speeds (m/s)
+    above which a standing track walks and below which a walking track stands (hysteresis). facing_tau: time
+    constant (s) of the facing average. heading_gate: a walking track faster than walk_speed, missed in the last
+    frame, takes no detection facing more than this (rad) away from its own facing (its velocity while it has none).
     """
 
     measurement_sigma: float = 0.15
@@ -74,6 +91,7 @@ class TrackerParams:
     gate_sigmas: float = 3.0
     min_gate: float = 0.5
     max_gate: float = 1.0
+    max_speed: float = 2.5
     confirm_hits: int = 3
     confirm_time: float = 0.2
     timeout: float = 1.5
@@ -91,6 +109,7 @@ class TrackerParams:
         check_numbers("tracker", self, seconds, low=0, unit="seconds")
         check_number("tracker", "heading_gate", self.heading_gate, low=0, high=math.pi, low_open=True, unit="radians")
         check_number("tracker", "walk_speed", self.walk_speed, low=0, low_open=True, unit="m/s")
+        check_number("tracker", "max_speed", self.max_speed, low=0, unit="m/s")
         check_number("tracker", "stand_speed", self.stand_speed, low=0, high=self.walk_speed, unit="m/s")
         check_whole("tracker", "confirm_hits", self.confirm_hits, low=1)
 
@@ -119,6 +138,7 @@ class PeopleTracker:
         self._quality = np.zeros(0)  # the facing's orientation quality in [0, 1], averaged as it; NaN while unknown
         self._detection = np.zeros(0, dtype=np.intp)  # index of this frame's matched detection, -1: none
         self._in_view = np.zeros(0, dtype=bool)  # the predicted position lies in the camera's view
+        self._gap_in_a_row = False  # the last frame came more than the timeout after the one before it
 
     @property
     def timestamp(self) -> float | None:
@@ -134,14 +154,18 @@ class PeopleTracker:
 
         ``view``: the camera's field of view in the same frame as the positions (None: everything is in view).
         Raises TrackingError, changing nothing, when the timestamp is not after the last one, a position or a
-        facing is not finite, or two people share an id.
+        facing is not finite, two people share an id, or ``view`` is not a view. Warns (TimeGapWarning) when the
+        frame comes more than ``timeout`` after the last one while there were tracks.
         """
         positions, facing, quality, ids = _measurements(people)
         check_time_order("tracker: frame", timestamp, self._time)
+        if view is not None and not isinstance(view, View):
+            raise TrackingError(f"tracker: view must be a ViewCone, a ViewRegion or None, got {type(view).__name__}")
         p = self.params
         r, q = p.measurement_sigma**2, p.acceleration_sigma**2
         dt = 0.0 if self._time is None else timestamp - self._time
         self._time = float(timestamp)
+        self._note_gap(dt)
         # Tracks undetected for longer than out_of_view_timeout expire below whatever their prediction says: dropped
         # first, so that the prediction never spans more than that (a gap of 1e308 s would overflow it).
         self._keep(timestamp - self._last_hit <= p.out_of_view_timeout + TIME_TOLERANCE)
@@ -152,7 +176,7 @@ class PeopleTracker:
         self._in_view = np.ones(len(self._ids), dtype=bool) if view is None else view.contains(self._motion.position)
         self._unseen += np.where(self._in_view & ~_behind(view, self._motion.position, positions), dt, 0.0)
         self._keep(~self._expired())
-        rows, cols = self._assign(positions, facing, r)
+        rows, cols = self._assign(positions, facing, r, dt)
         self._motion.correct(rows, positions[cols], r)
         self._smooth_facing(rows, facing[cols], quality[cols], timestamp)
         self._hits[rows] += 1
@@ -176,13 +200,28 @@ class PeopleTracker:
         self._walking = np.where(self._walking, speed > p.stand_speed, speed - speed_sigma > p.walk_speed)
         return self._report(ids)
 
+    def _note_gap(self, dt: float) -> None:
+        """TimeGapWarning when ``dt`` (s since the last frame) exceeds the timeout while there were tracks (tentative
+        ones too: at timestamps in nanoseconds none is ever confirmed), once for such frames in a row."""
+        timeout = self.params.timeout
+        gap = dt > timeout + TIME_TOLERANCE
+        if gap and not self._gap_in_a_row and len(self._ids):
+            warnings.warn(
+                TimeGapWarning(
+                    f"{dt:.3g} s after the last frame, more than the tracker's timeout ({timeout:g} s): every track "
+                    "ended (are the timestamps in seconds?); the frames right after it that do the same are not noted"
+                ),
+                stacklevel=3,
+            )
+        self._gap_in_a_row = gap
+
     def _expired(self) -> np.ndarray:
         """(N,) bool: the tracks undetected for longer than ``timeout`` while the camera could see them. Time hidden
         (out of view, behind someone) does not count towards it: a walker hidden behind a group for longer than it,
         then in view a moment before being detected again, keeps the track."""
         return self._unseen > self.params.timeout + TIME_TOLERANCE
 
-    def _assign(self, positions: np.ndarray, facing: np.ndarray, r: float) -> tuple[np.ndarray, np.ndarray]:
+    def _assign(self, positions: np.ndarray, facing: np.ndarray, r: float, dt: float) -> tuple[np.ndarray, np.ndarray]:
         """Rows of tracks and columns of detections matched by minimum total distance, each within its gate.
 
         A walking track faster than ``walk_speed`` that was missed in the last frame also refuses a detection facing
@@ -191,16 +230,25 @@ class PeopleTracker:
         if not len(self._ids) or not len(positions):
             return np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp)
         p = self.params
-        gate = np.clip(p.gate_sigmas * np.sqrt(self._motion.innovation_variance(r)), p.min_gate, p.max_gate)
+        # At a slow rate a walker moves farther than max_gate between frames (1.3 m at 1 Hz): a new track, whose
+        # velocity is still 0, never caught them again, and no walker was ever reported. Once a track has a velocity
+        # its prediction follows the walker, and max_gate holds.
+        bound = np.where(self._hits == 1, max(p.max_gate, p.max_speed * dt), p.max_gate)
+        gate = np.clip(p.gate_sigmas * np.sqrt(self._motion.innovation_variance(r)), p.min_gate, bound)
         d = self._motion.position[:, None, :] - positions[None, :, :]
         distance = np.sqrt(d[..., 0] ** 2 + d[..., 1] ** 2)
         allowed = distance <= gate[:, None]
         velocity = self._motion.velocity
         speed = np.sqrt(velocity[:, 0] ** 2 + velocity[:, 1] ** 2)
-        # coasting (missed in the last frame) walkers: one seen all along who turns round is still that person
+        # coasting (missed in the last frame) walkers: one seen all along who turns round is still that person. The
+        # track's own facing where it has one: a person stepping backwards faces against their velocity, and the
+        # velocity's heading refused them at every miss (18 tracks in 20 s, two of them a "walking group").
         striding = self._walking & (speed > p.walk_speed) & (self._detection < 0)
         if striding.any():
             heading = velocity[striding] / speed[striding, None]
+            own = self._facing[striding]
+            known = np.isfinite(own[:, 0])
+            heading[known] = own[known] / np.sqrt(own[known, 0] ** 2 + own[known, 1] ** 2)[:, None]
             turned = heading @ facing.T < math.cos(p.heading_gate)  # NaN facing: False, allowed
             allowed[striding] &= ~turned
         return gated_assignment(distance, allowed)
@@ -335,7 +383,8 @@ def _measurements(people: Sequence[Person]) -> tuple[np.ndarray, np.ndarray, np.
     quality = np.array([np.nan if p.theta is None else p.orientation_quality for p in people], dtype=float)
     known = [p.theta is not None for p in people]
     good_quality = (quality[known] >= 0) & (quality[known] <= 1)  # NaN: False
-    if not (np.isfinite(positions).all() and np.isfinite(theta[known]).all() and good_quality.all()) or (
+    facings_ok = (np.abs(theta[known]) <= YAW_LIMIT_RAD).all()  # NaN: False
+    if not (np.isfinite(positions).all() and facings_ok and good_quality.all()) or (
         len(positions) and np.abs(positions).max() > MAX_COORDINATE
     ):
         for person in people:  # name the first bad one
@@ -344,7 +393,7 @@ def _measurements(people: Sequence[Person]) -> tuple[np.ndarray, np.ndarray, np.
                 owner, person, ("x", "y"), low=-MAX_COORDINATE, high=MAX_COORDINATE, unit="metres", error=TrackingError
             )
             if person.theta is not None:
-                check_numbers(owner, person, ("theta",), error=TrackingError)
+                check_yaws(owner, person, ("theta",), error=TrackingError)
                 check_numbers(owner, person, ("orientation_quality",), low=0, high=1, error=TrackingError)
     if len(set(ids)) != len(ids):
         twice = sorted({i for i in ids if ids.count(i) > 1})

@@ -277,16 +277,35 @@ def test_a_gap_that_ends_every_track_is_noted_so_timestamps_in_another_unit_are_
     code, out, err = run_sid(["track", str(write_lines(tmp_path / "ns.jsonl", lines))], capsys)
     assert code == 0 and len(out) == 3 and all(record["people"] == [] for record in out)
     assert err == [  # once for the run of such lines, not at every line
-        "sid track: line 2: note: 3.3e+07 s after the last line, more than the tracker's timeout (1.5 s): every "
-        "track ended (are the timestamps in seconds?); the lines right after it that do the same are not noted"
+        "sid track: line 2: note: 3.3e+07 s after the last frame, more than the tracker's timeout (1.5 s): every "
+        "track ended (are the timestamps in seconds?); the frames right after it that do the same are not noted"
     ]
     pause = [{"timestamp": t, "people": step} for t in (0.0, 0.1, 0.2, 10.2, 10.3)]
     pause.insert(3, {"timestamp": 5.0, "people": []})  # tracks alive, none detected: they end at the next line
     code, out, err = run_sid(["track", str(write_lines(tmp_path / "pause.jsonl", pause))], capsys)
     assert code == 0 and [len(record["people"]) for record in out] == [0, 0, 2, 0, 0, 0]
     assert err == [
-        "sid track: line 4: note: 4.8 s after the last line, more than the tracker's timeout (1.5 s): every track "
-        "ended (are the timestamps in seconds?); the lines right after it that do the same are not noted"
+        "sid track: line 4: note: 4.8 s after the last frame, more than the tracker's timeout (1.5 s): every track "
+        "ended (are the timestamps in seconds?); the frames right after it that do the same are not noted"
+    ]
+
+
+def test_a_line_stamped_in_the_future_does_not_stop_the_tracking_for_good(tmp_path, capsys):
+    """One line stamped in milliseconds among lines in seconds: every line after it was refused as out of time order
+    (749 of 900 in a probe), and a looped recording lost every loop after the first. Time going back more than
+    max_time_back (1 s) now starts the trackers over, with a note; less than that is still refused."""
+    step = [{"x": 1.0, "y": 0.0}, {"x": 2.0, "y": 1.0}]
+    stamps = [1.7e9 + 0.25 * k for k in range(5)]
+    stamps[2] *= 1000
+    stamps += [stamps[-1] - 0.5]  # a line 0.5 s late: out of order, refused
+    lines = [{"timestamp": t, "people": step} for t in stamps]
+    code, out, err = run_sid(["track", str(write_lines(tmp_path / "glitch.jsonl", lines))], capsys)
+    assert code == 0 and [len(record["people"]) for record in out] == [0, 2, 0, 0, 2]
+    assert err[1:] == [
+        "sid track: line 4: note: time went back 1.7e+12 s: the trackers started over",
+        "sid track: line 6: frame is out of time order: its timestamp 1700000000.5 s is not after the last one, "
+        "1700000001.0 s",
+        "sid track: skipped 1 malformed line",
     ]
 
 

@@ -10,6 +10,8 @@ from sid.perception.people import Person
 from sid.perception.pipeline import FrameResult
 from sid.perception.robot_pose import RobotPose
 from sid.tracking import TrackingError, TrackingSession
+from sid.tracking.session import SessionUpdate
+from sid.tracking.tracker import TimeGapWarning
 
 
 def _result(frame: int, timestamp: float, people: list[Person]) -> FrameResult:
@@ -45,3 +47,28 @@ def test_a_result_with_bad_people_that_would_reset_the_trackers_leaves_them_as_t
     good = FrameResult(4, 0.4, [], [Person(0, 2.0, 0.0, 0.0)], [], frame_id="map", robot_pose=RobotPose(0, 0, 0))
     update = session.update(good)
     assert update.reset is None and [p.id for p in update.people] == [1]
+
+
+def test_time_going_back_more_than_max_time_back_starts_the_trackers_over() -> None:
+    """One frame stamped in milliseconds among frames in seconds (or a looped recording): every later frame was
+    refused as out of time order, for good. Time going back more than max_time_back now resets both trackers, with a
+    reason; going back less is refused as before, in ``update`` and in ``track`` alike."""
+    for feed in ("update", "track"):
+        session = TrackingSession()
+
+        def step(timestamp: float, session: TrackingSession = session, feed: str = feed) -> SessionUpdate:
+            people = [Person(0, 2.0, 0.0, 0.0), Person(1, 2.0, 1.0, math.pi)]
+            if feed == "update":
+                return session.update(_result(0, timestamp, people))
+            return session.track(people, timestamp)
+
+        for k in range(3):
+            assert step(1.7e9 + 0.1 * k).reset is None
+        with pytest.warns(TimeGapWarning):
+            step(1.7e12)  # the glitch: a gap that ends the tracks
+        with pytest.raises(TrackingError, match="out of time order"):
+            step(1.7e12 - 0.5)  # within max_time_back: a late frame, refused
+        update = step(1.7e9 + 0.3)
+        assert update.reset == "time went back 1.7e+12 s" and update.people == []
+        ids = {p.id for k in range(4, 8) for p in step(1.7e9 + 0.1 * k).people}
+        assert len(ids) == 2  # tracked again
