@@ -10,7 +10,7 @@ import sys
 import time
 from collections.abc import Iterable, Iterator, Sized
 from pathlib import Path
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import cv2
 import numpy as np
@@ -28,6 +28,7 @@ from sid.cli.common import (
     output_folder_lock,
     pose_model,
     positive_int,
+    positive_number,
     signals_deferred,
 )
 from sid.cli.grouping import add_group_params, add_params_file_option, group_params_from, params_file_from
@@ -43,7 +44,16 @@ from sid.perception.people import Person
 from sid.perception.pipeline import FrameResult, Pipeline, PosedFrame
 from sid.perception.pose.contracts import PoseModelError
 from sid.perception.pose.session import PROVIDER_CHOICES
-from sid.sources import BAG_TOPICS, RECORDING_SUFFIXES, FrameReadError, SourceError, frames_or_errors, open_source
+from sid.sources import (
+    BAG_TOPICS,
+    FOLDER_FPS,
+    RECORDING_SUFFIXES,
+    FrameReadError,
+    SourceError,
+    frames_or_errors,
+    is_frame_folder,
+    open_source,
+)
 from sid.tracking import PeopleStream, SessionUpdate, TrackingError, camera_fov
 
 if TYPE_CHECKING:  # costmap.render (the costmap layers, shapely) is imported only for --out: start-up time
@@ -87,6 +97,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--frames", type=positive_int, help=f"stop after this many frames (default: all; synthetic: {SYNTHETIC_FRAMES})"
     )
+    parser.add_argument(
+        "--fps",
+        type=positive_number("frame rate"),
+        help=f"a folder of frames: the rate they were taken at, frames per second; frame i is stamped i / FPS s, "
+        f"which the trackers' velocities and timeouts rest on (default {FOLDER_FPS:g}, said on stderr)",
+    )
     parser.add_argument("--out", metavar="DIR", help="also write detections.jsonl, overlay and top-view PNGs here")
     parser.add_argument(
         "--align",
@@ -126,8 +142,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.set_defaults(func=run)
 
 
-def _source_options(args: argparse.Namespace) -> dict:
-    topics = {name: getattr(args, name) for name in BAG_TOPICS}  # refused by open_source for a source without topics
+def _source_options(args: argparse.Namespace) -> dict[str, Any]:
+    # the topics and fps are refused by open_source for a source that has none
+    topics = {name: getattr(args, name) for name in BAG_TOPICS} | {"fps": args.fps}
     if args.source.startswith("synthetic:"):
         return {"frames": args.frames or SYNTHETIC_FRAMES} | topics
     if args.source == "realsense" or Path(args.source).suffix.lower() in RECORDING_SUFFIXES:
@@ -263,7 +280,7 @@ def _close_source(source: Iterable[Frame]) -> None:
         close()
 
 
-def _tracked_json(record: dict, tracked: SessionUpdate) -> dict:
+def _tracked_json(record: dict, tracked: SessionUpdate) -> dict[str, Any]:
     """A frame's JSON line with its people and groups replaced by the tracks (ids: track ids), each person's 3D
     keypoints taken from the detection it matched (null when missed), the trackers' times (ms) added to
     ``timing_ms`` and its ``total``, and ``reset`` when the trackers were."""
@@ -302,6 +319,12 @@ def run(args: argparse.Namespace) -> int:
         source = open_source(args.source, **_source_options(args))
         single = isinstance(source, Sized) and len(source) == 1
         tracking = not (args.no_tracking or single)
+        if tracking and args.fps is None and is_frame_folder(Path(args.source)):
+            print(
+                f"detect: note: a folder's frames carry no time: frame i is stamped i / {FOLDER_FPS:g} s, which the "
+                "trackers' velocities rest on (--fps sets the rate they were taken at)",
+                file=sys.stderr,
+            )
         # With tracking the groups come from the group tracker, so the frame's own grouping would be thrown away.
         pipeline = Pipeline(pose, mount, lift, group_params, group=not tracking)
     except MissingDependencyError as exc:  # --provider openvino without it

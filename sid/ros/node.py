@@ -41,7 +41,13 @@ from sid.ros import messages
 from sid.ros.convert import grid_fields, groups_document, scene_markers, yaw_from_quaternion
 from sid.ros.params import NODE_NAME, read_params
 from sid.sources import FrameReadError, SourceError, skip_unreadable
-from sid.sources.ros_messages import StampPairer, intrinsics_from_camera_info, rgbd_frame, stamp_seconds
+from sid.sources.ros_messages import (
+    StampPairer,
+    intrinsics_from_camera_info,
+    is_rectified_topic,
+    rgbd_frame,
+    stamp_seconds,
+)
 from sid.stream import SocialStream, StreamUpdate
 
 __all__ = ["LATCHED", "NO_DEPTH_REPORT", "SILENCE_REPORT", "SPIN_WAIT", "SocialCostmapNode", "spin"]
@@ -158,7 +164,7 @@ class SocialCostmapNode:
     def _on_camera_info(self, msg: CameraInfo) -> None:
         self.received["info"] += 1
         try:
-            self.intrinsics = intrinsics_from_camera_info(msg)
+            self.intrinsics = intrinsics_from_camera_info(msg, is_rectified_topic(self.params.color_topic))
         except ValueError as exc:
             self.node.get_logger().error(f"{self.params.camera_info_topic}: {exc}", throttle_duration_sec=5.0)
 

@@ -5,8 +5,10 @@
 - ``"realsense"``: a live RealSense camera (``sid.sources.realsense.RealSenseSource``);
 - ``"FILE.db3"`` / ``"FILE.bag"``: a RealSense recording (librealsense 2.59+ writes .db3, older versions .bag);
 - ``"FILE.db3"`` / ``"FILE.mcap"`` / a rosbag2 folder (with ``metadata.yaml``): a ``ros2 bag record`` of
-  realsense2_camera topics (``sid.sources.rosbag2.Rosbag2Source``); a .db3 is librealsense's when its topics live
-  under ``/device_N/``;
+  realsense2_camera topics (``sid.sources.rosbag2.Rosbag2Source``), and ``"FILE.bag"``, a ROS 1 ``rosbag record``
+  of them; a .db3 or .bag is librealsense's when its topics live under ``/device_N/``; the storage file of a
+  compressed rosbag2 recording (``ros2 bag record --compression-mode``) is read through its folder's
+  ``metadata.yaml``, which says how it was compressed;
 - a directory: a folder of colour + depth images (``sid.sources.folder.FolderSource``);
 - ``"synthetic:SCENARIO"``: rendered people (``sid.sources.synthetic``).
 
@@ -27,11 +29,13 @@ from sid.perception.frame import Frame
 
 __all__ = [
     "BAG_TOPICS",
+    "FOLDER_FPS",
     "FrameReadError",
     "RECORDING_SUFFIXES",
     "ROSBAG2_METADATA",
     "SourceError",
     "frames_or_errors",
+    "is_frame_folder",
     "open_source",
     "skip_unreadable",
 ]
@@ -40,6 +44,8 @@ RECORDING_SUFFIXES = (".db3", ".bag", ".mcap")
 ROSBAG2_METADATA = "metadata.yaml"
 BAG_TOPICS = ("color_topic", "depth_topic", "info_topic")
 """The options of a rosbag2 source that choose its topics (``sid.sources.rosbag2.Rosbag2Source``)."""
+FOLDER_FPS = 30.0
+"""Frames per second a folder's frames are stamped at unless told (``fps``; its files carry no time)."""
 
 
 class SourceError(SidError, RuntimeError):
@@ -69,6 +75,10 @@ def open_source(spec: str, **options: Any) -> Iterable[Frame]:
         named = ", ".join(f"--{name.replace('_', '-')}" for name in topics)
         raise SourceError(f"{named}: only rosbag2 recordings have topics to choose, and {spec} is not one")
     options |= topics
+    if options.get("fps") is None:
+        options.pop("fps", None)
+    elif not is_frame_folder(Path(spec)):
+        raise SourceError(f"--fps: only a folder of frames lacks timestamps of its own, and {spec} is not one")
     if spec.startswith("synthetic:"):
         from sid.sources.synthetic import synthetic_source
 
@@ -76,18 +86,20 @@ def open_source(spec: str, **options: Any) -> Iterable[Frame]:
     if spec == "realsense":
         return _realsense()(None, **options)
     path = Path(spec)
+    if path.is_file() and _compressed_bag_file(path):
+        return _rosbag2(path.parent, options)
     if path.suffix.lower() in RECORDING_SUFFIXES:
         if not path.exists():
             raise SourceError(f"recording {path} does not exist")
         special = special_file(path)
         if special:
             raise SourceError(f"recording {path}: {special}")
-        if path.suffix.lower() == ".bag" or _librealsense_db3(path):
+        if _librealsense_recording(path):
             return _realsense()(path, **options)
         return _rosbag2(path, options)
     if (path / ROSBAG2_METADATA).exists():
         return _rosbag2(path, options)
-    if path.is_dir():
+    if is_frame_folder(path):
         _refuse_bare_bag_folder(path)
         from sid.sources.folder import FolderSource
 
@@ -97,22 +109,38 @@ def open_source(spec: str, **options: Any) -> Iterable[Frame]:
     raise SourceError(f"source {spec!r}: not a recording (.db3/.bag/.mcap), a rosbag2 folder or a folder of frames")
 
 
+def is_frame_folder(path: Path) -> bool:
+    """Whether ``open_source`` reads ``path`` as a folder of frames (``sid.sources.folder``)."""
+    return path.is_dir() and not (path / ROSBAG2_METADATA).exists()
+
+
 def _is_rosbag2(path: Path) -> bool:
     """Whether ``open_source`` reads ``path`` as a rosbag2 recording."""
-    if (path / ROSBAG2_METADATA).exists():
+    if (path / ROSBAG2_METADATA).exists() or (path.is_file() and _compressed_bag_file(path)):
         return True
-    suffix = path.suffix.lower()
-    return suffix in RECORDING_SUFFIXES and suffix != ".bag" and path.is_file() and not _librealsense_db3(path)
+    return path.suffix.lower() in RECORDING_SUFFIXES and path.is_file() and not _librealsense_recording(path)
 
 
-def _librealsense_db3(path: Path) -> bool:
-    """A .db3 written by librealsense, or one rosbags cannot read (librealsense then has the last word); a file
-    that is not a readable SQLite database at all (cut short, overwritten) is refused here, naming the problem."""
+def _compressed_bag_file(path: Path) -> bool:
+    """Whether ``path`` is a storage file of a compressed rosbag2 recording with its ``metadata.yaml`` beside it:
+    only the folder says how its messages (or the file) were compressed."""
+    from sid.sources.rosbag2 import compressed_bag_files
+
+    return path.name in compressed_bag_files(path.parent)
+
+
+def _librealsense_recording(path: Path) -> bool:
+    """A .db3 or .bag written by librealsense, or one rosbags cannot read (librealsense then has the last word); a
+    .db3 that is not a readable SQLite database at all (cut short, overwritten) is refused here, naming the
+    problem."""
     from sid.sources.rosbag2 import is_librealsense_recording, sqlite_problem
 
+    suffix = path.suffix.lower()
     try:
-        return path.suffix.lower() == ".db3" and is_librealsense_recording(path)
+        return suffix in (".db3", ".bag") and is_librealsense_recording(path)
     except SourceError:
+        if suffix == ".bag":
+            return True
         problem = sqlite_problem(path)
         if problem:
             raise SourceError(

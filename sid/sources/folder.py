@@ -30,7 +30,7 @@ from sid.documents import image_cut_short, read_image_header, special_file
 from sid.errors import InputError
 from sid.perception.camera import Calibration
 from sid.perception.frame import Frame
-from sid.sources import FrameReadError, SourceError
+from sid.sources import FOLDER_FPS, FrameReadError, SourceError
 
 __all__ = ["CALIBRATION_NAMES", "COLOR_SUFFIXES", "FolderSource"]
 
@@ -45,7 +45,7 @@ class FolderSource:
     frame i; iterating reads them in order.
     """
 
-    def __init__(self, path: str | Path, *, calibration: Calibration | None = None, fps: float = 30.0) -> None:
+    def __init__(self, path: str | Path, *, calibration: Calibration | None = None, fps: float = FOLDER_FPS) -> None:
         self.path = Path(path)
         if not self.path.is_dir():
             raise SourceError(f"frame folder {self.path} does not exist or is not a directory")

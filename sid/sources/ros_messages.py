@@ -28,6 +28,7 @@ __all__ = [
     "color_rgb",
     "depth_metres",
     "intrinsics_from_camera_info",
+    "is_rectified_topic",
     "rgbd_frame",
     "stamp_seconds",
 ]
@@ -92,31 +93,49 @@ def depth_metres(msg: Any, depth_scale: float) -> np.ndarray:
     return values * np.float32(depth_scale)
 
 
-def intrinsics_from_camera_info(msg: Any) -> Intrinsics:
-    """A CameraInfo -> pinhole intrinsics (fx, fy, cx, cy from the 3x3 ``k``, row-major). ValueError when unusable.
+def is_rectified_topic(topic: str) -> bool:
+    """Whether an Image topic carries rectified images by ROS's naming (image_proc's ``image_rect``,
+    ``image_rect_color``; realsense2_camera's ``image_rect_raw``): its last name starts with ``image_rect``."""
+    return topic.rstrip("/").rsplit("/", 1)[-1].startswith("image_rect")
 
-    ROS pixel centres are at integer coordinates, as in sid (librealsense), so cx, cy carry over unchanged. The
-    distortion model and coefficients are kept; sid treats the camera as an ideal pinhole (realsense2_camera
-    reports zero distortion), and an InputWarning says so when ``d`` is not all zero.
+
+def intrinsics_from_camera_info(msg: Any, rectified: bool = False) -> Intrinsics:
+    """A CameraInfo -> pinhole intrinsics. ValueError when unusable.
+
+    ``rectified``: the images are rectified (``is_rectified_topic``), so their camera is the projection ``p``
+    (fx, fy, cx, cy from the 3x4 ``p``, row-major, as ROS's image_geometry projects rectified images) with no
+    distortion; ``k`` and ``d`` describe the raw image (with plumb_bob k1 = -0.2, ``k`` put people 7 % too near the
+    optical axis). Otherwise the 3x3 ``k``, and the distortion model and coefficients are kept; sid treats the camera
+    as an ideal pinhole (realsense2_camera reports zero distortion), and an InputWarning says so when ``d`` is not
+    all zero. ROS pixel centres are at integer coordinates, as in sid (librealsense), so cx, cy carry over unchanged.
     """
-    k = [float(v) for v in msg.k]
+    k = [float(v) for v in _info_field(msg, "k")]
+    p = [float(v) for v in _info_field(msg, "p")] if rectified else []
     if len(k) != 9:
         raise InputError(f"camera_info: k must hold 9 numbers, got {len(k)}")
+    if rectified and len(p) != 12:
+        raise InputError(f"camera_info: p must hold 12 numbers, got {len(p)}")
+    fx, fy, cx, cy = (p[0], p[5], p[2], p[6]) if rectified else (k[0], k[4], k[2], k[5])
     try:
         intrinsics = Intrinsics(
             int(msg.width),
             int(msg.height),
-            k[0],
-            k[4],
-            k[2],
-            k[5],
-            str(msg.distortion_model) or "none",
-            tuple(float(v) for v in msg.d),
+            fx,
+            fy,
+            cx,
+            cy,
+            "none" if rectified else str(msg.distortion_model) or "none",
+            () if rectified else tuple(float(v) for v in _info_field(msg, "d")),
         )
     except ValueError as exc:
-        raise InputError(f"camera_info: {exc} (k = {k})") from None
+        raise InputError(f"camera_info: {exc} ({'p' if rectified else 'k'} = {p if rectified else k})") from None
     warn_distortion(intrinsics, "camera_info")
     return intrinsics
+
+
+def _info_field(msg: Any, name: str) -> Any:
+    """A CameraInfo matrix by its ROS 2 name (``k``), or its ROS 1 one (``K``) in a ROS 1 bag's messages."""
+    return getattr(msg, name) if hasattr(msg, name) else getattr(msg, name.upper())
 
 
 def rgbd_frame(
@@ -125,8 +144,16 @@ def rgbd_frame(
     """A colour Image and the depth Image aligned to it -> ``Frame`` (registered depth, metres).
 
     ``intrinsics``: the colour camera's (``intrinsics_from_camera_info``). ``timestamp`` defaults to the colour
-    image's stamp (s). ValueError when an encoding is unsupported or a size differs from the calibration's.
+    image's stamp (s). ValueError when an encoding is unsupported, a size differs from the calibration's, or the two
+    images name different optical frames (depth that is not registered to colour).
     """
+    color_frame, depth_frame = (str(m.header.frame_id).strip("/") for m in (color, depth))
+    if color_frame and depth_frame and color_frame != depth_frame:
+        raise InputError(
+            f"the depth image is in frame {depth_frame!r} and the colour image in {color_frame!r}: the depth is not "
+            "registered to colour (record or subscribe to the registered depth, e.g. "
+            "aligned_depth_to_color/image_raw or depth_registered/image_raw)"
+        )
     rgb, metres = color_rgb(color), depth_metres(depth, depth_scale)
     expected = (intrinsics.height, intrinsics.width)
     for name, image in (("colour", rgb), ("depth", metres)):

@@ -34,11 +34,18 @@ from rosbags.rosbag2 import ReaderError
 from rosbags.typesys import Stores, get_typestore
 
 from sid.checks import check_number
-from sid.documents import InputWarning, decode_text, special_file
+from sid.documents import InputWarning, decode_text, load_document, special_file
 from sid.perception.camera import Intrinsics
 from sid.perception.frame import Frame
 from sid.sources import ROSBAG2_METADATA, FrameReadError, SourceError
-from sid.sources.ros_messages import Stamped, StampPairer, intrinsics_from_camera_info, rgbd_frame, stamp_seconds
+from sid.sources.ros_messages import (
+    Stamped,
+    StampPairer,
+    intrinsics_from_camera_info,
+    is_rectified_topic,
+    rgbd_frame,
+    stamp_seconds,
+)
 
 __all__ = [
     "CAMERA_INFO",
@@ -46,6 +53,7 @@ __all__ = [
     "DEPTH_TOPIC",
     "IMAGE",
     "Rosbag2Source",
+    "compressed_bag_files",
     "is_librealsense_recording",
     "sqlite_problem",
 ]
@@ -78,6 +86,22 @@ def _reader(path: Path) -> AnyReader:
         where = metadata if path.is_dir() else path
         raise SourceError(f"cannot read rosbag2 recording {where}: {exc}") from None
     return reader
+
+
+def compressed_bag_files(folder: Path) -> set[str]:
+    """The storage file names of the compressed rosbag2 recording in ``folder`` (its ``metadata.yaml`` gives a
+    compression mode); an empty set for any other folder, or a metadata file that does not read (the folder's
+    reader then says why)."""
+    metadata = folder / ROSBAG2_METADATA
+    if not metadata.is_file():
+        return set()
+    try:
+        info = load_document(metadata, "rosbag2 metadata")["rosbag2_bagfile_information"]
+        if not info.get("compression_mode"):
+            return set()
+        return {Path(str(name)).name for name in info.get("relative_file_paths") or ()}
+    except (ValueError, TypeError, KeyError, AttributeError):
+        return set()
 
 
 def sqlite_problem(path: Path) -> str | None:
@@ -148,13 +172,14 @@ def _topics(connections: list[Connection], msgtype: str) -> str:
     return ", ".join(names) if names else f"no {msgtype} topics"
 
 
-def _first_camera_info(reader: AnyReader, info: Connection) -> Intrinsics:
-    """The intrinsics of the first usable CameraInfo on ``info`` (the calibration of the whole recording); each
-    one before it that cannot be read or used is skipped with an ``InputWarning``."""
+def _first_camera_info(reader: AnyReader, info: Connection, rectified: bool) -> Intrinsics:
+    """The intrinsics of the first usable CameraInfo on ``info`` (the calibration of the whole recording; of the
+    rectified images when ``rectified``); each one before it that cannot be read or used is skipped with an
+    ``InputWarning``."""
     problems = []
     for connection, time_ns, raw in reader.messages(connections=[info]):
         try:
-            intrinsics = intrinsics_from_camera_info(reader.deserialize(raw, connection.msgtype))
+            intrinsics = intrinsics_from_camera_info(reader.deserialize(raw, connection.msgtype), rectified)
         except (AnyReaderError, ValueError) as exc:
             problems.append(f"the message at {time_ns * 1e-9:.3f} s (bag time) {_unreadable(exc)}")
             warnings.warn(f"{connection.topic}: {problems[-1]}; skipped", InputWarning, stacklevel=2)
@@ -207,7 +232,7 @@ class Rosbag2Source:
             namespace = self.color.topic.rsplit("/", 1)[0]
             info = f"{namespace}/camera_info"
             self.info = _pick(connections, CAMERA_INFO, info_topic, info, info.strip("/"), "info_topic")
-            self.intrinsics = _first_camera_info(reader, self.info)
+            self.intrinsics = _first_camera_info(reader, self.info, is_rectified_topic(self.color.topic))
         except SourceError as exc:
             self.close()
             raise SourceError(f"rosbag2 recording {self.path}: {exc}") from None

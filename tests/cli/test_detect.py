@@ -283,6 +283,31 @@ def test_summary_counts_every_skipped_frame(tmp_path, capsys):
     assert "0 frames with people, 1 frame with no confirmed track yet (people: []), 3 skipped" in captured.err
 
 
+def test_a_folder_sequence_is_stamped_at_fps_and_the_assumed_rate_is_said(tmp_path, capsys):
+    """A folder's files carry no time: frames taken at 2 Hz and stamped at 30 Hz moved people 15 times too fast (a
+    probe's panning head made a walking group of three standing people)."""
+    real = shared_path("data", "rgbd", "five_people")
+    model = shared_path("models", "yolo11n-pose-256.onnx")
+    for sub in ("color", "depth"):
+        (tmp_path / sub).mkdir()
+        for name in ("a", "b", "c"):
+            shutil.copy(real / f"{sub}.png", tmp_path / sub / f"{name}.png")
+    shutil.copy(real / "intrinsics.json", tmp_path / "intrinsics.json")
+    command = ["detect", "--source", str(tmp_path), "--model", str(model), "--no-keypoints"]
+    assert main([*command, "--fps", "2"]) == 0
+    captured = capsys.readouterr()
+    assert [line["timestamp"] for line in _lines(captured.out)] == [0.0, 0.5, 1.0]
+    assert "note" not in captured.err
+    assert main(command) == 0
+    captured = capsys.readouterr()
+    assert [line["timestamp"] for line in _lines(captured.out)] == pytest.approx([0.0, 1 / 30, 2 / 30])
+    assert "detect: note: a folder's frames carry no time: frame i is stamped i / 30 s" in captured.err
+    assert main(["detect", "--source", "synthetic:S1", "--fps", "2", "--frames", "1"]) == ExitCode.USAGE
+    assert "--fps: only a folder of frames lacks timestamps of its own, and synthetic:S1 is not one" in (
+        capsys.readouterr().err
+    )
+
+
 def test_a_source_none_of_whose_frames_can_be_read_is_bad_input(tmp_path, capsys):
     """Every frame skipped as unreadable is a bad source (exit 2), not a scene without people (exit 0)."""
     (tmp_path / "color").mkdir()

@@ -8,7 +8,8 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-from rosbags.rosbag2 import StoragePlugin, Writer
+from rosbags.rosbag1 import Writer as Ros1Writer
+from rosbags.rosbag2 import CompressionFormat, CompressionMode, StoragePlugin, Writer
 from rosbags.typesys import Stores, get_typestore
 
 from sid.perception.camera import Intrinsics
@@ -18,6 +19,7 @@ COLOR = f"{NAMESPACE}/color/image_raw"
 DEPTH = f"{NAMESPACE}/aligned_depth_to_color/image_raw"
 INFO = f"{NAMESPACE}/color/camera_info"
 TYPES = get_typestore(Stores.ROS2_HUMBLE)
+ROS1_TYPES = get_typestore(Stores.ROS1_NOETIC)
 
 
 def header(stamp_s: float, frame_id: str = "camera_color_optical_frame"):
@@ -96,11 +98,15 @@ def camera_messages(
     return out
 
 
-def write_messages(path: Path, messages: Iterable[Message], *, mcap: bool = True) -> Path:
-    """A rosbag2 folder ``path`` of ``messages`` written by rosbags, one connection per topic; returns the folder."""
+def write_messages(path: Path, messages: Iterable[Message], *, mcap: bool = True, compressed: bool = False) -> Path:
+    """A rosbag2 folder ``path`` of ``messages`` written by rosbags, one connection per topic, each message
+    zstd-compressed when ``compressed`` (``ros2 bag record --compression-mode message``); returns the folder."""
     plugin = StoragePlugin.MCAP if mcap else StoragePlugin.SQLITE3
     connections = {}
-    with Writer(path, version=8, storage_plugin=plugin) as writer:
+    writer = Writer(path, version=8, storage_plugin=plugin)
+    if compressed:
+        writer.set_compression(CompressionMode.MESSAGE, CompressionFormat.ZSTD)
+    with writer:
         for topic, msgtype, time_ns, raw in messages:
             if topic not in connections:
                 connections[topic] = writer.add_connection(topic, msgtype, typestore=TYPES)
@@ -121,3 +127,57 @@ def write_camera_bag(
     """Write (RGB uint8, depth uint16 mm) frames to a rosbag2 folder ``path`` (``camera_messages``); returns it."""
     messages = camera_messages(frames, intr, encoding=encoding, fps=fps, skip_depth=skip_depth)
     return write_messages(path, messages, mcap=mcap)
+
+
+def write_ros1_camera_bag(path: Path, frames: Iterable[tuple[np.ndarray, np.ndarray]], intr: Intrinsics) -> Path:
+    """A ROS 1 bag ``path`` (``rosbag record`` on Noetic) of realsense2_camera's ROS 1 topics: the colour camera_info,
+    colour and aligned depth images of (RGB uint8, depth uint16 mm) frames at 30 Hz from 100 s; returns it."""
+    t = ROS1_TYPES.types
+
+    def ros1_header(stamp_s: float):
+        sec, nanosec = divmod(round(stamp_s * 1e9), 1_000_000_000)
+        stamp = t["builtin_interfaces/msg/Time"](sec=sec, nanosec=nanosec)
+        return t["std_msgs/msg/Header"](seq=0, stamp=stamp, frame_id="camera_color_optical_frame")
+
+    def ros1_image(stamp_s: float, pixels: np.ndarray, encoding: str):
+        pixels = np.ascontiguousarray(pixels)
+        return t["sensor_msgs/msg/Image"](
+            header=ros1_header(stamp_s),
+            height=pixels.shape[0],
+            width=pixels.shape[1],
+            encoding=encoding,
+            is_bigendian=0,
+            step=pixels.strides[0],
+            data=pixels.view(np.uint8).ravel(),
+        )
+
+    k = np.array([intr.fx, 0, intr.cx, 0, intr.fy, intr.cy, 0, 0, 1], dtype=np.float64)
+    p = np.array([intr.fx, 0, intr.cx, 0, 0, intr.fy, intr.cy, 0, 0, 0, 1, 0], dtype=np.float64)
+    roi = t["sensor_msgs/msg/RegionOfInterest"](x_offset=0, y_offset=0, height=0, width=0, do_rectify=False)
+    connections = {}
+    with Ros1Writer(path) as writer:
+        for number, (rgb, depth) in enumerate(frames):
+            stamp = 100.0 + number / 30
+            info = t["sensor_msgs/msg/CameraInfo"](
+                header=ros1_header(stamp),
+                height=intr.height,
+                width=intr.width,
+                distortion_model="plumb_bob",
+                D=np.zeros(5),
+                K=k,
+                R=np.eye(3).ravel(),
+                P=p,
+                binning_x=0,
+                binning_y=0,
+                roi=roi,
+            )
+            for topic, message in (
+                ("/camera/color/camera_info", info),
+                ("/camera/color/image_raw", ros1_image(stamp, rgb, "rgb8")),
+                ("/camera/aligned_depth_to_color/image_raw", ros1_image(stamp + 0.002, depth, "16UC1")),
+            ):
+                msgtype = message.__msgtype__
+                if topic not in connections:
+                    connections[topic] = writer.add_connection(topic, msgtype, typestore=ROS1_TYPES)
+                writer.write(connections[topic], round(stamp * 1e9), ROS1_TYPES.serialize_ros1(message, msgtype))
+    return path

@@ -9,16 +9,30 @@ import numpy as np
 import pytest
 
 from sid.documents import InputWarning
-from sid.sources.ros_messages import StampPairer, color_rgb, depth_metres, intrinsics_from_camera_info, rgbd_frame
+from sid.sources.ros_messages import (
+    StampPairer,
+    color_rgb,
+    depth_metres,
+    intrinsics_from_camera_info,
+    is_rectified_topic,
+    rgbd_frame,
+)
 
 
-def image(pixels: np.ndarray, encoding: str, pad: int = 0, bigendian: bool = False, stamp: float = 1.5):
+def image(
+    pixels: np.ndarray,
+    encoding: str,
+    pad: int = 0,
+    bigendian: bool = False,
+    stamp: float = 1.5,
+    frame_id: str = "camera_color_optical_frame",
+):
     """An Image-shaped record of ``pixels`` whose rows carry ``pad`` extra bytes."""
     data = pixels.astype(pixels.dtype.newbyteorder(">" if bigendian else "<"))
     rows = data.reshape(pixels.shape[0], -1).view(np.uint8)
     padded = np.concatenate([rows, np.full((rows.shape[0], pad), 7, np.uint8)], axis=1)
     sec = int(stamp)
-    header = SimpleNamespace(stamp=SimpleNamespace(sec=sec, nanosec=round((stamp - sec) * 1e9)))
+    header = SimpleNamespace(stamp=SimpleNamespace(sec=sec, nanosec=round((stamp - sec) * 1e9)), frame_id=frame_id)
     return SimpleNamespace(
         header=header,
         height=pixels.shape[0],
@@ -68,6 +82,45 @@ def test_camera_info_and_frame() -> None:
     assert frame.depth[0, 0] == pytest.approx(1.5)
     with pytest.raises(ValueError, match="depth image is 4x3, camera_info says 5x4"):
         rgbd_frame(0, image(rgb, "rgb8"), image(mm[:3, :4], "16UC1"), intr, 0.001)
+
+
+def test_depth_in_another_optical_frame_than_colour_is_refused() -> None:
+    """An OpenNI camera with registration off publishes depth of the colour image's size in its own frame: taken as
+    registered, it moved people by centimetres and turned facings by up to 1 rad, without a word."""
+    info = SimpleNamespace(width=5, height=4, k=[50, 0, 2, 0, 51, 1.5, 0, 0, 1], d=[0.0] * 5, distortion_model="")
+    intr = intrinsics_from_camera_info(info)
+    rgb, mm = np.zeros((4, 5, 3), np.uint8), np.full((4, 5), 1500, np.uint16)
+    depth = image(mm, "16UC1", frame_id="camera_depth_optical_frame")
+    with pytest.raises(ValueError, match="depth image is in frame 'camera_depth_optical_frame' and the colour image"):
+        rgbd_frame(0, image(rgb, "rgb8"), depth, intr, 0.001)
+    slashed = image(mm, "16UC1", frame_id="/camera_color_optical_frame")  # ROS 1's leading slash names the same frame
+    assert rgbd_frame(0, image(rgb, "rgb8"), slashed, intr, 0.001).depth[0, 0] == pytest.approx(1.5)
+
+
+def test_rectified_images_take_the_projection_matrix_not_the_raw_camera(recwarn) -> None:
+    """image_rect topics are undistorted: their camera is P (image_geometry), K and D describe the raw image. With K,
+    a probe's plumb_bob camera put people 7 % too near the optical axis, and a warning asked to undistort them."""
+    info = SimpleNamespace(
+        width=5,
+        height=4,
+        k=[50, 0, 2, 0, 51, 1.5, 0, 0, 1],
+        p=[46, 0, 2.2, 0, 0, 47, 1.4, 0, 0, 0, 1, 0],
+        d=[-0.2, 0.05, 0, 0, 0],
+        distortion_model="plumb_bob",
+    )
+    rectified = intrinsics_from_camera_info(info, rectified=True)
+    assert (rectified.fx, rectified.fy, rectified.cx, rectified.cy, rectified.coeffs) == (46, 47, 2.2, 1.4, ())
+    assert not [w for w in recwarn if issubclass(w.category, InputWarning)]
+    with pytest.warns(InputWarning, match="distortion coefficients"):
+        assert intrinsics_from_camera_info(info).fx == 50  # raw images: K, and the warning
+    topics = {
+        "/head_camera/rgb/image_rect_color": True,
+        "/camera/depth/image_rect_raw": True,
+        "image_rect": True,
+        "/camera/camera/color/image_raw": False,
+        "/camera/rect/image_raw": False,
+    }
+    assert {topic: is_rectified_topic(topic) for topic in topics} == topics
 
 
 def test_camera_info_distortion_is_said_not_applied(recwarn) -> None:

@@ -18,7 +18,16 @@ from sid.sources.rosbag2 import Rosbag2Source, is_librealsense_recording
 from sid.sources.synthetic import SyntheticSource
 from sid.synthetic.pose import TruthPose
 from tests.conftest import realsense, shared_path
-from tests.sources.camera_bags import COLOR, INFO, TYPES, camera_messages, header, write_camera_bag, write_messages
+from tests.sources.camera_bags import (
+    COLOR,
+    INFO,
+    TYPES,
+    camera_messages,
+    header,
+    write_camera_bag,
+    write_messages,
+    write_ros1_camera_bag,
+)
 
 
 def synthetic_pairs(count: int) -> tuple[list[tuple[np.ndarray, np.ndarray]], list[Frame]]:
@@ -61,6 +70,34 @@ def test_bag_gives_the_frames_and_people_of_the_same_folder(tmp_path: Path, mcap
     bag_people = [[(p.x, p.y, p.theta) for p in pipeline(f).people] for f in open_source(str(bag))]
     folder_people = [[(p.x, p.y, p.theta) for p in pipeline(f).people] for f in open_source(str(folder))]
     assert len(bag_people[0]) == 3 and bag_people == folder_people
+
+
+@pytest.mark.parametrize("mcap", [True, False])
+def test_a_compressed_bag_reads_from_its_folder_and_from_its_storage_file(tmp_path: Path, mcap: bool) -> None:
+    """``ros2 bag record --compression-mode message``: given its storage file (as the docs allow), every message
+    was reported "damaged" (only the folder's metadata.yaml says how they were compressed)."""
+    pairs, synthetic = synthetic_pairs(2)
+    intr = synthetic[0].calibration.color
+    bag = write_messages(tmp_path / "bag", camera_messages(pairs, intr), mcap=mcap, compressed=True)
+    storage = next(bag.glob("*.mcap" if mcap else "*.db3"))
+    for spec in (bag, storage):
+        frames = list(open_source(str(spec)))
+        assert [f.index for f in frames] == [0, 1]
+        assert all(np.array_equal(f.color, rgb) for f, (rgb, _) in zip(frames, pairs, strict=True))
+
+
+def test_a_ros1_bag_of_realsense_topics_reads_as_a_rosbag2_one(tmp_path: Path) -> None:
+    """A ROS 1 ``rosbag record`` went to librealsense, whose error ("file does not contain topic /file_version")
+    suggested a damaged file; rosbags reads it like a rosbag2 recording (CameraInfo's K and D in ROS 1 spelling)."""
+    pairs, synthetic = synthetic_pairs(2)
+    intr = synthetic[0].calibration.color
+    bag = write_ros1_camera_bag(tmp_path / "robot.bag", pairs, intr)
+    source = open_source(str(bag))
+    assert isinstance(source, Rosbag2Source) and not is_librealsense_recording(bag)
+    frames = list(source)
+    assert [f.index for f in frames] == [0, 1] and frames[1].timestamp == pytest.approx(100 + 1 / 30)
+    assert np.allclose(frames[0].calibration.color.K, intr.K)
+    assert np.array_equal(frames[1].depth, pairs[1][1] * np.float32(0.001))
 
 
 def test_sid_detect_reads_a_bag_as_it_reads_the_folder(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
