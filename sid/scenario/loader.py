@@ -159,7 +159,9 @@ def _xy(value: Any, name: str) -> tuple[float, float]:
     return (x, y)
 
 
-def _mapping(value: Any, name: str, known: AbstractSet[str], required: AbstractSet[str] = frozenset()) -> dict:
+def _mapping(
+    value: Any, name: str, known: AbstractSet[str], required: AbstractSet[str] = frozenset()
+) -> dict[str, Any]:
     if not isinstance(value, dict):
         raise _fail(name, "a mapping", value)
     unknown = sorted(str(key) for key in set(value) - known)  # str: YAML reads `1:` as a number key
@@ -180,7 +182,8 @@ def _list(value: Any, name: str) -> list:
 def params_from_dict(value: Any, name: str, cls: type) -> Any:
     """A parameter dataclass ``cls`` from a mapping (the block ``name`` of a file) of some of its fields, typed by
     the defaults (bool, int, float or str; a field whose default is itself such a dataclass is a block of its own,
-    ``tracking.tracker``); the others keep their defaults. ScenarioError naming the field."""
+    ``tracking.tracker``); the others keep their defaults. A float field may be ``.inf`` where the record takes it
+    (``GroupParams.meeting_radius``). ScenarioError naming the field."""
     defaults = {f.name: getattr(cls(), f.name) for f in dataclasses.fields(cls)}
     data = _mapping(value, name, set(defaults))
     kwargs: dict[str, Any] = {}
@@ -198,6 +201,8 @@ def params_from_dict(value: Any, name: str, cls: type) -> Any:
             if not isinstance(raw, str):
                 raise _fail(key_name, "a string", raw)
             kwargs[key] = raw
+        elif raw == math.inf and not isinstance(raw, bool):  # YAML's .inf: a switch-off value the record may take
+            kwargs[key] = math.inf
         else:
             kwargs[key] = _number(raw, key_name)
     try:

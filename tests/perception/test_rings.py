@@ -61,6 +61,37 @@ def test_wide_circles_come_out_whole_where_the_search_alone_cuts_them(n: int, ra
     assert whole == 10
 
 
+@pytest.mark.parametrize(("n", "radius"), [(7, 1.6), (7, 1.75), (9, 1.6)])
+def test_a_circle_the_search_cuts_into_arcs_of_fewer_than_six_each_comes_out_whole(n: int, radius: float) -> None:
+    """Seven on 1.6 m came out of the search as arcs of 2, 2 and 3: joins of two parts at a time need six people
+    between them, so none was made, though all seven make one ring."""
+    assert sizes(ring_of(n, radius), NO_RINGS) != [n]
+    assert sizes(ring_of(n, radius)) == [n]
+    assert sum(sizes(ring_of(n, radius, seed)) == [n] for seed in range(10)) == 10
+
+
+@pytest.mark.parametrize(("n", "radius", "unknown"), [(12, 1.6, 3), (10, 1.35, 0)])
+def test_someone_of_unknown_facing_on_the_circle_joins_the_ring(n: int, radius: float, unknown: int) -> None:
+    """A half-hidden member (facing unknown) standing on the circle, in the gap between two members, was left
+    out: only people with a facing could join a ring."""
+    people = ring_of(n, radius)
+    people[unknown] = Person(unknown, people[unknown].x, people[unknown].y)
+    assert sizes(people) == [n]
+    outside = [*ring_of(n, radius)[:-1], Person(n - 1, radius + 0.8, 0.0)]  # off the circle: not a member
+    assert sizes(outside)[0] == n - 1
+
+
+def test_people_of_unknown_facing_never_make_a_ring() -> None:
+    """Five on a 1.6 m circle facing its centre are arcs; a sixth of unknown facing does not complete a ring."""
+    people = ring_of(6, 1.6)
+    people[5] = Person(5, people[5].x, people[5].y)
+    assert n_largest(people) < 6
+
+
+def n_largest(people: list[Person]) -> int:
+    return max(sizes(people), default=0)
+
+
 def test_two_neighbouring_conversations_are_not_joined() -> None:
     # Two circles of four, 1.2 m from each other's nearest member, each facing its own centre.
     people = ring_of(4, 0.6) + [replace_id(p, 10 + p.id, dx=2.4) for p in ring_of(4, 0.6)]

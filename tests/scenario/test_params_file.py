@@ -30,6 +30,20 @@ def test_each_block_sets_its_records_fields_and_leaves_the_others_at_their_defau
     assert isinstance(params.tracking.tracker.timeout, float)  # a YAML 2 for seconds is read as 2.0
 
 
+def test_infinity_is_taken_where_the_record_takes_it_and_refused_by_the_record_elsewhere(tmp_path: Path) -> None:
+    """``--meeting-radius inf`` and ``GroupParams(meeting_radius=math.inf)`` switch the merging off; the file's
+    ``.inf`` was refused as not finite."""
+    path = tmp_path / "params.yaml"
+    path.write_text("groups:\n  method: rays\n  meeting_radius: .inf\n")
+    assert load_params_file(path).groups == GroupParams(method="rays", meeting_radius=float("inf"))
+    with pytest.raises(
+        ScenarioError, match=r"tracking.tracker: timeout must be a finite number of seconds >= 0, got inf"
+    ):
+        params_file_from_dict({"tracking": {"tracker": {"timeout": float("inf")}}})
+    with pytest.raises(ScenarioError, match=r"groups.eps: expected a finite number, got NaN"):
+        params_file_from_dict({"groups": {"eps": float("nan")}})
+
+
 @pytest.mark.parametrize("document", [None, {}, {"groups": {}, "tracking": {}}, {"tracking": {"tracker": {}}}])
 def test_an_empty_file_or_empty_blocks_give_the_defaults(document: object) -> None:
     assert params_file_from_dict(document) == ParamsFile()
