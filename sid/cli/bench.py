@@ -18,6 +18,7 @@ from sid.cli.common import (
     positive_int,
     staged_output,
 )
+from sid.distribution import MissingDependencyError
 from sid.documents import plural
 from sid.experiments.bench import (
     FULL,
@@ -33,7 +34,7 @@ from sid.experiments.bench import (
     write_report,
 )
 from sid.experiments.bench.report import build_report
-from sid.perception.pose.session import PROVIDER_CHOICES, quiet_load_warnings
+from sid.perception.pose.session import PROVIDER_CHOICES, check_threads, quiet_load_warnings, resolve_providers
 
 __all__ = ["SHARED_ENV", "add_parser", "default_shared", "find_repository", "repository", "run"]
 
@@ -117,6 +118,10 @@ def run(args: argparse.Namespace) -> int:
     quiet_load_warnings()  # the pose stages load models: onnxruntime's load-time warnings are noise here
     try:
         old = load_report(args.compare) if args.compare else None
+        check_threads(args.threads)  # as sid detect: before the run, not at each pose stage
+        resolve_providers(args.provider)
+    except MissingDependencyError as exc:  # --provider openvino without it
+        return fail("sid bench", exc)
     except ValueError as exc:
         print(f"sid bench: {exc}", file=sys.stderr)
         return 2

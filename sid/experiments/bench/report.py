@@ -27,7 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from sid.cpu import physical_cores, usable_cpus
-from sid.documents import is_number, load_document, plural
+from sid.documents import is_number, load_document, plural, summary
 from sid.errors import InputError
 
 __all__ = [
@@ -127,6 +127,9 @@ def load_report(path: str | Path) -> dict[str, Any]:
     stages = data.get("stages") if isinstance(data, dict) else None
     if not isinstance(stages, dict):
         raise InputError(f'bench: {path} is not a sid bench report (no "stages" object)')
+    for key in ("machine", "settings"):  # read by the comparison, after the whole run
+        if key in data and not isinstance(data[key], dict):
+            raise InputError(f'bench: {path}: "{key}" must be an object, got {summary(data[key])}')
     for name, stage in stages.items():
         median = stage.get("median_ms") if isinstance(stage, dict) else None
         if not is_number(median) or median <= 0:  # a ratio against 0, NaN or inf means nothing

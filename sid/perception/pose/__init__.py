@@ -13,6 +13,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from sid.errors import InputError
 from sid.perception.pose.base import Letterbox, PoseEstimator
 from sid.perception.pose.contracts import (
@@ -75,6 +77,28 @@ def load_pose_estimator(
     """
     model = OnnxModel(path, threads=threads, providers=providers, spinning=spinning, load_warnings=load_warnings)
     name = detect_contract(model.signature, contract, source=str(model.path))
+    try:
+        estimator = _estimator(model, name, score_threshold, input_size, iou_threshold)
+        estimator(np.full((64, 64, 3), 128, np.uint8))  # a model whose signature fits but which fails when run
+    except Exception as exc:
+        if not type(exc).__module__.startswith("onnxruntime"):
+            raise
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise PoseModelError(
+            f"pose: {model.path}: the model fits the {name} contract but fails when run ({first[:300]}); "
+            "export it with a fixed input size, or give input_size for its dynamic one"
+        ) from None
+    return estimator
+
+
+def _estimator(
+    model: OnnxModel,
+    name: str,
+    score_threshold: float | None,
+    input_size: int | tuple[int, int] | str | None,
+    iou_threshold: float | None,
+) -> MoveNetMultiPose | MoveNetSinglePose | YoloPose:
+    """The estimator of contract ``name`` over ``model`` (``load_pose_estimator``'s options)."""
     if iou_threshold is not None and name != YOLO_POSE:
         raise InputError(f"pose: iou_threshold applies to yolo_pose models only, this one is {name}")
     options: dict[str, Any] = {} if score_threshold is None else {"score_threshold": score_threshold}

@@ -25,6 +25,7 @@ Needs the ``onnx`` package (``pip install 'sid-social[quantize]'``); onnxruntime
 
 from __future__ import annotations
 
+import os
 import tempfile
 import time
 from collections.abc import Iterable, Iterator, Sequence
@@ -45,17 +46,23 @@ __all__ = [
     "BOX_OUTPUTS",
     "FLOAT_LAYERS",
     "ONNX_MISSING",
+    "QUANTIZED_OPS",
     "QuantizeReport",
     "WEIGHTED_OPS",
     "box_branch_nodes",
     "check_paths",
     "decoding_nodes",
+    "is_quantized",
     "quantize_model",
+    "quantized_nodes",
     "simplify_graph",
     "simplify_model",
 ]
 
 WEIGHTED_OPS = ("Conv", "ConvTranspose", "MatMul", "Gemm")
+QUANTIZED_OPS = ("QuantizeLinear", "DequantizeLinear", "QLinearConv", "QLinearMatMul", "ConvInteger", "MatMulInteger")
+"""Operators of a quantized graph: a model holding them is quantized already (onnxruntime's tools loop for ever on
+one, or write a model that does not load)."""
 """Operators whose int8 kernels make the speed-up; the graph after the last of them is the decoding, kept float."""
 FLOAT_LAYERS = 4
 """``quantize_model``'s default: the last 4 weighted layers on every path to the outputs stay float, with the decoding
@@ -274,9 +281,12 @@ def quantize_model(
     channel (else one per tensor). float_layers: leave ``decoding_nodes`` with that many layers float (0: none).
     float_boxes: keep the branch that reaches only the boxes (``box_branch_nodes``) float too, as the other paths.
 
-    Raises PoseModelError (source missing or not a pose model, nothing to quantize, the written model not loading
-    with the same contract), ValueError (no calibration image, output = source), MissingDependencyError (onnx not
-    installed).
+    The model is written next to ``output`` under a temporary name and renamed when it loads with the source's
+    contract: a failed run leaves no file.
+
+    Raises PoseModelError (source missing, not a pose model or quantized already, nothing to quantize, the written
+    model not loading with the same contract), ValueError (no calibration image, output = source),
+    MissingDependencyError (onnx not installed).
     """
     onnx = _onnx()  # before onnxruntime.quantization, which imports onnx itself
     from onnxruntime.quantization import CalibrationMethod, QuantFormat, QuantType, quantize_static
@@ -294,12 +304,16 @@ def quantize_model(
     if not tensors:
         raise InputError("no calibration image: the calibration source gave no frames")
     model = onnx.load(str(source))
+    quantized = quantized_nodes(model)
+    if quantized:
+        raise PoseModelError(f"{source} is quantized already ({quantized} quantized nodes); quantize the float model")
     removed = simplify_graph(model)
     weighted = sum(node.op_type in WEIGHTED_OPS for node in model.graph.node)
     if weighted == 0:
         raise PoseModelError(f"{source}: no {', '.join(WEIGHTED_OPS)} node to quantize")
     with tempfile.TemporaryDirectory(prefix="sid-quantize-") as work:
         simplified, prepared = Path(work) / "simplified.onnx", Path(work) / "prepared.onnx"
+        written = output.with_name(f".{output.name}.sid-quantize-{os.getpid()}.onnx")
         onnx.save(model, str(simplified))
         quant_pre_process(str(simplified), str(prepared), skip_symbolic_shape=True)
         prepared_model = onnx.load(str(prepared))
@@ -313,7 +327,7 @@ def quantize_model(
         keep_float = [name for name in keep_float if name not in boxes]
         quantize_static(
             str(prepared),
-            str(output),
+            str(written),
             _CalibrationImages(input_name, tensors),
             quant_format=QuantFormat.QDQ,
             per_channel=per_channel,
@@ -323,7 +337,17 @@ def quantize_model(
             nodes_to_exclude=keep_float,
         )
         nodes = len(prepared_model.graph.node)
-    _check_contract(output, estimator.contract)
+    try:
+        made = sum(node.op_type == "QuantizeLinear" for node in onnx.load(str(written)).graph.node)
+        if not made:
+            raise PoseModelError(
+                f"{source}: nothing was quantized (float_layers {float_layers} keeps every weighted layer float); "
+                "lower --float-layers"
+            )
+        _check_contract(written, estimator.contract)
+        written.replace(output)
+    finally:
+        written.unlink(missing_ok=True)
     return QuantizeReport(
         source,
         output,
@@ -360,11 +384,21 @@ def _first(images: Iterable[np.ndarray], limit: int | None) -> Iterator[np.ndarr
         yield image
 
 
+def quantized_nodes(model: Any) -> int:
+    """How many nodes of the ONNX ``model`` (an ``onnx.ModelProto``) are ``QUANTIZED_OPS``: 0 for a float model."""
+    return sum(node.op_type in QUANTIZED_OPS for node in model.graph.node)
+
+
+def is_quantized(path: str | Path) -> bool:
+    """Whether the ONNX model at ``path`` is quantized already (``quantized_nodes``); needs the onnx package."""
+    return quantized_nodes(_onnx().load(str(path), load_external_data=False)) > 0
+
+
 def check_paths(source: str | Path, output: str | Path) -> tuple[Path, Path]:
     """``source`` and ``output`` as Paths; ValueError when the output is the source, a folder, or in a folder that
     does not exist (checked before any work)."""
     source, output = Path(source), Path(output)
-    if source.exists() and output.exists() and source.resolve() == output.resolve():
+    if source.exists() and output.exists() and os.path.samefile(source, output):  # a link to it too, hard or soft
         raise InputError(f"the output {output} is the input model; write to another file")
     if output.is_dir():
         raise InputError(f"the output {output} is a folder; name a .onnx file")

@@ -126,6 +126,14 @@ def test_bad_compare_file_and_unknown_stage_are_clear_errors(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "matches no benchmark" in err and "group/20" in err
     assert not (tmp_path / "bench.json").exists()
+    # A report the comparison cannot read ("machine": null) passed, and the comparison failed after the whole run,
+    # writing nothing; a thread count or a provider sid detect refuses ran every pose stage into a traceback.
+    bad.write_text('{"stages": {"x": {"median_ms": 1}}, "machine": null}')
+    assert main(["bench", "--quick", "--compare", str(bad), "--out", str(tmp_path)]) == 2
+    assert '"machine" must be an object, got null' in capsys.readouterr().err
+    assert main(["bench", "--quick", "--threads", "100000", "--out", str(tmp_path)]) == 2
+    assert "pose: threads must be at most" in capsys.readouterr().err
+    assert not (tmp_path / "bench.json").exists()
 
 
 def _context(tmp_path, settings: RunSettings = QUICK) -> Context:

@@ -146,6 +146,9 @@ def test_no_calibration_image_and_output_onto_input_are_refused(tmp_path):
         quantize_model(path, tmp_path / "out.onnx", [])
     with pytest.raises(ValueError, match="is the input model"):
         quantize_model(path, path, [np.zeros((48, 64, 3), np.uint8)])
+    (tmp_path / "linked.onnx").hardlink_to(path)  # a second name for the same file: writing it overwrote the input
+    with pytest.raises(ValueError, match="is the input model"):
+        quantize_model(path, tmp_path / "linked.onnx", [np.zeros((48, 64, 3), np.uint8)])
     with pytest.raises(ValueError, match="float_layers must be a whole number >= 0"):
         quantize_model(path, tmp_path / "out.onnx", [np.zeros((48, 64, 3), np.uint8)], float_layers=-1)
     with pytest.raises(PoseModelError, match="not found"):
@@ -197,3 +200,12 @@ def test_real_model_quantized_keeps_its_contract_people_and_groups(model, people
         assert row.well_facing_rad is None or row.well_facing_rad <= criteria.max_facing_rad
     color = cv2.cvtColor(cv2.imread(str(shared_path("data", "rgbd", "five_people", "color.png"))), cv2.COLOR_BGR2RGB)
     assert len(quantized(color)) == people[0]
+    # An INT8 model given again made onnxruntime loop for ever (YOLO) or write a model that does not load
+    # (MoveNet); a run that quantizes nothing said "INT8, 0 nodes quantized". Neither leaves a file.
+    again = tmp_path / "again.onnx"
+    with pytest.raises(PoseModelError, match=r"int8.onnx is quantized already \(\d+ quantized nodes\)"):
+        quantize_model(output, again, (frame.color for _, frame in frames[:1]))
+    if model.startswith("movenet"):  # YOLO's box branch is quantized whatever float_layers keeps
+        with pytest.raises(PoseModelError, match="nothing was quantized"):
+            quantize_model(source, again, (frame.color for _, frame in frames[:1]), float_layers=1000)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["int8.onnx"]

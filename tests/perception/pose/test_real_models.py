@@ -70,3 +70,21 @@ def test_overlay_of_the_real_frame(yolo_people, color, tmp_path):
     assert picture.shape[1:] == color.shape[1:] and picture.shape[0] > h and picture.dtype == np.uint8  # and a legend
     assert np.count_nonzero(np.any(picture[:h] != color[..., ::-1], axis=-1)) > 5000  # skeletons and boxes drawn
     assert cv2.imwrite(str(tmp_path / "five_people_pose.png"), picture)
+
+
+def test_a_model_that_fits_its_contract_but_fails_when_run_is_named_at_load(tmp_path):
+    """YOLO11n-pose-256 with its height and width declared dynamic runs at 640 x 640, where its fixed Reshape fails:
+    sid detect, sid model compare and sid simulate ended in onnxruntime's traceback (exit 1)."""
+    import onnx
+
+    from sid.perception.pose import PoseModelError
+
+    model = onnx.load(str(shared_path(*YOLO)))
+    dims = model.graph.input[0].type.tensor_type.shape.dim
+    for k, name in ((1, "H"), (2, "W")):
+        dims[k].ClearField("dim_value")
+        dims[k].dim_param = name
+    onnx.save(model, str(tmp_path / "dynamic.onnx"))
+    with pytest.raises(PoseModelError, match=r"dynamic.onnx: the model fits the yolo_pose contract but fails when run"):
+        load_pose_estimator(tmp_path / "dynamic.onnx")
+    assert load_pose_estimator(tmp_path / "dynamic.onnx", input_size=256).input_size == (256, 256)

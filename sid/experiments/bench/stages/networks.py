@@ -280,6 +280,12 @@ def pose_benchmarks(ctx: Context) -> list[Benchmark]:
     if models and importlib.util.find_spec("onnx") is None:
         ctx.note(f"INT8 pose benchmarks skipped: quantizing needs the onnx package ({install_hint('quantize')})")
     elif models:
+        from sid.perception.pose.quantize import is_quantized  # onnx: an optional extra, there
+
+        quantized = [p for p in models if is_quantized(p)]
+        if quantized:
+            names = ", ".join(p.name for p in quantized)
+            ctx.note(f"INT8 pose benchmarks skipped for {names}: quantized already (pose/* times them as they are)")
         items += [
             Benchmark(
                 f"pose_int8/{p.stem}",
@@ -287,6 +293,7 @@ def pose_benchmarks(ctx: Context) -> list[Benchmark]:
                 _bench_pose_int8(p),
             )
             for p in models
+            if p not in quantized
         ]
     return items
 
