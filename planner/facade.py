@@ -23,6 +23,7 @@ from planner.ompl_planners import OMPL_PLANNERS, seed_ompl, solve_ompl
 from planner.problem import CostField, EndpointCollisionError, PlanningError, PlanningProblem, WalledOffError
 from planner.smoothing import smooth
 from planner.validity import check_path
+from sid.checks import check_whole, is_real
 from sid.errors import InputError
 
 __all__ = [
@@ -84,6 +85,8 @@ class PlanResult:
 
 def resolve_planner(name: str) -> str:
     """The registry name for ``name`` (case-insensitive), or a ValueError listing the choices."""
+    if not isinstance(name, str):
+        raise InputError(f"planner must be a name, one of: {', '.join(PLANNERS)}; got {name!r}")
     key = name.strip().lower().replace("-", "_")
     if key in UNAVAILABLE:
         raise InputError(UNAVAILABLE[key])
@@ -171,18 +174,19 @@ def plan(
     ``success=False`` with the reason in ``message``.
     """
     name = resolve_planner(planner)
-    if not (math.isfinite(time_limit) and time_limit > 0):
-        raise InputError(f"time_limit must be a positive number of seconds, got {time_limit}")
-    if max_iterations is not None and max_iterations < 1:
-        raise InputError(f"max_iterations must be at least 1, got {max_iterations}")
+    if not (is_real(time_limit) and math.isfinite(time_limit) and time_limit > 0):
+        raise InputError(f"time_limit must be a positive number of seconds, got {time_limit!r}")
+    if max_iterations is not None:  # OMPL takes an unsigned int
+        max_iterations = check_whole("plan", "max_iterations", max_iterations, low=1, high=2**31 - 1)
     for option, value in (("settle", settle), ("soft_limit", soft_limit)):
-        if value is not None and not (math.isfinite(value) and value > 0):
-            raise InputError(f"{option} must be a positive number of seconds or None, got {value}")
+        if value is not None and not (is_real(value) and math.isfinite(value) and value > 0):
+            raise InputError(f"{option} must be a positive number of seconds or None, got {value!r}")
     t0 = time.perf_counter()
     if name != "grid":
-        seed = secrets.randbelow(2**31 - 1) + 1 if seed is None else int(seed)
-        if not 1 <= seed <= MAX_SEED:
-            raise InputError(f"seed must be a whole number from 1 to {MAX_SEED} (OMPL ignores 0), got {seed}")
+        # a whole number (1.5 was cut to 1, "7" taken), and not 0, which OMPL ignores
+        if seed is None:
+            seed = secrets.randbelow(2**31 - 1) + 1
+        seed = check_whole("plan", "seed", seed, low=1, high=MAX_SEED)
         seed_ompl(seed)
     else:
         seed = None

@@ -32,6 +32,7 @@ from planner.problem import CostField
 from planner.validity import state_validity_checker
 
 __all__ = [
+    "FMT_MAX_SAMPLES",
     "FMT_SAMPLES_PER_SECOND",
     "OMPL_PLANNERS",
     "SETTLE_GAIN",
@@ -44,8 +45,12 @@ __all__ = [
 FMT_SAMPLES_PER_SECOND = 250
 """Samples of FMT* per second of time budget. FMT* is not anytime: it plans on a fixed sample set and returns nothing
 if stopped early, so its sample count follows the time budget, at a rate below the one it reaches on the demo
-scenario (a margin for a slower or loaded machine; the rates in docs/parameters.md), or equals ``max_iterations``
-when that is given."""
+scenario (a margin for a slower or loaded machine; the rates in docs/parameters.md), up to ``FMT_MAX_SAMPLES``, or
+equals ``max_iterations`` when that is given."""
+FMT_MAX_SAMPLES = 25_000
+"""The most samples a time budget gives FMT* (100 s of it at ``FMT_SAMPLES_PER_SECOND``): a 'no limit' budget of 1e9 s
+asked OMPL for 2.5e11, past its unsigned int (a TypeError from setNumSamples), and 1e7 s for 2.5e9, which it was
+still drawing a minute later."""
 
 
 SETTLING_PLANNERS = ("bitstar",)
@@ -60,7 +65,8 @@ SETTLE_POLL_S = 0.002
 
 def _fmt(si: ob.SpaceInformation, time_limit: float, max_iterations: int | None) -> ob.Planner:
     planner = og.FMT(si)
-    samples = max_iterations if max_iterations is not None else int(FMT_SAMPLES_PER_SECOND * time_limit)
+    budget = int(min(FMT_SAMPLES_PER_SECOND * time_limit, FMT_MAX_SAMPLES))
+    samples = max_iterations if max_iterations is not None else budget
     planner.setNumSamples(max(50, samples))
     return planner
 

@@ -14,7 +14,8 @@ Planners see a slightly stricter mask, *plannable*: free cells whose eight neigh
 segment whose samples, at most one cell apart, all lie in plannable cells is free over its whole length (every
 point of it is within half a cell of a sample, so in that sample's cell or a neighbour). That is what lets OMPL
 check motions at the costmap resolution and still return paths that pass an exact check of every point; the price
-is one cell (``resolution``) of extra clearance. The start and goal cells are plannable when they are free.
+is one cell (``resolution``) of extra clearance. The start and goal cells are plannable when they are free, and so
+are the free border cells beside them (a corner cell's only links inward).
 
 Cost. Planners minimise J = integral over the path of (1 + w * c(s) / 252) ds, where c is the cost of the cell
 under the robot centre (0..252) and w = ``cost_weight``: w = 0 is the shortest path; with w = 4 a metre through a
@@ -164,7 +165,15 @@ class CostField:
         for xy in (problem.start, problem.goal):
             cell = spec.world_to_cell(np.array(xy))[0]
             if spec.in_bounds(cell[None])[0] and self.free[cell[0], cell[1]]:
-                self.plannable[cell[0], cell[1]] = True
+                # The end cell, and the free cells beside it on the border: a corner cell's only links inward are
+                # border cells, and a goal there (a far goal clamped to a rolling window) was walled off.
+                rows = slice(max(cell[0] - 1, 0), cell[0] + 2)
+                cols = slice(max(cell[1] - 1, 0), cell[1] + 2)
+                near = np.zeros(spec.shape, dtype=bool)
+                near[rows, cols] = True
+                near[1:-1, 1:-1] = False  # border cells only
+                near[cell[0], cell[1]] = True
+                self.plannable |= near & self.free
         graded = np.where(unknown, MAX_NON_OBSTACLE, np.minimum(costs, MAX_NON_OBSTACLE)).astype(float)
         self.weight = np.where(self.free, problem.cost_weight * graded / MAX_NON_OBSTACLE, 0.0)
         # Scalar lookups use grids padded by one row and column (copies of the last ones), so a point on the map's

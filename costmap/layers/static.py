@@ -13,7 +13,8 @@ __all__ = ["StaticLayer", "static_costs"]
 
 
 def static_costs(grid: OccupancyGrid, spec: GridSpec, track_unknown_space: bool = True) -> np.ndarray:
-    """A static map interpreted as Nav2's static layer does, sampled (nearest cell) onto ``spec``.
+    """A static map interpreted as Nav2's static layer does, on ``spec`` (``OccupancyGrid.resampled``: each cell
+    the most occupied map cell it overlaps).
 
     Cells of ``spec`` outside the map read NO_INFORMATION (or FREE when unknown space is not tracked).
     """

@@ -19,7 +19,7 @@ from typing import Any, TypeVar
 import numpy as np
 from shapely.geometry import box
 
-from costmap.grid import GridSpec
+from costmap.grid import BORDER_TOLERANCE, GridSpec
 from costmap.layers.inflation import check_reach
 from costmap.mapfile import MapFileError, read_map
 from costmap.occupancy import OccupancyGrid
@@ -540,11 +540,15 @@ def _check_overlap(static: GridSpec, grid: GridSpec, path: Path) -> None:
 
 
 def _warn_resampled(static: GridSpec, grid: GridSpec, path: Path) -> None:
-    """Say that the static map is sampled onto the scenario's grid when their cells differ (nearest cell)."""
-    if static.resolution != grid.resolution:
+    """Say that the static map is sampled onto the scenario's grid when their cells differ: another size, or
+    borders shifted by part of a cell (a wall there is drawn in both cells it overlaps)."""
+    offsets = ((static.origin_x - grid.origin_x) / grid.resolution, (static.origin_y - grid.origin_y) / grid.resolution)
+    shifted = any(abs(o - round(o)) > BORDER_TOLERANCE for o in offsets)
+    if static.resolution != grid.resolution or shifted:
+        cells = f"{static.resolution:g} m cells" + (", shifted by part of a cell," if shifted else "")
         warnings.warn(
-            f"static_map: {path}: {static.resolution:g} m cells sampled onto the scenario's {grid.resolution:g} m "
-            "cells (nearest cell)",
+            f"static_map: {path}: {cells} sampled onto the scenario's {grid.resolution:g} m cells (each takes the "
+            "most occupied map cell it overlaps)",
             InputWarning,
             stacklevel=2,
         )

@@ -62,6 +62,10 @@ def test_occupancy_to_cost_is_nav2_static_layer():
     assert occupancy_to_cost(values).tolist() == [255, 0, 0, 0, 253, 254]
     assert occupancy_to_cost(values, trinary=False).tolist() == [255, 0, 127, 248, 253, 254]
     assert occupancy_to_cost(values, track_unknown_space=False)[0] == 0
+    # Nav2 reads each value as an unsigned byte: -2 .. -128 are 254 .. 128, lethal (they came out free)
+    corrupt = np.array([-2, -50, -128, 101, 127], dtype=np.int8)
+    assert occupancy_to_cost(corrupt).tolist() == [254] * 5
+    assert occupancy_to_cost(corrupt, trinary=False).tolist() == [254] * 5
 
 
 # --- map_server files ------------------------------------------------------------------------------------
@@ -172,6 +176,30 @@ def test_static_map_is_resampled_onto_another_grid(tmp_path):
     assert len(lethal) == 4  # one 10 cm cell = four 5 cm cells
     assert np.allclose(spec.cell_to_world(lethal).mean(axis=0), [0.55, 0.55])
     assert costs[0, 0] == 255  # outside the static map
+
+
+@pytest.mark.parametrize("column", [80, 121])
+def test_a_thin_wall_of_a_finer_map_stays_on_coarser_cells(column):
+    """A one-pixel wall of a 0.025 m map on 0.05 m cells: each cell centre falls on a border between two pixels,
+    and sampling under it lost every wall on an even column; the planner drove through it."""
+    data = np.zeros((80, 160), dtype=np.int8)
+    data[:, column] = 100
+    data[10, 10] = -1  # one unknown pixel beside free ones: the cell is free
+    data[:2, :2] = -1  # four: the cell is unknown
+    grid = OccupancyGrid(GridSpec(0.025, 0.0, 0.0, 160, 80), data)
+    costs = static_costs(grid, GridSpec(0.05, 0.0, 0.0, 80, 40))
+    assert np.argwhere(costs == 254)[:, 1].tolist() == [column // 2] * 40
+    assert costs[5, 5] == 0 and costs[0, 0] == 255
+
+
+def test_a_map_shifted_by_part_of_a_cell_draws_a_wall_in_both_cells_it_overlaps():
+    data = np.zeros((4, 8), dtype=np.int8)
+    data[:, 3] = 100  # x 0.175 .. 0.225 m on cells shifted by half a cell
+    grid = OccupancyGrid(GridSpec(0.05, 0.025, 0.0, 8, 4), data)
+    costs = static_costs(grid, GridSpec(0.05, 0.0, 0.0, 10, 4))
+    assert np.argwhere(costs[0] == 254).ravel().tolist() == [3, 4]
+    aligned = static_costs(grid, GridSpec(0.05, -0.075, 0.0, 12, 4))  # whole cells apart: taken as it is
+    assert np.argwhere(aligned[0] == 254).ravel().tolist() == [5]
 
 
 # --- npz and mcap -------------------------------------------------------------------------------------------

@@ -415,6 +415,37 @@ def test_planner_names_and_prm_exclusion():
         resolve_planner("prmstar")
     with pytest.raises(ValueError, match="unknown planner 'astar'"):
         resolve_planner("astar")
+    for name in (None, 3):  # an AttributeError ('strip') before
+        with pytest.raises(ValueError, match=f"planner must be a name, one of: .*; got {name}"):
+            resolve_planner(name)  # type: ignore[arg-type]
+
+
+def test_a_seed_budget_or_sample_count_of_another_kind_is_refused(walls):
+    """A seed of 1.5 was cut to 1 and "7" taken; a 'no limit' budget of 1e9 s asked FMT* for 2.5e11 samples, past
+    OMPL's unsigned int (a TypeError from pybind11): the budget's samples stop at FMT_MAX_SAMPLES."""
+    for seed in (1.5, "7", 0, True):
+        with pytest.raises(ValueError, match="plan: seed must be a whole number from 1 to 4294967295"):
+            plan(walls, "rrtconnect", seed=seed)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="time_limit must be a positive number of seconds, got '1'"):
+        plan(walls, "rrtconnect", time_limit="1")  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="plan: max_iterations must be a whole number from 1 to 2147483647"):
+        plan(walls, "fmtstar", max_iterations=2**40)
+    assert plan(walls, "rrtconnect", seed=7.0, time_limit=0.3).seed == 7
+    space = ompl_planners.ob.RealVectorStateSpace(2)
+    space.setBounds(0.0, 1.0)
+    fmt = ompl_planners.OMPL_PLANNERS["fmtstar"](ompl_planners.ob.SpaceInformation(space), 1e12, None)
+    assert fmt.getNumSamples() == ompl_planners.FMT_MAX_SAMPLES
+
+
+@pytest.mark.parametrize("corner", [(0, 0), (0, 30), (20, 0), (20, 30)])
+def test_a_goal_in_a_corner_cell_of_an_empty_map_is_reached(corner: tuple[int, int]) -> None:
+    """Border cells are no planner's (the robot would reach past the map); an end cell is, but a corner's only links
+    inward are border cells, and a corner goal (a far goal clamped to a rolling window) was 'walled off'."""
+    spec = GridSpec(0.1, -5.0, 5.0, 31, 21)
+    empty = Costmap2D(spec, np.zeros(spec.shape, np.uint8))
+    goal = tuple(spec.cell_to_world(np.array([corner]))[0])
+    for name in ("grid", "bitstar"):
+        assert plan(PlanningProblem(empty, (-3.5, 6.0), goal, 0.1), name, time_limit=0.5, seed=1).success, name
 
 
 @pytest.mark.parametrize(

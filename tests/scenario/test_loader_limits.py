@@ -64,8 +64,16 @@ def test_the_resampling_warning_is_one_line_of_the_command(tmp_path, capsys):
     err = capsys.readouterr().err.splitlines()
     assert [line for line in err if "warning" in line] == [
         f"sid costmap: warning: static_map: {tmp_path / 'room.yaml'}: 0.5 m cells sampled onto the scenario's "
-        "0.05 m cells (nearest cell)"
+        "0.05 m cells (each takes the most occupied map cell it overlaps)"
     ]
+
+
+def test_a_static_map_shifted_by_part_of_a_cell_is_said(tmp_path):
+    scenario = _with_static_map(tmp_path, 0.05)
+    path = tmp_path / "room.yaml"
+    path.write_text(path.read_text().replace("origin: [-1.0,", "origin: [-0.975,", 1))
+    with pytest.warns(InputWarning, match=r"0.05 m cells, shifted by part of a cell, sampled onto the scenario's"):
+        load_scenario(scenario)
 
 
 def test_a_static_map_on_the_same_cells_gives_no_warning(tmp_path, recwarn):
