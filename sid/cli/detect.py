@@ -143,8 +143,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 
 def _source_options(args: argparse.Namespace) -> dict[str, Any]:
-    # the topics and fps are refused by open_source for a source that has none
-    topics = {name: getattr(args, name) for name in BAG_TOPICS} | {"fps": args.fps}
+    topics = {name: getattr(args, name) for name in BAG_TOPICS}  # refused by open_source for a source without topics
+    if args.fps is not None:
+        if not is_frame_folder(Path(args.source)):
+            raise SourceError(
+                f"--fps: only a folder of frames lacks timestamps of its own, and {args.source} is not one"
+            )
+        return topics | {"fps": args.fps}
     if args.source.startswith("synthetic:"):
         return {"frames": args.frames or SYNTHETIC_FRAMES} | topics
     if args.source == "realsense" or Path(args.source).suffix.lower() in RECORDING_SUFFIXES:

@@ -11,7 +11,7 @@ from sid.checks import check_number, check_whole
 from sid.errors import InputError, InputTypeError
 from sid.perception.align import check_depth_image
 from sid.perception.camera import Calibration
-from sid.perception.pose.base import check_color_image
+from sid.perception.pose.base import validate_color_image
 from sid.perception.robot_pose import RobotPose
 
 __all__ = ["MAX_MEDIAN_DEPTH_M", "Frame"]
@@ -56,7 +56,8 @@ class Frame:
                 f"frame: robot_pose must be a sid.perception.robot_pose.RobotPose or None, got "
                 f"{type(self.robot_pose).__name__}"
             )
-        height, width = check_color_image(self.color, "frame").shape[:2]
+        validate_color_image(self.color, "frame")  # not copied: a frame's colour image may be a view
+        height, width = self.color.shape[:2]
         color = calibration.color
         if (width, height) != (color.width, color.height):
             raise InputError(

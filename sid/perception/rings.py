@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from sid.checks import check_number
 from sid.perception.ospace import TIE
 
-__all__ = ["MAX_PARTS", "MIN_MEMBERS", "Ring", "RingModel", "fit_ring", "joined_rings"]
+__all__ = ["MAX_NEAR", "MAX_PARTS", "MIN_MEMBERS", "Ring", "RingModel", "fit_ring", "joined_rings"]
 
 MIN_MEMBERS = 6
 """The fewest people a joined ring holds: n people 1 m apart on a circle stand 1 / (2 sin(pi / n)) from its centre,
@@ -30,6 +30,10 @@ within the o-space search's radii (0.85 m) up to five; wider circles hold six or
 MAX_PARTS = 4
 """The most parts one join takes: seven people on a 1.6 m circle came out of the search as arcs of 2, 2 and 3, no
 two of which hold six people, and stayed apart when joins took two parts at a time."""
+MAX_NEAR = 10
+"""A group with more parts than this near it joins two at a time only: the joins of three and four parts grow with
+the cube of their number (an audience of 60 around a speaker, all facing one spot, took 164 ms a call), and a ring's
+arcs have few neighbours."""
 _COLLINEAR = 1e-9
 """Points whose spread matrix's determinant is below this share of its squared trace lie on a line: no circle."""
 _ANGLE_TIE = TIE
@@ -152,10 +156,11 @@ class _Joins:
     def rings(self, group: list[int], near: list[tuple[int, list[int]]]) -> list[tuple[Ring, list[int]]]:
         """Each ring of ``group`` with up to ``MAX_PARTS`` - 1 of the ``near`` parts ((key, people), in order) and
         the keys it took: taken in order, each added part close to the ones before it, each union short of
-        ``MIN_MEMBERS`` an arc when it holds three people or more. Someone alone of unknown facing joins a group of
-        ``MIN_MEMBERS`` or more on its own."""
+        ``MIN_MEMBERS`` an arc when it holds three people or more; with more than ``MAX_NEAR`` parts near, one part at
+        a time. Someone alone of unknown facing joins a group of ``MIN_MEMBERS`` or more on its own."""
         found: list[tuple[Ring, list[int]]] = []
         facing = self.facing
+        parts = MAX_PARTS if len(near) <= MAX_NEAR else 2
 
         def grow(union: list[int], keys: list[int], start: int) -> None:
             for k in range(start, len(near)):
@@ -170,7 +175,7 @@ class _Joins:
                     ring = _ring(joined, self.positions, facing, self.slack, self.model)
                     if ring is not None:
                         found.append((ring, [*keys, key]))
-                elif len(keys) + 2 < MAX_PARTS and (
+                elif len(keys) + 2 < parts and (
                     len(joined) < 3 or _arc(joined, self.positions, facing, self.slack, self.model)
                 ):
                     grow(joined, [*keys, key], k + 1)

@@ -75,10 +75,6 @@ def open_source(spec: str, **options: Any) -> Iterable[Frame]:
         named = ", ".join(f"--{name.replace('_', '-')}" for name in topics)
         raise SourceError(f"{named}: only rosbag2 recordings have topics to choose, and {spec} is not one")
     options |= topics
-    if options.get("fps") is None:
-        options.pop("fps", None)
-    elif not is_frame_folder(Path(spec)):
-        raise SourceError(f"--fps: only a folder of frames lacks timestamps of its own, and {spec} is not one")
     if spec.startswith("synthetic:"):
         from sid.sources.synthetic import synthetic_source
 

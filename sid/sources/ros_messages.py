@@ -103,11 +103,12 @@ def intrinsics_from_camera_info(msg: Any, rectified: bool = False) -> Intrinsics
     """A CameraInfo -> pinhole intrinsics. ValueError when unusable.
 
     ``rectified``: the images are rectified (``is_rectified_topic``), so their camera is the projection ``p``
-    (fx, fy, cx, cy from the 3x4 ``p``, row-major, as ROS's image_geometry projects rectified images) with no
-    distortion; ``k`` and ``d`` describe the raw image (with plumb_bob k1 = -0.2, ``k`` put people 7 % too near the
-    optical axis). Otherwise the 3x3 ``k``, and the distortion model and coefficients are kept; sid treats the camera
-    as an ideal pinhole (realsense2_camera reports zero distortion), and an InputWarning says so when ``d`` is not
-    all zero. ROS pixel centres are at integer coordinates, as in sid (librealsense), so cx, cy carry over unchanged.
+    (fx, fy, cx, cy from the 3x4 ``p``, row-major, as ROS's image_geometry projects rectified images; ``k`` when
+    ``p`` is left zero) with no distortion; ``k`` and ``d`` describe the raw image (with plumb_bob k1 = -0.2, ``k``
+    put people 7 % too near the optical axis). Otherwise the 3x3 ``k``, and the distortion model and coefficients
+    are kept; sid treats the camera as an ideal pinhole (realsense2_camera reports zero distortion), and an
+    InputWarning says so when ``d`` is not all zero. ROS pixel centres are at integer coordinates, as in sid
+    (librealsense), so cx, cy carry over unchanged.
     """
     k = [float(v) for v in _info_field(msg, "k")]
     p = [float(v) for v in _info_field(msg, "p")] if rectified else []
@@ -115,6 +116,7 @@ def intrinsics_from_camera_info(msg: Any, rectified: bool = False) -> Intrinsics
         raise InputError(f"camera_info: k must hold 9 numbers, got {len(k)}")
     if rectified and len(p) != 12:
         raise InputError(f"camera_info: p must hold 12 numbers, got {len(p)}")
+    rectified = rectified and p[0] != 0.0  # a p left unset (zeros) by a driver: k is all there is
     fx, fy, cx, cy = (p[0], p[5], p[2], p[6]) if rectified else (k[0], k[4], k[2], k[5])
     try:
         intrinsics = Intrinsics(
@@ -181,14 +183,20 @@ class StampPairer(Generic[T]):
     returns it as (colour, depth). Messages of one stream older than a paired one can never pair; they are dropped.
     The caller reports the colour ones, kept by why: ``dropped_colors``, waiting colour messages that found no depth
     message before a later pair (or the queue's end); ``late_colors``, a colour message that arrives with a stamp
-    older than ``last_color_stamp``, the last paired one (the stamps went back); ``duplicate_colors``, a colour
-    message whose stamp is that of one already waiting or paired (one stamp, one frame).
+    older than ``last_color_stamp``, the last paired one (the stamps went back), by up to ``rewind`` seconds;
+    ``duplicate_colors``, a colour message whose stamp is that of one already waiting or paired (one stamp, one
+    frame). A colour message more than ``rewind`` seconds older starts the pairing over (a looped recording, a clock
+    reset, or the message after one stamped in the future, which made every later one late, for good): the waiting
+    messages stamped after it by more than ``rewind`` are dropped (colour ones into ``dropped_colors``), and the
+    trackers downstream start over likewise (``sid.tracking.session``, ``max_time_back``).
     At most ``keep`` messages wait per stream.
     """
 
-    def __init__(self, tolerance: float, keep: int = 30) -> None:
+    def __init__(self, tolerance: float, keep: int = 30, rewind: float = 1.0) -> None:
         check_number("stamp pairing", "tolerance", tolerance, low=0, unit="seconds")
+        check_number("stamp pairing", "rewind", rewind, low=0, unit="seconds")
         self.tolerance = float(tolerance)
+        self.rewind = float(rewind)
         self.waiting: dict[str, deque[Stamped[T]]] = {"color": deque(maxlen=keep), "depth": deque(maxlen=keep)}
         self.dropped_colors: list[Stamped[T]] = []
         self.duplicate_colors: list[Stamped[T]] = []
@@ -199,6 +207,9 @@ class StampPairer(Generic[T]):
     def add(self, stream: str, stamp: float, item: T) -> tuple[Stamped[T], Stamped[T]] | None:
         if stream not in self.waiting:
             raise InputError(f"stamp pairing: stream must be 'color' or 'depth', got {stream!r}")
+        last = self.last_color_stamp
+        if stream == "color" and last is not None and stamp < last - self.rewind:
+            self._start_over(stamp)
         if stream == "color" and (
             stamp == self.last_color_stamp or any(m.stamp == stamp for m in self.waiting["color"])
         ):
@@ -220,6 +231,17 @@ class StampPairer(Generic[T]):
         self._take_pair(color, depth)
         self.last_color_stamp = color.stamp
         return color, depth
+
+    def _start_over(self, stamp: float) -> None:
+        """Forget the last pair and the waiting messages stamped more than ``rewind`` after ``stamp`` (s)."""
+        for stream, queue in self.waiting.items():
+            later = [m for m in queue if m.stamp > stamp + self.rewind]
+            if stream == "color":
+                self.dropped_colors.extend(later)
+            kept = [m for m in queue if m.stamp <= stamp + self.rewind]
+            queue.clear()
+            queue.extend(kept)
+        self.last_color_stamp = None
 
     def _take_pair(self, color: Stamped[T], depth: Stamped[T]) -> None:
         """Take the pair out of the queues, and every message older than its own half (older colours into

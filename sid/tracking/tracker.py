@@ -208,8 +208,9 @@ class PeopleTracker:
         if gap and not self._gap_in_a_row and len(self._ids):
             warnings.warn(
                 TimeGapWarning(
-                    f"{dt:.3g} s after the last frame, more than the tracker's timeout ({timeout:g} s): every track "
-                    "ended (are the timestamps in seconds?); the frames right after it that do the same are not noted"
+                    f"{dt:.3g} s after the last frame, more than the tracker's timeout ({timeout:g} s): every track in "
+                    "view ended (are the timestamps in seconds?); the frames right after it that do the same are not "
+                    "noted"
                 ),
                 stacklevel=3,
             )
@@ -240,16 +241,19 @@ class PeopleTracker:
         allowed = distance <= gate[:, None]
         velocity = self._motion.velocity
         speed = np.sqrt(velocity[:, 0] ** 2 + velocity[:, 1] ** 2)
-        # coasting (missed in the last frame) walkers: one seen all along who turns round is still that person. The
-        # track's own facing where it has one: a person stepping backwards faces against their velocity, and the
-        # velocity's heading refused them at every miss (18 tracks in 20 s, two of them a "walking group").
+        # coasting (missed in the last frame) walkers: one seen all along who turns round is still that person. A
+        # detection is refused when it faces away from both the track's velocity and its own facing (where it has
+        # one): a person stepping backwards faces against their velocity (the velocity alone refused them at every
+        # miss: 18 tracks in 20 s), and a detector's front/back flip turns the facing, not the velocity.
         striding = self._walking & (speed > p.walk_speed) & (self._detection < 0)
         if striding.any():
             heading = velocity[striding] / speed[striding, None]
             own = self._facing[striding]
-            known = np.isfinite(own[:, 0])
-            heading[known] = own[known] / np.sqrt(own[known, 0] ** 2 + own[known, 1] ** 2)[:, None]
-            turned = heading @ facing.T < math.cos(p.heading_gate)  # NaN facing: False, allowed
+            norm = np.sqrt(own[:, 0] ** 2 + own[:, 1] ** 2)  # NaN: no facing yet
+            limit = math.cos(p.heading_gate)
+            away = heading @ facing.T < limit  # NaN facing: False, allowed
+            away &= ~((own / norm[:, None]) @ facing.T >= limit)  # an unknown own facing refuses by the velocity
+            turned = away
             allowed[striding] &= ~turned
         return gated_assignment(distance, allowed)
 

@@ -113,6 +113,9 @@ def test_rectified_images_take_the_projection_matrix_not_the_raw_camera(recwarn)
     assert not [w for w in recwarn if issubclass(w.category, InputWarning)]
     with pytest.warns(InputWarning, match="distortion coefficients"):
         assert intrinsics_from_camera_info(info).fx == 50  # raw images: K, and the warning
+    info.p = [0.0] * 12  # a driver that leaves P unset: K is all there is
+    with pytest.warns(InputWarning, match="distortion coefficients"):
+        assert intrinsics_from_camera_info(info, rectified=True).fx == 50
     topics = {
         "/head_camera/rgb/image_rect_color": True,
         "/camera/depth/image_rect_raw": True,
@@ -168,6 +171,21 @@ def test_a_colour_image_older_than_a_paired_one_is_late_not_paired() -> None:
     assert pairer.add("color", 100.0, "c back in time") is None  # older than c1, paired: never a frame
     assert [m.item for m in pairer.late_colors] == ["c back in time"] and pairer.last_color_stamp == 100.1
     assert pairer.dropped_colors == [] and pairer.duplicate_colors == []  # it is late, not without depth
+
+
+def test_a_colour_image_far_back_in_time_starts_the_pairing_over() -> None:
+    """One pair stamped in the future (or a looped recording) made every later colour image late, for good: the ROS
+    node and a bag skipped every frame after it. More than ``rewind`` (1 s) back, the pairing starts over."""
+    pairer: StampPairer[str] = StampPairer(0.015)
+    assert pairer.add("color", 100.0, "c0") is None and pairer.add("depth", 100.0, "d0") is not None
+    assert pairer.add("color", 1e6, "future") is None and pairer.add("depth", 1e6, "future d") is not None
+    assert pairer.add("color", 2e6, "waiting in the future") is None
+    assert pairer.add("depth", 100.1, "d1") is None  # comes first, and waits
+    pair = pairer.add("color", 100.1, "c1")
+    assert pair is not None and (pair[0].item, pair[1].item) == ("c1", "d1")
+    assert [m.item for m in pairer.dropped_colors] == ["waiting in the future"] and pairer.late_colors == []
+    assert pairer.add("color", 99.5, "c back 0.6 s") is None  # within rewind: late, as before
+    assert [m.item for m in pairer.late_colors] == ["c back 0.6 s"]
 
 
 def test_colour_images_waiting_out_of_stamp_order_each_end_once() -> None:

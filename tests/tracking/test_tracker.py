@@ -309,6 +309,21 @@ def test_timestamps_in_nanoseconds_are_said_once_not_silently_tracked_as_nobody(
     assert len(said) == 1
 
 
+def test_a_walker_whose_facing_the_detector_flips_once_keeps_the_track_through_a_miss() -> None:
+    """At 3 Hz one flipped facing turns the track's own facing round; a miss, then a detection facing the right way:
+    compared with the own facing alone, it was refused and the walker became two tracks."""
+    tracker = PeopleTracker()
+    rate, ids = 3.0, set()
+    for k in range(15):
+        t = k / rate
+        facing = math.pi if k == 8 else 0.0  # the front/back flip
+        people = [] if k == 9 else [Person(0, 1.2 * t, 0.0, facing, 1.0)]
+        tracks = tracker.update(people, t)
+        assert len(tracks) <= 1
+        ids |= {p.id for p in tracks}
+    assert ids == {1}
+
+
 def test_a_walker_who_stops_and_turns_round_keeps_the_id() -> None:
     tracker = PeopleTracker()
     y = -1.0

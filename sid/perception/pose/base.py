@@ -28,6 +28,7 @@ __all__ = [
     "PoseEstimator",
     "check_boxes",
     "check_color_image",
+    "validate_color_image",
     "clip_corners",
     "fit_letterbox",
     "most_detections",
@@ -206,8 +207,14 @@ def most_detections(found: int) -> int:
 
 
 def check_color_image(color_rgb: np.ndarray, what: str = "pose") -> np.ndarray:
-    """Validate a colour image: (H, W, 3) uint8 RGB, non-empty. Returns it as a C-contiguous array. ``what`` names
-    the caller in the message."""
+    """Validate a colour image (``validate_color_image``); returns it as a C-contiguous array."""
+    validate_color_image(color_rgb, what)
+    return np.ascontiguousarray(color_rgb)
+
+
+def validate_color_image(color_rgb: np.ndarray, what: str = "pose") -> None:
+    """Raise unless ``color_rgb`` is a colour image: (H, W, 3) uint8 RGB, non-empty; ``what`` names the caller in the
+    message. Nothing is copied."""
     if not isinstance(color_rgb, np.ndarray):
         raise InputTypeError(f"{what}: colour image must be a numpy array, got {type(color_rgb).__name__}")
     if color_rgb.ndim != 3 or color_rgb.shape[2] != 3:
@@ -216,7 +223,6 @@ def check_color_image(color_rgb: np.ndarray, what: str = "pose") -> np.ndarray:
         raise InputError(f"{what}: colour image is empty, shape {color_rgb.shape}")
     if color_rgb.dtype != np.uint8:
         raise InputError(f"{what}: colour image must be uint8 (0-255), got {color_rgb.dtype}")
-    return np.ascontiguousarray(color_rgb)
 
 
 def check_boxes(boxes: np.ndarray | Sequence[Sequence[float]]) -> np.ndarray:

@@ -60,10 +60,10 @@ __all__ = [
 ]
 
 WEIGHTED_OPS = ("Conv", "ConvTranspose", "MatMul", "Gemm")
+"""Operators whose int8 kernels make the speed-up; the graph after the last of them is the decoding, kept float."""
 QUANTIZED_OPS = ("QuantizeLinear", "DequantizeLinear", "QLinearConv", "QLinearMatMul", "ConvInteger", "MatMulInteger")
 """Operators of a quantized graph: a model holding them is quantized already (onnxruntime's tools loop for ever on
 one, or write a model that does not load)."""
-"""Operators whose int8 kernels make the speed-up; the graph after the last of them is the decoding, kept float."""
 FLOAT_LAYERS = 4
 """``quantize_model``'s default: the last 4 weighted layers on every path to the outputs stay float, with the decoding
 after them (docs/models.md has the measurements that chose it)."""
@@ -311,33 +311,33 @@ def quantize_model(
     weighted = sum(node.op_type in WEIGHTED_OPS for node in model.graph.node)
     if weighted == 0:
         raise PoseModelError(f"{source}: no {', '.join(WEIGHTED_OPS)} node to quantize")
-    with tempfile.TemporaryDirectory(prefix="sid-quantize-") as work:
-        simplified, prepared = Path(work) / "simplified.onnx", Path(work) / "prepared.onnx"
-        written = output.with_name(f".{output.name}.sid-quantize-{os.getpid()}.onnx")
-        onnx.save(model, str(simplified))
-        quant_pre_process(str(simplified), str(prepared), skip_symbolic_shape=True)
-        prepared_model = onnx.load(str(prepared))
-        keep_float = decoding_nodes(prepared_model, float_layers) if float_layers else []
-        box = BOX_OUTPUTS.get(estimator.contract)
-        boxes = (
-            box_branch_nodes(prepared_model, keep_float, tensors[0], box)
-            if keep_float and box and not float_boxes
-            else set()
-        )
-        keep_float = [name for name in keep_float if name not in boxes]
-        quantize_static(
-            str(prepared),
-            str(written),
-            _CalibrationImages(input_name, tensors),
-            quant_format=QuantFormat.QDQ,
-            per_channel=per_channel,
-            activation_type=QuantType.QUInt8,
-            weight_type=QuantType.QInt8,
-            calibrate_method=CalibrationMethod.MinMax,
-            nodes_to_exclude=keep_float,
-        )
-        nodes = len(prepared_model.graph.node)
+    written = output.with_name(f".{output.name}.sid-quantize-{os.getpid()}.onnx")  # renamed once it loads
     try:
+        with tempfile.TemporaryDirectory(prefix="sid-quantize-") as work:
+            simplified, prepared = Path(work) / "simplified.onnx", Path(work) / "prepared.onnx"
+            onnx.save(model, str(simplified))
+            quant_pre_process(str(simplified), str(prepared), skip_symbolic_shape=True)
+            prepared_model = onnx.load(str(prepared))
+            keep_float = decoding_nodes(prepared_model, float_layers) if float_layers else []
+            box = BOX_OUTPUTS.get(estimator.contract)
+            boxes = (
+                box_branch_nodes(prepared_model, keep_float, tensors[0], box)
+                if keep_float and box and not float_boxes
+                else set()
+            )
+            keep_float = [name for name in keep_float if name not in boxes]
+            quantize_static(
+                str(prepared),
+                str(written),
+                _CalibrationImages(input_name, tensors),
+                quant_format=QuantFormat.QDQ,
+                per_channel=per_channel,
+                activation_type=QuantType.QUInt8,
+                weight_type=QuantType.QInt8,
+                calibrate_method=CalibrationMethod.MinMax,
+                nodes_to_exclude=keep_float,
+            )
+            nodes = len(prepared_model.graph.node)
         made = sum(node.op_type == "QuantizeLinear" for node in onnx.load(str(written)).graph.node)
         if not made:
             raise PoseModelError(
