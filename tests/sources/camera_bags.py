@@ -43,24 +43,23 @@ def image(stamp_s: float, pixels: np.ndarray, encoding: str):
     )
 
 
+def camera_info_fields(intr: Intrinsics, types, ros1: bool = False) -> dict:
+    """The fields of a sensor_msgs/CameraInfo of ``intr`` (no distortion) but its header, in ``types``' spelling
+    (ROS 1 names its matrices K, D, R, P)."""
+    matrices = {
+        "k": np.array([intr.fx, 0, intr.cx, 0, intr.fy, intr.cy, 0, 0, 1], dtype=np.float64),
+        "p": np.array([intr.fx, 0, intr.cx, 0, 0, intr.fy, intr.cy, 0, 0, 0, 1, 0], dtype=np.float64),
+        "r": np.eye(3).ravel(),
+        "d": np.zeros(5),
+    }
+    roi = types.types["sensor_msgs/msg/RegionOfInterest"](x_offset=0, y_offset=0, height=0, width=0, do_rectify=False)
+    spelt = {name.upper() if ros1 else name: matrix for name, matrix in matrices.items()}
+    return {"height": intr.height, "width": intr.width, "distortion_model": "plumb_bob", "binning_x": 0,
+            "binning_y": 0, "roi": roi} | spelt  # fmt: skip
+
+
 def camera_info(stamp_s: float, intr: Intrinsics):
-    t = TYPES.types
-    k = np.array([intr.fx, 0, intr.cx, 0, intr.fy, intr.cy, 0, 0, 1], dtype=np.float64)
-    p = np.array([intr.fx, 0, intr.cx, 0, 0, intr.fy, intr.cy, 0, 0, 0, 1, 0], dtype=np.float64)
-    roi = t["sensor_msgs/msg/RegionOfInterest"](x_offset=0, y_offset=0, height=0, width=0, do_rectify=False)
-    return t["sensor_msgs/msg/CameraInfo"](
-        header=header(stamp_s),
-        height=intr.height,
-        width=intr.width,
-        distortion_model="plumb_bob",
-        d=np.zeros(5),
-        k=k,
-        r=np.eye(3).ravel(),
-        p=p,
-        binning_x=0,
-        binning_y=0,
-        roi=roi,
-    )
+    return TYPES.types["sensor_msgs/msg/CameraInfo"](header=header(stamp_s), **camera_info_fields(intr, TYPES))
 
 
 Message = tuple[str, str, int, bytes]
@@ -151,26 +150,12 @@ def write_ros1_camera_bag(path: Path, frames: Iterable[tuple[np.ndarray, np.ndar
             data=pixels.view(np.uint8).ravel(),
         )
 
-    k = np.array([intr.fx, 0, intr.cx, 0, intr.fy, intr.cy, 0, 0, 1], dtype=np.float64)
-    p = np.array([intr.fx, 0, intr.cx, 0, 0, intr.fy, intr.cy, 0, 0, 0, 1, 0], dtype=np.float64)
-    roi = t["sensor_msgs/msg/RegionOfInterest"](x_offset=0, y_offset=0, height=0, width=0, do_rectify=False)
     connections = {}
     with Ros1Writer(path) as writer:
         for number, (rgb, depth) in enumerate(frames):
             stamp = 100.0 + number / 30
-            info = t["sensor_msgs/msg/CameraInfo"](
-                header=ros1_header(stamp),
-                height=intr.height,
-                width=intr.width,
-                distortion_model="plumb_bob",
-                D=np.zeros(5),
-                K=k,
-                R=np.eye(3).ravel(),
-                P=p,
-                binning_x=0,
-                binning_y=0,
-                roi=roi,
-            )
+            fields = camera_info_fields(intr, ROS1_TYPES, ros1=True)
+            info = t["sensor_msgs/msg/CameraInfo"](header=ros1_header(stamp), **fields)
             for topic, message in (
                 ("/camera/color/camera_info", info),
                 ("/camera/color/image_raw", ros1_image(stamp, rgb, "rgb8")),
