@@ -30,11 +30,13 @@ from sid.errors import InputError
 from sid.experiments.fformation import (
     DEFAULT_GRID,
     DEFAULT_THRESHOLDS,
+    FACING_AGREEMENT_MIN,
     GROUP_ERRORS,
     Fold,
     LabelledFrame,
     cross_validate,
     detect_all,
+    facing_agreement,
     gcff_settings,
     group_errors,
     load_dataset_any_yaw,
@@ -228,7 +230,7 @@ def run(args: argparse.Namespace) -> int:
                 reason = "as radians it reaches beyond two turns"
                 print(f"sid eval fformation: {name}: theta read as degrees ({reason})", file=sys.stderr)
             units[name] = scale
-            _warn_about_data(name, datasets[name], scale)
+            _warn_about_data(name, datasets[name], scale, params.positions_only_reach > 0)
             if args.facing_missing:
                 datasets[name] = without_facings(datasets[name], args.facing_missing)
             if args.facing_noise:
@@ -312,10 +314,11 @@ def _write_pictures(
         print_written(files)
 
 
-def _warn_about_data(name: str, frames: list[LabelledFrame], scale: float) -> None:
+def _warn_about_data(name: str, frames: list[LabelledFrame], scale: float, by_positions: bool) -> None:
     """On stderr: positions implausible as metres once scaled (with the --scale that fits), people left out for a
-    non-finite position, people without a facing (a theta that is not a finite number), and ground-truth members
-    missing from their frame's people."""
+    non-finite position, people without a facing (a theta that is not a finite number; without any, unless
+    ``by_positions``: --positions-only-reach is set, that no group can be found), no ground-truth group, and
+    ground-truth members missing from their frame's people."""
     if reason := unit_warning(frames, scale):
         print(f"sid eval fformation: warning: {name}: {reason} (set it with --scale)", file=sys.stderr)
     unplaced = sum(f.unplaced for f in frames)
@@ -331,7 +334,28 @@ def _warn_about_data(name: str, frames: list[LabelledFrame], scale: float) -> No
         print(
             f"sid eval fformation: warning: {name}: {sum(unknown)} of {people} (in "
             f"{plural(sum(n > 0 for n in unknown), 'frame')}) have a theta that is not a finite number: their "
-            "facing is taken as unknown",
+            "facing is taken as unknown"
+            + (
+                "; with no facing at all the o-space methods find no group (a group needs one known facing): "
+                "--positions-only-reach M groups by positions alone"
+                if sum(unknown) == sum(len(f.people) for f in frames) and not by_positions
+                else ""
+            ),
+            file=sys.stderr,
+        )
+    agreement = facing_agreement(frames)
+    if agreement is not None and agreement < FACING_AGREEMENT_MIN:
+        print(
+            f"sid eval fformation: warning: {name}: ground-truth members face their group's centre little (mean "
+            f"cosine {agreement:.2f}, {FACING_AGREEMENT_MIN:g} or more expected): theta in another convention (a "
+            "compass heading, clockwise from +y? a y axis flipped without its yaws?); facings are yaws "
+            "counter-clockwise from +x",
+            file=sys.stderr,
+        )
+    if not any(f.truth for f in frames):
+        print(
+            f"sid eval fformation: warning: {name}: no ground-truth group of two or more people in any frame: every "
+            "group found counts as false (check how GTgroups lists the groups)",
             file=sys.stderr,
         )
     missing, total = missing_members(frames)

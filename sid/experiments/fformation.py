@@ -1,14 +1,16 @@
 """F-formation group benchmarks: load the Verona datasets' ``.mat`` files and score a group detector on them.
 
 Format (``features.mat`` / ``groundtruth.mat``, MATLAB v5 to v7, one folder per sequence): ``features{t}`` is an N x 4
-array ``[id, x, y, theta]`` per frame with ``timestamp(t)`` (further columns are not read, with a warning);
+array ``[id, x, y, theta]`` per frame with ``timestamp(t)`` (further columns are not read, with a warning; 4 x N
+frames, four rows each and column counts that vary, are read transposed, with a warning);
 ``GTgroups{t}`` lists the member ids of each group at ``GTtimestamp(t)``; the variables may be one struct's fields. x, y
 are ground-plane coordinates (centimetres in the public sets: use ``scale=0.01``), theta is the facing yaw in radians in
 the same frame (``degrees=True`` for files in degrees). A dataset is a folder holding ``features.mat`` (one sequence) or
 sub-folders that do (sequences pooled frame by frame; those without ``groundtruth.mat`` beside others that have one left
 out, with a warning). Ids are whole numbers, unique within a frame; timestamps are unique within a file; a ground-truth
-group is an id vector, a cell of them, or a matrix with one group per row (shorter ones padded with NaN, or 0 where
-nobody has id 0). A ground-truth timestamp stored in single precision finds its double-precision frame.
+group is an id vector, a cell of them (or of single ids), or a matrix with one group per row (shorter ones padded
+with NaN, or 0 where nobody has id 0). A ground-truth timestamp stored in single precision, or rounded by less than a
+quarter of the smallest gap between frames, finds its frame.
 
 Scoring (the protocol of this literature; its source: docs/parameters.md): only frames with ground truth are scored,
 groups of one are dropped on both sides; a truth group is found when some detected group G has
@@ -47,17 +49,21 @@ from sid.perception.people import Person
 __all__ = [
     "DEFAULT_GRID",
     "DEFAULT_THRESHOLDS",
+    "DEGREES_SHARE",
+    "FACING_AGREEMENT_MIN",
     "GROUP_ERRORS",
     "Fold",
     "LabelledFrame",
     "PLAUSIBLE_MEMBER_M",
     "PLAUSIBLE_NEIGHBOUR_M",
+    "PLAUSIBLE_STRIDE_M",
     "Score",
     "UNIT_SCALES",
     "YawUnitError",
     "cross_validate",
     "detect_all",
     "evaluate",
+    "facing_agreement",
     "fitting_unit",
     "format_threshold",
     "frame_matches",
@@ -101,7 +107,15 @@ defaults (docs/groups.md)."""
 
 
 class YawUnitError(SidError, ValueError):
-    """A yaw beyond ``YAW_LIMIT_RAD`` read as radians: the file is in degrees, most likely."""
+    """A yaw beyond ``YAW_LIMIT_RAD`` read as radians: the file is in degrees, most likely. ``where``: the file and
+    frame; ``reach``: the largest yaw magnitude there."""
+
+    def __init__(self, where: str, reach: float) -> None:
+        super().__init__(
+            f"fformation: {where}: theta reaches {reach:g}, beyond two turns: not radians; for a file in degrees "
+            "load it with degrees=True (sid eval fformation --degrees, or without --radians)"
+        )
+        self.where, self.reach = where, reach
 
 
 @dataclass
@@ -156,6 +170,7 @@ def load_sequence(folder: str | Path, scale: float = 1.0, degrees: bool = False)
         raise InputError(
             f"fformation: {truth_path}: {len(truth_groups)} GTgroups frames but {len(truth_timestamps)} GTtimestamps"
         )
+    frames_people = _upright(frames_people, features_path)
     _check_unique(timestamps, features_path, "timestamp")
     _check_unique(truth_timestamps, truth_path, "GTtimestamp")
     index = _frame_index(timestamps)
@@ -199,9 +214,26 @@ def load_sequence(folder: str | Path, scale: float = 1.0, degrees: bool = False)
     return frames
 
 
-_NEAR_SHARE = 0.05
+def _upright(frames_people: list, path: Path) -> list:
+    """The features cells, each transposed (with an ``InputWarning``) when the file stores them 4 x N: every frame
+    with four rows while the frames' column counts differ (people come and go; fields do not)."""
+    shapes = [np.shape(cell) for cell in frames_people if np.size(cell)]
+    rows = {shape[0] if len(shape) == 2 else None for shape in shapes}
+    if rows != {4} or len({shape[1] for shape in shapes}) < 2:
+        return frames_people
+    warnings.warn(
+        InputWarning(
+            f"fformation: {path}: every frame's features have 4 rows and their columns vary: read as 4 x N, one "
+            "column per person (transposed)"
+        ),
+        stacklevel=3,
+    )
+    return [np.asarray(cell).T if np.size(cell) else cell for cell in frames_people]
+
+
+_NEAR_SHARE = 0.25
 """A ground-truth timestamp within this share of the smallest gap between two frames' timestamps of one frame is that
-frame's, when every unmatched one is (``_nearest_frames``)."""
+frame's, when every unmatched one is (``_nearest_frames``): any other frame is then at least three times as far."""
 
 
 def _nearest_frames(timestamps: np.ndarray, truth: np.ndarray, index: dict[float, int]) -> dict[float, int]:
@@ -272,16 +304,26 @@ def without_facings(frames: Sequence[LabelledFrame], share: float, seed: int = 0
 
 
 def sequence_folders(folder: str | Path) -> list[Path]:
-    """The sequence folders of a dataset folder: itself when it holds ``features.mat``, else its sub-folders that
-    do, sorted. Raises ValueError when there is none, and for a folder of datasets (``features.mat`` two levels
-    down)."""
+    """The sequence folders of a dataset folder: itself when it holds ``features.mat`` (an ``InputWarning`` when
+    sub-folders do too), else its sub-folders that do, sorted (hidden ones, ``_hidden``, left out). Raises ValueError
+    when there is none, and for a folder of datasets (``features.mat`` two levels down)."""
     folder = Path(folder)
     if not folder.is_dir():
         raise InputError(f"fformation: {folder} is not a folder")
+    sequences = sorted(p.parent for p in folder.glob("*/features.mat") if not _hidden(p.parent.name))
     if (folder / "features.mat").exists():
+        if sequences:
+            warnings.warn(
+                InputWarning(
+                    f"fformation: {folder} holds features.mat and sequence folders that do too: its own file is "
+                    f"scored, {', '.join(s.name for s in sequences)} not (give their folders to score them)"
+                ),
+                stacklevel=2,
+            )
         return [folder]
-    sequences = sorted(p.parent for p in folder.glob("*/features.mat"))
-    deeper = sorted({p.parent.parent.name for p in folder.glob("*/*/features.mat")})
+    deeper = sorted(
+        {p.parent.parent.name for p in folder.glob("*/*/features.mat") if not _hidden(p.parent.parent.name)}
+    )
     if deeper:  # a folder of datasets: pooling its one-sequence datasets, and leaving the others out, is no score
         datasets = sorted({s.name for s in sequences} | set(deeper))
         raise InputError(
@@ -292,16 +334,37 @@ def sequence_folders(folder: str | Path) -> list[Path]:
     return sequences
 
 
+def _hidden(name: str) -> bool:
+    """Whether a folder's ``name`` hides it from a dataset: a dot folder (a backup, a tool's copy) or an archiver's
+    ``__MACOSX``."""
+    return name.startswith(".") or name == "__MACOSX"
+
+
+PLAUSIBLE_STRIDE_M = (0.05, 2.0)
+"""The range (m) of GCFF strides that fit people (the published settings: 0.10-0.60 m): a scaled stride outside it
+was written in other units than the positions (``gcff_settings`` warns)."""
+
+
 def gcff_settings(folder: str | Path, scale: float = 0.01) -> dict[str, GroupParams]:
     """Per sequence of a dataset folder (by its folder's name, as ``LabelledFrame.sequence`` holds it), the
     ``gcff`` method with that sequence's own ``settings_gc.mat``: GCFF tuned per sequence, the literature's
     reference. The settings are in the positions' units: ``scale`` turns them into metres, as it does the
-    positions (``load_settings_gc``)."""
-    return {
-        sequence.name: GroupParams(method="gcff", gcff_stride=settings.stride, gcff_mdl=settings.mdl)
-        for sequence in _labelled(sequence_folders(folder))[0]
-        for settings in (load_settings_gc(sequence, scale=scale),)
-    }
+    positions (``load_settings_gc``); an ``InputWarning`` names a stride that, scaled, is outside
+    ``PLAUSIBLE_STRIDE_M``."""
+    out = {}
+    for sequence in _labelled(sequence_folders(folder))[0]:
+        settings = load_settings_gc(sequence, scale=scale)
+        low, high = PLAUSIBLE_STRIDE_M
+        if not low <= settings.stride <= high:
+            warnings.warn(
+                InputWarning(
+                    f"fformation: {sequence / 'settings_gc.mat'}: stride scaled by {scale:g} is {settings.stride:g} m, "
+                    f"implausible for people (expected {low:g}-{high:g} m): are the settings in the positions' units?"
+                ),
+                stacklevel=2,
+            )
+        out[sequence.name] = GroupParams(method="gcff", gcff_stride=settings.stride, gcff_mdl=settings.mdl)
+    return out
 
 
 def load_dataset(folder: str | Path, scale: float = 1.0, degrees: bool = False) -> list[LabelledFrame]:
@@ -395,18 +458,34 @@ def unit_warning(frames: Sequence[LabelledFrame], scale: float) -> str | None:
     )
 
 
+DEGREES_SHARE = 0.1
+"""The share of a dataset's known yaws beyond two turns (``YAW_LIMIT_RAD``) as radians from which the file is read in
+degrees (``load_dataset_any_yaw``): read as degrees, the four Verona sets have 58-92 % of their yaws beyond 12.6."""
+
+
 def load_dataset_any_yaw(
     folder: str | Path, scale: float = 1.0, degrees: bool | None = None
 ) -> tuple[list[LabelledFrame], bool]:
     """``load_dataset``, with ``degrees`` None (the default) reading the yaws as radians unless one of the dataset
-    reaches beyond two turns (``YAW_LIMIT_RAD``), then all of them as degrees: facings span every direction, so a
-    file in degrees has yaws of tens of degrees or more. Returns the frames and whether they were read as degrees."""
+    reaches beyond two turns (``YAW_LIMIT_RAD``), then all of them as degrees when at least ``DEGREES_SHARE`` of the
+    known yaws do (facings span every direction, so most yaws of a file in degrees are tens of degrees or more); fewer
+    are outliers among radians, in neither unit: InputError naming the first. Returns the frames and whether they
+    were read as degrees."""
     if degrees is not None:
         return load_dataset(folder, scale, degrees), degrees
     try:
         return load_dataset(folder, scale, False), False
-    except YawUnitError:
-        return load_dataset(folder, scale, True), True
+    except YawUnitError as exc:
+        frames = load_dataset(folder, scale, True)
+        yaws = np.abs([math.degrees(p.theta) for f in frames for p in f.people if p.theta is not None])
+        beyond = float((yaws > YAW_LIMIT_RAD).mean())
+        if beyond < DEGREES_SHARE:  # as radians, nearly all are within two turns: an outlier, not degrees
+            raise InputError(
+                f"fformation: {exc.where}: theta reaches {exc.reach:g}, beyond two turns, while {beyond:.1%} of the "
+                "dataset's yaws do: neither radians nor degrees; fix that yaw (or force a unit: degrees=True, sid "
+                "eval fformation --degrees or --radians)"
+            ) from None
+        return frames, True
 
 
 def load_dataset_in_metres(
@@ -419,6 +498,31 @@ def load_dataset_in_metres(
     frames, degrees = load_dataset_any_yaw(folder, 1.0, degrees)
     unit, scale = fitting_unit(frames) or ("metres", 1.0)
     return (frames if scale == 1.0 else load_dataset(folder, scale, degrees)), unit, scale, degrees
+
+
+FACING_AGREEMENT_MIN = 0.2
+"""The least mean cosine between a ground-truth member's facing and the direction to their group's centre that looks
+like this format's convention (yaw counter-clockwise from +x, in the positions' frame): 0.36-0.71 on the four Verona
+sets, 0.14 with compass headings and 0.09 with the y axis flipped but not the yaws (a probe, 7 December 2026)."""
+
+
+def facing_agreement(frames: Sequence[LabelledFrame]) -> float | None:
+    """The mean, over ground-truth group members with a known facing, of the cosine between the facing and the
+    direction to their group's centre (the mean position of its members present); None when there is none."""
+    cosines = []
+    for frame in frames:
+        at = {p.id: p for p in frame.people}
+        for group in frame.truth:
+            members = [at[i] for i in sorted(group) if i in at]
+            if len(members) < 2:
+                continue
+            cx, cy = np.mean([(p.x, p.y) for p in members], axis=0)
+            for p in members:
+                dx, dy = cx - p.x, cy - p.y
+                norm = math.hypot(dx, dy)
+                if p.theta is not None and norm > 0:
+                    cosines.append((math.cos(p.theta) * dx + math.sin(p.theta) * dy) / norm)
+    return float(np.mean(cosines)) if cosines else None
 
 
 def missing_members(frames: Sequence[LabelledFrame]) -> tuple[int, int]:
@@ -855,10 +959,7 @@ def _people(cell: np.ndarray, scale: float, degrees: bool, where: str) -> tuple[
             "radians nor degrees"
         )
     if reach > YAW_LIMIT_RAD:
-        raise YawUnitError(
-            f"fformation: {where}: theta reaches {reach:g}, beyond two turns: not radians; for a file in degrees "
-            "load it with degrees=True (sid eval fformation --degrees, or without --radians)"
-        )
+        raise YawUnitError(where, reach)
     with np.errstate(over="ignore"):
         xy = rows[:, 1:3] * scale
     overflow = ~np.isfinite(xy).all(axis=1)
@@ -873,12 +974,16 @@ def _people(cell: np.ndarray, scale: float, degrees: bool, where: str) -> tuple[
     return people, unplaced
 
 
-def _groups(cell: object, where: str, present: set[int]) -> list[frozenset[int]]:
-    """Member-id sets from a GTgroups cell: a cell array of id arrays (possibly nested), an id vector, a matrix of
-    one group per row (shorter groups padded with NaN, or with 0: any 0 when nobody ``present`` has id 0, the 0s that
-    end rows when 0 is in more than one row, as nobody stands in two groups), or empty."""
+def _groups(cell: object, where: str, present: set[int], depth: int = 0) -> list[frozenset[int]]:
+    """Member-id sets from a frame's GTgroups cell: a cell array of id arrays (possibly nested; inside the frame's
+    cell, a cell of single ids is one group), an id vector, a matrix of one group per row (shorter groups padded with
+    NaN, or with 0: any 0 when nobody ``present`` has id 0, the 0s that end rows when 0 is in more than one row, as
+    nobody stands in two groups), or empty. ``depth``: how many cells down from the frame's."""
     if isinstance(cell, np.ndarray) and cell.dtype == object:
-        return [g for item in cell.ravel() for g in _groups(item, where, present)]
+        items = cell.ravel()
+        if depth > 0 and len(items) and all(_is_scalar(item) for item in items):  # {{1, 2}, {3, 4, 5}}: one each
+            return _groups(np.array([np.asarray(item).ravel()[0] for item in items]), where, present, depth)
+        return [g for item in items for g in _groups(item, where, present, depth + 1)]
     ids = _real(cell, f"{where}: a group must list real ids")
     if ids.size == 0:
         return []
@@ -887,7 +992,13 @@ def _groups(cell: object, where: str, present: set[int]) -> list[frozenset[int]]
         ending = np.flip(np.logical_and.accumulate(np.flip(zero | np.isnan(ids), axis=1), axis=1), axis=1) & zero
         rows_with_zero = int(zero.any(axis=1).sum())  # ids from 0: [0 2 9; 3 8 0] is (0, 2, 9) and (3, 8)
         padding = np.isnan(ids) | (zero & (0 not in present)) | (ending & (rows_with_zero > 1))
-        return [g for row, pad in zip(ids, padding, strict=True) for g in _groups(row[~pad], where, present)]
+        return [g for row, pad in zip(ids, padding, strict=True) for g in _groups(row[~pad], where, present, depth)]
     if not np.all(np.isfinite(ids)) or not np.array_equal(ids, np.round(ids)):
         raise InputError(f"fformation: {where}: group member ids must be finite whole numbers, got {ids.ravel()[:10]}")
     return [frozenset(int(i) for i in ids.ravel().tolist())]
+
+
+def _is_scalar(item: object) -> bool:
+    """Whether a cell's item holds one plain number (not a cell, not a vector)."""
+    array = np.asarray(item)
+    return array.dtype != object and array.size == 1 and array.dtype.kind in "biuf"

@@ -80,6 +80,9 @@ _PENALTY_CAP = 1e6
 # Relative (to mdl) energy change below which "best" treats two moves as tied, and a move as no improvement; rounding
 # after a rigid motion changes energies by ~1e-15 mdl.
 _TIE = 1e-9
+# Distance (m) from a centre within which a person stands on it, as far as rounding can tell: coordinates of 1 km carry
+# errors of ~1e-13 m.
+_ON_CENTRE_M = 1e-9
 # Stand-in for a forbidden assignment (joining an unknown facing's own label) in sums: 0 x inf would make them NaN.
 _FORBIDDEN = 1e200
 
@@ -209,7 +212,12 @@ def _costs(
             with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
                 # (Products written out: BLAS on an (m, 2) x (2, m) product is slower than this.)
                 inner = o[:, 0, None] * o[None, :, 0] + o[:, 1, None] * o[None, :, 1]
-                cosine = inner / (d[:, None] * d[None, :])  # NaN for someone at the centre
+                cosine = inner / (d[:, None] * d[None, :])
+                # Someone on the centre (within rounding of it: a turned or moved scene puts them 1e-16 m off in any
+                # direction) has no direction from it: they block nobody and nobody blocks them.
+                on_centre = d <= _ON_CENTRE_M
+                cosine[on_centre, :] = 0.0
+                cosine[:, on_centre] = 0.0
                 blocks = (d[:, None] > d[None, :]) & (cosine > params.visibility_cosine)
                 penalty = np.minimum(unit * params.visibility_base ** (cosine * d[:, None] / d[None, :]), cap)
             column[near] += np.where(blocks, penalty, 0.0).sum(axis=1)

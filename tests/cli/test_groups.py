@@ -261,6 +261,26 @@ def test_eval_fformation_warns_of_people_without_a_facing(tmp_path, capsys):
     assert code == 0 and "theta" not in err
 
 
+def test_eval_fformation_says_what_finds_no_group_and_facings_in_another_convention(tmp_path, capsys):
+    """Silent scores of 0 before: no facing at all, a ground truth that lists no group, compass headings."""
+    blind = [np.column_stack([f[:, :3], np.full(len(f), np.nan)]) for f in tiny_frames()]
+    folder = write_sequence(tmp_path / "Blind", blind, {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]})
+    code, _, err = run_sid(["eval", "fformation", str(folder)], capsys)
+    assert code == 0 and "with no facing at all the o-space methods find no group" in err
+    code, _, err = run_sid(["eval", "fformation", str(folder), "--positions-only-reach", "1"], capsys)
+    assert code == 0 and "taken as unknown" in err and "find no group" not in err
+    lonely = write_sequence(tmp_path / "Lonely", tiny_frames(), {1: [[1]], 2: [[3]]})
+    code, _, err = run_sid(["eval", "fformation", str(lonely)], capsys)
+    assert code == 0 and "no ground-truth group of two or more people in any frame" in err
+    compass = [np.column_stack([f[:, :3], math.pi / 2 - f[:, 3]]) for f in tiny_frames()]
+    folder = write_sequence(tmp_path / "Compass", compass, {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]})
+    code, _, err = run_sid(["eval", "fformation", str(folder)], capsys)
+    assert code == 0 and "face their group's centre little (mean cosine" in err
+    tiny = write_sequence(tmp_path / "Tiny", tiny_frames(), {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]})
+    code, _, err = run_sid(["eval", "fformation", str(tiny)], capsys)
+    assert code == 0 and "warning" not in err
+
+
 def test_eval_fformation_scores_past_ground_truth_frames_without_features(tmp_path, capsys):
     slip = write_sequence(tmp_path / "Slip", tiny_frames(), {1: [[1, 2]], 9: [[4, 5]], 2: [[1, 2, 3]]})
     code, out, err = run_sid(["eval", "fformation", str(slip)], capsys)

@@ -17,9 +17,11 @@ from sid.experiments.fformation import (
     YawUnitError,
     cross_validate,
     evaluate,
+    facing_agreement,
     fitting_unit,
     format_threshold,
     frame_precision_recall,
+    gcff_settings,
     group_errors,
     load_dataset,
     load_dataset_any_yaw,
@@ -32,6 +34,7 @@ from sid.experiments.fformation import (
     parse_threshold,
     repeated_members,
     score,
+    sequence_folders,
     shifted_ids,
     unit_warning,
     with_facing_noise,
@@ -656,3 +659,66 @@ def test_ground_truth_timestamps_written_with_fewer_digits_find_their_frames_and
     scipy.io.savemat(folder / "groundtruth.mat", {"GTgroups": truth, "GTtimestamp": shifted[None, :]})
     with pytest.warns(InputWarning, match="13 ground-truth frames of 20 without a frame"):
         assert len(load_sequence(folder)) == 7
+
+
+def test_features_stored_four_by_n_are_read_transposed_with_a_warning(tmp_path: Path) -> None:
+    """Whole-number cm and degrees pass the id check the other way round: the shape tells (four rows in every frame,
+    a column count that varies as people come and go)."""
+    upright = write_sequence(tmp_path / "Upright", tiny_frames(), {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]})
+    turned = write_sequence(
+        tmp_path / "Turned", [f.T for f in tiny_frames()], {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]}
+    )
+    with pytest.warns(InputWarning, match="every frame's features have 4 rows and their columns vary"):
+        frames = load_sequence(turned, 0.01)
+    assert frames == [replace(f, sequence="Turned") for f in load_sequence(upright, 0.01)]
+
+
+def test_ground_truth_groups_as_cells_of_single_ids_keep_their_members(tmp_path: Path) -> None:
+    folder = write_sequence(tmp_path / "Cells", tiny_frames(), {1: [[1, 2]]})
+    frame_cell = cells([cells([np.array([[1]]), np.array([[2]])])])  # GTgroups{1} = {{1, 2}}
+    scipy.io.savemat(folder / "groundtruth.mat", {"GTgroups": cells([frame_cell]), "GTtimestamp": [[1]]})
+    assert [sorted(map(sorted, f.truth)) for f in load_sequence(folder)] == [[[1, 2]]]
+
+
+def test_one_yaw_beyond_two_turns_among_radians_is_named_not_taken_for_degrees(tmp_path: Path) -> None:
+    frames = [tiny_frames()[0].copy() for _ in range(10)]  # a pair and a loner, ten times: 30 yaws
+    frames[0][0, 3] = 12.7  # one unwrapped yaw; every other within a turn
+    folder = write_sequence(tmp_path / "Outlier", frames, {k: [[1, 2]] for k in range(1, 11)})
+    with pytest.raises(ValueError, match=r"theta reaches 12.7, beyond two turns, while 3.3% .*neither radians nor"):
+        load_dataset_any_yaw(folder, 0.01)
+
+
+def test_ground_truth_stamps_rounded_to_a_fifth_of_a_frame_gap_find_their_frames(tmp_path: Path) -> None:
+    folder = tmp_path / "Rounded"
+    folder.mkdir()
+    four = np.array([[k, 100.0 * k, 0.0, 0.0] for k in range(1, 5)])
+    _write_features(folder, [four] * 3, np.array([1, 2, 3]) / 15)  # 15 fps
+    truth = cells([np.array([[1, 2]])] * 3)
+    scipy.io.savemat(folder / "groundtruth.mat", {"GTgroups": truth, "GTtimestamp": np.round(np.arange(1, 4) / 15, 2)})
+    assert len(load_sequence(folder)) == 3  # 10 ms off of 67 ms gaps
+
+
+def test_a_dataset_folder_with_its_own_file_and_sequence_folders_says_which_is_scored(tmp_path: Path) -> None:
+    top = write_sequence(tmp_path / "Both", tiny_frames(), {1: [[1, 2]]})
+    write_sequence(top / "Seq1", tiny_frames(), {1: [[1, 2]]})
+    with pytest.warns(InputWarning, match="its own file is scored, Seq1 not"):
+        assert sequence_folders(top) == [top]
+
+
+def test_hidden_folders_are_no_sequences_and_gcff_settings_in_other_units_are_named(tmp_path: Path) -> None:
+    dataset = tmp_path / "Set"
+    for name in ("Seq1", ".Seq1_backup", "__MACOSX"):
+        folder = write_sequence(dataset / name, tiny_frames(), {1: [[1, 2]]})
+        scipy.io.savemat(folder / "settings_gc.mat", {"stride": [[3000.0]], "mdl": [[30000.0]]})  # in mm, say
+    assert sequence_folders(dataset) == [dataset / "Seq1"]
+    with pytest.warns(InputWarning, match=r"stride scaled by 0.01 is 30 m, implausible for people"):
+        gcff_settings(dataset, scale=0.01)
+
+
+def test_facing_agreement_is_the_mean_cosine_of_members_facings_towards_their_centre(tiny):
+    frames = load_sequence(tiny, 0.01)
+    # the pair face each other and the triangle its centre (+1 each), the two back to back away (-1 each)
+    assert facing_agreement(frames) == pytest.approx(3 / 7)
+    turned = [replace(f, people=[replace(p, theta=p.theta + math.pi) for p in f.people]) for f in frames]
+    assert facing_agreement(turned) == pytest.approx(-3 / 7)
+    assert facing_agreement([replace(f, truth=[]) for f in frames]) is None

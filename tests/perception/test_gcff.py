@@ -211,6 +211,21 @@ def test_rigid_motions_and_mirroring_do_not_change_the_groups(seed, angle, shift
     assert partition(moved) == partition(direct)
 
 
+@pytest.mark.parametrize(("angle", "shift"), [(0.01, (0.0, 0.0)), (2.7, (0.0, 0.0)), (0.2, (250.0, -730.0))])
+def test_a_person_standing_on_a_centre_blocks_nobody_however_the_scene_is_turned(
+    angle: float, shift: tuple[float, float]
+) -> None:
+    """Five people on a line, the votes of the first and the last meeting exactly on the middle one: the direction
+    from that centre to them is rounding noise (1e-16 m), which turned the scene's groups from one into two when it
+    pointed along the line (a probe, 7 December 2026)."""
+    positions = np.array([[0.0, 2.84], [0.0, 3.80], [0.0, 4.84], [0.0, 5.80], [0.0, 6.84]])
+    yaw = np.array([math.pi / 2, np.nan, -1.6, 0.0, -math.pi / 2])
+    rotation = np.array([[math.cos(angle), -math.sin(angle)], [math.sin(angle), math.cos(angle)]])
+    direct = partition(gcff_labels(positions, yaw))
+    assert direct == {frozenset(range(5))}
+    assert partition(gcff_labels(positions @ rotation.T + shift, yaw + angle)) == direct
+
+
 def test_a_permuted_circle_is_still_one_group_in_either_order():
     positions, yaw = ring(6, 0.9)
     order = np.array([3, 0, 5, 1, 4, 2])
