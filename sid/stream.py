@@ -14,7 +14,7 @@ changed): a frame not after the last one in time, a non-finite timestamp, a robo
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from costmap.grid import Costmap2D, GridSpec
 from costmap.layer import LayerInputs
@@ -29,7 +29,7 @@ from sid.perception.frame import Frame
 from sid.perception.pipeline import FrameResult, Pipeline
 from sid.perception.robot_pose import RobotPose
 from sid.tracking.assignment import load_solver
-from sid.tracking.records import TrackedGroup, TrackedPerson, Tracks
+from sid.tracking.records import TrackedGroup, TrackedPerson
 from sid.tracking.session import TrackingParams
 from sid.tracking.stream import PeopleStream
 from sid.tracking.view import ViewCone
@@ -45,11 +45,13 @@ class StreamUpdate:
     """The stream's state after one frame.
 
     frame_id: the frame of every position ("map" or "base_footprint"). timestamp: the frame's (s). people, groups:
-    confirmed tracks. costmap: the combined grid after this frame (``costmap.costs``: uint8, Nav2 values), a copy that
-    later frames leave as it is (the stream's live LayeredCostmap is ``SocialStream.costmap``).
+    the tracks reported and the confirmed groups (``sid.tracking.session.split_reported``; the costmap also draws
+    the tracks held, missed for longer than ``TrackingParams.report_timeout``). costmap: the combined grid after
+    this frame (``costmap.costs``: uint8, Nav2 values), a copy that later frames leave as it is (the stream's live
+    LayeredCostmap is ``SocialStream.costmap``).
     result: the per-frame pipeline's raw result. timing_ms: per stage ("pose", "lift", "group" from the pipeline,
     then "track", "track_groups", "costmap", and "total"). reset: why the trackers were reset at this frame (None:
-    they were not).
+    they were not). held: the confirmed tracks not reported (``SessionUpdate.held``).
     """
 
     frame_id: str
@@ -60,6 +62,7 @@ class StreamUpdate:
     result: FrameResult
     timing_ms: dict[str, float]
     reset: str | None = None
+    held: list[TrackedPerson] = field(default_factory=list)
 
 
 class SocialStream:
@@ -101,8 +104,8 @@ class SocialStream:
         result, tracked = step.result, step.tracks
         t0 = time.perf_counter()
         conversations = [g.as_group() for g in tracked.groups if g.kind == "conversation"]
-        tracks = Tracks(tracked.people, tracked.groups)
-        people = [p.as_person() for p in tracked.people]
+        tracks = tracked.all_tracks()
+        people = [p.as_person() for p in tracks.people]
         self.costmap.update(LayerInputs({PEOPLE: people, GROUPS: conversations, SCAN: scan, TRACKS: tracks}))
         t1 = time.perf_counter()
         timing = result.timing_ms | tracked.timing_ms | {"costmap": (t1 - t0) * 1e3, "total": (t1 - start) * 1e3}
@@ -115,6 +118,7 @@ class SocialStream:
             result,
             timing,
             tracked.reset,
+            tracked.held,
         )
 
     def view(self, frame: Frame) -> ViewCone:

@@ -190,3 +190,22 @@ def test_a_rendered_conversation_is_tracked_through_the_real_pipeline() -> None:
     truth = source[11].truth
     (true_group,) = truth.groups
     assert np.hypot(*np.subtract(group.interest_point, true_group.interest_point)) < 0.15
+
+
+def test_a_person_missed_for_longer_than_the_report_timeout_is_held_and_still_drawn() -> None:
+    people: dict[str, list[Person]] = {"now": [Person(0, 3.0, 0.0, math.pi)]}  # alone, 3 m ahead, in plain view
+    stream = SocialStream(ScriptedPipeline(lambda t: people["now"]), SPEC, params=TrackingParams(report_timeout=0.4))
+    for k in range(10):
+        before = stream.update(_frame(k))
+    (track,) = before.people
+    people["now"] = []
+    missed = [stream.update(_frame(k)) for k in range(10, 20)]  # missed for 1/15 to 10/15 s
+    reported = [update for update in missed if update.people]
+    assert len(reported) == 6 and all(u.people[0].id == track.id and u.held == [] for u in reported)  # <= 0.4 s
+    for update in missed[6:]:
+        assert update.people == [] and [p.id for p in update.held] == [track.id]
+        assert update.held[0].missed_in_view > 0.4
+        assert update.costmap.costs[_cell(3.0, 0.0)] == LETHAL  # the costmap keeps their space
+    people["now"] = [Person(0, 3.0, 0.0, math.pi)]
+    back = stream.update(_frame(20))
+    assert [p.id for p in back.people] == [track.id] and back.held == [] and back.people[0].missed_in_view == 0.0

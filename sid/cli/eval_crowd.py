@@ -153,7 +153,7 @@ def _folds_table(result: dict[str, Any]) -> str:
     w = name_width((fold["held_out"] for fold in result["folds"]), 12)
     lines = [f"{'held out':<{w}} {'stage':<9} {'train':>6} {'held out':>8}  chosen"]
     for fold in result["folds"]:
-        for stage, score in (("tracker", "idf1"), ("groups", "f1"), ("coherent", "f1")):
+        for stage, score in (("tracker", "idf1"), ("groups", "f1"), ("coherent", "f1"), ("reporting", "idf1")):
             entry = fold[stage]
             chosen = ", ".join(f"{k}={v:g}" for k, v in entry["chosen"].items())
             metric = "IDF1" if score == "idf1" else "G-MITRE F1"

@@ -9,17 +9,19 @@ Protocol:
   positions), so that a track coasting out of the scene is not counted as a person in it. The coherent-motion
   reference (``sid.tracking.coherent``) runs on the same tracks.
 - people (py-motmetrics): ground truth = the people present (inside the robot's view when one is set);
-  hypotheses = the confirmed tracks detected in the frame or inside the view. A track within ``match_distance`` may
-  match. MOTA, IDF1, identity switches (also per 100 true tracks). People and tracks never within
-  ``match_distance`` of each other are scored in separate motmetrics accumulators and merged (``MOT_PART_IDS``).
+  hypotheses = the confirmed tracks detected in the frame or inside the view that ``TrackingSession`` reports
+  (``split_reported``: detected, missed in the view for at most ``report_timeout``, or a group's member). A track
+  within ``match_distance`` may match. MOTA, IDF1, identity switches (also per 100 true tracks). People and tracks
+  never within ``match_distance`` of each other are scored in separate motmetrics accumulators and merged
+  (``MOT_PART_IDS``).
 - groups: each frame's tracks are identified with true people by minimum total distance within ``match_distance``
   (an unidentified member is a stranger). Truth = the annotated groups holding among the people present (two or
   more members there). G-MITRE (``sid.experiments.gmitre``): link counts over the people present, everyone not
   in a group alone, pooled over all frames. Group matching at T = 2/3 and T = 1 (``fformation.frame_matches``): the
   true groups found, groups reported and true groups, summed over all frames (frames without any group on either
   side then count for nothing).
-- ``cross_validate``: leave one set out over a grid of the group trackers' parameters, choosing the best mean
-  G-MITRE F1 on the others.
+- ``cross_validate``: leave one set out, in three stages: the people tracker's parameters by the best mean IDF1 on
+  the others, the group trackers' by the best mean G-MITRE F1, then ``report_timeout`` by the best mean IDF1.
 """
 
 from __future__ import annotations
@@ -45,7 +47,7 @@ from sid.experiments.workers import map_in_workers
 from sid.tracking.coherent import CoherentMotion, CoherentMotionParams
 from sid.tracking.groups import GroupTracker, GroupTrackerParams
 from sid.tracking.records import TrackedPerson
-from sid.tracking.session import TrackingParams, TrackingSession
+from sid.tracking.session import TrackingParams, TrackingSession, split_reported
 from sid.tracking.tracker import TimeGapWarning, TrackerParams
 from sid.tracking.view import View, scene_view
 
@@ -61,6 +63,7 @@ __all__ = [
     "find_groups",
     "record_tracks",
     "replay_view",
+    "reported_log",
     "score_groups",
     "score_people",
 ]
@@ -80,8 +83,10 @@ DEFAULT_GRID: dict[str, dict[str, tuple[float, ...]]] = {
         "walk_window": (2.0, 3.0, 4.0),
     },
     "coherent": {"distance": (1.0, 1.5, 2.0), "velocity_difference": (0.3, 0.4, 0.5, 0.6), "share": (0.4, 0.6, 0.8)},
+    "reporting": {"report_timeout": (0.2, 0.4, 0.8, 1.5)},
 }
-"""What ``cross_validate`` chooses among: the people tracker's, the group tracker's and the reference's parameters."""
+"""What ``cross_validate`` chooses among: the people tracker's, the group tracker's and the reference's parameters,
+and how long a missed track is reported (``TrackingParams.report_timeout``; 1.5 s, the tracker's timeout: always)."""
 
 
 @dataclass(frozen=True)
@@ -99,7 +104,8 @@ class CrowdSettings:
 @dataclass(frozen=True, eq=False)
 class TrackLog:
     """One replayed set through the people tracker: per frame the time (s), the truth (ids, (K, 2) positions m)
-    and the confirmed tracks (``TrackedPerson``s) that count as hypotheses."""
+    and the confirmed tracks (``TrackedPerson``s) detected or in view: the group tracker's input, and the
+    hypotheses once ``reported_log`` has kept those reported."""
 
     name: str
     times: list[float]
@@ -151,6 +157,16 @@ def replay_view(trajectories: TrajectorySet, replay_settings: ReplaySettings) ->
         return scene_view(np.concatenate(trajectories.positions))
     except ValueError as exc:
         raise TrajectoryError(f"{trajectories.name}: {exc}; set the robot's view instead (--view)") from None
+
+
+def reported_log(log: TrackLog, groups: Sequence[Sequence[frozenset[int]]], report_timeout: float) -> TrackLog:
+    """``log`` with, in each frame, only the tracks reported beside ``groups`` (that frame's groups, member track
+    ids): ``sid.tracking.session.split_reported``, as ``TrackingSession`` reports them."""
+    tracks = [
+        split_reported(people, frozenset().union(*found), report_timeout)[0]
+        for people, found in zip(log.tracks, groups, strict=True)
+    ]
+    return TrackLog(log.name, log.times, log.truth_ids, log.truth_positions, tracks)
 
 
 def score_groups(
@@ -254,10 +270,10 @@ def evaluate_crowd(
     for trajectories in sets:
         passes = [_pass(progress, k, trajectories.name) for k in range(len(EVALUATION_PASSES))]
         log = record_tracks(trajectories, settings, passes[0])
-        people = score_people(log, settings.match_distance, passes[1])
-        groups = score_groups(
-            trajectories, log, find_groups(log, settings.tracking.groups, passes[2]), settings, passes[3]
-        )
+        found = find_groups(log, settings.tracking.groups, passes[1])
+        shown = reported_log(log, found, settings.tracking.report_timeout)
+        people = score_people(shown, settings.match_distance, passes[2])
+        groups = score_groups(trajectories, shown, found, settings, passes[3])
         reference = find_coherent_groups(log, settings.coherent, passes[4])
         out["sets"][trajectories.name] = {
             "frames": len(log.times),
@@ -271,8 +287,8 @@ def evaluate_crowd(
 
 EVALUATION_PASSES = (
     "tracking",
-    "matching people",
     "group tracker",
+    "matching people",
     "scoring groups",
     "reference groups",
     "scoring the reference",
@@ -301,11 +317,13 @@ def cross_validate(
     progress: Progress | None = None,
     workers: int = 1,
 ) -> dict[str, Any]:
-    """Leave one set out, in two stages per held-out set: the people tracker's grid point (``grid["tracker"]``) with
-    the best mean IDF1 on the other sets, then, on that tracker's tracks, the group tracker's (``grid["groups"]``) and
-    the reference's (``grid["coherent"]``) points with the best mean G-MITRE F1 on the other sets; each scored on the
-    held-out set. Ties go to the first point in the grid's order. Each stage's grid points are scored in ``workers``
-    processes (``sid.experiments.workers``; the same result as one)."""
+    """Leave one set out, in three stages per held-out set: the people tracker's grid point (``grid["tracker"]``)
+    with the best mean IDF1 on the other sets (of every confirmed track detected or in view: the tracker's own);
+    then, on that tracker's tracks, the group tracker's (``grid["groups"]``) and the reference's
+    (``grid["coherent"]``) points with the best mean G-MITRE F1 on the other sets; then, beside the chosen group
+    tracker's groups, the ``report_timeout`` (``grid["reporting"]``) with the best mean IDF1 of the tracks reported;
+    each scored on the held-out set. Ties go to the first point in the grid's order. The first two stages' grid
+    points are scored in ``workers`` processes (``sid.experiments.workers``; the same result as one)."""
     require_motmetrics()
     settings = settings or CrowdSettings()
     for trajectories in sets:  # every set's replay checked before the first runs
@@ -319,12 +337,13 @@ def cross_validate(
     ]
     idf1 = np.array(map_in_workers(_tracker_idf1, (sets, settings), trackers, workers, progress, "tracker points"))
     group_f1: dict[int, np.ndarray] = {}  # tracker row -> (candidates, sets)
+    tracker_logs: dict[int, list[TrackLog]] = {}
     folds = []
     for col, trajectories in enumerate(sets):
         train = np.delete(idf1, col, axis=1).mean(axis=1)
         row = int(np.argmax(train))
         if row not in group_f1:  # the chosen tracker's tracks, replayed again (seeded: the same) for its groups
-            logs = [record_tracks(s, _with_tracker(settings, trackers[row])) for s in sets]
+            logs = tracker_logs[row] = [record_tracks(s, _with_tracker(settings, trackers[row])) for s in sets]
             what = f"group points on tracker {row + 1}"
             group_f1[row] = np.array(
                 map_in_workers(_group_f1, (sets, logs, settings), candidates, workers, progress, what)
@@ -337,16 +356,21 @@ def cross_validate(
                 "held_out_idf1": float(idf1[row, col]),
             },
         }
+        chosen: dict[str, Any] = {}
         for which in ("groups", "coherent"):
             rows = [k for k, (kind, _) in enumerate(candidates) if kind == which]
             table = group_f1[row][rows]
             others = np.delete(table, col, axis=1).mean(axis=1)
             best = int(np.argmax(others))
+            chosen[which] = candidates[rows[best]][1]
             fold[which] = {
                 "chosen": _changed(candidates[rows[best]][1], grid.get(which, {})),
                 "train_f1": float(others[best]),
                 "held_out_f1": float(table[best, col]),
             }
+        fold["reporting"] = _choose_reporting(
+            tracker_logs[row], settings, chosen["groups"], grid.get("reporting", {}), col
+        )
         folds.append(fold)
     return {"folds": folds, "grid": {k: {n: list(v) for n, v in g.items()} for k, g in grid.items()}}
 
@@ -374,6 +398,36 @@ def _group_f1(
             found = find_coherent_groups(log, params)
         out.append(score_groups(trajectories, log, found, settings)["gmitre"]["f1"])
     return out
+
+
+def _choose_reporting(
+    logs: Sequence[TrackLog],
+    settings: CrowdSettings,
+    params: GroupTrackerParams,
+    axes: Mapping[str, Sequence[float]],
+    held_out: int,
+) -> dict[str, Any]:
+    """``cross_validate``'s third stage for the set ``held_out`` (an index of ``logs``): the point of ``axes`` (fields
+    of ``TrackingParams``) whose tracks reported beside the groups of the group tracker with ``params`` have the best
+    mean IDF1 on the other sets; that IDF1 and the held-out set's."""
+    points = _points(settings.tracking, axes)
+    groups = [find_groups(log, params) for log in logs]
+    idf1 = np.array(
+        [
+            [
+                score_people(reported_log(log, found, point.report_timeout), settings.match_distance)["idf1"]
+                for log, found in zip(logs, groups, strict=True)
+            ]
+            for point in points
+        ]
+    ).reshape(len(points), len(logs))
+    others = np.delete(idf1, held_out, axis=1).mean(axis=1)
+    best = int(np.argmax(others))
+    return {
+        "chosen": _changed(points[best], axes),
+        "train_idf1": float(others[best]),
+        "held_out_idf1": float(idf1[best, held_out]),
+    }
 
 
 def _points(base: Any, axes: Mapping[str, Sequence[float]]) -> list[Any]:
@@ -466,6 +520,7 @@ def _settings_json(settings: CrowdSettings) -> dict[str, Any]:
         "replay": replay_settings,
         "tracker": dataclasses.asdict(settings.tracking.tracker),
         "group_tracker": dataclasses.asdict(settings.tracking.groups),
+        "report_timeout": settings.tracking.report_timeout,
         "coherent_motion": dataclasses.asdict(settings.coherent),
         "match_distance": settings.match_distance,
         "thresholds": list(settings.thresholds),

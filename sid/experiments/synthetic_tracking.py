@@ -8,10 +8,10 @@ Protocol:
 - people (py-motmetrics): ground truth = the people whose position lies in the camera's field of view (the
   stream's view cone: the colour image's horizontal opening up to the lifting's max range), hidden or not, since a
   tracker should keep people through occlusions, and those within that range the image shows at its edge;
-  hypotheses = the confirmed tracks detected in the frame or inside the same cone (tracks coasting out of view
-  make no claim about the image). A track within ``match_distance`` of a person may match (motmetrics' squared
-  Euclidean distance). MOTA = 1 - (misses + false positives + id switches) / ground-truth objects; IDF1: the F1
-  of identity matches over the sequence.
+  hypotheses = the reported tracks (``StreamUpdate.people``) detected in the frame or inside the same cone
+  (tracks coasting out of view make no claim about the image). A track within ``match_distance`` of a person may
+  match (motmetrics' squared Euclidean distance). MOTA = 1 - (misses + false positives + id switches) /
+  ground-truth objects; IDF1: the F1 of identity matches over the sequence.
 - groups: per frame, precision and recall of the conversational groups under the F-formation rule
   (``sid.experiments.fformation.score``, tolerance T) against the declared conversations that hold then (all
   members standing), both sides restricted to the ground-truth people above (a group keeps its members the camera

@@ -275,7 +275,10 @@ def _section_parameters(node: Node, name: str, plugin: str, use: str = "") -> di
 
 _RECORD_DESCRIPTIONS = {
     "groups": "the group detector (sid.perception.groups.GroupParams; docs/groups.md)",
-    "tracking": "the trackers' session: what counts as a jump of the robot pose (sid.tracking.session.TrackingParams)",
+    "tracking": (
+        "the trackers' session: what counts as a jump of the robot pose, how long a missed track is reported "
+        "(sid.tracking.session.TrackingParams)"
+    ),
     "tracking.tracker": "the people tracker (sid.tracking.tracker.TrackerParams; docs/tracking.md)",
     "tracking.groups": "the group tracker (sid.tracking.groups.GroupTrackerParams; docs/tracking.md)",
 }

@@ -39,7 +39,9 @@ class TrackedPerson:
     last detection. detection: the id of the person of this frame's input it was matched to (None when missed).
     speed_sigma: standard deviation of the velocity estimate along each axis (m/s; a new track's velocity is
     unknown: ``TrackerParams.initial_speed_sigma``). orientation_quality: the measured facings' orientation quality
-    in [0, 1] (``Person.orientation_quality``), averaged as theta is; 0 while theta is None.
+    in [0, 1] (``Person.orientation_quality``), averaged as theta is; 0 while theta is None. missed_in_view:
+    seconds undetected since the last detection while the camera could see the track (time out of its view or behind
+    someone detected nearer to it does not count; 0 when visible), the clock of ``TrackerParams.timeout``.
     """
 
     id: int
@@ -55,6 +57,7 @@ class TrackedPerson:
     detection: int | None
     speed_sigma: float
     orientation_quality: float
+    missed_in_view: float = 0.0
 
     @property
     def speed(self) -> float:

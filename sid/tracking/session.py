@@ -6,15 +6,18 @@ and ``SessionUpdate.reset`` says why, when the robot pose jumps (moves faster th
 faster than ``max_turn_rate``, plus a tolerance: a relocalisation puts every track in the wrong place), when the
 frame the results are given in changes (a pose that appears or disappears), or when time goes back more than
 ``max_time_back`` (a looped recording, a clock reset, or the frame after one stamped in the future: refused for
-good, every later frame would be). Errors (``TrackingError``, nothing changed): a result not after the last one in
-time (but within ``max_time_back`` of it), a non-finite timestamp or robot pose.
+good, every later frame would be). Reported (``SessionUpdate.people``): a confirmed track while detected, missed in
+the camera's view for at most ``report_timeout``, or a member of a confirmed group; the others are held
+(``SessionUpdate.held``): kept for re-association until the tracker's timeout, still drawn on the costmap, but not
+claimed as people present (a track coasting on after its person left). Errors (``TrackingError``, nothing changed):
+a result not after the last one in time (but within ``max_time_back`` of it), a non-finite timestamp or robot pose.
 """
 
 from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass, field
 
 from sid.checks import check_numbers, is_real
@@ -23,11 +26,11 @@ from sid.perception.people import Person
 from sid.perception.pipeline import FrameResult
 from sid.perception.robot_pose import RobotPose
 from sid.tracking.groups import GroupTracker, GroupTrackerParams
-from sid.tracking.records import TrackedGroup, TrackedPerson
+from sid.tracking.records import TIME_TOLERANCE, TrackedGroup, TrackedPerson, Tracks
 from sid.tracking.tracker import PeopleTracker, TrackerParams, TrackingError, check_people, check_time_order
 from sid.tracking.view import View
 
-__all__ = ["SessionUpdate", "TrackingParams", "TrackingSession"]
+__all__ = ["SessionUpdate", "TrackingParams", "TrackingSession", "split_reported"]
 
 
 @dataclass(frozen=True)
@@ -35,7 +38,9 @@ class TrackingParams:
     """The two trackers' parameters, what counts as a jump of the robot pose: it moves more than
     ``max_robot_speed`` (m/s) x dt + ``jump_tolerance`` (m), or turns more than ``max_turn_rate`` (rad/s) x dt +
     ``yaw_tolerance`` (rad), between consecutive frames dt seconds apart, and of time: a frame more than
-    ``max_time_back`` (s) before the last one starts the trackers over (one less before it is refused)."""
+    ``max_time_back`` (s) before the last one starts the trackers over (one less before it is refused).
+    ``report_timeout`` (s): how long a confirmed track missed in the camera's view is still reported
+    (``split_reported``; the tracker keeps it until its own ``timeout``)."""
 
     tracker: TrackerParams = field(default_factory=TrackerParams)
     groups: GroupTrackerParams = field(default_factory=GroupTrackerParams)
@@ -44,21 +49,36 @@ class TrackingParams:
     max_turn_rate: float = 3.0
     yaw_tolerance: float = 0.3
     max_time_back: float = 1.0
+    report_timeout: float = 0.4
 
     def __post_init__(self) -> None:
-        names = ("max_robot_speed", "jump_tolerance", "max_turn_rate", "yaw_tolerance", "max_time_back")
+        names = (
+            "max_robot_speed",
+            "jump_tolerance",
+            "max_turn_rate",
+            "yaw_tolerance",
+            "max_time_back",
+            "report_timeout",
+        )
         check_numbers("tracking", self, names, low=0)
 
 
 @dataclass
 class SessionUpdate:
-    """Confirmed people and groups after one result, why the trackers were reset at it (None: they were not), and
-    the time (ms) the two trackers took ("track", "track_groups")."""
+    """The people reported and the confirmed groups after one result, why the trackers were reset at it (None: they
+    were not), the time (ms) the two trackers took ("track", "track_groups"), and the confirmed tracks held but not
+    reported (``split_reported``). Every group member is among ``people``."""
 
     people: list[TrackedPerson]
     groups: list[TrackedGroup]
     reset: str | None
     timing_ms: dict[str, float]
+    held: list[TrackedPerson] = field(default_factory=list)
+
+    def all_tracks(self) -> Tracks:
+        """Every confirmed track, reported and held, with the groups: what the tracked-people layer draws (a person
+        the detector has missed for a moment still gets their space on the costmap)."""
+        return Tracks([*self.people, *self.held], self.groups)
 
 
 class TrackingSession:
@@ -129,7 +149,9 @@ class TrackingSession:
         t1 = time.perf_counter()
         groups = self.groups.update(tracked, timestamp)
         t2 = time.perf_counter()
-        return SessionUpdate(tracked, groups, None, {"track": (t1 - t0) * 1e3, "track_groups": (t2 - t1) * 1e3})
+        grouped = {i for group in groups for i in group.members}
+        reported, held = split_reported(tracked, grouped, self.params.report_timeout)
+        return SessionUpdate(reported, groups, None, {"track": (t1 - t0) * 1e3, "track_groups": (t2 - t1) * 1e3}, held)
 
     def _reset_reason(self, result: FrameResult) -> str | None:
         """Why the tracks no longer hold at this result (None: they do)."""
@@ -149,3 +171,18 @@ class TrackingSession:
         if turned > p.max_turn_rate * dt + p.yaw_tolerance:
             return f"the robot pose turned {turned:.2f} rad in {dt:.3f} s"
         return None
+
+
+def split_reported(
+    people: Sequence[TrackedPerson], grouped: Collection[int], report_timeout: float
+) -> tuple[list[TrackedPerson], list[TrackedPerson]]:
+    """The confirmed tracks ``people`` split into those reported and those held: a track is reported while it was
+    missed in the camera's view for at most ``report_timeout`` (s; ``TrackedPerson.missed_in_view``), or while its
+    id is ``grouped`` (a member of a confirmed group: a group holds its members through their misses). Held tracks
+    coast on the tracker's prediction where the detector, looking there, sees nobody: mostly people who left."""
+    limit = report_timeout + TIME_TOLERANCE
+    reported: list[TrackedPerson] = []
+    held: list[TrackedPerson] = []
+    for person in people:
+        (reported if person.missed_in_view <= limit or person.id in grouped else held).append(person)
+    return reported, held

@@ -324,6 +324,7 @@ class PeopleTracker:
         theta = [None if t != t else t for t in np.arctan2(facing[:, 1], facing[:, 0]).tolist()]  # NaN -> None
         quality = np.nan_to_num(self._quality[rows], nan=0.0).tolist()  # no facing: quality 0
         detection = self._detection[rows].tolist()
+        missed = self._unseen[rows].tolist()
         return [
             TrackedPerson(
                 track_id,
@@ -339,8 +340,9 @@ class PeopleTracker:
                 ids[d] if d >= 0 else None,
                 sd,
                 q,
+                unseen,
             )
-            for track_id, (x, y), (vx, vy), th, walking, d, seen, last, sd, q in zip(
+            for track_id, (x, y), (vx, vy), th, walking, d, seen, last, sd, q, unseen in zip(
                 self._ids[rows].tolist(),
                 self._motion.position[rows].tolist(),
                 self._motion.velocity[rows].tolist(),
@@ -351,6 +353,7 @@ class PeopleTracker:
                 self._last_hit[rows].tolist(),
                 speed_sigma,
                 quality,
+                missed,
                 strict=True,
             )
         ]

@@ -55,13 +55,18 @@ def test_cross_validation_prints_one_row_per_stage_and_held_out_set(
 ) -> None:
     from sid.cli import eval_crowd
 
-    small = {"tracker": {"timeout": (1.0, 1.5)}, "groups": {"walk_distance": (1.5,)}, "coherent": {"share": (0.8,)}}
+    small = {
+        "tracker": {"timeout": (1.0, 1.5)},
+        "groups": {"walk_distance": (1.5,)},
+        "coherent": {"share": (0.8,)},
+        "reporting": {"report_timeout": (0.4, 1.5)},
+    }
     monkeypatch.setattr(eval_crowd, "DEFAULT_GRID", small)
     folders = [str(pair_and_strangers(tmp_path / name, frames=12)) for name in ("a", "b")]
     assert main(["eval", "crowd", *folders, "--cross-validate"]) == 0
     out = capsys.readouterr().out
     rows = [line.split()[:2] for line in out.splitlines()[1:]]
-    assert rows == [[s, stage] for s in ("a", "b") for stage in ("tracker", "groups", "coherent")]
+    assert rows == [[s, stage] for s in ("a", "b") for stage in ("tracker", "groups", "coherent", "reporting")]
     assert main(["eval", "crowd", *folders, "--cross-validate", "--workers", "2"]) == 0
     assert capsys.readouterr().out == out  # the same table from two worker processes
 

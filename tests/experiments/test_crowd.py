@@ -17,11 +17,15 @@ from sid.experiments.crowd import (
     TrackLog,
     cross_validate,
     evaluate_crowd,
+    find_groups,
     record_tracks,
+    replay_view,
+    reported_log,
     score_people,
 )
 from sid.experiments.synthetic_tracking import mot_scores
-from sid.experiments.trajectories import ReplaySettings, TrajectoryError, TrajectorySet, load_trajectory_set
+from sid.experiments.trajectories import ReplaySettings, TrajectoryError, TrajectorySet, load_trajectory_set, replay
+from sid.tracking.session import TrackingSession
 from sid.tracking.view import ViewCone
 from tests.conftest import shared_path
 from tests.experiments.trajectory_files import pair_and_strangers, write_set
@@ -87,6 +91,7 @@ def test_cross_validation_reports_each_held_out_set(tmp_path: Path) -> None:
         "tracker": {"timeout": (1.0, 1.5)},
         "groups": {"walk_distance": (1.0, 2.0)},
         "coherent": {"share": (0.5, 1.0)},
+        "reporting": {"report_timeout": (0.4, 1.5)},
     }
     result = cross_validate(sets, CrowdSettings(), grid)
     assert [fold["held_out"] for fold in result["folds"]] == ["a", "b"]
@@ -94,12 +99,28 @@ def test_cross_validation_reports_each_held_out_set(tmp_path: Path) -> None:
         assert fold["tracker"]["chosen"]["timeout"] in (1.0, 1.5) and 0.5 < fold["tracker"]["held_out_idf1"] <= 1
         assert fold["groups"]["chosen"]["walk_distance"] in (1.0, 2.0)
         assert 0.0 <= fold["coherent"]["held_out_f1"] <= 1.0
+        assert fold["reporting"]["chosen"]["report_timeout"] in (0.4, 1.5)
+        assert 0.5 < fold["reporting"]["held_out_idf1"] <= 1
     calls: list[tuple[int, int, str]] = []
     pooled = cross_validate(sets, CrowdSettings(), grid, lambda *call: calls.append(call), workers=2)
     assert pooled == result  # the same folds from worker processes
     finished = [(total, what) for done, total, what in calls if done == total]  # each stage's last call
     assert finished[0] == (2, "tracker points") and 1 <= len(finished[1:]) <= 2  # then each chosen tracker's groups
     assert all(total == 4 and what.startswith("group points on tracker ") for total, what in finished[1:])
+
+
+def test_the_people_scored_are_those_the_tracking_session_reports(tmp_path: Path) -> None:
+    """One rule for what is reported (``split_reported``): the evaluation's hypotheses are, frame by frame, the
+    people ``TrackingSession.track`` reports (detected or in view), tracks held after their person left among them."""
+    scene, settings = load_trajectory_set(crossing_crowds(tmp_path / "crowds", crowds=2)), CrowdSettings()
+    log = record_tracks(scene, settings)
+    scored = reported_log(log, find_groups(log, settings.tracking.groups), settings.tracking.report_timeout)
+    session, view, held = TrackingSession(settings.tracking), replay_view(scene, settings.replay), 0
+    for k, frame in enumerate(replay(scene, settings.replay)):
+        update = session.track(frame.detections, frame.timestamp, view)
+        assert [p.id for p in update.people if p.visible or p.in_view] == [p.id for p in scored.tracks[k]]
+        held += sum(p.in_view for p in update.held)
+    assert held > 5
 
 
 def crossing_crowds(folder: Path, crowds: int = 5, walkers: int = 6) -> Path:

@@ -9,8 +9,8 @@ import pytest
 from sid.perception.people import Person
 from sid.perception.pipeline import FrameResult
 from sid.perception.robot_pose import RobotPose
-from sid.tracking import TrackingError, TrackingSession
-from sid.tracking.session import SessionUpdate
+from sid.tracking import TrackedPerson, TrackingError, TrackingParams, TrackingSession
+from sid.tracking.session import SessionUpdate, split_reported
 from sid.tracking.tracker import TimeGapWarning
 
 
@@ -72,3 +72,29 @@ def test_time_going_back_more_than_max_time_back_starts_the_trackers_over() -> N
         assert update.reset == "time went back 1.7e+12 s" and update.people == []
         ids = {p.id for k in range(4, 8) for p in step(1.7e9 + 0.1 * k).people}
         assert len(ids) == 2  # tracked again
+
+
+def test_a_missed_member_of_a_group_stays_reported_while_a_lone_one_is_held() -> None:
+    """Held: a confirmed track missed in the camera's view for longer than report_timeout, kept for re-association
+    but not reported; a member of a confirmed group is reported while its group holds it."""
+    session = TrackingSession(TrackingParams(report_timeout=0.3))
+    pair = [Person(0, 2.0, 0.4, -math.pi / 2), Person(1, 2.0, -0.4, math.pi / 2)]
+    lone = Person(2, 6.0, 3.0, 0.0)
+    for k in range(10):
+        update = session.track([*pair, lone], 0.1 * k)
+    assert len(update.groups) == 1 and len(update.people) == 3
+    ids = {p.id for p in update.people}
+    for k in range(10, 15):  # one member and the lone person missed for 0.5 s
+        update = session.track(pair[:1], 0.1 * k)
+    (group,) = update.groups
+    assert {p.id for p in update.people} == set(group.members) and len(group.members) == 2
+    (held,) = update.held
+    assert held.id in ids - set(group.members) and held.missed_in_view == pytest.approx(0.5)
+    assert {p.id for p in update.people} | {held.id} == ids
+
+
+def test_split_reported_keeps_the_order_and_the_report_timeout_bound() -> None:
+    tracks = [TrackedPerson(i, 0.0, 0.0, 0.0, 0.0, None, "standing", False, True, 0.0, None, 0.1, 0.0, missed)
+              for i, missed in ((1, 0.4), (2, 0.5), (3, 0.0), (4, 2.0))]  # fmt: skip
+    reported, held = split_reported(tracks, {4}, 0.4)
+    assert [p.id for p in reported] == [1, 3, 4] and [p.id for p in held] == [2]

@@ -54,7 +54,7 @@ def _bench_track(n: int) -> Callable[[Context], Records]:
         from costmap.layer import LayerInputs
         from costmap.layers.tracked import TRACKS, TrackedPeopleLayer
         from sid.perception.pipeline import FrameResult
-        from sid.tracking import TrackingSession, Tracks
+        from sid.tracking import TrackingSession
 
         scene = grouping_scene(n)
         rng = np.random.default_rng(1)
@@ -78,7 +78,7 @@ def _bench_track(n: int) -> Callable[[Context], Records]:
             result = FrameResult(k, k / TRACK_FPS, [], frames[k % len(frames)], [])
             tracked = session.update(result)
             t0 = time.perf_counter()
-            layer.update(LayerInputs({TRACKS: Tracks(tracked.people, tracked.groups)}), None)
+            layer.update(LayerInputs({TRACKS: tracked.all_tracks()}), None)
             layer_ms = (time.perf_counter() - t0) * 1e3
             seen.update(people=len(tracked.people), groups=len(tracked.groups))
             parts = {
@@ -143,7 +143,7 @@ def _bench_crowd(n: int) -> Callable[[Context], Records]:
         from costmap.grid import GridSpec
         from costmap.layer import LayerInputs
         from costmap.layers.tracked import TRACKS, TrackedPeopleLayer
-        from sid.tracking import TrackingSession, Tracks, scene_view
+        from sid.tracking import TrackingSession, scene_view
         from sid.tracking.coherent import CoherentMotion
 
         s = ctx.settings
@@ -162,9 +162,9 @@ def _bench_crowd(n: int) -> Callable[[Context], Records]:
             frame = next(frames)
             tracked = session.track(frame.detections, frame.timestamp, view)
             t0 = time.perf_counter_ns()
-            layer.update(LayerInputs({TRACKS: Tracks(tracked.people, tracked.groups)}), None)
+            layer.update(LayerInputs({TRACKS: tracked.all_tracks()}), None)
             t1 = time.perf_counter_ns()
-            coherent = reference.update(tracked.people, frame.timestamp)
+            coherent = reference.update([*tracked.people, *tracked.held], frame.timestamp)
             t2 = time.perf_counter_ns()
             seen.append((len(frame.truth_ids), len(tracked.people), len(tracked.groups), len(coherent)))
             parts = {"people": tracked.timing_ms["track"], "groups": tracked.timing_ms["track_groups"],
