@@ -215,20 +215,33 @@ def load_sequence(folder: str | Path, scale: float = 1.0, degrees: bool = False)
 
 
 def _upright(frames_people: list, path: Path) -> list:
-    """The features cells, each transposed (with an ``InputWarning``) when the file stores them 4 x N: every frame
-    with four rows while the frames' column counts differ (people come and go; fields do not)."""
-    shapes = [np.shape(cell) for cell in frames_people if np.size(cell)]
-    rows = {shape[0] if len(shape) == 2 else None for shape in shapes}
-    if rows != {4} or len({shape[1] for shape in shapes}) < 2:
+    """The features cells, each transposed (with an ``InputWarning``) when the file stores them 4 x N, one column per
+    person: every frame with four rows, and either column counts that differ (people come and go; fields do not),
+    fewer than four columns (no room for [id, x, y, theta]), or ids that recur from frame to frame only when read
+    along the first row (the same people in every frame; read down the first column, a person's x, y and theta)."""
+    cells = [np.asarray(cell) for cell in frames_people if np.size(cell)]
+    shapes = {cell.shape if cell.ndim == 2 else None for cell in cells}
+    if not shapes or any(shape is None or shape[0] != 4 for shape in shapes):
+        return frames_people
+    columns = {shape[1] for shape in shapes if shape is not None}
+    if columns == {4} or (len(columns) == 1 and min(columns) > 4 and not _ids_along_rows(cells)):
         return frames_people
     warnings.warn(
         InputWarning(
-            f"fformation: {path}: every frame's features have 4 rows and their columns vary: read as 4 x N, one "
-            "column per person (transposed)"
+            f"fformation: {path}: every frame's features have 4 rows, read as 4 x N, one column per person (transposed)"
         ),
         stacklevel=3,
     )
     return [np.asarray(cell).T if np.size(cell) else cell for cell in frames_people]
+
+
+def _ids_along_rows(cells: list[np.ndarray]) -> bool:
+    """Whether the first row of the (4, C) ``cells`` reads as ids and their first column does not: whole numbers
+    that take fewer distinct values over the frames (the same people seen again) than the first column's."""
+    along, down = np.concatenate([c[0] for c in cells]), np.concatenate([c[:, 0] for c in cells])
+    with np.errstate(invalid="ignore"):
+        whole = np.isfinite(along).all() and np.array_equal(along, np.round(along))
+    return bool(whole and len(cells) > 1 and len(np.unique(along)) < len(np.unique(down)))
 
 
 _NEAR_SHARE = 0.25

@@ -215,10 +215,9 @@ def _costs(
                 cosine = inner / (d[:, None] * d[None, :])
                 # Someone on the centre (within rounding of it: a turned or moved scene puts them 1e-16 m off in any
                 # direction) has no direction from it: they block nobody and nobody blocks them.
-                on_centre = d <= _ON_CENTRE_M
-                cosine[on_centre, :] = 0.0
-                cosine[:, on_centre] = 0.0
+                off_centre = d > _ON_CENTRE_M
                 blocks = (d[:, None] > d[None, :]) & (cosine > params.visibility_cosine)
+                blocks &= off_centre[:, None] & off_centre[None, :]
                 penalty = np.minimum(unit * params.visibility_base ** (cosine * d[:, None] / d[None, :]), cap)
             column[near] += np.where(blocks, penalty, 0.0).sum(axis=1)
         cost[:, k] = column

@@ -668,9 +668,21 @@ def test_features_stored_four_by_n_are_read_transposed_with_a_warning(tmp_path: 
     turned = write_sequence(
         tmp_path / "Turned", [f.T for f in tiny_frames()], {1: [[1, 2]], 2: [[1, 2, 3]], 3: [[4, 5]]}
     )
-    with pytest.warns(InputWarning, match="every frame's features have 4 rows and their columns vary"):
+    with pytest.warns(InputWarning, match="every frame's features have 4 rows, read as 4 x N"):
         frames = load_sequence(turned, 0.01)
     assert frames == [replace(f, sequence="Turned") for f in load_sequence(upright, 0.01)]
+    # The same six people in every frame: the ids recur along the first row, positions down the first column.
+    six = [np.array([[k, 100.0 * k + t, 50.0 * t, 0.1 * k] for k in range(1, 7)]) for t in range(3)]
+    truth = {1: [[1, 2]], 2: [[3, 4]], 3: [[5, 6]]}
+    constant = write_sequence(tmp_path / "Six", [f.T for f in six], truth)
+    with pytest.warns(InputWarning, match="read as 4 x N"):
+        assert [[p.id for p in f.people] for f in load_sequence(constant)] == [[1, 2, 3, 4, 5, 6]] * 3
+    # Four people with six columns each, in every frame: read as they are, without a word.
+    wide = [np.column_stack([f[:4], np.zeros((4, 2))]) for f in six]
+    with pytest.warns(InputWarning, match="features have 6 columns"):  # the extra columns' warning alone
+        assert [[p.id for p in f.people] for f in load_sequence(write_sequence(tmp_path / "Wide", wide, truth))] == [
+            [1, 2, 3, 4]
+        ] * 3
 
 
 def test_ground_truth_groups_as_cells_of_single_ids_keep_their_members(tmp_path: Path) -> None:

@@ -226,6 +226,18 @@ def test_a_person_standing_on_a_centre_blocks_nobody_however_the_scene_is_turned
     assert partition(gcff_labels(positions @ rotation.T + shift, yaw + angle)) == direct
 
 
+@pytest.mark.parametrize("cosine", [0.75, -0.5])
+def test_a_person_exactly_on_the_centre_costs_a_finite_amount_at_any_visibility_cosine(cosine: float) -> None:
+    """The on-centre rule once zeroed their cosine: with a negative visibility_cosine they then blocked everyone,
+    with a penalty of 0 x inf = NaN."""
+    params = GCFFParams(visibility_cosine=cosine)
+    xy = np.array([[0.0, 0.0], [0.45, 0.0], [-0.45, 0.0]])  # the first stands exactly where the others vote
+    theta = np.array([math.pi / 2, math.pi, 0.0])
+    votes = xy + params.stride * np.column_stack([np.cos(theta), np.sin(theta)])
+    cost = gcff._costs(xy, votes, np.ones(3, bool), np.zeros((1, 2)), np.array([-1]), params)
+    assert np.isfinite(cost).all() and cost[1:, 0] == pytest.approx([0.0, 0.0], abs=1e-12)
+
+
 def test_a_permuted_circle_is_still_one_group_in_either_order():
     positions, yaw = ring(6, 0.9)
     order = np.array([3, 0, 5, 1, 4, 2])
