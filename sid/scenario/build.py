@@ -9,6 +9,7 @@ from costmap.layered import LayeredCostmap
 from costmap.layers.obstacle import SCAN
 from costmap.layers.social import GROUPS, PEOPLE
 from costmap.layers.static import static_costs
+from costmap.layers.tracked import TRACKS
 from costmap.mapfile import read_map
 from costmap.occupancy import OccupancyGrid
 from costmap.plugins import CostmapParams, layered_costmap
@@ -18,6 +19,7 @@ from sid.perception.groups import detect_groups
 from sid.scenario.known_map import known_map
 from sid.scenario.lidar import simulate_scan
 from sid.scenario.loader import Scenario
+from sid.tracking.records import still_tracks
 
 __all__ = ["build_costmap", "map_walls", "planning_problem"]
 
@@ -34,7 +36,8 @@ def build_costmap(
     drawn into the ``static_map`` file, if any; without either there is no static layer. The LiDAR layer marks what
     the scan from the start sees (obstacles' near faces, the map file's walls, people).
 
-    ``social`` False leaves the social layer out (a robot without recognition). ``groups`` None: detect them with
+    ``social`` False leaves the social layer out, and gives a tracked-people layer no tracks (a robot without
+    recognition). ``groups`` None: detect them with
     ``sid.perception.groups.detect_groups`` (only when ``social``). ``params`` None: the scenario's "layers" block.
     """
     params = params or scenario.layers
@@ -64,7 +67,9 @@ def build_costmap(
     )
     if groups is None:
         groups = detect_groups(scenario.people, scenario.group_params) if social else []
-    layered.update(LayerInputs({PEOPLE: scenario.people, GROUPS: groups, SCAN: scan}))
+    # A tracked-people layer draws the scene at rest: its people as standing tracks, its groups as conversations.
+    tracks = still_tracks(scenario.people, groups) if social else None
+    layered.update(LayerInputs({PEOPLE: scenario.people, GROUPS: groups, SCAN: scan, TRACKS: tracks}))
     return layered
 
 

@@ -17,7 +17,7 @@ from sid.errors import InputError
 from sid.perception.group import Group, group_json
 from sid.perception.people import Person
 
-__all__ = ["TIME_TOLERANCE", "GroupKind", "MotionState", "TrackedGroup", "TrackedPerson", "Tracks"]
+__all__ = ["TIME_TOLERANCE", "GroupKind", "MotionState", "TrackedGroup", "TrackedPerson", "Tracks", "still_tracks"]
 
 MotionState = Literal["standing", "walking"]
 GroupKind = Literal["conversation", "walking"]
@@ -145,3 +145,20 @@ class Tracks:
             missing = sorted(set(group.members) - ids)
             if missing:
                 raise InputError(f"tracks: group {group.id} has members {missing} that are not among the people")
+
+
+def still_tracks(people: Sequence[Person], groups: Sequence[Group], timestamp: float = 0.0) -> Tracks:
+    """``people`` as standing tracks seen at ``timestamp`` (s), each with its own id, no velocity and its facing at
+    full orientation quality, and ``groups`` as conversations (ids from 1): the tracks of a scene at rest, for a
+    tracked-people layer drawn from a snapshot (``sid plan``, ``sid costmap``)."""
+    tracked = [
+        TrackedPerson(p.id, p.x, p.y, 0.0, 0.0, p.theta, "standing", True, True, timestamp, p.id, 0.0,
+                      p.orientation_quality)
+        for p in people
+    ]  # fmt: skip
+    conversations = [
+        TrackedGroup(k, "conversation", tuple(sorted(g.members)), g.interest_point, g.zone, g.area, g.spread,
+                     (0.0, 0.0), timestamp)
+        for k, g in enumerate(groups, start=1)
+    ]  # fmt: skip
+    return Tracks(tracked, conversations)

@@ -145,6 +145,27 @@ def test_a_scenario_names_its_layers_in_order(tmp_path):
             scenario_from_dict({**data, "layers": {"plugins": plugins}}, base_dir=tmp_path)
 
 
+def test_a_scenarios_tracked_people_layer_draws_its_people_as_the_social_layer_does(tmp_path) -> None:
+    """With tracked_people the only people layer, sid plan's costmap was empty: nothing fed it tracks, and a path
+    went between two people in conversation, 0.4 m from each (a probe, 7 December 2026)."""
+    data = {
+        "map": {"resolution": 0.05, "origin": [0.0, 0.0], "size": [12.0, 8.0]},
+        "people": [{"id": 1, "x": 6.0, "y": 4.4, "theta": -1.57}, {"id": 2, "x": 6.0, "y": 3.6, "theta": 1.57}],
+        "robot": {"start": [1.0, 4.0], "goal": [11.0, 4.0]},
+    }
+    drawn = {
+        plugins: build_costmap(scenario_from_dict({**data, "layers": {"plugins": list(plugins)}}, base_dir=tmp_path))
+        for plugins in (("tracked_people", "inflation"), ("social", "inflation"))
+    }
+    tracked, social = (drawn[k].master.costs for k in drawn)
+    assert tracked[int(4.0 / 0.05), int(6.0 / 0.05)] >= 253  # between the two: their o-space
+    np.testing.assert_array_equal(tracked, social)
+    without = build_costmap(
+        scenario_from_dict({**data, "layers": {"plugins": ["tracked_people"]}}, base_dir=tmp_path), social=False
+    )
+    assert not without.master.costs.any()  # a robot without recognition: no tracks
+
+
 def test_unknown_space_and_the_peoples_clearing_come_from_the_listed_layer_instances(tmp_path) -> None:
     data = _scenario(
         {
