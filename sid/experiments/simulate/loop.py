@@ -73,9 +73,22 @@ from sid.stream import SocialStream
 from sid.synthetic.pose import TruthPose
 from sid.synthetic.sensor import SyntheticCamera
 
-__all__ = ["Observer", "PERCEPTIONS", "RunOptions", "RunTrace", "StepView", "make_sensing", "simulate"]
+__all__ = [
+    "MAX_CONTROL_PERIOD_S",
+    "Observer",
+    "PERCEPTIONS",
+    "RunOptions",
+    "RunTrace",
+    "StepView",
+    "make_sensing",
+    "simulate",
+]
 
 PERCEPTIONS = ("camera", "exact")
+MAX_CONTROL_PERIOD_S = 0.25
+"""The longest the path follower's command is held (s): a world stepped more slowly (rate_hz below 4) runs the
+follower several times per step, as a robot's controller runs at its own rate whatever its camera's; held for a
+2 s step, a turn in place passed the bend's bearing and back for ever (a probe at 0.5 Hz, 7 December 2026)."""
 
 
 @dataclass(frozen=True)
@@ -288,6 +301,7 @@ def simulate(
     scenario, settings = world.scenario, world.settings
     limits = settings.limits
     dt = 1.0 / settings.rate_hz
+    control_steps = math.ceil(dt / MAX_CONTROL_PERIOD_S - 1e-9)
     walls = map_walls(scenario)  # read once: the world's collisions and scans, exact perception's sight lines
     sensing = make_sensing(world, options, color, walls)
     planner = _Planner(world, options)
@@ -333,11 +347,6 @@ def simulate(
                              range_max=lidar.range_max, body_radius=lidar.body_radius, static=walls)  # fmt: skip
         seen = sensing(k, pose, people, scan)
         planner.update(t, sensing.costmap.master, (state.x, state.y), limits.radius)
-        if planner.path is not None:
-            command = follow(planner.path, state.pose, state.v, follower)
-            linear, angular = command.linear, command.angular
-        else:
-            linear, angular = 0.0, 0.0
         if observer is not None:
             observer(
                 StepView(
@@ -345,7 +354,12 @@ def simulate(
                 )
             )
         before = ((state.x, state.y), people)
-        state = step(state, linear, angular, dt, limits)
+        for _ in range(control_steps):  # the follower at its own rate, at most MAX_CONTROL_PERIOD_S apart
+            linear, angular = 0.0, 0.0  # without a path the robot waits
+            if planner.path is not None:
+                command = follow(planner.path, state.pose, state.v, follower)
+                linear, angular = command.linear, command.angular
+            state = step(state, linear, angular, dt / control_steps, limits)
         k += 1
     trace.plans, trace.replans, trace.planning_time_s = planner.plans, planner.replans, planner.time_s
     return trace

@@ -227,16 +227,36 @@ def _ambush(start_time: float) -> dict:
 
 def test_a_walker_crossing_the_robot_between_two_steps_is_a_collision():
     # Checked at the steps alone, the walker stood 0.75 m from the robot at t = 7 s and t = 8 s, and the run reached
-    # its goal; in between they were 0.24 m apart, under the 0.45 m of the two bodies.
+    # its goal; in between they were 0.30 m apart, under the 0.45 m of the two bodies (0.24 m before the follower ran
+    # at its own rate between the 1 s steps, MAX_CONTROL_PERIOD_S).
     trace = simulate(world_from_dict(_ambush(5.5)), EXACT)
     assert not trace.success and trace.collisions == 1 and trace.reason.startswith("collision with person 1 at t = 8")
-    assert run_metrics(trace, 10.0)["min_person_distance_m"] == pytest.approx(0.237, abs=0.001)
+    assert run_metrics(trace, 10.0)["min_person_distance_m"] == pytest.approx(0.296, abs=0.001)
 
 
 def test_the_closest_approach_is_over_the_step_not_against_where_the_people_were_at_its_start():
-    # Half a second earlier the walker passes in front of the robot: 0.495 m at the closest (a walker moving straight
-    # between the steps' positions); the segment against the walker's position at each step's start read 0.388 m.
+    # Half a second earlier the walker passes in front of the robot: 0.561 m at the closest (a walker moving straight
+    # between the steps' positions; 0.495 m before the follower ran at its own rate between the 0.5 s steps); the
+    # segment against the walker's position at each step's start read 0.388 m then.
     world = world_from_dict(_ambush(5.0) | {"simulation": {"rate_hz": 2.0, "time_limit_s": 40.0}})
     trace = simulate(world, EXACT)
     assert trace.success and trace.collisions == 0
-    assert run_metrics(trace, 10.0)["min_person_distance_m"] == pytest.approx(0.4947, abs=0.001)
+    assert run_metrics(trace, 10.0)["min_person_distance_m"] == pytest.approx(0.5606, abs=0.001)
+
+
+def test_a_world_stepped_at_half_a_hertz_still_follows_a_bend_round_a_pair():
+    """Held for a whole 2 s step, the follower's turn in place passed the bend's bearing and back until the time
+    limit (a probe, 7 December 2026); it now runs at least every MAX_CONTROL_PERIOD_S between the world's steps."""
+    corridor = [{"type": "segment", "points": [[0, y], [10, y]]} for y in (0.5, 3.5)]
+    pair = [{"id": 1, "x": 5, "y": 2.9, "theta": -1.57}, {"id": 2, "x": 5, "y": 2.1, "theta": 1.57}]
+    world = world_from_dict(
+        {
+            "map": {"resolution": 0.05, "origin": [0, 0], "size": [10, 4]},
+            "obstacles": corridor,
+            "people": pair,
+            "robot": {"start": [1, 2, 0], "goal": [9, 2, 0]},
+            "simulation": {"time_limit_s": 40, "rate_hz": 0.5},
+        }
+    )
+    run = run_metrics(simulate(world, EXACT), 4.0)
+    assert run["success"] and run["collisions"] == 0 and run["ospace_intrusion_m"] == 0.0
