@@ -2,7 +2,7 @@
 
 Two people walk in file, then two side by side, past a robot's camera (``synthetic:walking_pairs``). One
 ``SocialStream.update`` per frame runs the per-frame pipeline (here ``TruthPose``: the rendered keypoints with
-detector-like noise), the people and group trackers and the costmap. Once a second it prints each confirmed track
+detector-like noise), the people and group trackers and the costmap. Once a second it prints each reported track
 (map frame, m and m/s) and the tracked groups: walkers come out as a ``walking`` group, never as a conversation.
 """
 

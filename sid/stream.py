@@ -45,13 +45,13 @@ class StreamUpdate:
     """The stream's state after one frame.
 
     frame_id: the frame of every position ("map" or "base_footprint"). timestamp: the frame's (s). people, groups:
-    the tracks reported and the confirmed groups (``sid.tracking.session.split_reported``; the costmap also draws
-    the tracks held, missed for longer than ``TrackingParams.report_timeout``). costmap: the combined grid after
+    the tracks and groups reported (``sid.tracking.session.split_reported``; the costmap also draws those held,
+    missed for longer than ``TrackingParams.report_timeout``). costmap: the combined grid after
     this frame (``costmap.costs``: uint8, Nav2 values), a copy that later frames leave as it is (the stream's live
     LayeredCostmap is ``SocialStream.costmap``).
     result: the per-frame pipeline's raw result. timing_ms: per stage ("pose", "lift", "group" from the pipeline,
     then "track", "track_groups", "costmap", and "total"). reset: why the trackers were reset at this frame (None:
-    they were not). held: the confirmed tracks not reported (``SessionUpdate.held``).
+    they were not). held, held_groups: the confirmed tracks and groups not reported (``SessionUpdate.held``).
     """
 
     frame_id: str
@@ -63,6 +63,7 @@ class StreamUpdate:
     timing_ms: dict[str, float]
     reset: str | None = None
     held: list[TrackedPerson] = field(default_factory=list)
+    held_groups: list[TrackedGroup] = field(default_factory=list)
 
 
 class SocialStream:
@@ -103,8 +104,8 @@ class SocialStream:
         step = self.people.update(frame, robot_pose)
         result, tracked = step.result, step.tracks
         t0 = time.perf_counter()
-        conversations = [g.as_group() for g in tracked.groups if g.kind == "conversation"]
         tracks = tracked.all_tracks()
+        conversations = [g.as_group() for g in tracks.groups if g.kind == "conversation"]
         people = [p.as_person() for p in tracks.people]
         self.costmap.update(LayerInputs({PEOPLE: people, GROUPS: conversations, SCAN: scan, TRACKS: tracks}))
         t1 = time.perf_counter()
@@ -119,6 +120,7 @@ class SocialStream:
             timing,
             tracked.reset,
             tracked.held,
+            tracked.held_groups,
         )
 
     def view(self, frame: Frame) -> ViewCone:

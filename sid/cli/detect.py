@@ -347,7 +347,7 @@ def run(args: argparse.Namespace) -> int:
         return fail("sid detect", exc)
 
     done = skipped = unreadable = 0  # unreadable: frames whose files could not be read, among the skipped
-    unconfirmed = 0  # frames written with people detected but none a confirmed track yet (tracking's people: [])
+    unconfirmed = 0  # frames written with people detected but no track reported yet (tracking's people: [])
 
     def skip(index: int | None, reason: object) -> None:
         nonlocal skipped
@@ -409,7 +409,7 @@ def run(args: argparse.Namespace) -> int:
     seconds = time.perf_counter() - started  # the frames' wall-clock time, start-up (imports, model load) aside
     rate = f" in {seconds:.1f} s ({(done + skipped) / seconds:.1f} frames/s)" if done + skipped else ""
     median = f", median {np.median(totals):.2f} ms per frame" if totals else ""
-    waiting = f", {plural(unconfirmed, 'frame')} with no confirmed track yet (people: [])" if unconfirmed else ""
+    waiting = f", {plural(unconfirmed, 'frame')} with no track reported yet (people: [])" if unconfirmed else ""
     summary = f"{plural(done - unconfirmed, 'frame')} with people{waiting}, {skipped} skipped{rate}{median}"
     print(f"detect: {summary}", file=sys.stderr)
     if args.out is not None:  # as every command that writes files says what it wrote; stdout is the JSON lines'

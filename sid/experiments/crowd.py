@@ -83,10 +83,11 @@ DEFAULT_GRID: dict[str, dict[str, tuple[float, ...]]] = {
         "walk_window": (2.0, 3.0, 4.0),
     },
     "coherent": {"distance": (1.0, 1.5, 2.0), "velocity_difference": (0.3, 0.4, 0.5, 0.6), "share": (0.4, 0.6, 0.8)},
-    "reporting": {"report_timeout": (0.2, 0.4, 0.8, 1.5)},
+    "reporting": {"report_timeout": (0.2, 0.4, 0.6, 0.8, 1.5)},
 }
 """What ``cross_validate`` chooses among: the people tracker's, the group tracker's and the reference's parameters,
-and how long a missed track is reported (``TrackingParams.report_timeout``; 1.5 s, the tracker's timeout: always)."""
+and how long a missed track is reported (``TrackingParams.report_timeout``; 1.5 s, the default tracker's timeout:
+every track it keeps is reported)."""
 
 
 @dataclass(frozen=True)
@@ -103,15 +104,22 @@ class CrowdSettings:
 
 @dataclass(frozen=True, eq=False)
 class TrackLog:
-    """One replayed set through the people tracker: per frame the time (s), the truth (ids, (K, 2) positions m)
-    and the confirmed tracks (``TrackedPerson``s) detected or in view: the group tracker's input, and the
-    hypotheses once ``reported_log`` has kept those reported."""
+    """One replayed set through the people tracker: per frame the time (s), the truth (ids, (K, 2) positions m),
+    the confirmed tracks (``TrackedPerson``s) detected or in view (``tracks``: the tracker's own hypotheses; those
+    reported once ``reported_log`` has kept them), and every confirmed track (``confirmed``: the group tracker's
+    input, as in ``TrackingSession``; None: ``tracks``)."""
 
     name: str
     times: list[float]
     truth_ids: list[np.ndarray]
     truth_positions: list[np.ndarray]
     tracks: list[list[TrackedPerson]]
+    confirmed: list[list[TrackedPerson]] | None = None
+
+    @property
+    def group_input(self) -> list[list[TrackedPerson]]:
+        """Per frame, the tracks the group tracker sees: every confirmed one."""
+        return self.tracks if self.confirmed is None else self.confirmed
 
     def track_positions(self, frame: int) -> np.ndarray:
         return np.array([[p.x, p.y] for p in self.tracks[frame]]).reshape(-1, 2)
@@ -123,7 +131,8 @@ def record_tracks(
     """Replay ``trajectories`` through the people tracker (``TrackingSession.track``, groups left to the caller)."""
     settings = settings or CrowdSettings()
     session = TrackingSession(settings.tracking)
-    log = TrackLog(trajectories.name, [], [], [], [])
+    confirmed: list[list[TrackedPerson]] = []
+    log = TrackLog(trajectories.name, [], [], [], [], confirmed)
     total = replay_length(trajectories, settings.replay.rate)
     view = replay_view(trajectories, settings.replay)
     for k, frame in enumerate(replay(trajectories, settings.replay)):
@@ -134,6 +143,7 @@ def record_tracks(
         log.truth_ids.append(frame.truth_ids)
         log.truth_positions.append(frame.truth_positions)
         log.tracks.append([p for p in people if p.visible or p.in_view])
+        confirmed.append(people)
         if progress is not None:
             progress(k + 1, total, trajectories.name)
     if not any(len(ids) for ids in log.truth_ids):
@@ -159,14 +169,18 @@ def replay_view(trajectories: TrajectorySet, replay_settings: ReplaySettings) ->
         raise TrajectoryError(f"{trajectories.name}: {exc}; set the robot's view instead (--view)") from None
 
 
-def reported_log(log: TrackLog, groups: Sequence[Sequence[frozenset[int]]], report_timeout: float) -> TrackLog:
-    """``log`` with, in each frame, only the tracks reported beside ``groups`` (that frame's groups, member track
-    ids): ``sid.tracking.session.split_reported``, as ``TrackingSession`` reports them."""
-    tracks = [
-        split_reported(people, frozenset().union(*found), report_timeout)[0]
-        for people, found in zip(log.tracks, groups, strict=True)
-    ]
-    return TrackLog(log.name, log.times, log.truth_ids, log.truth_positions, tracks)
+def reported_log(
+    log: TrackLog, groups: Sequence[Sequence[frozenset[int]]], report_timeout: float
+) -> tuple[TrackLog, list[list[frozenset[int]]]]:
+    """``log`` with, in each frame, only the tracks detected or in view that ``TrackingSession`` reports beside
+    ``groups`` (that frame's groups of every confirmed track, member track ids: ``find_groups``), and the groups it
+    reports (``sid.tracking.session.split_reported``)."""
+    tracks, shown = [], []
+    for people, found in zip(log.group_input, groups, strict=True):
+        reported, _, kept = split_reported(people, found, report_timeout)
+        tracks.append([p for p in reported if p.visible or p.in_view])
+        shown.append([group for group, keep in zip(found, kept, strict=True) if keep])
+    return TrackLog(log.name, log.times, log.truth_ids, log.truth_positions, tracks, log.confirmed), shown
 
 
 def score_groups(
@@ -176,7 +190,8 @@ def score_groups(
     settings: CrowdSettings | None = None,
     progress: Progress | None = None,
 ) -> dict[str, Any]:
-    """G-MITRE and per-frame matching of ``groups`` (per frame of ``log``: member track ids) against the truth;
+    """G-MITRE and per-frame matching of ``groups`` (per frame of ``log``: member track ids) against the truth,
+    each group cut to its members among the frame's tracks (two or more; those out of view are no hypotheses);
     ``progress`` after each frame."""
     settings = settings or CrowdSettings()
     links = LinkCounts()
@@ -189,7 +204,9 @@ def score_groups(
         truth = trajectories.truth_groups(present)
         track_ids = [p.id for p in log.tracks[k]]
         identity = identify(log.track_positions(k), ids, log.truth_positions[k], settings.match_distance)
-        as_truth = as_truth_ids([tuple(g) for g in found], track_ids, identity)
+        scored = set(track_ids)  # a group's members out of view are not scored, as the truth's absent members
+        seen = [tuple(sorted(g & scored)) for g in found if len(g & scored) >= 2]
+        as_truth = as_truth_ids(seen, track_ids, identity)
         in_scene = [g & present for g in as_truth]
         grouped = set().union(*truth)
         found_grouped = set().union(*in_scene) if in_scene else set()
@@ -219,10 +236,14 @@ def score_groups(
 def find_groups(
     log: TrackLog, params: GroupTrackerParams, progress: Progress | None = None
 ) -> list[list[frozenset[int]]]:
-    """Per frame of ``log``: the group tracker's confirmed groups (any kind), as member track ids; ``progress``
-    after each frame."""
+    """Per frame of ``log``: the group tracker's confirmed groups (any kind) on every confirmed track, as
+    ``TrackingSession`` runs it, as member track ids; ``progress`` after each frame."""
     tracker = GroupTracker(params)
-    return _per_frame(log, lambda people, t: [frozenset(g.members) for g in tracker.update(people, t)], progress)
+
+    def update(people: list[TrackedPerson], timestamp: float) -> list[frozenset[int]]:
+        return [frozenset(g.members) for g in tracker.update(people, timestamp)]
+
+    return _per_frame(log, log.group_input, update, progress)
 
 
 def find_coherent_groups(
@@ -230,17 +251,18 @@ def find_coherent_groups(
 ) -> list[list[frozenset[int]]]:
     """Per frame of ``log``: the coherent-motion reference's groups, as member track ids; ``progress`` after each
     frame."""
-    return _per_frame(log, CoherentMotion(params).update, progress)
+    return _per_frame(log, log.tracks, CoherentMotion(params).update, progress)
 
 
 def _per_frame(
     log: TrackLog,
+    tracks: Sequence[list[TrackedPerson]],
     update: Callable[[list[TrackedPerson], float], list[frozenset[int]]],
     progress: Progress | None,
 ) -> list[list[frozenset[int]]]:
-    """``update(tracks, timestamp)`` on every frame of ``log`` in order, its answers; ``progress`` after each."""
+    """``update(tracks[k], timestamp)`` on every frame k of ``log`` in order, its answers; ``progress`` after each."""
     found = []
-    for k, (t, people) in enumerate(zip(log.times, log.tracks, strict=True)):
+    for k, (t, people) in enumerate(zip(log.times, tracks, strict=True)):
         found.append(update(people, t))
         if progress is not None:
             progress(k + 1, len(log.times), log.name)
@@ -271,9 +293,9 @@ def evaluate_crowd(
         passes = [_pass(progress, k, trajectories.name) for k in range(len(EVALUATION_PASSES))]
         log = record_tracks(trajectories, settings, passes[0])
         found = find_groups(log, settings.tracking.groups, passes[1])
-        shown = reported_log(log, found, settings.tracking.report_timeout)
+        shown, reported = reported_log(log, found, settings.tracking.report_timeout)
         people = score_people(shown, settings.match_distance, passes[2])
-        groups = score_groups(trajectories, shown, found, settings, passes[3])
+        groups = score_groups(trajectories, shown, reported, settings, passes[3])
         reference = find_coherent_groups(log, settings.coherent, passes[4])
         out["sets"][trajectories.name] = {
             "frames": len(log.times),
@@ -369,7 +391,7 @@ def cross_validate(
                 "held_out_f1": float(table[best, col]),
             }
         fold["reporting"] = _choose_reporting(
-            tracker_logs[row], settings, chosen["groups"], grid.get("reporting", {}), col
+            tracker_logs[row], settings, chosen["groups"], grid.get("reporting", {}), col, progress
         )
         folds.append(fold)
     return {"folds": folds, "grid": {k: {n: list(v) for n, v in g.items()} for k, g in grid.items()}}
@@ -393,10 +415,10 @@ def _group_f1(
     out = []
     for trajectories, log in zip(sets, logs, strict=True):
         if isinstance(params, GroupTrackerParams):
-            found = find_groups(log, params)
-        else:
-            found = find_coherent_groups(log, params)
-        out.append(score_groups(trajectories, log, found, settings)["gmitre"]["f1"])
+            scored, found = reported_log(log, find_groups(log, params), settings.tracking.report_timeout)
+        else:  # as evaluate_crowd scores them
+            scored, found = log, find_coherent_groups(log, params)
+        out.append(score_groups(trajectories, scored, found, settings)["gmitre"]["f1"])
     return out
 
 
@@ -406,21 +428,21 @@ def _choose_reporting(
     params: GroupTrackerParams,
     axes: Mapping[str, Sequence[float]],
     held_out: int,
+    progress: Progress | None = None,
 ) -> dict[str, Any]:
     """``cross_validate``'s third stage for the set ``held_out`` (an index of ``logs``): the point of ``axes`` (fields
     of ``TrackingParams``) whose tracks reported beside the groups of the group tracker with ``params`` have the best
-    mean IDF1 on the other sets; that IDF1 and the held-out set's."""
+    mean IDF1 on the other sets; that IDF1 and the held-out set's. ``progress`` after each point."""
     points = _points(settings.tracking, axes)
     groups = [find_groups(log, params) for log in logs]
-    idf1 = np.array(
-        [
-            [
-                score_people(reported_log(log, found, point.report_timeout), settings.match_distance)["idf1"]
-                for log, found in zip(logs, groups, strict=True)
+    idf1 = np.zeros((len(points), len(logs)))
+    for k, point in enumerate(points):
+        for col, (log, found) in enumerate(zip(logs, groups, strict=True)):
+            idf1[k, col] = score_people(reported_log(log, found, point.report_timeout)[0], settings.match_distance)[
+                "idf1"
             ]
-            for point in points
-        ]
-    ).reshape(len(points), len(logs))
+        if progress is not None:
+            progress(k + 1, len(points), f"reporting points, {logs[held_out].name} held out")
     others = np.delete(idf1, held_out, axis=1).mean(axis=1)
     best = int(np.argmax(others))
     return {

@@ -6,11 +6,12 @@ and ``SessionUpdate.reset`` says why, when the robot pose jumps (moves faster th
 faster than ``max_turn_rate``, plus a tolerance: a relocalisation puts every track in the wrong place), when the
 frame the results are given in changes (a pose that appears or disappears), or when time goes back more than
 ``max_time_back`` (a looped recording, a clock reset, or the frame after one stamped in the future: refused for
-good, every later frame would be). Reported (``SessionUpdate.people``): a confirmed track while detected, missed in
-the camera's view for at most ``report_timeout``, or a member of a confirmed group; the others are held
-(``SessionUpdate.held``): kept for re-association until the tracker's timeout, still drawn on the costmap, but not
-claimed as people present (a track coasting on after its person left). Errors (``TrackingError``, nothing changed):
-a result not after the last one in time (but within ``max_time_back`` of it), a non-finite timestamp or robot pose.
+good, every later frame would be). Reported (``SessionUpdate.people``, ``groups``): a confirmed track while detected
+or missed in the camera's view for at most ``report_timeout``, a confirmed group while one of its members is, and
+its members with it; the others are held (``SessionUpdate.held``, ``held_groups``): kept by the trackers until their
+timeouts, still drawn on the costmap, but not claimed as present (a track coasting on after its person left).
+Errors (``TrackingError``, nothing changed): a result not after the last one in time (but within ``max_time_back`` of
+it), a non-finite timestamp or robot pose.
 """
 
 from __future__ import annotations
@@ -65,20 +66,22 @@ class TrackingParams:
 
 @dataclass
 class SessionUpdate:
-    """The people reported and the confirmed groups after one result, why the trackers were reset at it (None: they
-    were not), the time (ms) the two trackers took ("track", "track_groups"), and the confirmed tracks held but not
-    reported (``split_reported``). Every group member is among ``people``."""
+    """The people and groups reported after one result, why the trackers were reset at it (None: they were not), the
+    time (ms) the two trackers took ("track", "track_groups"), and the confirmed tracks and groups held but not
+    reported (``split_reported``). Every member of a group reported is among ``people``, of a group held among
+    ``held``."""
 
     people: list[TrackedPerson]
     groups: list[TrackedGroup]
     reset: str | None
     timing_ms: dict[str, float]
     held: list[TrackedPerson] = field(default_factory=list)
+    held_groups: list[TrackedGroup] = field(default_factory=list)
 
     def all_tracks(self) -> Tracks:
-        """Every confirmed track, reported and held, with the groups: what the tracked-people layer draws (a person
-        the detector has missed for a moment still gets their space on the costmap)."""
-        return Tracks([*self.people, *self.held], self.groups)
+        """Every confirmed track and group, reported and held: what the tracked-people layer draws (a person the
+        detector has missed for a moment still gets their space on the costmap)."""
+        return Tracks([*self.people, *self.held], [*self.groups, *self.held_groups])
 
 
 class TrackingSession:
@@ -149,9 +152,12 @@ class TrackingSession:
         t1 = time.perf_counter()
         groups = self.groups.update(tracked, timestamp)
         t2 = time.perf_counter()
-        grouped = {i for group in groups for i in group.members}
-        reported, held = split_reported(tracked, grouped, self.params.report_timeout)
-        return SessionUpdate(reported, groups, None, {"track": (t1 - t0) * 1e3, "track_groups": (t2 - t1) * 1e3}, held)
+        reported, held, kept = split_reported(tracked, [g.members for g in groups], self.params.report_timeout)
+        timing = {"track": (t1 - t0) * 1e3, "track_groups": (t2 - t1) * 1e3}
+        shown = [g for g, keep in zip(groups, kept, strict=True) if keep]
+        return SessionUpdate(
+            reported, shown, None, timing, held, [g for g, k in zip(groups, kept, strict=True) if not k]
+        )
 
     def _reset_reason(self, result: FrameResult) -> str | None:
         """Why the tracks no longer hold at this result (None: they do)."""
@@ -174,15 +180,20 @@ class TrackingSession:
 
 
 def split_reported(
-    people: Sequence[TrackedPerson], grouped: Collection[int], report_timeout: float
-) -> tuple[list[TrackedPerson], list[TrackedPerson]]:
-    """The confirmed tracks ``people`` split into those reported and those held: a track is reported while it was
-    missed in the camera's view for at most ``report_timeout`` (s; ``TrackedPerson.missed_in_view``), or while its
-    id is ``grouped`` (a member of a confirmed group: a group holds its members through their misses). Held tracks
-    coast on the tracker's prediction where the detector, looking there, sees nobody: mostly people who left."""
+    people: Sequence[TrackedPerson], groups: Sequence[Collection[int]], report_timeout: float
+) -> tuple[list[TrackedPerson], list[TrackedPerson], list[bool]]:
+    """The confirmed tracks ``people`` split into those reported and those held, and which of ``groups`` (member
+    ids) are reported. A track is fresh while it was missed in the camera's view for at most ``report_timeout`` (s;
+    ``TrackedPerson.missed_in_view``); a group is reported while one of its members is fresh, and a track while it is
+    fresh or a member of a group reported (a group holds its members through their misses). Held tracks, and groups
+    whose members all went unseen, coast on the trackers' predictions where the detector, looking there, sees nobody:
+    mostly people who left."""
     limit = report_timeout + TIME_TOLERANCE
+    fresh = {p.id for p in people if p.missed_in_view <= limit}
+    kept = [any(i in fresh for i in group) for group in groups]
+    grouped = {i for group, keep in zip(groups, kept, strict=True) if keep for i in group}
     reported: list[TrackedPerson] = []
     held: list[TrackedPerson] = []
     for person in people:
-        (reported if person.missed_in_view <= limit or person.id in grouped else held).append(person)
-    return reported, held
+        (reported if person.id in fresh or person.id in grouped else held).append(person)
+    return reported, held, kept

@@ -280,7 +280,7 @@ def test_summary_counts_every_skipped_frame(tmp_path, capsys):
     assert main(["detect", "--source", str(tmp_path), "--model", str(model), "--no-keypoints"]) == 0
     captured = capsys.readouterr()
     assert len(_lines(captured.out)) == 1
-    assert "0 frames with people, 1 frame with no confirmed track yet (people: []), 3 skipped" in captured.err
+    assert "0 frames with people, 1 frame with no track reported yet (people: []), 3 skipped" in captured.err
 
 
 def test_a_folder_sequence_is_stamped_at_fps_and_the_assumed_rate_is_said(tmp_path, capsys):

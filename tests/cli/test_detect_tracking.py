@@ -36,7 +36,7 @@ def test_the_summary_and_the_total_time_are_those_of_the_printed_tracks(capsys) 
     captured = capsys.readouterr()
     records = _lines(captured.out)
     assert [len(r["people"]) for r in records] == [0, 0, 2, 2]
-    assert "detect: 2 frames with people, 2 frames with no confirmed track yet (people: []), 0 skipped" in captured.err
+    assert "detect: 2 frames with people, 2 frames with no track reported yet (people: []), 0 skipped" in captured.err
     for record in records:
         timing = record["timing_ms"]
         assert list(timing)[-1] == "total" and {"track", "track_groups"} <= timing.keys()
@@ -100,7 +100,7 @@ def test_a_frame_out_of_time_order_is_skipped_and_the_tracks_go_on(capsys, monke
     records = _lines(captured.out)
     assert [r["frame"] for r in records] == [0, 1, 2, 3, 4, 6, 7]
     assert "detect: frame 5: skipped, frame 5 is out of time order" in captured.err
-    assert "5 frames with people, 2 frames with no confirmed track yet (people: []), 1 skipped" in captured.err
+    assert "5 frames with people, 2 frames with no track reported yet (people: []), 1 skipped" in captured.err
     ids = [sorted(p["id"] for p in r["people"]) for r in records[2:]]
     assert all(i == ids[0] for i in ids) and len(ids[0]) == 2
 

@@ -93,8 +93,22 @@ def test_a_missed_member_of_a_group_stays_reported_while_a_lone_one_is_held() ->
     assert {p.id for p in update.people} | {held.id} == ids
 
 
-def test_split_reported_keeps_the_order_and_the_report_timeout_bound() -> None:
+def test_split_reported_keeps_the_order_and_a_group_while_one_member_is_fresh() -> None:
     tracks = [TrackedPerson(i, 0.0, 0.0, 0.0, 0.0, None, "standing", False, True, 0.0, None, 0.1, 0.0, missed)
-              for i, missed in ((1, 0.4), (2, 0.5), (3, 0.0), (4, 2.0))]  # fmt: skip
-    reported, held = split_reported(tracks, {4}, 0.4)
-    assert [p.id for p in reported] == [1, 3, 4] and [p.id for p in held] == [2]
+              for i, missed in ((1, 0.4), (2, 0.5), (3, 0.0), (4, 2.0), (5, 0.9), (6, 1.0))]  # fmt: skip
+    reported, held, kept = split_reported(tracks, [{3, 4}, {5, 6}], 0.4)
+    assert [p.id for p in reported] == [1, 3, 4] and [p.id for p in held] == [2, 5, 6] and kept == [True, False]
+
+
+def test_a_group_whose_members_all_went_unseen_is_held_with_them() -> None:
+    """A pair that walked out of the detector's sight together: its tracks coast, held by nobody fresh."""
+    session = TrackingSession(TrackingParams(report_timeout=0.3))
+    pair = [Person(0, 2.0, 0.4, -math.pi / 2), Person(1, 2.0, -0.4, math.pi / 2)]
+    for k in range(10):
+        update = session.track(pair, 0.1 * k)
+    (group,) = update.groups
+    for k in range(10, 15):  # both missed for 0.5 s, in view
+        update = session.track([], 0.1 * k)
+    assert update.people == [] and update.groups == []
+    assert [g.id for g in update.held_groups] == [group.id] and {p.id for p in update.held} == set(group.members)
+    assert update.all_tracks().groups == tuple(update.held_groups)
