@@ -354,8 +354,8 @@ def _hidden(name: str) -> bool:
 
 
 PLAUSIBLE_STRIDE_M = (0.05, 2.0)
-"""The range (m) of GCFF strides that fit people (the published settings: 0.10-0.60 m): a scaled stride outside it
-was written in other units than the positions (``gcff_settings`` warns)."""
+"""The range (m) of GCFF strides that fit people (the published settings' range: docs/groups.md, "Other datasets"):
+a scaled stride outside it was written in other units than the positions (``gcff_settings`` warns)."""
 
 
 def gcff_settings(folder: str | Path, scale: float = 0.01) -> dict[str, GroupParams]:
@@ -473,7 +473,7 @@ def unit_warning(frames: Sequence[LabelledFrame], scale: float) -> str | None:
 
 DEGREES_SHARE = 0.1
 """The share of a dataset's known yaws beyond two turns (``YAW_LIMIT_RAD``) as radians from which the file is read in
-degrees (``load_dataset_any_yaw``): read as degrees, the four Verona sets have 58-92 % of their yaws beyond 12.6."""
+degrees (``load_dataset_any_yaw``; docs/groups.md, "Other datasets", gives the four sets' shares)."""
 
 
 def load_dataset_any_yaw(
@@ -515,8 +515,8 @@ def load_dataset_in_metres(
 
 FACING_AGREEMENT_MIN = 0.2
 """The least mean cosine between a ground-truth member's facing and the direction to their group's centre that looks
-like this format's convention (yaw counter-clockwise from +x, in the positions' frame): 0.36-0.71 on the four Verona
-sets, 0.14 with compass headings and 0.09 with the y axis flipped but not the yaws (a probe, 7 December 2026)."""
+like this format's convention (yaw counter-clockwise from +x, in the positions' frame; ``facing_agreement``; the four
+sets' values and those of other conventions: docs/groups.md, "Other datasets")."""
 
 
 def facing_agreement(frames: Sequence[LabelledFrame]) -> float | None:

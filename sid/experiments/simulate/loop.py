@@ -87,8 +87,8 @@ __all__ = [
 PERCEPTIONS = ("camera", "exact")
 MAX_CONTROL_PERIOD_S = 0.25
 """The longest the path follower's command is held (s): a world stepped more slowly (rate_hz below 4) runs the
-follower several times per step, as a robot's controller runs at its own rate whatever its camera's; held for a
-2 s step, a turn in place passed the bend's bearing and back for ever (a probe at 0.5 Hz, 7 December 2026)."""
+follower several times per step, as a robot's controller runs at its own rate whatever its camera's (held for a whole
+slow step, a turn in place passes the bend's bearing and turns back, step after step)."""
 
 
 @dataclass(frozen=True)
