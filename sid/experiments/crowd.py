@@ -10,10 +10,10 @@ Protocol:
   reference (``sid.tracking.coherent``) runs on the same tracks.
 - people (py-motmetrics): ground truth = the people present (inside the robot's view when one is set);
   hypotheses = the confirmed tracks detected in the frame or inside the view that ``TrackingSession`` reports
-  (``split_reported``: detected, missed in the view for at most ``report_timeout``, or a group's member). A track
-  within ``match_distance`` may match. MOTA, IDF1, identity switches (also per 100 true tracks). People and tracks
-  never within ``match_distance`` of each other are scored in separate motmetrics accumulators and merged
-  (``MOT_PART_IDS``).
+  (``split_reported``: detected or missed in the view for at most ``report_timeout``, or a member of a group with
+  such a member). A track within ``match_distance`` may match. MOTA, IDF1, identity switches (also per 100 true
+  tracks). People and tracks never within ``match_distance`` of each other are scored in separate motmetrics
+  accumulators and merged (``MOT_PART_IDS``).
 - groups: each frame's tracks are identified with true people by minimum total distance within ``match_distance``
   (an unidentified member is a stranger). Truth = the annotated groups holding among the people present (two or
   more members there). G-MITRE (``sid.experiments.gmitre``): link counts over the people present, everyone not

@@ -1,8 +1,8 @@
 """F-formation group benchmarks: load the Verona datasets' ``.mat`` files and score a group detector on them.
 
 Format (``features.mat`` / ``groundtruth.mat``, MATLAB v5 to v7, one folder per sequence): ``features{t}`` is an N x 4
-array ``[id, x, y, theta]`` per frame with ``timestamp(t)`` (further columns are not read, with a warning; 4 x N
-frames, four rows each and column counts that vary, are read transposed, with a warning);
+array ``[id, x, y, theta]`` per frame with ``timestamp(t)`` (further columns are not read, with a warning; frames
+stored 4 x N, one column per person, are read transposed, with a warning: ``_upright`` tells them);
 ``GTgroups{t}`` lists the member ids of each group at ``GTtimestamp(t)``; the variables may be one struct's fields. x, y
 are ground-plane coordinates (centimetres in the public sets: use ``scale=0.01``), theta is the facing yaw in radians in
 the same frame (``degrees=True`` for files in degrees). A dataset is a folder holding ``features.mat`` (one sequence) or

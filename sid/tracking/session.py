@@ -153,11 +153,10 @@ class TrackingSession:
         groups = self.groups.update(tracked, timestamp)
         t2 = time.perf_counter()
         reported, held, kept = split_reported(tracked, [g.members for g in groups], self.params.report_timeout)
-        timing = {"track": (t1 - t0) * 1e3, "track_groups": (t2 - t1) * 1e3}
-        shown = [g for g, keep in zip(groups, kept, strict=True) if keep]
-        return SessionUpdate(
-            reported, shown, None, timing, held, [g for g, k in zip(groups, kept, strict=True) if not k]
-        )
+        update = SessionUpdate(reported, [], None, {"track": (t1 - t0) * 1e3, "track_groups": (t2 - t1) * 1e3}, held)
+        for group, keep in zip(groups, kept, strict=True):
+            (update.groups if keep else update.held_groups).append(group)
+        return update
 
     def _reset_reason(self, result: FrameResult) -> str | None:
         """Why the tracks no longer hold at this result (None: they do)."""
