@@ -25,8 +25,8 @@ people = [
     Person(3, 3.0, -0.3, facing(3.0, -0.3, 3.0, -1.0) + 0.08),
     Person(4, 2.4, -1.35, facing(2.4, -1.35, 3.0, -1.0) - 0.05),
     Person(5, 3.6, -1.35, facing(3.6, -1.35, 3.0, -1.0)),
-    # Someone walking past the pair, facing along the corridor.
-    Person(6, 1.5, 0.2, math.pi / 2),
+    # Someone walking away from the pair along the corridor, their back to it.
+    Person(6, 1.5, 0.2, -math.pi / 2),
     # Someone whose facing the camera could not tell (theta None): never a member.
     Person(7, 4.2, 0.4, None),
 ]

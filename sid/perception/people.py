@@ -21,7 +21,8 @@ class Person:
     theta is None when the orientation is unknown (too few keypoints, degenerate geometry).
     orientation_quality in [0, 1]: how far theta can be trusted, the product of how planar the keypoints are, how
     horizontal that plane's normal is and how much left/right evidence tells front from back
-    (``sid.perception.orientation.estimate_orientation``); 0 = unknown.
+    (``sid.perception.orientation.estimate_orientation``); 0 = unknown. A facing given without one is trusted (1), as
+    every reader of facings does (scenario files, ``sid groups`` lines, the benchmarks' annotations).
     keypoints_world: optional (17, 3) keypoints in the same frame (z up from the ground), NaN rows where a keypoint
     was unusable.
     """
@@ -30,7 +31,7 @@ class Person:
     x: float
     y: float
     theta: float | None = None
-    orientation_quality: float = 0.0
+    orientation_quality: float = 1.0
     keypoints_world: np.ndarray | None = field(default=None, repr=False)
 
     @property
