@@ -19,8 +19,9 @@ are in the set's own ground frame; the facing is unknown (None): the sets have n
 
 from __future__ import annotations
 
+import itertools
 import math
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -33,6 +34,7 @@ from sid.perception.people import Person
 from sid.tracking.view import View
 
 __all__ = [
+    "APART_M",
     "DEFAULT_INTERVAL",
     "REUSED_AFTER_S",
     "WALKING_SPEED_MAX",
@@ -138,6 +140,7 @@ def load_trajectory_set(folder: str | Path, interval: float | None = None) -> Tr
             )
             raise TrajectoryError(f"{folder}: no {path.name} (a trajectory set holds obsmat.txt and groups.txt){hint}")
     rows = _read_obsmat(obsmat)
+    _check_ground_columns(obsmat, rows)
     # Sorted by frame, then pedestrian (then the rest); a row written twice is one annotation.
     rows, repeated = np.unique(rows, axis=0, return_counts=True)
     notes = [f"{obsmat.name}: {int((repeated - 1).sum())} repeated rows read once"] if (repeated > 1).any() else []
@@ -157,6 +160,8 @@ def load_trajectory_set(folder: str | Path, interval: float | None = None) -> Tr
     notes += [note] if note else []
     times = (frames[starts] - frames[0]) / step * interval
     groups, group_notes = _read_groups(groups_file, set(ids.tolist()))
+    note = _apart_note(groups_file, groups, frames, ids, position)
+    group_notes += (note,) if note else ()
     ids, aliases, note = _split_returns(frames, ids, step, interval)
     notes += [note] if note else []
     if aliases:  # a group of an id reused holds for each of its people, as it did for the one id
@@ -357,6 +362,49 @@ def _read_obsmat(path: Path) -> np.ndarray:
     if not rows:
         raise TrajectoryError(f"{path}: no annotations")
     return np.array(rows)
+
+
+def _check_ground_columns(path: Path, rows: np.ndarray) -> None:
+    """TrajectoryError when pos_x (column 3) or pos_y (column 5) is the same on every row while pos_z (column 4)
+    varies: the columns are then in another order (x y z) than the format's (frame id x z y vx vz vy)."""
+    spread = np.ptp(rows[:, 2:5], axis=0)
+    for column, name in ((2, "pos_x"), (4, "pos_y")):
+        if spread[column - 2] == 0 and spread[1] > 0:
+            raise TrajectoryError(
+                f"{path}: {name} (column {column + 1}) is {rows[0, column]:g} on every row while pos_z (column 4) "
+                "varies: the columns must be frame id pos_x pos_z pos_y v_x v_z v_y (written in x y z order?)"
+            )
+
+
+APART_M = 2.0
+"""A group whose members never come this close (m) to each other in one frame is not one: ``_apart_note``."""
+
+
+def _apart_note(
+    path: Path, groups: Sequence[frozenset[int]], frames: np.ndarray, ids: np.ndarray, position: np.ndarray
+) -> str:
+    """A note when a tenth or more of the groups never have two members within ``APART_M`` of each other in one
+    frame (one such group is an annotation slip; many say that groups.txt numbers people otherwise than obsmat.txt:
+    ids shifted by one, another file's ids)."""
+    where: dict[int, dict[int, np.ndarray]] = {}
+    for frame, person, xy in zip(frames.tolist(), ids.tolist(), position, strict=True):
+        where.setdefault(person, {})[frame] = xy
+    apart = [group for group in groups if not _ever_close(group, where)]
+    if len(apart) < max(2, len(groups) / 10):
+        return ""
+    example = ", ".join(map(str, sorted(apart[0])))
+    return (
+        f"{path.name}: {len(apart)} of {len(groups)} groups never have two members within {APART_M:g} m of each other "
+        f"(e.g. pedestrians {example}): are its ids obsmat.txt's?"
+    )
+
+
+def _ever_close(group: frozenset[int], where: dict[int, dict[int, np.ndarray]]) -> bool:
+    for a, b in itertools.combinations(sorted(group), 2):
+        shared = where[a].keys() & where[b].keys()
+        if any(np.hypot(*(where[a][f] - where[b][f])) <= APART_M for f in shared):
+            return True
+    return False
 
 
 def _read_groups(path: Path, known: set[int]) -> tuple[tuple[frozenset[int], ...], tuple[str, ...]]:

@@ -118,6 +118,24 @@ def test_an_id_annotated_again_long_after_it_left_is_another_person_with_a_note(
     )
 
 
+def test_groups_whose_members_never_come_near_each_other_are_noted_as_other_ids(tmp_path: Path) -> None:
+    """Groups.txt numbering people otherwise than obsmat.txt (ids shifted by one) pairs strangers: when a tenth of
+    the groups or more (and two or more) never have two members within 2 m of each other, a note asks."""
+    rows = _walkers() + [(row[0], row[1] + 3, row[2], 0, row[4] + 10, *row[5:]) for row in _walkers()]
+    shifted = load_trajectory_set(write_set(tmp_path / "shifted", rows, "1 3\n4 6\n"))  # 3, 6 walk 3 m away
+    assert shifted.notes == (
+        "groups.txt: 2 of 2 groups never have two members within 2 m of each other (e.g. pedestrians 1, 3): are its "
+        "ids obsmat.txt's?",
+    )
+    assert load_trajectory_set(write_set(tmp_path / "one", rows, "1 2\n4 6\n")).notes == ()  # one slip: no note
+
+
+def test_positions_in_x_y_z_column_order_are_refused_naming_the_columns(tmp_path: Path) -> None:
+    xyz = [(f, i, x, y, 0.0, vx, vy, 0.0) for f, i, x, _, y, vx, _, vy in _walkers()]  # y in pos_z's column
+    with pytest.raises(TrajectoryError, match=r"pos_y \(column 5\) is 0 on every row while pos_z \(column 4\) varies"):
+        load_trajectory_set(write_set(tmp_path / "xyz", xyz))
+
+
 def test_a_groups_file_without_a_group_is_noted(tmp_path: Path) -> None:
     for groups in ("", "\r\n  \n", "7 8\n"):
         trajectories = load_trajectory_set(write_set(tmp_path / "s", _walkers(), groups))
