@@ -1,12 +1,12 @@
 """Multi-person tracking on the ground plane: stable ids, constant-velocity motion, standing / walking.
 
 Per frame (``PeopleTracker.update``): every track is predicted to the frame's timestamp (``sid.tracking.motion``);
-tracks are deleted when undetected for longer than ``timeout`` while in the camera's view (time out of it or
-behind someone detected nearer to the camera does not count: nobody looked there) or for longer than
-``out_of_view_timeout`` in all; detections are
+tracks undetected for longer than ``out_of_view_timeout`` are deleted; detections are
 assigned to tracks by position alone, the least total distance to the predictions within a gate that grows with the
-track's uncertainty (``sid.tracking.assignment``); matched tracks are corrected; a tentative track that is missed is
-deleted, and one detected ``confirm_hits`` times (or twice in a row ``confirm_time`` apart) is confirmed; every
+track's uncertainty (``sid.tracking.assignment``); matched tracks are corrected; a track missed in a frame that comes
+more than ``timeout`` after its last detection, counting only time in the camera's view (time out of it or behind
+someone detected nearer to the camera does not count: nobody looked there), is deleted, as is a tentative track that
+is missed, and one detected ``confirm_hits`` times (or twice in a row ``confirm_time`` apart) is confirmed; every
 unmatched detection starts a tentative track. Facing is smoothed on the circle (an exponential average of unit
 vectors, a new one weighted by the time since the track's last measured facing), and the state switches to
 walking above ``walk_speed`` and back to standing below ``stand_speed``.
@@ -78,8 +78,10 @@ class TrackerParams:
     when that is more than max_gate (at frames more than max_gate / max_speed, 0.4 s, apart).
     confirm_hits: detections that confirm a track; confirm_time: two detections in a row at least this far apart (s)
     confirm it too, so that a slow detector (a few Hz) does not hold a person back for confirm_hits long frames.
-    timeout: seconds a confirmed track survives undetected while in the camera's view (not behind someone detected
-    nearer to it); out_of_view_timeout: seconds it survives undetected in all. walk_speed, stand_speed: speeds (m/s)
+    timeout: a confirmed track missed in a frame more than this (s) after its last detection, counting time in the
+    camera's view only (not behind someone detected nearer to it), is deleted (a detection in that frame still
+    continues it: a slow detector's frames may come further apart); out_of_view_timeout: seconds it survives
+    undetected in all. walk_speed, stand_speed: speeds (m/s)
     above which a standing track walks and below which a walking track stands (hysteresis). facing_tau: time
     constant (s) of the facing average. heading_gate: a walking track faster than walk_speed, missed in the last
     frame, takes no detection facing more than this (rad) away from its own facing (its velocity while it has none).
@@ -175,7 +177,6 @@ class PeopleTracker:
         self._motion.predict(dt, q, hold=~self._walking & (self._detection < 0) & ~self._in_view)
         self._in_view = np.ones(len(self._ids), dtype=bool) if view is None else view.contains(self._motion.position)
         self._unseen += np.where(self._in_view & ~_behind(view, self._motion.position, positions), dt, 0.0)
-        self._keep(~self._expired())
         rows, cols = self._assign(positions, facing, r, dt)
         self._motion.correct(rows, positions[cols], r)
         self._smooth_facing(rows, facing[cols], quality[cols], timestamp)
@@ -189,7 +190,9 @@ class PeopleTracker:
         )
         self._detection[:] = -1
         self._detection[rows] = cols
-        self._keep(self._confirmed | (self._detection >= 0))  # a tentative track dies at its first miss
+        # A tentative track dies at its first miss; a confirmed one when missed after the timeout (expired only now, so
+        # that a detection coming after a long gap, a slow detector's next frame, can still continue it).
+        self._keep((self._confirmed | (self._detection >= 0)) & ~self._expired())
         if len(cols) < len(ids):
             unmatched = np.ones(len(ids), dtype=bool)
             unmatched[cols] = False
@@ -209,17 +212,17 @@ class PeopleTracker:
             warnings.warn(
                 TimeGapWarning(
                     f"{dt:.3g} s after the last frame, more than the tracker's timeout ({timeout:g} s): every track in "
-                    "view ended (are the timestamps in seconds?); the frames right after it that do the same are not "
-                    "noted"
+                    "view that it missed ended (are the timestamps in seconds?); the frames right after it that do the "
+                    "same are not noted"
                 ),
                 stacklevel=3,
             )
         self._gap_in_a_row = gap
 
     def _expired(self) -> np.ndarray:
-        """(N,) bool: the tracks undetected for longer than ``timeout`` while the camera could see them. Time hidden
-        (out of view, behind someone) does not count towards it: a walker hidden behind a group for longer than it,
-        then in view a moment before being detected again, keeps the track."""
+        """(N,) bool: the tracks undetected (this frame included) for longer than ``timeout`` while the camera could
+        see them. Time hidden (out of view, behind someone) does not count towards it: a walker hidden behind a group
+        for longer than it, then in view a moment before being detected again, keeps the track."""
         return self._unseen > self.params.timeout + TIME_TOLERANCE
 
     def _assign(self, positions: np.ndarray, facing: np.ndarray, r: float, dt: float) -> tuple[np.ndarray, np.ndarray]:

@@ -278,8 +278,8 @@ def test_a_gap_that_ends_every_track_is_noted_so_timestamps_in_another_unit_are_
     assert code == 0 and len(out) == 3 and all(record["people"] == [] for record in out)
     assert err == [  # once for the run of such lines, not at every line
         "sid track: line 2: note: 3.3e+07 s after the last frame, more than the tracker's timeout (1.5 s): every "
-        "track in view ended (are the timestamps in seconds?); the frames right after it that do the same are not "
-        "noted"
+        "track in view that it missed ended (are the timestamps in seconds?); the frames right after it that do the "
+        "same are not noted"
     ]
     pause = [{"timestamp": t, "people": step} for t in (0.0, 0.1, 0.2, 10.2, 10.3)]
     pause.insert(3, {"timestamp": 5.0, "people": []})  # tracks alive, none detected: they end at the next line
@@ -287,7 +287,8 @@ def test_a_gap_that_ends_every_track_is_noted_so_timestamps_in_another_unit_are_
     assert code == 0 and [len(record["people"]) for record in out] == [0, 0, 2, 0, 0, 0]
     assert err == [
         "sid track: line 4: note: 4.8 s after the last frame, more than the tracker's timeout (1.5 s): every track "
-        "in view ended (are the timestamps in seconds?); the frames right after it that do the same are not noted"
+        "in view that it missed ended (are the timestamps in seconds?); the frames right after it that do the same "
+        "are not noted"
     ]
 
 
