@@ -16,8 +16,8 @@ __all__ = ["parse_person"]
 def parse_person(data: Any, index: int, fields: tuple[str, ...], *, id_default: bool = False) -> Person:
     """The person at ``index`` of a line's ``people`` list (ground frame: x, y in metres; theta in radians, null or
     absent when unknown; orientation_quality in [0, 1], default 1 with a facing and 0 without, when ``fields``
-    holds it). ``fields``: the keys the command reads (any other is refused); ``id_default``: a missing id is
-    ``index``. ValueError naming the entry and the key."""
+    holds it); id an integer (a whole float such as 3.0 counts as one). ``fields``: the keys the command reads (any
+    other is refused); ``id_default``: a missing id is ``index``. ValueError naming the entry and the key."""
     where = f"people[{index}]"
     if not isinstance(data, dict):
         raise InputError(f"{where} must be an object with {', '.join(fields)}")
@@ -25,6 +25,8 @@ def parse_person(data: Any, index: int, fields: tuple[str, ...], *, id_default: 
     if "id" not in data and not id_default:
         raise InputError(f"{where} is missing 'id'")
     person_id = data.get("id", index)
+    if isinstance(person_id, float) and person_id.is_integer() and abs(person_id) <= 2**53:
+        person_id = int(person_id)  # 3.0: a writer that keeps every number a float (a pandas column), not a fraction
     if isinstance(person_id, bool) or not isinstance(person_id, int):
         raise InputError(f"{where}: id must be an integer, got {summary(person_id)}")
     where = f"{where} (id {person_id})"

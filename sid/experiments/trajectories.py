@@ -352,7 +352,8 @@ def _read_obsmat(path: Path) -> np.ndarray:
         if not all(math.isfinite(v) for v in values):
             raise TrajectoryError(f"{path}:{number}: a value is not finite")
         if any(v != int(v) or abs(v) > _LARGEST_ID for v in values[:2]):
-            raise TrajectoryError(f"{path}:{number}: frame and pedestrian id must be whole numbers up to 2^53")
+            hint = " (the first column is the frame number, not a time)" if values[0] != int(values[0]) else ""
+            raise TrajectoryError(f"{path}:{number}: frame and pedestrian id must be whole numbers up to 2^53{hint}")
         if max(abs(values[2]), abs(values[4])) > MAX_COORDINATE:  # x and y, as the tracker bounds them
             raise TrajectoryError(
                 f"{path}:{number}: position ({values[2]:g}, {values[4]:g}) is farther than {MAX_COORDINATE:g} m from "

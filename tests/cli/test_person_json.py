@@ -17,6 +17,14 @@ def test_a_person_is_read_with_the_quality_its_facing_implies() -> None:
     assert read.orientation_quality == 0.25 and isinstance(read.x, float)
 
 
+def test_a_whole_float_id_is_that_integer_and_a_fraction_is_refused() -> None:
+    read = parse_person({"id": 3.0, "x": 0, "y": 0}, 0, FIELDS)  # pandas writes a float column's 3 as 3.0
+    assert read.id == 3 and isinstance(read.id, int)
+    for bad in (1.5, 1e300, float("nan")):
+        with pytest.raises(ValueError, match="id must be an integer"):
+            parse_person({"id": bad, "x": 0, "y": 0}, 0, FIELDS)
+
+
 def test_a_missing_id_is_the_index_only_where_the_command_says_so() -> None:
     assert parse_person({"x": 0, "y": 0}, 3, FIELDS, id_default=True).id == 3
     with pytest.raises(ValueError, match=r"^people\[3\] is missing 'id'$"):

@@ -162,6 +162,8 @@ def test_a_row_written_twice_is_read_once_with_a_note(tmp_path: Path) -> None:
         ("0 1 0 0 0 0 0 nan\n", "", "obsmat.txt:1: a value is not finite"),
         ("0 1 0 0 zero 0 0 0\n", "", "obsmat.txt:1: not numbers"),
         ("0.5 1 0 0 0 0 0 0\n", "", "obsmat.txt:1: frame and pedestrian id must be whole numbers"),
+        ("0.4 1 0 0 0 0 0 0\n", "", r"up to 2^53 \(the first column is the frame number, not a time\)$"),
+        ("0 1.5 0 0 0 0 0 0\n", "", r"must be whole numbers up to 2^53$"),
         ("0 1e300 0 0 0 0 0 0\n", "", "obsmat.txt:1: frame and pedestrian id must be whole numbers up to 2^53"),
         ("0 1 0 0 -1e9 0 0 0\n", "", r"obsmat.txt:1: position \(0, -1e\+09\) is farther than 1e\+08 m"),
         ("0 1 0 0 0 0 0 0\n0 1 1 0 0 0 0 0\n", "", "obsmat.txt: pedestrian 1 appears twice in frame 0"),
