@@ -3,7 +3,11 @@ planning problem."""
 
 from __future__ import annotations
 
-from costmap.grid import Costmap2D
+import warnings
+
+import numpy as np
+
+from costmap.grid import LETHAL, Costmap2D
 from costmap.layer import LayerInputs
 from costmap.layered import LayeredCostmap
 from costmap.layers.obstacle import SCAN
@@ -14,6 +18,7 @@ from costmap.mapfile import read_map
 from costmap.occupancy import OccupancyGrid
 from costmap.plugins import CostmapParams, layered_costmap
 from planner.problem import DEFAULT_COST_WEIGHT, PlanningProblem
+from sid.documents import InputWarning
 from sid.perception.group import Group
 from sid.perception.groups import detect_groups
 from sid.scenario.known_map import known_map
@@ -47,6 +52,7 @@ def build_costmap(
     known = None  # the static layer's map: the declared obstacles drawn into the map file (sid.scenario.known_map)
     if scenario.obstacles or static_map is not None:
         known = known_map(scenario.obstacles, scenario.grid, static_map)
+        _warn_people_in_walls(scenario, known)
     layered = layered_costmap(
         scenario.grid,
         params,
@@ -71,6 +77,22 @@ def build_costmap(
     tracks = still_tracks(scenario.people, groups) if social else None
     layered.update(LayerInputs({PEOPLE: scenario.people, GROUPS: groups, SCAN: scan, TRACKS: tracks}))
     return layered
+
+
+def _warn_people_in_walls(scenario: Scenario, known: OccupancyGrid) -> None:
+    """Warn of each person standing in an occupied cell of the known map (a declared obstacle or the map file's
+    walls): nobody can stand there, so the people's positions or the map are likely in different frames or units;
+    the costmap is drawn as given (``sid simulate``, whose scene is the true world, refuses such a person)."""
+    occupied = static_costs(known, scenario.grid, track_unknown_space=False) == LETHAL
+    cells = scenario.grid.world_to_cell(np.array([[p.x, p.y] for p in scenario.people]).reshape(-1, 2))
+    for i, ((row, col), person) in enumerate(zip(cells.tolist(), scenario.people, strict=True)):
+        if scenario.grid.in_bounds(np.array([row, col]))[0] and occupied[row, col]:
+            warnings.warn(
+                f"people[{i}]: person {person.id} at ({person.x:g}, {person.y:g}) stands in an occupied cell of the "
+                "known map (an obstacle or the static_map file's walls): are the people and the map in one frame?",
+                InputWarning,
+                stacklevel=3,
+            )
 
 
 def map_walls(scenario: Scenario) -> Costmap2D | None:

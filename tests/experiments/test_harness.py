@@ -8,6 +8,7 @@ import itertools
 import pytest
 
 from planner.problem import NoPathError, PlanningError, WalledOffError
+from sid.documents import InputWarning
 from sid.experiments.demo import DEMO_SCENARIO, demo_scenario
 from sid.experiments.harness import (
     compare_with_without,
@@ -240,5 +241,6 @@ def test_people_against_the_walls_who_close_the_way_are_named():
     )
     boxed = _corridor([people[1], {"id": 3, "x": 6.0, "y": 0.2, "theta": 0.0}])
     boxed["obstacles"].append({"type": "box", "min": [5.5, 0.0], "max": [6.5, 0.5]})
-    task = prepare(scenario_from_dict(boxed))
+    with pytest.warns(InputWarning, match=r"person 3 at \(6, 0.2\) stands in an occupied cell of the known map"):
+        task = prepare(scenario_from_dict(boxed))
     assert people_walling_off(task.scenario, task.problems["with"]).startswith("person 2 at (6.00, 1.30) closes")

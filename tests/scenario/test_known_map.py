@@ -8,6 +8,7 @@ import pytest
 
 from costmap.grid import FREE_SPACE, LETHAL, NO_INFORMATION, GridSpec
 from costmap.layers.obstacle import SCAN
+from costmap.layers.social import PEOPLE
 from costmap.mapfile import write_map
 from costmap.occupancy import OCC_OCCUPIED, OCC_UNKNOWN, OccupancyGrid
 from planner.facade import plan
@@ -167,3 +168,20 @@ def test_a_wall_on_the_declared_border_of_a_map_of_no_whole_number_of_cells_is_i
     assert mask[-1].all() and mask[:, -1].all()
     beyond = obstacle_mask([SegmentObstacle(((0.0, spec.bounds[3] + resolution * 0.6), (6.0, 5.0)))], spec)
     assert not beyond[-1].any()  # more than half a cell beyond: outside the map, as before
+
+
+def test_a_person_standing_in_an_obstacle_is_warned_of_and_drawn_as_given():
+    """A person inside a box or on a wall's cells stands where nobody can: the people and the map are likely in
+    different frames. sid plan and sid costmap drew such a scene without a word (sid simulate refuses it)."""
+    wall = {"type": "segment", "points": [[0.5, 5.0], [9.5, 5.0]]}
+    people = [{"id": 1, "x": 5.5, "y": 3.0, "theta": 0.0}, {"id": 2, "x": 3.0, "y": 5.0}, {"id": 3, "x": 8.0, "y": 1.0}]
+    with pytest.warns(InputWarning) as said:
+        layered = build_costmap(scenario([BOX, wall], people=people))
+    messages = [str(w.message) for w in said if "occupied cell" in str(w.message)]
+    assert messages == [
+        "people[0]: person 1 at (5.5, 3) stands in an occupied cell of the known map (an obstacle or the static_map "
+        "file's walls): are the people and the map in one frame?",
+        "people[1]: person 2 at (3, 5) stands in an occupied cell of the known map (an obstacle or the static_map "
+        "file's walls): are the people and the map in one frame?",
+    ]
+    assert len(layered.inputs[PEOPLE]) == 3  # drawn as given
