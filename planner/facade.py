@@ -104,7 +104,11 @@ def _collision(cost: int, problem: PlanningProblem) -> str:
         return f"an obstacle is within the robot radius {radius} (cell cost {INSCRIBED}, inscribed)"
     if cost == NO_INFORMATION:
         return f"it lies in unknown space (cell cost {NO_INFORMATION})"
-    return f"an obstacle is within the robot radius {radius} (cell cost {cost})"
+    # Below INSCRIBED yet not free: the costmap was inflated for a smaller robot; the planner checks this one's disc.
+    return (
+        f"an obstacle is within the robot radius {radius} (the cell's cost, {cost}, is below inscribed: the costmap "
+        "was inflated for a smaller robot)"
+    )
 
 
 def free_regions(field: CostField) -> np.ndarray:

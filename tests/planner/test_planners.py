@@ -391,6 +391,18 @@ def test_an_end_in_collision_says_which_end_and_survives_pickling():
     assert str(copy).startswith("no path: goal (6.60, 6.00) is in collision")
 
 
+def test_an_end_too_near_for_a_robot_wider_than_the_inflation_says_so():
+    """The costmap inflated for a 0.25 m robot, planned for a 0.6 m one: a goal 0.45 m from the wall sits in a cell
+    of graded cost, below inscribed, yet the robot's disc reaches the wall; the message said "(cell cost 34)"."""
+    with pytest.raises(EndpointCollisionError) as caught:
+        plan(PlanningProblem(walled_map(), (1.0, 6.0), (6.05, 6.0), 0.6), "grid")
+    message = str(caught.value)
+    assert message.startswith(
+        "no path: goal (6.05, 6.00) is in collision: an obstacle is within the robot radius 0.60 m"
+    )
+    assert "is below inscribed: the costmap was inflated for a smaller robot)" in message
+
+
 @pytest.mark.parametrize("name", ["grid", "rrtstar"])
 def test_disconnected_goal_fails_fast_with_reason(name):
     costmap = walled_map()
