@@ -109,19 +109,27 @@ def _detect_until_interrupted(out: Path, sig: signal.Signals) -> int:
     argv = [sys.executable, "-c", code, "detect", "--source", "synthetic:S1", "--frames", "10000", "--out", str(out)]
     # A shell's background job starts with SIGINT ignored, and Python then keeps ignoring it (as a user's
     # background `sid` should): give the command the default disposition, whatever ran this test.
+    # faulthandler on: a run that hangs is aborted below and prints where each of its threads stood.
     process = subprocess.Popen(
         argv,
         cwd=REPO_ROOT,
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+        env={**os.environ, "PYTHONFAULTHANDLER": "1"},
     )
     try:
         deadline = time.monotonic() + 300  # a hang bound, not a speed check
         while len(list(out.glob("topview_*.png"))) < 2 and time.monotonic() < deadline and process.poll() is None:
             time.sleep(0.05)
+        frames_before = len(list(out.glob("topview_*.png")))
         process.send_signal(sig)
-        process.wait(timeout=300)
+        try:
+            process.wait(timeout=300)
+        except subprocess.TimeoutExpired:
+            process.send_signal(signal.SIGABRT)  # faulthandler's dump of every thread, then the end
+            _, err = process.communicate(timeout=60)
+            pytest.fail(f"no exit within 300 s of {sig.name} ({frames_before} frames written before):\n{err.decode()}")
     finally:
         if process.poll() is None:
             process.kill()
