@@ -27,7 +27,7 @@ from sid.errors import InputError
 from sid.experiments.progress import ProgressBar
 from sid.experiments.simulate.loop import PERCEPTIONS, RunOptions
 from sid.experiments.simulate.scenes import SCENE_ORDER, load_scene, scene_list
-from sid.perception.groups import detect_groups
+from sid.scenario.sight import scenario_groups
 
 __all__ = ["RUN_FILES", "SUMMARY_KEYS", "SWEEP_FILES", "add_parser", "run"]
 
@@ -145,7 +145,7 @@ def run(args: argparse.Namespace) -> int:
         out = check_output_folder(args.out)
         world = load_scene(args.scene)
         scenario = world.scenario
-        warn_zones("sid simulate", scenario, detect_groups(scenario.people, scenario.group_params))
+        warn_zones("sid simulate", scenario, scenario_groups(scenario))
         with staged_output(out, RUN_FILES) as staged:  # whole files only, even when interrupted; earlier ones go
             record = write_run(
                 world, options, staged.path, gif=args.gif, progress=ProgressBar("simulate"), still_s=args.still

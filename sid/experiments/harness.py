@@ -1,11 +1,12 @@
 """The with/without comparison harness: plan a scenario's robot task on the costmap without the social layer (the
 known map and LiDAR: "without") and on the costmap with it ("with"), measure every path alike, and summarise runs.
 
-One ``Task`` per scenario holds its groups (detected from its people with ``sid.perception.groups.detect_groups``),
-the costmap and planning problem of each mode, and the grid planner's cost as the reference for cost ratios. Every
-path is measured against those groups and on the social costmap (``sid.experiments.path_metrics.result_metrics``),
-also when the robot planned without the social layer: "the path went through the conversation" is measured whether
-or not the robot knew about it, and the two modes' numbers compare directly. ``sid demo``, ``sid plan``, ``sid
+One ``Task`` per scenario holds its groups (detected from its people, nobody through a wall of its known map:
+``sid.scenario.sight.scenario_groups``), the costmap and planning problem of each mode, and the grid planner's cost
+as the reference for cost ratios. Every path is measured against those groups and on the social costmap
+(``sid.experiments.path_metrics.result_metrics``), also when the robot planned without the social layer: "the path
+went through the conversation" is measured whether or not the robot knew about it, and the two modes' numbers
+compare directly. ``sid demo``, ``sid plan``, ``sid
 compare``, ``sid reproduce navigation`` and ``sid bench``'s planner stages all plan through here.
 
 World frame (REP-103), metres, seconds. A run's ``cost_ratio`` is its path cost J over the grid planner's J on the
@@ -44,9 +45,9 @@ from sid.errors import InputError
 from sid.experiments.path_metrics import result_metrics
 from sid.experiments.progress import Progress
 from sid.perception.group import Group
-from sid.perception.groups import detect_groups
 from sid.scenario.build import build_costmap, planning_problem
 from sid.scenario.loader import Scenario
+from sid.scenario.sight import scenario_groups
 
 __all__ = [
     "Comparison",
@@ -106,8 +107,9 @@ class Task:
 
 
 def prepare(scenario: Scenario, cost_weight: float = DEFAULT_COST_WEIGHT, labels: dict | None = None) -> Task:
-    """Detect the scenario's groups and build the costmap and planning problem of each mode."""
-    groups = detect_groups(scenario.people, scenario.group_params)
+    """Detect the scenario's groups (nobody grouped through a wall of its known map) and build the costmap and
+    planning problem of each mode."""
+    groups = scenario_groups(scenario)
     costmaps = {mode: build_costmap(scenario, social=s, groups=groups if s else []) for mode, s in MODES.items()}
     problems = {mode: planning_problem(scenario, c.master, cost_weight) for mode, c in costmaps.items()}
     return Task(scenario, groups, costmaps, problems, dict(labels or {}))

@@ -7,7 +7,7 @@ import warnings
 
 import numpy as np
 
-from costmap.grid import LETHAL, Costmap2D
+from costmap.grid import Costmap2D
 from costmap.layer import LayerInputs
 from costmap.layered import LayeredCostmap
 from costmap.layers.obstacle import SCAN
@@ -20,10 +20,10 @@ from costmap.plugins import CostmapParams, layered_costmap
 from planner.problem import DEFAULT_COST_WEIGHT, PlanningProblem
 from sid.documents import InputWarning
 from sid.perception.group import Group
-from sid.perception.groups import detect_groups
 from sid.scenario.known_map import known_map
 from sid.scenario.lidar import simulate_scan
 from sid.scenario.loader import Scenario
+from sid.scenario.sight import Walls, known_walls, scenario_groups
 from sid.tracking.records import still_tracks
 
 __all__ = ["build_costmap", "map_walls", "planning_problem"]
@@ -42,8 +42,8 @@ def build_costmap(
     the scan from the start sees (obstacles' near faces, the map file's walls, people).
 
     ``social`` False leaves the social layer out, and gives a tracked-people layer no tracks (a robot without
-    recognition). ``groups`` None: detect them with
-    ``sid.perception.groups.detect_groups`` (only when ``social``). ``params`` None: the scenario's "layers" block.
+    recognition). ``groups`` None: detect them (only when ``social``), nobody grouped through a wall of the known
+    map (``sid.scenario.sight.scenario_groups``). ``params`` None: the scenario's "layers" block.
     """
     params = params or scenario.layers
     if not social:
@@ -52,7 +52,9 @@ def build_costmap(
     known = None  # the static layer's map: the declared obstacles drawn into the map file (sid.scenario.known_map)
     if scenario.obstacles or static_map is not None:
         known = known_map(scenario.obstacles, scenario.grid, static_map)
-        _warn_people_in_walls(scenario, known)
+    sight = None if known is None else known_walls(scenario, known)  # the known map's occupied cells
+    if sight is not None:
+        _warn_people_in_walls(scenario, sight)
     layered = layered_costmap(
         scenario.grid,
         params,
@@ -72,21 +74,20 @@ def build_costmap(
         static=walls,
     )
     if groups is None:
-        groups = detect_groups(scenario.people, scenario.group_params) if social else []
+        groups = scenario_groups(scenario, walls=sight) if social else []
     # A tracked-people layer draws the scene at rest: its people as standing tracks, its groups as conversations.
     tracks = still_tracks(scenario.people, groups) if social else None
     layered.update(LayerInputs({PEOPLE: scenario.people, GROUPS: groups, SCAN: scan, TRACKS: tracks}))
     return layered
 
 
-def _warn_people_in_walls(scenario: Scenario, known: OccupancyGrid) -> None:
+def _warn_people_in_walls(scenario: Scenario, walls: Walls) -> None:
     """Warn of each person standing in an occupied cell of the known map (a declared obstacle or the map file's
     walls): nobody can stand there, so the people's positions or the map are likely in different frames or units;
     the costmap is drawn as given (``sid simulate``, whose scene is the true world, refuses such a person)."""
-    occupied = static_costs(known, scenario.grid, track_unknown_space=False) == LETHAL
     cells = scenario.grid.world_to_cell(np.array([[p.x, p.y] for p in scenario.people]).reshape(-1, 2))
     for i, ((row, col), person) in enumerate(zip(cells.tolist(), scenario.people, strict=True)):
-        if scenario.grid.in_bounds(np.array([row, col]))[0] and occupied[row, col]:
+        if scenario.grid.in_bounds(np.array([row, col]))[0] and walls.occupied[row, col]:
             warnings.warn(
                 f"people[{i}]: person {person.id} at ({person.x:g}, {person.y:g}) stands in an occupied cell of the "
                 "known map (an obstacle or the static_map file's walls): are the people and the map in one frame?",

@@ -63,12 +63,12 @@ from sid.experiments.simulate.perception import (
 from sid.experiments.simulate.robot import RobotState, step
 from sid.experiments.simulate.world import SimWorld, collision, jittered, obstacle_geometry
 from sid.perception.group import Group
-from sid.perception.groups import detect_groups
 from sid.perception.people import Person
 from sid.perception.pipeline import Pipeline, PoseFn, image_pose
 from sid.perception.robot_pose import RobotPose
 from sid.scenario.build import build_costmap, map_walls
 from sid.scenario.lidar import simulate_scan
+from sid.scenario.sight import scenario_groups, scenario_walls
 from sid.stream import SocialStream
 from sid.synthetic.pose import TruthPose
 from sid.synthetic.sensor import SyntheticCamera
@@ -315,6 +315,7 @@ def simulate(
             trace.trajectory.append((0.0, x, y, yaw))
             return trace
     obstacles = obstacle_geometry(scenario.obstacles, walls)
+    sight = scenario_walls(scenario)  # the true groups: nobody talks through a wall
     lidar, goal = scenario.lidar, scenario.robot.goal
     state = RobotState(*scenario.robot.start)
     follower = FollowerParams(max_speed=limits.max_speed, max_turn_rate=limits.max_turn_rate)
@@ -323,7 +324,7 @@ def simulate(
     while True:
         t = k * dt
         people = world.people_at(t)
-        truth_groups = detect_groups(people, scenario.group_params)
+        truth_groups = scenario_groups(scenario, people, sight)
         trace.trajectory.append((t, state.x, state.y, state.yaw))
         trace.truth.append((people, truth_groups))
         trace.time_s = t
