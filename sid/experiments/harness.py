@@ -176,8 +176,9 @@ def people_walling_off(scenario: Scenario, problem: PlanningProblem) -> str | No
     when the two are connected or would stay walled off without the people too. The wall is made of the cells the
     robot's centre can reach on the scenario's costmap without people (no social layer) but not on ``problem``'s,
     taken as connected pieces; the people are those who keep the robot off a piece that borders both the start's
-    free region and the goal's (``free_regions``): a cell of it lies within ``_reach`` of them (their centre may
-    lie where the robot cannot stand anyway, against a wall or inside an obstacle)."""
+    free region and the goal's (``free_regions``), or that lies on a shortest chain of regions and pieces from the
+    one to the other (two groups closing a corridor one after the other): a cell of it lies within ``_reach`` of them
+    (their centre may lie where the robot cannot stand anyway, against a wall or inside an obstacle)."""
     field = CostField(problem)
     spec = field.spec
     labels = free_regions(field)
@@ -190,17 +191,15 @@ def people_walling_off(scenario: Scenario, problem: PlanningProblem) -> str | No
     open_labels = free_regions(bare)
     if int(open_labels[ends[0][0], ends[0][1]]) != int(open_labels[ends[1][0], ends[1][1]]):
         return None
-    pieces, _ = ndimage.label(bare.plannable & ~field.plannable, structure=np.ones((3, 3), bool))
+    pieces, count = ndimage.label(bare.plannable & ~field.plannable, structure=np.ones((3, 3), bool))
     boxes, reach = ndimage.find_objects(pieces), _reach(scenario)
-    closing: dict[int, bool] = {}  # piece -> whether it borders both ends' regions
-    wall = []
-    for person in scenario.people:
-        for piece in _pieces_within(pieces, spec, (person.x, person.y), reach):
-            if piece not in closing:
-                closing[piece] = {start, goal} <= _bordering(pieces, piece, boxes[piece - 1], labels)
-            if closing[piece]:
-                wall.append(person)
-                break
+    borders = {piece: _bordering(pieces, piece, boxes[piece - 1], labels) - {0} for piece in range(1, count + 1)}
+    closing = _on_a_shortest_chain(borders, start, goal)
+    wall = [
+        person
+        for person in scenario.people
+        if closing.intersection(_pieces_within(pieces, spec, (person.x, person.y), reach))
+    ]
     if not wall:
         return None
     names = ", ".join(f"{p.id} at ({p.x:.2f}, {p.y:.2f})" for p in wall)
@@ -209,6 +208,44 @@ def people_walling_off(scenario: Scenario, problem: PlanningProblem) -> str | No
         f"them (without people it is open): a person is an obstacle of radius {scenario.lidar.body_radius:.2f} m "
         f"(lidar.body_radius) and the robot a disc of radius {scenario.robot.radius:.2f} m (robot.radius)"
     )
+
+
+def _on_a_shortest_chain(borders: dict[int, set[int]], start: int, goal: int) -> set[int]:
+    """The pieces on a shortest chain region - piece - region ... from free region ``start`` to ``goal``, each piece
+    joining the regions it borders (``borders``): breadth-first from both ends, a piece lies on one when its two
+    distances sum to the chain's length. Empty when no chain joins them."""
+    touching: dict[int, set[int]] = {}
+    for piece, regions in borders.items():
+        for region in regions:
+            touching.setdefault(region, set()).add(piece)
+
+    def distances(origin: int) -> dict[tuple[str, int], int]:
+        seen, frontier, step = {("region", origin): 0}, [("region", origin)], 0
+        while frontier:
+            step += 1
+            ahead = []
+            for kind, node in frontier:
+                nexts = (
+                    [("piece", p) for p in touching.get(node, ())]
+                    if kind == "region"
+                    else [("region", r) for r in borders[node]]
+                )
+                for item in nexts:
+                    if item not in seen:
+                        seen[item] = step
+                        ahead.append(item)
+            frontier = ahead
+        return seen
+
+    from_start, from_goal = distances(start), distances(goal)
+    length = from_start.get(("region", goal))
+    if length is None:
+        return set()
+    return {
+        piece
+        for piece in borders
+        if from_start.get(("piece", piece), length + 1) + from_goal.get(("piece", piece), length + 1) == length
+    }
 
 
 def _bordering(pieces: np.ndarray, piece: int, box: tuple[slice, slice], labels: np.ndarray) -> set[int]:

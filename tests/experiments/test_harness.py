@@ -221,6 +221,17 @@ def test_a_way_closed_by_people_names_them(mode):
     )  # person 3 stands in the corridor too, on the start's side only: not named
 
 
+def test_two_pairs_closing_the_corridor_one_after_the_other_are_all_named():
+    """Each pair's piece of wall borders a region between them, not both ends' regions: the message named nobody,
+    and the user looked for a fault in the map (a probe's corridor_two_blockers). Pieces on a shortest chain of
+    regions from the start to the goal count now; a person off that chain (3, on the start's side) still does not."""
+    second = [{**p, "id": p["id"] + 10, "x": 9.0} for p in PAIR_ACROSS]
+    task = prepare(scenario_from_dict(_corridor(PAIR_ACROSS + second + [{"id": 3, "x": 3.0, "y": 0.4, "theta": 0.0}])))
+    assert people_walling_off(task.scenario, task.problems["with"]).startswith(
+        "people 1 at (6.00, 0.35), 2 at (6.00, 1.25), 11 at (9.00, 0.35), 12 at (9.00, 1.25) close the way"
+    )
+
+
 def test_people_walling_off_is_none_when_the_map_alone_closes_the_way_or_nothing_does():
     walled = prepare(scenario_from_dict(_corridor(PAIR_ACROSS, wall_across=True)))
     assert people_walling_off(walled.scenario, walled.problems["with"]) is None
