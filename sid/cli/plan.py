@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 
 from planner.facade import resolve_planner
 from sid.cli.common import ExitCode, check_output_folder, fail, plain_text, print_written, staged_output
@@ -13,6 +14,7 @@ from sid.cli.planning import (
     add_scenario_arguments,
     warn_zones,
 )
+from sid.experiments.path_metrics import crosses_group
 from sid.experiments.scenario_plan import plan_scenario, write_plan
 from sid.scenario.loader import load_scenario
 
@@ -67,6 +69,14 @@ def run(args: argparse.Namespace) -> int:
             f"crosses a group: {'yes' if m['crosses_group'] else 'no'}, closest person {closest}, "
             f"planning {m['planning_time_s']:.2f} s"
         )
+        crossed = [g for g in comparison.task.groups if crosses_group(r.path, comparison.task.scenario.people, [g])]
+        if crossed and not args.no_social:
+            names = ", ".join(f"({', '.join(map(str, g.members))})" for g in crossed)
+            print(
+                f"sid plan: note: the path passes between members of group {names}: no way round was cheaper (the "
+                "social layer is a cost, not a wall; a corridor it fills leaves no other way)",
+                file=sys.stderr,
+            )
     if r.seed is not None and r.iterations > 0:  # no iteration ran within --time: nothing to repeat
         print(f"repeat exactly: --seed {r.seed} --iterations {r.iterations} --time {max(10.0, 4 * args.time):g}")
     print_written(files.values())

@@ -117,3 +117,24 @@ def test_demo_command_prints_the_table(tmp_path, capsys):
     printed = capsys.readouterr().out
     assert "[1/2]" in printed and "in group zone" in printed and "comparison.png" in printed
     assert set(json.loads((tmp_path / "demo" / "metrics.json").read_text())) == {"without", "with"}
+
+
+def test_a_path_between_a_groups_members_is_named_on_stderr(tmp_path, capsys):
+    """A pair talking across a 2 m corridor leaves no way round: the plan passes between them, and the summary said
+    only "crosses a group: yes". A note names the group and why."""
+    scenario = {
+        "map": {"origin": [0, -0.5], "size": [10, 3]},
+        "obstacles": [
+            {"type": "segment", "points": [[0, 0], [10, 0]]},
+            {"type": "segment", "points": [[0, 2], [10, 2]]},
+        ],
+        "people": [{"id": 1, "x": 5.0, "y": 0.3, "theta": 1.5708}, {"id": 2, "x": 5.0, "y": 1.7, "theta": -1.5708}],
+        "robot": {"start": [0.6, 1.0, 0], "goal": [9.4, 1.0, 0]},
+    }
+    path = tmp_path / "corridor.json"
+    path.write_text(json.dumps(scenario))
+    assert main(["plan", str(path), "--planner", "grid", "--out", str(tmp_path / "out")]) == 0
+    err = capsys.readouterr().err
+    assert "sid plan: note: the path passes between members of group (1, 2): no way round was cheaper" in err
+    assert main(["plan", str(path), "--planner", "grid", "--no-social", "--out", str(tmp_path / "bare")]) == 0
+    assert "passes between members" not in capsys.readouterr().err  # without recognition the robot knows no group
