@@ -23,6 +23,8 @@ __all__ = ["T", "run_ahead"]
 T = TypeVar("T")
 
 _END = object()  # the worker's last message: the iterator ended, with or without an exception
+_POLL_S = 0.05
+"""Seconds between the worker's looks at a full queue (``_ahead``'s ``hand_over``)."""
 
 
 def run_ahead(items: Iterable[T], depth: int = 1) -> Iterator[T]:
@@ -42,13 +44,25 @@ def _ahead(items: Iterable[T], depth: int) -> Iterator[T]:
     ready: queue.Queue[tuple[object, BaseException | None]] = queue.Queue(maxsize=depth)
     stop = threading.Event()
 
+    def hand_over(entry: tuple[object, BaseException | None]) -> bool:
+        """Put ``entry`` in the queue, waiting while it is full; False when the consumer stopped meanwhile. The wait
+        looks again every ``_POLL_S``: a consumer interrupted by a signal inside ``get`` (an item taken, its
+        notification to the waiting worker not yet sent) left the worker waiting for ever, and the consumer's
+        clean-up with it (a CI run: ``sid detect`` did not exit on SIGTERM)."""
+        while True:
+            try:
+                ready.put(entry, timeout=_POLL_S)
+                return True
+            except queue.Full:
+                if stop.is_set():
+                    return False
+
     def work() -> None:
         iterator = iter(items)
         error: BaseException | None = None
         try:
             for item in iterator:
-                ready.put((item, None))  # blocks while the queue is full: the consumer may close meanwhile
-                if stop.is_set():  # now, before making another item
+                if not hand_over((item, None)) or stop.is_set():  # stopped: make no other item
                     break
         except BaseException as exc:  # handed to the consumer, which raises it in its own thread
             error = exc
@@ -56,7 +70,7 @@ def _ahead(items: Iterable[T], depth: int) -> Iterator[T]:
             close = getattr(iterator, "close", None)
             if close is not None:
                 close()
-        ready.put((_END, error))
+        hand_over((_END, error))
 
     worker = threading.Thread(target=work, name="sid-run-ahead", daemon=True)
     worker.start()

@@ -3,6 +3,7 @@ and a worker that stops when the consumer does."""
 
 from __future__ import annotations
 
+import queue
 import threading
 from collections.abc import Iterator
 
@@ -109,6 +110,52 @@ def test_an_exception_in_the_consumer_stops_the_worker():
         for item in run_ahead(items()):
             if item == 5:
                 raise ZeroDivisionError
+    assert closed.wait(TIMEOUT)
+
+
+class _InterruptedGet(queue.Queue):
+    """A queue whose get, once ``interrupt`` is set, takes the item and raises KeyboardInterrupt before telling a
+    waiting producer that there is room: what a signal's handler raising in the consumer's thread between the two
+    does (a CI run of ``sid detect`` never exited on SIGTERM, the worker waiting for that word for ever)."""
+
+    interrupt = False
+
+    def get(self, block: bool = True, timeout: float | None = None) -> object:
+        if not _InterruptedGet.interrupt:
+            return super().get(block, timeout)
+        _InterruptedGet.interrupt = False
+        with self.not_empty:
+            while not self._qsize():
+                self.not_empty.wait()
+            self._get()
+        raise KeyboardInterrupt
+
+
+def test_a_consumer_interrupted_inside_the_queue_still_stops_the_worker(monkeypatch):
+    monkeypatch.setattr(queue, "Queue", _InterruptedGet)
+    closed, full = threading.Event(), threading.Event()
+
+    def items() -> Iterator[int]:
+        try:
+            for k in range(10**6):
+                if k == 2:
+                    full.set()  # item 1 waits in the queue: the worker is about to wait with item 2
+                yield k
+        finally:
+            closed.set()
+
+    def consume() -> None:
+        stream = run_ahead(items(), depth=1)
+        assert next(stream) == 0
+        assert full.wait(TIMEOUT)
+        _InterruptedGet.interrupt = True
+        with pytest.raises(KeyboardInterrupt):
+            next(stream)
+
+    consumer = threading.Thread(target=consume, daemon=True)
+    consumer.start()
+    consumer.join(TIMEOUT)
+    assert not consumer.is_alive()  # the clean-up ended: no wait for a word that never comes
     assert closed.wait(TIMEOUT)
 
 
