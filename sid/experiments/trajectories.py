@@ -401,6 +401,8 @@ def _apart_note(
 
 
 def _ever_close(group: frozenset[int], where: dict[int, dict[int, np.ndarray]]) -> bool:
+    """Whether two members of ``group`` stand within ``APART_M`` of each other in a frame (``where``: per person,
+    frame -> position, m)."""
     for a, b in itertools.combinations(sorted(group), 2):
         shared = where[a].keys() & where[b].keys()
         if any(np.hypot(*(where[a][f] - where[b][f])) <= APART_M for f in shared):

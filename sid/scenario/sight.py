@@ -10,6 +10,7 @@ their own.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse
@@ -28,11 +29,13 @@ from sid.scenario.loader import Scenario
 __all__ = ["Walls", "groups_in_sight", "known_walls", "scenario_groups", "scenario_walls"]
 
 
+@dataclass(frozen=True, eq=False)
 class Walls:
-    """The occupied (LETHAL) cells of a known map on its grid, and whether a straight line of sight crosses one."""
+    """The occupied (LETHAL) cells of a known map on its grid ``spec`` ((rows, cols) bool), and whether a straight
+    line of sight crosses one."""
 
-    def __init__(self, spec: GridSpec, occupied: np.ndarray) -> None:
-        self.spec, self.occupied = spec, occupied
+    spec: GridSpec
+    occupied: np.ndarray
 
     def block(self, a: tuple[float, float], b: tuple[float, float]) -> bool:
         """True when the segment from ``a`` to ``b`` (m) passes through an occupied cell: sampled every half cell,
